@@ -1,0 +1,232 @@
+"""Parameter objects of a weftsim scene: frozen dataclasses in SI units.
+
+Scene files (TOML) speak mm, deg, rpm and GPa; :mod:`weftsim.scene` converts them
+and validates them once, so every object here holds checked SI values (m, rad,
+rad/s, kg, kg m^2, Pa).  Variants are made with :func:`dataclasses.replace`.
+
+Frames follow SPEC.md section 1: O is the origin, x = rocker axis D (normal of the
+four-bar plane), y along OG, z = x cross y, gravity along -z.  Four-bar plane
+coordinates are (Y, Z) = (y, z).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """Link lengths and angles of the spatial linkage (SPEC.md section 1).
+
+    Attributes
+    ----------
+    crank_inclination : float
+        beta, arc A-B of the spherical 4R, rad.  Arcs B-C, C-D, A-D are 90 deg.
+    rocker_arm_angle : float
+        theta_OE0, angle of OE (from +y towards +z) when the rocker angle phi is 0, rad.
+    l_oe, l_ef, l_fg, l_og : float
+        Lengths of rocker arm OE, connecting rod EF, sector arm FG and frame OG, m.
+    fourbar_branch : int
+        +1 or -1: sign in front of the acos of the four-bar assembly (SPEC "+" branch is +1).
+    sector_pitch_radius, pinion_pitch_radius, rapier_gear_pitch_radius : float
+        d5, d6, d7, m.  Rapier s = (d5 d7 / d6) (theta_FG - theta_FG(0)).
+    """
+
+    crank_inclination: float = math.radians(20.0)
+    rocker_arm_angle: float = math.radians(105.0)
+    l_oe: float = 0.120
+    l_ef: float = 0.270
+    l_fg: float = 0.050
+    l_og: float = 0.220
+    fourbar_branch: int = 1
+    sector_pitch_radius: float = 0.135
+    pinion_pitch_radius: float = 0.030
+    rapier_gear_pitch_radius: float = 0.150
+
+    @property
+    def rapier_ratio(self) -> float:
+        """ds/dtheta_FG = d5 d7 / d6, m/rad."""
+        return self.sector_pitch_radius * self.rapier_gear_pitch_radius / self.pinion_pitch_radius
+
+    @property
+    def pinion_ratio(self) -> float:
+        """d(gear 6/7 angle)/dtheta_FG = -d5/d6 (magnitude d5/d6)."""
+        return self.sector_pitch_radius / self.pinion_pitch_radius
+
+
+@dataclass(frozen=True)
+class Inertia:
+    """Masses and inertias of members 1-8 (SPEC.md section 1, reference mechanism).
+
+    Attributes
+    ----------
+    crank_inertia : float
+        J1, crank about axis A (balanced: centre of mass on A), kg m^2.
+    coupler_mass : float
+        m2, kg; centre of mass at O (no gravity work).
+    coupler_inertia : tuple of float
+        Principal inertia of the coupler about O in its body frame [b, c, b x c], kg m^2.
+    rocker_mass, rocker_com, rocker_inertia : float
+        m3 (kg); distance of its centre of mass from O along OE (m); J3 about axis D (kg m^2).
+    rod_mass, rod_inertia : float
+        m4 (kg), centre of mass at mid EF; J4 about that centre (kg m^2).
+    sector_inertia : float
+        J5 about G (balanced), kg m^2.
+    pinion_gear_inertia : float
+        J67, pinion 6 and rapier gear 7 on one shaft (balanced), kg m^2.
+    rapier_mass : float
+        m8, moves along y (no gravity work), kg.
+    gravity : float
+        g, m/s^2, acting along -z.
+    """
+
+    crank_inertia: float = 0.010
+    coupler_mass: float = 1.0
+    coupler_inertia: tuple[float, float, float] = (2e-3, 2e-3, 1e-3)
+    rocker_mass: float = 1.2
+    rocker_com: float = 0.040
+    rocker_inertia: float = 0.010
+    rod_mass: float = 0.6
+    rod_inertia: float = 0.0045
+    sector_inertia: float = 0.025
+    pinion_gear_inertia: float = 0.0308
+    rapier_mass: float = 0.5
+    gravity: float = 9.81
+
+
+@dataclass(frozen=True)
+class Material:
+    """Elastic constants of one contact partner."""
+
+    youngs_modulus: float = 207e9  # Pa
+    poisson_ratio: float = 0.3
+
+    @property
+    def compliance(self) -> float:
+        """sigma = (1 - nu^2) / E, 1/Pa (SPEC.md section 3)."""
+        return (1.0 - self.poisson_ratio**2) / self.youngs_modulus
+
+
+@dataclass(frozen=True)
+class ClearanceJoint:
+    """The revolute joint at E with radial clearance (SPEC.md sections 2 and 3).
+
+    Attributes
+    ----------
+    clearance : float
+        Radial clearance c = R_b - R_j, m.  0 means the ideal revolute joint.
+    journal_radius : float
+        R_j, m.  Bearing radius R_b = R_j + c.
+    bearing_length : float
+        L_b, axial length of the bearing, m (used by ``elastic_foundation``).
+    journal_material, bearing_material : Material
+    law : str
+        Name of the contact force law in :data:`weftsim.contact.LAWS`.
+    restitution : float
+        Coefficient of restitution ce in (0, 1].
+    friction_coefficient : float
+        mu of the modified Coulomb law; 0 switches friction off.
+    friction_velocities : tuple of float
+        (v0, v1), m/s: the friction factor ramps from 0 to 1 between them.
+    min_impact_velocity : float
+        Floor v_min on the held impact velocity, m/s.
+    """
+
+    clearance: float = 0.25e-3
+    journal_radius: float = 10e-3
+    bearing_length: float = 20e-3
+    journal_material: Material = field(default_factory=Material)
+    bearing_material: Material = field(default_factory=Material)
+    law: str = "variable_kd"
+    restitution: float = 0.9
+    friction_coefficient: float = 0.0
+    friction_velocities: tuple[float, float] = (1e-4, 2e-4)
+    min_impact_velocity: float = 1e-4
+
+    @property
+    def is_ideal(self) -> bool:
+        return self.clearance == 0.0
+
+    @property
+    def bearing_radius(self) -> float:
+        return self.journal_radius + self.clearance
+
+    @property
+    def effective_modulus(self) -> float:
+        """E* = 1 / (sigma_b + sigma_j), Pa."""
+        return 1.0 / (self.journal_material.compliance + self.bearing_material.compliance)
+
+
+@dataclass(frozen=True)
+class Drive:
+    """Constant crank speed and run length."""
+
+    speed: float = 400.0 * 2.0 * math.pi / 60.0  # omega, rad/s
+    revolutions: float = 2.0
+
+    @property
+    def period(self) -> float:
+        """Time of one crank revolution, s."""
+        return 2.0 * math.pi / self.speed
+
+    @property
+    def end_time(self) -> float:
+        return self.revolutions * self.period
+
+
+@dataclass(frozen=True)
+class ReferenceSolver:
+    """Settings of the closed-form Lagrange solver (scipy)."""
+
+    method: str = "DOP853"
+    rtol: float = 1e-9
+    atol: float = 1e-12
+    max_step: float = math.radians(0.5)  # crank angle, rad
+
+
+@dataclass(frozen=True)
+class ExudynSolver:
+    """Settings of the Exudyn engine."""
+
+    model: str = "rigid_body"
+    step_size: float = 2e-6  # s
+    spectral_radius: float = 0.8
+    modified_newton: bool = True
+    newton_relative_tolerance: float = 1e-8
+    newton_max_iterations: int = 25
+    callback: str = "auto"
+
+
+@dataclass(frozen=True)
+class Output:
+    """Output sampling."""
+
+    sample_angle: float = math.radians(0.5)  # crank angle between output samples, rad
+
+
+@dataclass(frozen=True)
+class CompareTolerance:
+    """Agreement the two engines must reach (relative, see issue text / SPEC.md section 6)."""
+
+    first_contact_angle: float = math.radians(0.1)
+    first_revolution_peaks: float = 0.01
+    rms: float = 0.03
+    percentile_99: float = 0.10
+    ideal_curves: float = 1e-4
+
+
+@dataclass(frozen=True)
+class Scene:
+    """Everything one simulation needs; produced by :func:`weftsim.scene.load_scene`."""
+
+    name: str = "reference"
+    geometry: Geometry = field(default_factory=Geometry)
+    inertia: Inertia = field(default_factory=Inertia)
+    joint: ClearanceJoint = field(default_factory=ClearanceJoint)
+    drive: Drive = field(default_factory=Drive)
+    reference_solver: ReferenceSolver = field(default_factory=ReferenceSolver)
+    exudyn_solver: ExudynSolver = field(default_factory=ExudynSolver)
+    output: Output = field(default_factory=Output)
+    compare: CompareTolerance = field(default_factory=CompareTolerance)
+    source: str = ""
