@@ -1,0 +1,139 @@
+"""The result of one simulation, shared by both engines.
+
+A :class:`RunResult` holds named channels (units in their names) twice: on the
+uniform crank-angle output grid (``samples``) and at every accepted solver step
+(``steps``).  Peaks and statistics are taken from ``steps`` because an impact
+lasts about 0.1 ms, a fraction of a degree, and falls between output samples.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from weftsim.params import Scene
+
+CHANNELS: tuple[str, ...] = (
+    "time_s",
+    "crank_angle_deg",
+    "rapier_displacement_m",
+    "rapier_velocity_m_s",
+    "rapier_acceleration_m_s2",
+    "driving_torque_Nm",
+    "contact_force_N",
+    "penetration_m",
+    "eccentricity_y_m",
+    "eccentricity_z_m",
+    "impact_velocity_m_s",
+    "in_contact",
+    "kinetic_energy_J",
+    "potential_energy_J",
+    "contact_energy_J",
+    "driving_work_J",
+    "dissipated_energy_J",
+)
+
+# Channels that describe the contact at E; identically zero for the ideal joint.
+CONTACT_CHANNELS: tuple[str, ...] = (
+    "contact_force_N",
+    "penetration_m",
+    "eccentricity_y_m",
+    "eccentricity_z_m",
+    "impact_velocity_m_s",
+    "in_contact",
+    "contact_energy_J",
+    "dissipated_energy_J",
+)
+
+# Channels summarised by peaks and statistics (SPEC.md section 4; paper Fig. 12).
+PEAK_CHANNELS: tuple[str, ...] = (
+    "rapier_displacement_m",
+    "rapier_velocity_m_s",
+    "rapier_acceleration_m_s2",
+    "driving_torque_Nm",
+    "contact_force_N",
+    "penetration_m",
+)
+
+STATUSES = ("success", "failed")
+ENGINES = ("reference", "exudyn")
+
+
+def _as_channels(data: dict[str, np.ndarray], what: str) -> dict[str, np.ndarray]:
+    missing = [name for name in CHANNELS if name not in data]
+    if missing:
+        raise ValueError(f"{what} lacks channels {missing}; every engine must provide all of {list(CHANNELS)}")
+    lengths = {name: np.shape(data[name]) for name in CHANNELS}
+    n = len(np.asarray(data["time_s"]))
+    bad = {name: shape for name, shape in lengths.items() if shape != (n,)}
+    if bad:
+        raise ValueError(f"{what}: channels must be 1-D of length {n} like time_s, got {bad}")
+    out = {}
+    for name in CHANNELS:
+        arr = np.array(data[name], dtype=float)
+        arr.setflags(write=False)
+        out[name] = arr
+    return out
+
+
+@dataclass(frozen=True)
+class RunResult:
+    """Outcome of one engine run on one scene.
+
+    Attributes
+    ----------
+    scene : Scene
+        The scene that produced it (after command-line overrides).
+    engine : str
+        ``"reference"`` (closed-form Lagrange) or ``"exudyn"``.
+    status : str
+        ``"success"`` or ``"failed"``; a failed run keeps what it computed up to the failure.
+    message : str
+        Empty on success; otherwise what failed, at which time and crank angle, and what to try.
+    samples, steps : dict of str to ndarray
+        All :data:`CHANNELS`, on the uniform output grid and at every accepted solver step.
+    solver_stats : dict
+        Steps, rejected steps, function evaluations, contact events, ``wall_time_s``, ...
+    events : dict
+        E.g. ``first_contact_time_s`` (true onset, located within the step) or None.
+    """
+
+    scene: Scene
+    engine: str
+    status: str
+    message: str
+    samples: dict[str, np.ndarray]
+    steps: dict[str, np.ndarray]
+    solver_stats: dict = field(default_factory=dict)
+    events: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if self.engine not in ENGINES:
+            raise ValueError(f"engine must be one of {ENGINES}, got {self.engine!r}")
+        if self.status not in STATUSES:
+            raise ValueError(f"status must be one of {STATUSES}, got {self.status!r}")
+        object.__setattr__(self, "samples", _as_channels(self.samples, "samples"))
+        object.__setattr__(self, "steps", _as_channels(self.steps, "steps"))
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "success"
+
+    @property
+    def first_contact_angle_deg(self) -> float | None:
+        """Crank angle of the first contact onset, deg, or None if the journal never touched."""
+        t = self.events.get("first_contact_time_s")
+        if t is None:
+            return None
+        return math.degrees(self.scene.drive.speed * t)
+
+    @property
+    def wall_time_s(self) -> float:
+        return float(self.solver_stats.get("wall_time_s", float("nan")))
+
+
+def empty_channels() -> dict[str, np.ndarray]:
+    """All channels with no rows, for a run that failed before its first step."""
+    return {name: np.zeros(0) for name in CHANNELS}
