@@ -1,0 +1,223 @@
+"""Command line: ``weftsim kinematics | run | compare``.  Thin: parse, call, report.
+
+Every expected failure (bad scene, bad flag, unwritable output, failed solve) is one
+line on stderr and a non-zero exit status; tracebacks only for real bugs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import math
+import sys
+from pathlib import Path
+
+EXIT_USAGE = 2  # bad scene, flag or output directory
+EXIT_FAILED = 3  # the simulation itself failed (partial results written)
+EXIT_DISAGREE = 4  # compare: engines disagree beyond the scene's tolerance
+
+
+class CliError(Exception):
+    """An error to print as one line, with an exit status."""
+
+    def __init__(self, message: str, status: int = EXIT_USAGE):
+        super().__init__(message)
+        self.status = status
+
+
+def _positive(kind):
+    def parse(text: str):
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+        if not math.isfinite(value) or value <= 0:
+            raise argparse.ArgumentTypeError(f"must be a finite number > 0, got {text!r}")
+        return value
+
+    return parse
+
+
+def _non_negative(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not math.isfinite(value) or value < 0:
+        raise argparse.ArgumentTypeError(f"must be a finite number >= 0, got {text!r}")
+    return value
+
+
+def _add_scene_flags(p: argparse.ArgumentParser, full: bool = True) -> None:
+    p.add_argument("scene", help="scene file (TOML), e.g. models/reference.toml")
+    p.add_argument("-o", "--output", default=None, help="output directory (default: out/<scene name>)")
+    p.add_argument("--speed-rpm", type=_positive(float), help="override drive.speed_rpm")
+    if full:
+        p.add_argument("--clearance-mm", type=_non_negative, help="override joint_e.clearance_mm (0 = ideal joint)")
+        p.add_argument("--law", help="override joint_e.law (contact force law)")
+        p.add_argument("--revolutions", type=_positive(float), help="override drive.revolutions")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="weftsim",
+        description="Weft insertion mechanism of a rapier loom with a clearance joint at E: "
+        "Exudyn multibody model and closed-form Lagrange cross-check.",
+    )
+    parser.add_argument("-v", "--verbose", action="store_true", help="log what happens")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    p = sub.add_parser("kinematics", help="ideal rapier motion over one revolution (CSV + plot)")
+    _add_scene_flags(p, full=False)
+
+    p = sub.add_parser("run", help="simulate a scene with one engine (CSV, summary.json, figure)")
+    _add_scene_flags(p)
+    p.add_argument("--engine", default="reference", help="reference (closed-form Lagrange) or exudyn")
+    p.add_argument("--no-plot", action="store_true", help="skip the figure")
+
+    p = sub.add_parser("compare", help="run both engines on one scene and compare them")
+    _add_scene_flags(p)
+    p.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
+    return parser
+
+
+def _overrides(args) -> dict:
+    return {
+        "drive.speed_rpm": getattr(args, "speed_rpm", None),
+        "joint_e.clearance_mm": getattr(args, "clearance_mm", None),
+        "joint_e.law": getattr(args, "law", None),
+        "drive.revolutions": getattr(args, "revolutions", None),
+    }
+
+
+def _load(args):
+    from weftsim.scene import load_scene
+
+    return load_scene(args.scene, _overrides(args))
+
+
+def _outdir(args, scene, suffix: str = "") -> Path:
+    return Path(args.output) if args.output else Path("out") / (scene.name + suffix)
+
+
+def cmd_kinematics(args) -> int:
+    import numpy as np
+
+    from weftsim.kinematics import linkage_state
+    from weftsim.output import prepare_directory, write_csv, write_figure
+    from weftsim.plots import plot_kinematics
+
+    scene = _load(args)
+    outdir = prepare_directory(_outdir(args, scene, "-kinematics"))
+    step = scene.output.sample_angle
+    theta = np.linspace(0.0, 2.0 * math.pi, int(round(2.0 * math.pi / step)) + 1)
+    state = linkage_state(theta, scene.geometry, scene.inertia.rocker_com)
+    w = scene.drive.speed
+    columns = {
+        "crank_angle_deg": np.degrees(theta),
+        "rapier_displacement_m": state.rapier_displacement,
+        "rapier_velocity_m_s": w * state.d_rapier_displacement,
+        "rapier_acceleration_m_s2": w * w * state.dd_rapier_displacement,
+        "rocker_angle_deg": np.degrees(state.phi),
+        "rocker_arm_angle_deg": np.degrees(state.theta_oe),
+        "sector_angle_deg": np.degrees(state.theta_fg),
+        "rod_angle_deg": np.degrees(state.theta_ef),
+        "transmission_angle_deg": np.degrees(state.transmission_angle),
+    }
+    csv = write_csv(outdir / "kinematics.csv", columns)
+    rpm = scene.drive.speed * 30 / math.pi
+    fig = plot_kinematics(columns["crank_angle_deg"], columns["rapier_displacement_m"],
+                          columns["rapier_velocity_m_s"], columns["rapier_acceleration_m_s2"],
+                          f"{scene.name}: ideal rapier motion at {rpm:g} rpm")
+    png = write_figure(outdir / "kinematics.png", fig)
+    s, v, a = columns["rapier_displacement_m"], columns["rapier_velocity_m_s"], columns["rapier_acceleration_m_s2"]
+    print(f"scene {scene.name}: {rpm:g} rpm, ideal joints")
+    print(f"  stroke        {s.max() - s.min():.6f} m at {columns['crank_angle_deg'][s.argmax()]:.1f} deg")
+    print(f"  velocity      {v.min():+.3f} .. {v.max():+.3f} m/s")
+    print(f"  acceleration  {a.min():+.2f} .. {a.max():+.2f} m/s^2 (on the {math.degrees(step):g} deg grid)")
+    ta = columns["transmission_angle_deg"]
+    print(f"  transmission angle at F {ta.min():.2f} .. {ta.max():.2f} deg")
+    print(f"wrote {csv} and {png}")
+    return 0
+
+
+def _solve(scene, engine: str, label: str | None = None):
+    from weftsim.progress import Progress
+
+    if engine == "reference":
+        from weftsim.reference import solve
+    elif engine == "exudyn":
+        from weftsim.exudyn_engine import solve
+    else:
+        raise CliError(f"--engine must be 'reference' or 'exudyn', got {engine!r}")
+    progress = Progress(label or f"{engine} {scene.name}")
+    try:
+        return solve(scene, progress=progress)
+    finally:
+        progress.close()
+
+
+def _report_run(result, written) -> None:
+    from weftsim.analysis import complete_revolutions, peaks
+
+    print(f"scene {result.scene.name}, engine {result.engine}: {result.status} "
+          f"in {result.wall_time_s:.2f} s wall time")
+    n = complete_revolutions(result)
+    if n:
+        p = peaks(result, n - 1)
+        print(f"  peaks over revolution {n}:")
+        for name, v in p.items():
+            print(f"    {name:28s} {v['min']:+.6g} .. {v['max']:+.6g}")
+    if result.first_contact_angle_deg is not None:
+        print(f"  first contact at crank angle {result.first_contact_angle_deg:.3f} deg")
+    for kind, path in written.items():
+        print(f"  wrote {path}")
+
+
+def cmd_run(args) -> int:
+    from weftsim.output import prepare_directory, write_run
+
+    scene = _load(args)
+    outdir = prepare_directory(_outdir(args, scene))
+    result = _solve(scene, args.engine)
+    written = write_run(result, outdir, figure=not args.no_plot)
+    _report_run(result, written)
+    if not result.ok:
+        raise CliError(f"simulation failed: {result.message} (results up to the failure written to {outdir}, "
+                       "marked incomplete in summary.json)", EXIT_FAILED)
+    return 0
+
+
+def cmd_compare(args) -> int:
+    from weftsim.compare import run_compare
+
+    scene = _load(args)
+    return run_compare(scene, _outdir(args, scene, "-compare"), as_json=args.json, solve=_solve)
+
+
+COMMANDS = {"kinematics": cmd_kinematics, "run": cmd_run, "compare": cmd_compare}
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
+                        format="%(name)s: %(message)s")
+    from weftsim.output import OutputError
+    from weftsim.scene import SceneError
+
+    try:
+        return COMMANDS[args.command](args)
+    except (SceneError, OutputError) as exc:
+        print(f"weftsim {args.command}: error: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except CliError as exc:
+        print(f"weftsim {args.command}: error: {exc}", file=sys.stderr)
+        return exc.status
+    except KeyboardInterrupt:
+        print(f"weftsim {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,119 @@
+"""Writing results to disk: atomic CSV, JSON and figure files.
+
+Every file is written to a temporary name in the target directory and then
+renamed over the final name, so a run that dies leaves either the complete
+previous file or the complete new one, never half of one.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from weftsim.results import CHANNELS, RunResult
+
+
+class OutputError(OSError):
+    """The output directory or a file in it cannot be written."""
+
+
+def prepare_directory(path: str | Path) -> Path:
+    """Create ``path`` (and parents) and check it is a writable directory."""
+    path = Path(path)
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except FileExistsError:
+        raise OutputError(f"output directory {path} exists and is not a directory") from None
+    except OSError as exc:
+        raise OutputError(f"cannot create output directory {path}: {exc.strerror}") from None
+    if not os.access(path, os.W_OK | os.X_OK):
+        raise OutputError(f"output directory {path} is not writable")
+    return path
+
+
+def write_atomic(target: Path, write: Callable[[Path], None]) -> Path:
+    """Call ``write(tmp_path)`` and rename the temporary file onto ``target``."""
+    target = Path(target)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=target.parent)
+    os.close(fd)
+    try:
+        write(Path(tmp))
+        os.replace(tmp, target)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return target
+
+
+def write_text(target: Path, text: str) -> Path:
+    return write_atomic(target, lambda p: p.write_text(text, encoding="utf-8"))
+
+
+def _json_default(value):
+    if isinstance(value, (np.floating, np.integer)):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, Path):
+        return str(value)
+    raise TypeError(f"cannot write {type(value).__name__} to JSON")
+
+
+def _clean(value):
+    """NaN and inf are not JSON: write them as null."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _clean(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_clean(v) for v in value]
+    return value
+
+
+def to_json(data: dict) -> str:
+    return json.dumps(_clean(data), indent=2, default=_json_default) + "\n"
+
+
+def write_json(target: Path, data: dict) -> Path:
+    return write_text(target, to_json(data))
+
+
+def write_csv(target: Path, columns: dict[str, np.ndarray]) -> Path:
+    """Columns of equal length, header = column names, full double precision."""
+    names = list(columns)
+    table = np.column_stack([np.asarray(columns[n], dtype=float) for n in names]) if names else np.zeros((0, 0))
+
+    def write(tmp: Path) -> None:
+        np.savetxt(tmp, table, delimiter=",", header=",".join(names), comments="", fmt="%.10g")
+
+    return write_atomic(target, write)
+
+
+def write_figure(target: Path, figure) -> Path:
+    import matplotlib.pyplot as plt
+
+    try:
+        return write_atomic(target, lambda p: figure.savefig(p, format=target.suffix.lstrip("."), dpi=130))
+    finally:
+        plt.close(figure)
+
+
+def write_run(result: RunResult, outdir: str | Path, figure: bool = True) -> dict[str, Path]:
+    """Write ``channels.csv``, ``summary.json`` and ``channels.png`` for one run."""
+    from weftsim.analysis import summary
+    from weftsim.plots import plot_channels
+
+    outdir = prepare_directory(outdir)
+    written = {
+        "channels": write_csv(outdir / "channels.csv", {n: result.samples[n] for n in CHANNELS}),
+        "summary": write_json(outdir / "summary.json", summary(result)),
+    }
+    if figure and result.steps["time_s"].size:
+        written["figure"] = write_figure(outdir / "channels.png", plot_channels([result]))
+    return written

@@ -1,0 +1,78 @@
+"""Figures (no physics here): matplotlib with the Agg backend, imported only when called."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+PANELS = (
+    ("rapier_displacement_m", "rapier displacement [mm]", 1e3),
+    ("rapier_velocity_m_s", "rapier velocity [m/s]", 1.0),
+    ("rapier_acceleration_m_s2", "rapier acceleration [m/s²]", 1.0),
+    ("driving_torque_Nm", "driving torque [N·m]", 1.0),
+    ("contact_force_N", "contact force at E [N]", 1.0),
+    ("penetration_m", "penetration at E [mm]", 1e3),
+)
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def last_revolution(result):
+    """Per-step channels of the last complete revolution (all steps if the run is shorter)."""
+    from weftsim.analysis import complete_revolutions
+
+    steps = result.steps
+    n = complete_revolutions(result)
+    if n == 0:
+        return steps, 0
+    period = result.scene.drive.period
+    t = steps["time_s"]
+    keep = (t >= (n - 1) * period - 1e-12) & (t <= n * period + 1e-12)
+    return {k: v[keep] for k, v in steps.items()}, n - 1
+
+
+def plot_channels(results, labels=None, title=None):
+    """Six panels like the paper's Fig. 12 / Fig. 16, over the last complete revolution of each result."""
+    plt = _pyplot()
+    fig, axes = plt.subplots(3, 2, figsize=(11, 9), sharex=True)
+    labels = labels or [f"{r.engine}, c = {r.scene.joint.clearance * 1e3:g} mm, "
+                        f"{r.scene.drive.speed * 30 / math.pi:g} rpm" for r in results]
+    for result, label in zip(results, labels):
+        data, k = last_revolution(result)
+        angle = data["crank_angle_deg"] - 360.0 * k
+        for ax, (name, ylabel, scale) in zip(axes.flat, PANELS):
+            ax.plot(angle, data[name] * scale, lw=0.8, label=label, rasterized=len(angle) > 20000)
+            ax.set_ylabel(ylabel)
+            ax.grid(alpha=0.3)
+    for ax in axes[-1]:
+        ax.set_xlabel("crank angle [deg]")
+        ax.set_xlim(0, 360)
+        ax.set_xticks(range(0, 361, 60))
+    axes.flat[0].legend(fontsize=8, loc="best")
+    fig.suptitle(title or (results[0].scene.name + (" (last revolution)" if results else "")))
+    fig.tight_layout()
+    return fig
+
+
+def plot_kinematics(angle_deg, s, v, a, title=""):
+    """Ideal rapier displacement, velocity and acceleration over one revolution."""
+    plt = _pyplot()
+    fig, axes = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
+    for ax, y, label in zip(axes, (s * 1e3, v, a), ("displacement [mm]", "velocity [m/s]", "acceleration [m/s²]")):
+        ax.plot(angle_deg, y, lw=1.2)
+        ax.set_ylabel("rapier " + label)
+        ax.grid(alpha=0.3)
+    axes[-1].set_xlabel("crank angle [deg]")
+    axes[-1].set_xlim(0, 360)
+    axes[-1].set_xticks(range(0, 361, 60))
+    fig.suptitle(title)
+    fig.tight_layout()
+    return fig

@@ -1,0 +1,321 @@
+"""Scene files: TOML in, validated :class:`weftsim.params.Scene` out.
+
+A scene file may ``extends = "other.toml"`` (path relative to the file) and then
+holds only what differs; tables merge key by key.  Units live in the key names
+(``_mm``, ``_deg``, ``_rpm``, ``_gpa``, ...) and are converted to SI here.  Every
+problem is reported as one :class:`SceneError` naming the file, the key, the bad
+value and what is allowed.  :data:`SCHEMA` is the single list of keys; the README's
+scene reference is written from it.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any, Callable
+
+from weftsim import params
+
+INTEGRATORS = ("DOP853", "RK45", "Radau", "LSODA", "BDF")
+EXUDYN_MODELS = ("rigid_body",)
+CALLBACK_ROUTES = ("auto", "python", "symbolic", "numba")
+BRANCHES = {"+": 1, "-": -1}
+
+
+class SceneError(ValueError):
+    """A scene file or a command-line override is not acceptable."""
+
+
+@dataclass(frozen=True)
+class Key:
+    """One scene-file key: where it goes, its unit conversion and its allowed range."""
+
+    path: str  # dotted TOML key, e.g. "joint_e.clearance_mm"
+    target: str  # "<scene attribute>.<field>" or deeper, e.g. "joint.clearance"
+    kind: str  # "float", "int", "bool", "str", "floats2", "floats3"
+    scale: float = 1.0  # SI value = file value * scale
+    low: float | None = None
+    high: float | None = None
+    low_open: bool = True  # low excluded
+    high_open: bool = False  # high excluded
+    choices: tuple = ()
+    doc: str = ""
+
+    def allowed(self) -> str:
+        if self.choices:
+            return "one of " + ", ".join(repr(c) for c in self.choices)
+        parts = []
+        if self.low is not None:
+            parts.append(f"{'>' if self.low_open else '>='} {self.low:g}")
+        if self.high is not None:
+            parts.append(f"{'<' if self.high_open else '<='} {self.high:g}")
+        return " and ".join(parts) or "any finite value"
+
+
+MM, DEG, GPA, RPM = 1e-3, math.pi / 180.0, 1e9, 2.0 * math.pi / 60.0
+
+SCHEMA: tuple[Key, ...] = (
+    Key("mechanism.crank_inclination_deg", "geometry.crank_inclination", "float", DEG, 0, 90, True, True,
+        doc="beta, arc A-B of the spherical 4R"),
+    Key("mechanism.rocker_arm_angle_deg", "geometry.rocker_arm_angle", "float", DEG, -360, 360, False, False,
+        doc="theta_OE0, angle of OE from +y towards +z at phi = 0"),
+    Key("mechanism.l_oe_mm", "geometry.l_oe", "float", MM, 0, doc="rocker arm OE"),
+    Key("mechanism.l_ef_mm", "geometry.l_ef", "float", MM, 0, doc="connecting rod EF"),
+    Key("mechanism.l_fg_mm", "geometry.l_fg", "float", MM, 0, doc="sector arm FG"),
+    Key("mechanism.l_og_mm", "geometry.l_og", "float", MM, 0, doc="frame O-G"),
+    Key("mechanism.fourbar_branch", "geometry.fourbar_branch", "str", choices=tuple(BRANCHES),
+        doc="assembly branch of the four-bar (SPEC.md: \"+\")"),
+    Key("mechanism.sector_pitch_radius_mm", "geometry.sector_pitch_radius", "float", MM, 0, doc="d5"),
+    Key("mechanism.pinion_pitch_radius_mm", "geometry.pinion_pitch_radius", "float", MM, 0, doc="d6"),
+    Key("mechanism.rapier_gear_pitch_radius_mm", "geometry.rapier_gear_pitch_radius", "float", MM, 0, doc="d7"),
+    Key("inertia.crank_inertia_kg_m2", "inertia.crank_inertia", "float", 1, 0, doc="J1 about A"),
+    Key("inertia.coupler_mass_kg", "inertia.coupler_mass", "float", 1, 0, doc="m2 (centre of mass at O)"),
+    Key("inertia.coupler_inertia_kg_m2", "inertia.coupler_inertia", "floats3", 1, 0,
+        doc="principal inertia of the coupler about O in [b, c, b x c]"),
+    Key("inertia.rocker_mass_kg", "inertia.rocker_mass", "float", 1, 0, doc="m3"),
+    Key("inertia.rocker_com_mm", "inertia.rocker_com", "float", MM, None, doc="rocker centre of mass on OE from O"),
+    Key("inertia.rocker_inertia_kg_m2", "inertia.rocker_inertia", "float", 1, 0, doc="J3 about D"),
+    Key("inertia.rod_mass_kg", "inertia.rod_mass", "float", 1, 0, doc="m4 (centre of mass mid EF)"),
+    Key("inertia.rod_inertia_kg_m2", "inertia.rod_inertia", "float", 1, 0, doc="J4 about its centre of mass"),
+    Key("inertia.sector_inertia_kg_m2", "inertia.sector_inertia", "float", 1, 0, doc="J5 about G"),
+    Key("inertia.pinion_gear_inertia_kg_m2", "inertia.pinion_gear_inertia", "float", 1, 0, doc="J67"),
+    Key("inertia.rapier_mass_kg", "inertia.rapier_mass", "float", 1, 0, doc="m8"),
+    Key("inertia.gravity_m_s2", "inertia.gravity", "float", 1, 0, doc="g along -z"),
+    Key("joint_e.clearance_mm", "joint.clearance", "float", MM, 0, 5, False, doc="radial clearance c; 0 = ideal joint"),
+    Key("joint_e.journal_radius_mm", "joint.journal_radius", "float", MM, 0, doc="R_j"),
+    Key("joint_e.bearing_length_mm", "joint.bearing_length", "float", MM, 0, doc="L_b"),
+    Key("joint_e.law", "joint.law", "str", doc="contact force law (see weftsim.contact.LAWS)"),
+    Key("joint_e.restitution", "joint.restitution", "float", 1, 0, 1, True, False, doc="coefficient of restitution ce"),
+    Key("joint_e.friction_coefficient", "joint.friction_coefficient", "float", 1, 0, 2, False,
+        doc="mu of the modified Coulomb law; 0 = off"),
+    Key("joint_e.friction_velocities_m_s", "joint.friction_velocities", "floats2", 1, 0,
+        doc="[v0, v1] of the friction ramp, v0 < v1"),
+    Key("joint_e.min_impact_velocity_m_s", "joint.min_impact_velocity", "float", 1, 0,
+        doc="floor on the held impact velocity"),
+    Key("joint_e.journal_material.youngs_modulus_gpa", "joint.journal_material.youngs_modulus", "float", GPA, 0),
+    Key("joint_e.journal_material.poisson_ratio", "joint.journal_material.poisson_ratio", "float", 1, 0, 0.5,
+        False, True),
+    Key("joint_e.bearing_material.youngs_modulus_gpa", "joint.bearing_material.youngs_modulus", "float", GPA, 0),
+    Key("joint_e.bearing_material.poisson_ratio", "joint.bearing_material.poisson_ratio", "float", 1, 0, 0.5,
+        False, True),
+    Key("drive.speed_rpm", "drive.speed", "float", RPM, 0, 5000, doc="constant crank speed"),
+    Key("drive.revolutions", "drive.revolutions", "float", 1, 0, 1000, doc="crank revolutions to simulate"),
+    Key("solver.reference.method", "reference_solver.method", "str", choices=INTEGRATORS,
+        doc="scipy solve_ivp method of the reference engine"),
+    Key("solver.reference.rtol", "reference_solver.rtol", "float", 1, 0, 1e-2, doc="relative tolerance"),
+    Key("solver.reference.atol", "reference_solver.atol", "float", 1, 0, 1e-2, doc="absolute tolerance"),
+    Key("solver.reference.max_step_deg", "reference_solver.max_step", "float", DEG, 0, 90,
+        doc="largest step, as crank angle"),
+    Key("solver.exudyn.model", "exudyn_solver.model", "str", choices=EXUDYN_MODELS, doc="Exudyn model variant"),
+    Key("solver.exudyn.step_size_s", "exudyn_solver.step_size", "float", 1, 0, 1e-2,
+        doc="generalized-alpha step size"),
+    Key("solver.exudyn.spectral_radius", "exudyn_solver.spectral_radius", "float", 1, 0, 1, False, False,
+        doc="generalized-alpha spectral radius (<= 0.9 for smooth constraint torques)"),
+    Key("solver.exudyn.modified_newton", "exudyn_solver.modified_newton", "bool", doc="modified Newton"),
+    Key("solver.exudyn.newton_relative_tolerance", "exudyn_solver.newton_relative_tolerance", "float", 1, 0, 1e-2),
+    Key("solver.exudyn.newton_max_iterations", "exudyn_solver.newton_max_iterations", "int", 1, 0, 1000),
+    Key("solver.exudyn.callback", "exudyn_solver.callback", "str", choices=CALLBACK_ROUTES,
+        doc="contact callback route; auto = fastest measured"),
+    Key("output.sample_deg", "output.sample_angle", "float", DEG, 0, 0.5, True, False,
+        doc="output grid spacing in crank angle (0.5 deg or finer)"),
+    Key("compare.first_contact_angle_deg", "compare.first_contact_angle", "float", DEG, 0),
+    Key("compare.first_revolution_peaks", "compare.first_revolution_peaks", "float", 1, 0,
+        doc="relative tolerance on first-revolution maxima"),
+    Key("compare.rms", "compare.rms", "float", 1, 0, doc="relative tolerance on RMS over revolutions 2..N"),
+    Key("compare.percentile_99", "compare.percentile_99", "float", 1, 0, doc="relative tolerance on 99th percentiles"),
+    Key("compare.ideal_curves", "compare.ideal_curves", "float", 1, 0,
+        doc="ideal joint: largest difference at any sample, relative to the peak"),
+)
+_BY_PATH = {key.path: key for key in SCHEMA}
+TOP_LEVEL = ("name", "description", "extends")
+
+
+def _flatten(table: dict, prefix: str = "") -> dict[str, Any]:
+    flat = {}
+    for name, value in table.items():
+        path = f"{prefix}{name}"
+        if isinstance(value, dict):
+            flat.update(_flatten(value, path + "."))
+        else:
+            flat[path] = value
+    return flat
+
+
+def _read_toml(path: Path) -> dict:
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise SceneError(f"{path}: scene file not found") from None
+    except IsADirectoryError:
+        raise SceneError(f"{path}: is a directory, expected a scene file (.toml)") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise SceneError(f"{path}: cannot be read ({exc})") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"{path}: not valid TOML ({exc})") from None
+
+
+def _read_merged(path: Path, chain: tuple[Path, ...] = ()) -> tuple[dict[str, Any], dict[str, Path]]:
+    """Flattened keys of a scene and its ``extends`` chain, and the file each key came from."""
+    path = path.resolve()
+    if path in chain:
+        raise SceneError(f"{path}: 'extends' loops back to itself via {[str(p) for p in chain]}")
+    table = _read_toml(path)
+    flat = _flatten(table)
+    base, origin = {}, {}
+    if "extends" in flat:
+        parent = flat.pop("extends")
+        if not isinstance(parent, str):
+            raise SceneError(f"{path}: key 'extends' must be a path string, got {parent!r}")
+        base, origin = _read_merged(path.parent / parent, chain + (path,))
+    base.pop("name", None)
+    base.pop("description", None)
+    base.update(flat)
+    origin.update({key: path for key in flat})
+    return base, origin
+
+
+def _convert(key: Key, value: Any, where: str) -> Any:
+    def fail(expect: str) -> SceneError:
+        return SceneError(f"{where}: key '{key.path}' {expect}, got {value!r}")
+
+    if key.kind == "bool":
+        if not isinstance(value, bool):
+            raise fail("must be true or false")
+        return value
+    if key.kind == "str":
+        if not isinstance(value, str):
+            raise fail("must be a string")
+        if key.choices and value not in key.choices:
+            raise fail(f"must be {key.allowed()}")
+        return value
+    if key.kind == "int":
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise fail("must be a whole number")
+        numbers = [value]
+    elif key.kind == "float":
+        numbers = [value]
+    else:
+        size = {"floats2": 2, "floats3": 3}[key.kind]
+        if not isinstance(value, list) or len(value) != size:
+            raise fail(f"must be a list of {size} numbers")
+        numbers = value
+    for number in numbers:
+        if isinstance(number, bool) or not isinstance(number, (int, float)):
+            raise fail("must be a number")
+        if not math.isfinite(number):
+            raise fail("must be a finite number")
+        low_bad = key.low is not None and (number <= key.low if key.low_open else number < key.low)
+        high_bad = key.high is not None and (number >= key.high if key.high_open else number > key.high)
+        if low_bad or high_bad:
+            raise fail(f"must be {key.allowed()}")
+    if key.kind == "int":
+        return value
+    scaled = tuple(float(n) * key.scale for n in numbers)
+    return scaled[0] if key.kind == "float" else scaled
+
+
+def _set(scene: params.Scene, target: str, value: Any) -> params.Scene:
+    head, _, rest = target.partition(".")
+    if not rest:
+        return replace(scene, **{head: value})
+    return replace(scene, **{head: _set(getattr(scene, head), rest, value)})
+
+
+def _check_scene(scene: params.Scene, where: str) -> None:
+    """Cross-key checks: law names, friction ramp, linkage assembly."""
+    from weftsim.contact import LAWS
+
+    joint = scene.joint
+    if joint.law not in LAWS:
+        raise SceneError(f"{where}: key 'joint_e.law' must be one of {', '.join(sorted(LAWS))}, got {joint.law!r}")
+    v0, v1 = joint.friction_velocities
+    if not v0 < v1:
+        raise SceneError(f"{where}: key 'joint_e.friction_velocities_m_s' must have v0 < v1, got [{v0:g}, {v1:g}]")
+    if joint.clearance >= joint.journal_radius:
+        raise SceneError(
+            f"{where}: key 'joint_e.clearance_mm' must be smaller than the journal radius "
+            f"{joint.journal_radius / MM:g} mm, got {joint.clearance / MM:g}"
+        )
+    if scene.output.sample_angle / scene.drive.speed > scene.drive.end_time:
+        raise SceneError(f"{where}: key 'drive.revolutions' is shorter than one output sample")
+    from weftsim.kinematics import assembly_failure_angle
+
+    angle = assembly_failure_angle(scene.geometry)
+    if angle is not None:
+        raise SceneError(
+            f"{where}: the linkage cannot be assembled at crank angle {math.degrees(angle):.2f} deg "
+            "(the four-bar O-E-F-G does not close: check mechanism.l_oe_mm, l_ef_mm, l_fg_mm, l_og_mm "
+            "and rocker_arm_angle_deg)"
+        )
+
+
+def scene_from_keys(flat: dict[str, Any], where: str = "scene", origin: dict[str, Path] | None = None) -> params.Scene:
+    """Validated :class:`Scene` from flattened dotted keys (file values, file units)."""
+    origin = origin or {}
+    name = flat.get("name", "scene")
+    if not isinstance(name, str):
+        raise SceneError(f"{where}: key 'name' must be a string, got {name!r}")
+    scene = params.Scene(name=name, source=where)
+    for path, value in flat.items():
+        if path in TOP_LEVEL:
+            continue
+        src = str(origin.get(path, where))
+        key = _BY_PATH.get(path)
+        if key is None:
+            section = path.rpartition(".")[0]
+            near = [k.path for k in SCHEMA if k.path.rpartition(".")[0] == section] or sorted(
+                {k.path.partition(".")[0] for k in SCHEMA}
+            )
+            raise SceneError(f"{src}: unknown key '{path}'; allowed here: {', '.join(near)}")
+        value = _convert(key, value, src)
+        if key.path == "mechanism.fourbar_branch":
+            value = BRANCHES[value]
+        scene = _set(scene, key.target, value)
+    _check_scene(scene, where)
+    return scene
+
+
+def load_scene(path: str | Path, overrides: dict[str, Any] | None = None) -> params.Scene:
+    """Read, merge (``extends``), override and validate a scene file.
+
+    Parameters
+    ----------
+    path : str or Path
+        The TOML scene file.
+    overrides : dict, optional
+        Dotted file keys with file-unit values, e.g. ``{"drive.speed_rpm": 500}``,
+        applied after the file (the command-line flags use this).
+
+    Raises
+    ------
+    SceneError
+        Naming the file (or "command line"), the key, the bad value and what is allowed.
+    """
+    path = Path(path)
+    flat, origin = _read_merged(path)
+    flat.setdefault("name", path.stem)
+    for dotted, value in (overrides or {}).items():
+        if value is None:
+            continue
+        flat[dotted] = value
+        origin[dotted] = Path("command line")
+    return scene_from_keys(flat, str(path), origin)
+
+
+def to_file_keys(scene: params.Scene) -> dict[str, Any]:
+    """The scene as flattened file keys in file units (for summaries and provenance)."""
+    out: dict[str, Any] = {"name": scene.name}
+    for key in SCHEMA:
+        obj: Any = scene
+        for part in key.target.split("."):
+            obj = getattr(obj, part)
+        if key.path == "mechanism.fourbar_branch":
+            obj = "+" if obj > 0 else "-"
+        elif key.kind in ("float", "floats2", "floats3"):
+            obj = obj / key.scale if key.kind == "float" else [v / key.scale for v in obj]
+        out[key.path] = obj
+    return out
