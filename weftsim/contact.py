@@ -1,0 +1,503 @@
+"""Continuous contact force laws of the clearance joint (SPEC.md section 3).
+
+Every law gives the normal contact force of a journal pressed into its bearing,
+
+    F_N = max(0, K(delta) delta^n (1 + xi delta_dot / v_imp))   for delta > 0,
+    F_N = 0                                                     for delta <= 0,
+
+with penetration delta (m, positive in contact), penetration rate delta_dot (m/s,
+positive while approaching), held impact velocity v_imp (m/s, the value of
+delta_dot at contact onset), stiffness K (N/m^n, or a function of delta),
+exponent n and dimensionless hysteresis factor xi.  The damping coefficient is
+D = xi K delta^n / v_imp (N s/m, paper Eq. 19/23), so F_N = K delta^n + D delta_dot.
+
+The impact velocity is supplied by the caller (the engines hold delta_dot at the
+onset and floor it at ``ClearanceJoint.min_impact_velocity``); the numpy form raises
+``ValueError`` where a non-positive value would be used, the scalar forms do not
+check (speed).
+
+Laws (chosen by name from :data:`LAWS`, built by :func:`make_law`):
+
+==========================  ================================  ==========================
+name                        stiffness                         xi
+==========================  ================================  ==========================
+``lankarani_nikravesh``     K_LN (constant, Hertz/Johnson)    3 (1 - ce^2) / 4
+``variable_kd``             K_BZ(delta) (Bai-Zhao)            3 (1 - ce^2) / 4
+``flores``                  K_LN                              8 (1 - ce) / (5 ce)
+``hunt_crossley``           K_LN                              3 (1 - ce) / 2
+``gonthier``                K_LN                              (1 - ce^2) / ce
+``elastic_foundation``      L_b pi E* / (2 sqrt(2 (c+delta)))  3 (1 - ce^2) / 4
+==========================  ================================  ==========================
+
+with sigma_k = (1 - nu_k^2) / E_k, E* = 1 / (sigma_b + sigma_j) and
+
+    K_LN = 4 / (3 (sigma_b + sigma_j)) sqrt(R_b R_j / (R_b - R_j))             N/m^1.5
+    K_BZ(delta) = (pi/8) E* sqrt(2 delta (3c + 2 delta)^2 / (c + delta)^3)     "N/m^1.5"
+
+K_BZ is d/d(delta) of Liu's per-unit-length elastic-foundation force, so it has the
+units of a modulus (N/m^2); multiplying it by delta^1.5 (paper Eqs. 21-24) gives an
+*empirical* law that is only meaningful in SI units.  ``elastic_foundation`` is the
+dimensionally consistent cousin: Liu's force over the bearing length L_b,
+F = L_b (pi/2) E* delta sqrt(delta / (2 (c + delta))), written here as K(delta)
+delta^1.5 with K(delta) = L_b pi E* / (2 sqrt(2 (c + delta))).
+
+Each law declares ``valid_restitution = (lo, hi)``: the range of ce for which a
+single-mass impact returns the requested ce within 0.05 (absolute).  For every law of
+this family (damping proportional to the elastic force) the restored ce depends on xi
+only, not on K(delta), mass or impact velocity: with W = integral F_el d(delta) and
+u = delta_dot / v_imp, m v_imp^2 u du/dW = -(1 + xi u), whence the exact relation of
+:func:`restored_restitution`.  Laws sharing xi (``lankarani_nikravesh``, ``variable_kd``,
+``elastic_foundation``) therefore share their validity range.  Table of
+restored - requested ce (from that relation, confirmed by direct integration in
+``tests/test_contact.py``):
+
+==========  =======  =======  =======  =======  =======  =======
+ce          0.1      0.3      0.5      0.7      0.8      0.9
+==========  =======  =======  =======  =======  =======  =======
+LN/BZ/EF    +0.565   +0.384   +0.225   +0.096   +0.047   +0.013
+flores      -0.031   -0.044   -0.030   -0.017   -0.011   -0.006
+hunt_c.     +0.416   +0.281   +0.163   +0.068   +0.033   +0.009
+gonthier    +0.001   +0.004   -0.012   -0.030   -0.032   -0.024
+==========  =======  =======  =======  =======  =======  =======
+
+Sources: Lankarani & Nikravesh, J. Mech. Des. 112 (1990); Hunt & Crossley,
+J. Appl. Mech. 42 (1975); Gonthier et al., Multibody Syst. Dyn. 11 (2004); Flores
+et al., Mech. Mach. Theory 46 (2011); Bai & Zhao, Int. J. Non-Linear Mech. 48
+(2013); Liu, Zhang & Yang, Mech. Mach. Theory 42 (2007); Li et al. (2020), Eqs. 14-24;
+Ambrosio (2003) for the modified Coulomb friction.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+from typing import Callable, ClassVar
+
+import numpy as np
+
+from weftsim.params import ClearanceJoint
+
+ScalarLaw = Callable[[float, float, float], float]
+
+# Below this value of x = delta / c the energy integrals of the delta-dependent laws
+# are summed as binomial series (closed forms cancel catastrophically as x -> 0).
+_SERIES_LIMIT = 0.25
+_SERIES_TERMS = 40  # 0.25**40 ~ 1e-24: far below double round-off
+
+
+def lankarani_nikravesh_stiffness(joint: ClearanceJoint) -> float:
+    """K_LN = 4 / (3 (sigma_b + sigma_j)) sqrt(R_b R_j / (R_b - R_j)), N/m^1.5 (paper Eq. 17)."""
+    if joint.clearance <= 0.0:
+        raise ValueError(f"`clearance` must be > 0 for a contact law, got {joint.clearance}")
+    r_b, r_j = joint.bearing_radius, joint.journal_radius
+    return 4.0 / 3.0 * joint.effective_modulus * math.sqrt(r_b * r_j / (r_b - r_j))
+
+
+def bai_zhao_stiffness(penetration, clearance: float, effective_modulus: float):
+    """K_BZ(delta) = (pi/8) E* sqrt(2 delta (3c + 2 delta)^2 / (c + delta)^3) (Bai & Zhao 2013).
+
+    Empirical SI stiffness (N/m^2 dimensionally, used as N/m^1.5); 0 for delta <= 0.
+    """
+    d = np.maximum(np.asarray(penetration, dtype=float), 0.0)
+    c = clearance
+    return math.pi / 8.0 * effective_modulus * np.sqrt(2.0 * d * (3.0 * c + 2.0 * d) ** 2 / (c + d) ** 3)
+
+
+def _binomial_moment(y, m: float, p: float):
+    """Series of integral_0^y x^m (1 + x)^p dx = sum_k C(p, k) y^(m+k+1) / (m+k+1), for 0 <= y <= 1/4."""
+    total = np.zeros_like(y)
+    coeff = 1.0
+    for k in range(_SERIES_TERMS):
+        total += coeff * y ** (m + k + 1.0) / (m + k + 1.0)
+        coeff *= (p - k) / (k + 1.0)
+    return total
+
+
+def _check_impact_velocity(delta, impact_velocity) -> None:
+    bad = (delta > 0.0) & ~(impact_velocity > 0.0)
+    if np.any(bad):
+        v = np.broadcast_to(impact_velocity, bad.shape)[bad].ravel()[0]
+        raise ValueError(
+            f"`impact_velocity` must be > 0 where penetration > 0 (the engines floor it at "
+            f"ClearanceJoint.min_impact_velocity), got {v}"
+        )
+
+
+@dataclass(frozen=True)
+class _Law:
+    """Common part of all laws: F_N = max(0, K(delta) delta^n (1 + xi delta_dot / v_imp)), n = 1.5.
+
+    Subclasses define ``stiffness``, ``elastic_energy``, ``scalar`` and ``hysteresis_factor``.
+    """
+
+    hysteresis: float  # xi, dimensionless
+    restitution: float  # ce the hysteresis factor was built from
+
+    name: ClassVar[str] = ""
+    exponent: ClassVar[float] = 1.5
+    valid_restitution: ClassVar[tuple[float, float]] = (0.0, 1.0)
+
+    @staticmethod
+    def hysteresis_factor(restitution: float) -> float:
+        """xi(ce) of Lankarani-Nikravesh, 3 (1 - ce^2) / 4 (paper Eq. 16)."""
+        return 0.75 * (1.0 - restitution**2)
+
+    def stiffness(self, penetration):
+        raise NotImplementedError
+
+    def elastic_force(self, penetration):
+        """F_el = K(delta) delta^1.5 for delta > 0, else 0, N."""
+        d = np.maximum(np.asarray(penetration, dtype=float), 0.0)
+        return self.stiffness(d) * (d * np.sqrt(d))
+
+    def damping(self, penetration, impact_velocity):
+        """D = xi K(delta) delta^1.5 / v_imp, N s/m (paper Eqs. 19, 23)."""
+        return self.hysteresis * self.elastic_force(penetration) / np.asarray(impact_velocity, dtype=float)
+
+    def normal_force(self, penetration, penetration_rate, impact_velocity):
+        """F_N = max(0, K delta^1.5 (1 + xi delta_dot / v_imp)) for delta > 0, else 0, N.
+
+        Parameters (broadcast together)
+        ----------
+        penetration : array_like
+            delta = |e| - c, m.
+        penetration_rate : array_like
+            delta_dot = e_dot . n, m/s, positive while approaching.
+        impact_velocity : array_like
+            Held delta_dot at contact onset, m/s, floored by the caller; must be > 0
+            wherever delta > 0 (else ``ValueError``).
+        """
+        d = np.asarray(penetration, dtype=float)
+        v = np.asarray(impact_velocity, dtype=float)
+        _check_impact_velocity(d, v)
+        v_safe = np.where(v > 0.0, v, 1.0)
+        f = self.elastic_force(d) * (1.0 + self.hysteresis * np.asarray(penetration_rate, dtype=float) / v_safe)
+        return np.where(d > 0.0, np.maximum(f, 0.0), 0.0)
+
+    def numba(self) -> ScalarLaw:
+        """The scalar law compiled with ``numba.njit`` (ImportError if numba is missing).
+
+        Compiled once per distinct law (cached); the first call costs ~0.5 s of compilation.
+        """
+        return _jit(self)
+
+    @classmethod
+    def from_joint(cls, joint: ClearanceJoint) -> "_Law":
+        raise NotImplementedError
+
+
+@functools.lru_cache(maxsize=32)
+def _jit(law: _Law) -> ScalarLaw:
+    import numba  # optional: only this method needs it
+
+    return numba.njit(cache=False)(law.scalar())
+
+
+@dataclass(frozen=True)
+class _ConstantStiffnessLaw(_Law):
+    """Law with constant stiffness K = K_LN; subclasses only change xi(ce)."""
+
+    stiffness_constant: float = 0.0  # K, N/m^1.5
+
+    def stiffness(self, penetration):
+        """K = K_LN, constant, N/m^1.5."""
+        return np.full(np.shape(penetration), self.stiffness_constant)
+
+    def elastic_energy(self, penetration):
+        """integral_0^delta K s^1.5 ds = K delta^2.5 / 2.5, J (0 for delta <= 0)."""
+        d = np.maximum(np.asarray(penetration, dtype=float), 0.0)
+        return self.stiffness_constant * d**2.5 / 2.5
+
+    def scalar(self) -> ScalarLaw:
+        """Plain-``math`` F_N(delta, delta_dot, v_imp), float -> float (same as normal_force)."""
+        k, xi = self.stiffness_constant, self.hysteresis
+
+        def normal_force(delta: float, delta_dot: float, impact_velocity: float) -> float:
+            if delta <= 0.0:
+                return 0.0
+            f = k * (delta * math.sqrt(delta)) * (1.0 + xi * delta_dot / impact_velocity)
+            return f if f > 0.0 else 0.0
+
+        return normal_force
+
+    @classmethod
+    def from_joint(cls, joint: ClearanceJoint) -> "_ConstantStiffnessLaw":
+        ce = joint.restitution
+        if not 0.0 < ce <= 1.0:
+            raise ValueError(f"`restitution` must be in (0, 1], got {ce}")
+        return cls(
+            hysteresis=cls.hysteresis_factor(ce),
+            restitution=ce,
+            stiffness_constant=lankarani_nikravesh_stiffness(joint),
+        )
+
+
+@dataclass(frozen=True)
+class LankaraniNikravesh(_ConstantStiffnessLaw):
+    """Lankarani & Nikravesh (1990), paper Eq. 20: K_LN, xi = 3 (1 - ce^2) / 4.
+
+    Derived for ce -> 1 (energy loss small against the elastic energy): a single-mass
+    impact gives back 0.913 for ce = 0.9, 0.847 for 0.8, but 0.725 for 0.5 and 0.684
+    for 0.3, so it is declared valid for ce >= 0.8 only (the paper notes the same limit).
+    """
+
+    name: ClassVar[str] = "lankarani_nikravesh"
+    valid_restitution: ClassVar[tuple[float, float]] = (0.8, 1.0)
+
+
+@dataclass(frozen=True)
+class Flores(_ConstantStiffnessLaw):
+    """Flores et al. (2011): K_LN, xi = 8 (1 - ce) / (5 ce); meant for any ce in (0, 1].
+
+    Restored ce is slightly low everywhere, worst -0.045 near ce = 0.25 (0.256 for 0.3).
+    """
+
+    name: ClassVar[str] = "flores"
+    valid_restitution: ClassVar[tuple[float, float]] = (0.0, 1.0)
+
+    @staticmethod
+    def hysteresis_factor(restitution: float) -> float:
+        """xi = 8 (1 - ce) / (5 ce)."""
+        return 8.0 * (1.0 - restitution) / (5.0 * restitution)
+
+
+@dataclass(frozen=True)
+class HuntCrossley(_ConstantStiffnessLaw):
+    """Hunt & Crossley (1975): K_LN, xi = 3 (1 - ce) / 2; derived for ce -> 1.
+
+    Restored ce: 0.909 for 0.9, 0.799 for 0.75, 0.663 for 0.5: valid for ce >= 0.75.
+    """
+
+    name: ClassVar[str] = "hunt_crossley"
+    valid_restitution: ClassVar[tuple[float, float]] = (0.75, 1.0)
+
+    @staticmethod
+    def hysteresis_factor(restitution: float) -> float:
+        """xi = 3 (1 - ce) / 2."""
+        return 1.5 * (1.0 - restitution)
+
+
+@dataclass(frozen=True)
+class Gonthier(_ConstantStiffnessLaw):
+    """Gonthier et al. (2004): K_LN, xi = (1 - ce^2) / ce.
+
+    Restored ce within 0.033 of the requested one over the whole range (worst near
+    ce = 0.75-0.8, e.g. 0.876 for 0.9; 0.304 for 0.3): valid for any ce.
+    """
+
+    name: ClassVar[str] = "gonthier"
+    valid_restitution: ClassVar[tuple[float, float]] = (0.0, 1.0)
+
+    @staticmethod
+    def hysteresis_factor(restitution: float) -> float:
+        """xi = (1 - ce^2) / ce."""
+        return (1.0 - restitution**2) / restitution
+
+
+@dataclass(frozen=True)
+class VariableKD(_Law):
+    """The paper's law (Eqs. 21-24, as restored): K_BZ(delta) delta^1.5 (1 + xi delta_dot / v_imp).
+
+    K_BZ(delta) = a sqrt(2 delta (3c + 2 delta)^2 / (c + delta)^3), a = (pi/8) E*, so
+    F_el = a sqrt(2) c^1.5 x^2 (3 + 2x) / (1 + x)^1.5 with x = delta / c.  Empirical in SI
+    units (see module docstring).  xi is that of Lankarani-Nikravesh, derived for a constant
+    K, but the restored ce depends on xi only (module docstring), so it is exactly that of
+    Lankarani-Nikravesh: valid for ce >= 0.8.
+    """
+
+    clearance: float = 0.0  # c, m
+    modulus_factor: float = 0.0  # a = (pi/8) E*, Pa
+
+    name: ClassVar[str] = "variable_kd"
+    valid_restitution: ClassVar[tuple[float, float]] = (0.8, 1.0)
+
+    def stiffness(self, penetration):
+        """K_BZ(delta), 0 for delta <= 0, SI ("N/m^1.5")."""
+        d = np.maximum(np.asarray(penetration, dtype=float), 0.0)
+        c = self.clearance
+        return self.modulus_factor * np.sqrt(2.0 * d * (3.0 * c + 2.0 * d) ** 2 / (c + d) ** 3)
+
+    def elastic_energy(self, penetration):
+        """W = a sqrt(2) c^2.5 g(delta/c), g(x) = integral_0^x t^2 (3 + 2t) (1 + t)^-1.5 dt, J.
+
+        g(x) = 4/5 u^2.5 - 2 u^1.5 - 2 u^-0.5 + 16/5 with u = 1 + x for x > 1/4; binomial
+        series below (relative error ~1e-14 everywhere).
+        """
+        x = np.maximum(np.asarray(penetration, dtype=float), 0.0) / self.clearance
+        small = x <= _SERIES_LIMIT
+        xs = np.where(small, x, 0.0)
+        series = 3.0 * _binomial_moment(xs, 2.0, -1.5) + 2.0 * _binomial_moment(xs, 3.0, -1.5)
+        u = 1.0 + np.where(small, 1.0, x)
+        closed = 0.8 * u**2.5 - 2.0 * u**1.5 - 2.0 / np.sqrt(u) + 3.2
+        g = np.where(small, series, closed)
+        return self.modulus_factor * math.sqrt(2.0) * self.clearance**2.5 * g
+
+    def scalar(self) -> ScalarLaw:
+        """Plain-``math`` F_N(delta, delta_dot, v_imp), float -> float (same as normal_force)."""
+        a, c, xi = self.modulus_factor, self.clearance, self.hysteresis
+
+        def normal_force(delta: float, delta_dot: float, impact_velocity: float) -> float:
+            if delta <= 0.0:
+                return 0.0
+            k = a * math.sqrt(2.0 * delta * (3.0 * c + 2.0 * delta) ** 2 / (c + delta) ** 3)
+            f = k * (delta * math.sqrt(delta)) * (1.0 + xi * delta_dot / impact_velocity)
+            return f if f > 0.0 else 0.0
+
+        return normal_force
+
+    @classmethod
+    def from_joint(cls, joint: ClearanceJoint) -> "VariableKD":
+        ce = joint.restitution
+        if not 0.0 < ce <= 1.0:
+            raise ValueError(f"`restitution` must be in (0, 1], got {ce}")
+        if joint.clearance <= 0.0:
+            raise ValueError(f"`clearance` must be > 0 for a contact law, got {joint.clearance}")
+        return cls(
+            hysteresis=cls.hysteresis_factor(ce),
+            restitution=ce,
+            clearance=joint.clearance,
+            modulus_factor=math.pi / 8.0 * joint.effective_modulus,
+        )
+
+
+@dataclass(frozen=True)
+class ElasticFoundation(_Law):
+    """Liu, Zhang & Yang (2007) improved elastic foundation over the bearing length L_b.
+
+    F_el = L_b (pi/2) E* delta sqrt(delta / (2 (c + delta))) = K(delta) delta^1.5 with
+    K(delta) = b / sqrt(2 (c + delta)), b = L_b pi E* / 2 (N/m, so K is N/m^1.5).  Damping
+    with xi of Lankarani-Nikravesh (a choice of ours; the source is purely elastic), hence
+    the same restored ce and validity (ce >= 0.8) as Lankarani-Nikravesh.
+    """
+
+    clearance: float = 0.0  # c, m
+    length_modulus: float = 0.0  # b = L_b (pi/2) E*, N/m
+
+    name: ClassVar[str] = "elastic_foundation"
+    valid_restitution: ClassVar[tuple[float, float]] = (0.8, 1.0)
+
+    def stiffness(self, penetration):
+        """K(delta) = L_b (pi/2) E* / sqrt(2 (c + delta)), N/m^1.5 (at delta <= 0 the value at 0)."""
+        d = np.maximum(np.asarray(penetration, dtype=float), 0.0)
+        return self.length_modulus / np.sqrt(2.0 * (self.clearance + d))
+
+    def elastic_energy(self, penetration):
+        """W = (b / sqrt(2)) c^2 h(delta/c), h(x) = integral_0^x t^1.5 (1 + t)^-0.5 dt, J.
+
+        h(x) = sqrt(x (1 + x)) (2x - 3) / 4 + 3/4 asinh(sqrt(x)) for x > 1/4; binomial series below.
+        """
+        x = np.maximum(np.asarray(penetration, dtype=float), 0.0) / self.clearance
+        small = x <= _SERIES_LIMIT
+        series = _binomial_moment(np.where(small, x, 0.0), 1.5, -0.5)
+        xl = np.where(small, 1.0, x)
+        closed = 0.25 * np.sqrt(xl * (1.0 + xl)) * (2.0 * xl - 3.0) + 0.75 * np.arcsinh(np.sqrt(xl))
+        h = np.where(small, series, closed)
+        return self.length_modulus / math.sqrt(2.0) * self.clearance**2 * h
+
+    def scalar(self) -> ScalarLaw:
+        """Plain-``math`` F_N(delta, delta_dot, v_imp), float -> float (same as normal_force)."""
+        b, c, xi = self.length_modulus, self.clearance, self.hysteresis
+
+        def normal_force(delta: float, delta_dot: float, impact_velocity: float) -> float:
+            if delta <= 0.0:
+                return 0.0
+            k = b / math.sqrt(2.0 * (c + delta))
+            f = k * (delta * math.sqrt(delta)) * (1.0 + xi * delta_dot / impact_velocity)
+            return f if f > 0.0 else 0.0
+
+        return normal_force
+
+    @classmethod
+    def from_joint(cls, joint: ClearanceJoint) -> "ElasticFoundation":
+        ce = joint.restitution
+        if not 0.0 < ce <= 1.0:
+            raise ValueError(f"`restitution` must be in (0, 1], got {ce}")
+        if joint.clearance <= 0.0:
+            raise ValueError(f"`clearance` must be > 0 for a contact law, got {joint.clearance}")
+        if joint.bearing_length <= 0.0:
+            raise ValueError(f"`bearing_length` must be > 0, got {joint.bearing_length}")
+        return cls(
+            hysteresis=cls.hysteresis_factor(ce),
+            restitution=ce,
+            clearance=joint.clearance,
+            length_modulus=joint.bearing_length * math.pi / 2.0 * joint.effective_modulus,
+        )
+
+
+LAWS: dict[str, type[_Law]] = {
+    law.name: law
+    for law in (LankaraniNikravesh, VariableKD, Flores, HuntCrossley, Gonthier, ElasticFoundation)
+}
+
+
+def make_law(joint: ClearanceJoint) -> _Law:
+    """Build the contact law named by ``joint.law`` from the joint's geometry and materials."""
+    try:
+        cls = LAWS[joint.law]
+    except KeyError:
+        raise ValueError(
+            f"unknown contact law `law` = {joint.law!r}; allowed: {', '.join(sorted(LAWS))}"
+        ) from None
+    return cls.from_joint(joint)
+
+
+def _excess_over_log(z: float) -> float:
+    """phi(z) = z - log(1 + z) for z > -1, without cancellation near 0."""
+    if abs(z) > 0.1:
+        return z - math.log1p(z)
+    total, term = 0.0, -z
+    for k in range(2, 40):  # term = (-1)^k z^k; |z|^40 / 40 < 1e-41: far below round-off
+        term *= -z
+        total += term / k
+    return total
+
+
+def restored_restitution(hysteresis: float) -> float:
+    """Coefficient of restitution actually produced by a law with hysteresis factor xi.
+
+    For m delta_ddot = -F_el(delta) (1 + xi delta_dot / v_imp), with any elastic law
+    F_el >= 0 and W = integral_0^delta F_el, u = delta_dot / v_imp obeys
+    m v_imp^2 u du/dW = -(1 + xi u).  Integrating from u = 1 (W = 0) to u = 0 (W max)
+    and back to u = -ce (W = 0) gives phi(-xi ce) = phi(xi), phi(z) = z - ln(1 + z),
+    independent of K(delta), n, m and v_imp; ce < 1/xi always (the force never clamps).
+    """
+    if hysteresis < 0.0:
+        raise ValueError(f"`hysteresis` must be >= 0, got {hysteresis}")
+    if hysteresis == 0.0:
+        return 1.0
+    from scipy.optimize import brentq  # only this diagnostic needs scipy
+
+    xi = hysteresis
+    target = _excess_over_log(xi)
+    hi = min(1.0, 1.0 / xi) * (1.0 - 1e-15)
+    return brentq(lambda ce: _excess_over_log(-xi * ce) - target, 0.0, hi, xtol=1e-16, rtol=1e-15)
+
+
+def friction_factor(tangential_speed, v0: float, v1: float):
+    """Dynamic correction factor c_d of the modified Coulomb law (Ambrosio 2003), in [0, 1].
+
+    Piecewise linear in |v_T| as in Ambrosio's law:
+    c_d = 0 for |v_T| <= v0, (|v_T| - v0) / (v1 - v0) for v0 < |v_T| < v1, 1 for |v_T| >= v1.
+
+    Parameters
+    ----------
+    tangential_speed : array_like
+        Relative tangential velocity v_T (sign ignored), m/s.
+    v0, v1 : float
+        Ramp limits, m/s, 0 <= v0 < v1 (SPEC.md 2: 1e-4 and 2e-4).
+    """
+    if not 0.0 <= v0 < v1:
+        raise ValueError(f"friction velocities must satisfy 0 <= v0 < v1, got v0={v0}, v1={v1}")
+    s = np.abs(np.asarray(tangential_speed, dtype=float))
+    return np.clip((s - v0) / (v1 - v0), 0.0, 1.0)
+
+
+def friction_factor_scalar(tangential_speed: float, v0: float, v1: float) -> float:
+    """Plain-``math`` :func:`friction_factor` (no argument checks)."""
+    s = abs(tangential_speed)
+    if s <= v0:
+        return 0.0
+    if s >= v1:
+        return 1.0
+    return (s - v0) / (v1 - v0)
