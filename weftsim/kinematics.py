@@ -245,6 +245,9 @@ def linkage_state(theta, geometry: Geometry, rocker_com_distance: float | None =
     d_ef, dd_ef = chain(fb.d_theta_ef, fb.dd_theta_ef)
     k = g.rapier_ratio
     p = g.pinion_ratio
+    # atan2 may put theta_FG on either side of its 2 pi cut; a rocker swings < pi,
+    # so the wrapped difference is the true turn of the sector since theta = 0.
+    turn = np.angle(np.exp(1j * (fb.theta_fg - fg0)))
     e, d_e, dd_e = _point_on_arm(g.l_oe, q, d_phi, dd_phi)
     r, d_r, dd_r = _point_on_arm(rocker_com_distance, q, d_phi, dd_phi)
     f, d_f, dd_f = _point_on_arm(g.l_fg, fb.theta_fg, d_fg, dd_fg)
@@ -257,9 +260,9 @@ def linkage_state(theta, geometry: Geometry, rocker_com_distance: float | None =
         theta_oe=q, d_theta_oe=d_phi, dd_theta_oe=dd_phi,
         theta_fg=fb.theta_fg, d_theta_fg=d_fg, dd_theta_fg=dd_fg,
         theta_ef=fb.theta_ef, d_theta_ef=d_ef, dd_theta_ef=dd_ef,
-        rapier_displacement=k * (fb.theta_fg - fg0),
+        rapier_displacement=k * turn,
         d_rapier_displacement=k * d_fg, dd_rapier_displacement=k * dd_fg,
-        gear67_angle=-p * (fb.theta_fg - fg0), d_gear67_angle=-p * d_fg, dd_gear67_angle=-p * dd_fg,
+        gear67_angle=-p * turn, d_gear67_angle=-p * d_fg, dd_gear67_angle=-p * dd_fg,
         point_e=e, d_point_e=d_e, dd_point_e=dd_e,
         point_f=f, d_point_f=d_f, dd_point_f=dd_f,
         rod_com=0.5 * (e + f), d_rod_com=0.5 * (d_e + d_f), dd_rod_com=0.5 * (dd_e + dd_f),
