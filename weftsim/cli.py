@@ -25,6 +25,13 @@ class CliError(Exception):
         self.status = status
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (the usage stays behind --help)."""
+
+    def error(self, message: str):
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+
+
 def _positive(kind):
     def parse(text: str):
         try:
@@ -59,7 +66,7 @@ def _add_scene_flags(p: argparse.ArgumentParser, full: bool = True) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="weftsim",
         description="Weft insertion mechanism of a rapier loom with a clearance joint at E: "
         "Exudyn multibody model and closed-form Lagrange cross-check.",

@@ -225,23 +225,26 @@ def _set(scene: params.Scene, target: str, value: Any) -> params.Scene:
     return replace(scene, **{head: _set(getattr(scene, head), rest, value)})
 
 
-def _check_scene(scene: params.Scene, where: str) -> None:
+def _check_scene(scene: params.Scene, where: str, origin: dict[str, Path]) -> None:
     """Cross-key checks: law names, friction ramp, linkage assembly."""
     from weftsim.contact import LAWS
 
+    def at(key: str) -> str:
+        return str(origin.get(key, where))
+
     joint = scene.joint
     if joint.law not in LAWS:
-        raise SceneError(f"{where}: key 'joint_e.law' must be one of {', '.join(sorted(LAWS))}, got {joint.law!r}")
+        raise SceneError(f"{at('joint_e.law')}: key 'joint_e.law' must be one of {', '.join(sorted(LAWS))}, got {joint.law!r}")
     v0, v1 = joint.friction_velocities
     if not v0 < v1:
-        raise SceneError(f"{where}: key 'joint_e.friction_velocities_m_s' must have v0 < v1, got [{v0:g}, {v1:g}]")
+        raise SceneError(f"{at('joint_e.friction_velocities_m_s')}: key 'joint_e.friction_velocities_m_s' must have v0 < v1, got [{v0:g}, {v1:g}]")
     if joint.clearance >= joint.journal_radius:
         raise SceneError(
-            f"{where}: key 'joint_e.clearance_mm' must be smaller than the journal radius "
+            f"{at('joint_e.clearance_mm')}: key 'joint_e.clearance_mm' must be smaller than the journal radius "
             f"{joint.journal_radius / MM:g} mm, got {joint.clearance / MM:g}"
         )
     if scene.output.sample_angle / scene.drive.speed > scene.drive.end_time:
-        raise SceneError(f"{where}: key 'drive.revolutions' is shorter than one output sample")
+        raise SceneError(f"{at('drive.revolutions')}: key 'drive.revolutions' is shorter than one output sample")
     from weftsim.kinematics import assembly_failure_angle
 
     angle = assembly_failure_angle(scene.geometry)
@@ -275,7 +278,7 @@ def scene_from_keys(flat: dict[str, Any], where: str = "scene", origin: dict[str
         if key.path == "mechanism.fourbar_branch":
             value = BRANCHES[value]
         scene = _set(scene, key.target, value)
-    _check_scene(scene, where)
+    _check_scene(scene, where, origin)
     return scene
 
 
