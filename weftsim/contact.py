@@ -149,7 +149,7 @@ class _Law:
     def elastic_force(self, penetration):
         """F_el = K(delta) delta^1.5 for delta > 0, else 0, N."""
         d = np.maximum(np.asarray(penetration, dtype=float), 0.0)
-        return self.stiffness(d) * (d * np.sqrt(d))
+        return (self.stiffness(d) * (d * np.sqrt(d)))[()]
 
     def damping(self, penetration, impact_velocity):
         """D = xi K(delta) delta^1.5 / v_imp, N s/m (paper Eqs. 19, 23)."""
@@ -173,7 +173,7 @@ class _Law:
         _check_impact_velocity(d, v)
         v_safe = np.where(v > 0.0, v, 1.0)
         f = self.elastic_force(d) * (1.0 + self.hysteresis * np.asarray(penetration_rate, dtype=float) / v_safe)
-        return np.where(d > 0.0, np.maximum(f, 0.0), 0.0)
+        return np.where(d > 0.0, np.maximum(f, 0.0), 0.0)[()]
 
     def numba(self) -> ScalarLaw:
         """The scalar law compiled with ``numba.njit`` (ImportError if numba is missing).
@@ -202,7 +202,7 @@ class _ConstantStiffnessLaw(_Law):
 
     def stiffness(self, penetration):
         """K = K_LN, constant, N/m^1.5."""
-        return np.full(np.shape(penetration), self.stiffness_constant)
+        return np.full(np.shape(penetration), self.stiffness_constant)[()]
 
     def elastic_energy(self, penetration):
         """integral_0^delta K s^1.5 ds = K delta^2.5 / 2.5, J (0 for delta <= 0)."""
