@@ -1,0 +1,210 @@
+"""Planar revolute clearance joint: geometry, normal and friction force (SPEC.md section 2).
+
+Pure functions used by both engines (Flores-Ambrosio formulation)::
+
+             bearing (R_b), centre P_b
+          .-----------.
+        /     journal   \\            e = P_j - P_b        eccentricity vector, m
+       |   P_b --e--> P_j|Q          n = e / |e|          contact normal (bearing -> journal)
+        \\               /            t = (-n_y, n_x)     n turned +90 deg about +z
+          '-----------'              delta = |e| - c      penetration, m (< 0: free flight)
+                                     Q = P_b + R_b n      contact point (on both bodies)
+
+- Penetration rate delta_dot = e_dot . n (m/s, positive while approaching).
+- Normal force F_N = law.normal_force(delta, delta_dot, v_imp) >= 0 (:mod:`weftsim.contact`).
+  The impact velocity v_imp is *held* by the engine: delta_dot at the contact onset, kept
+  until separation and floored at ``joint.min_impact_velocity``; this module only uses it.
+- Friction (modified Coulomb, Ambrosio 2003): on the journal, F_T = -mu c_d(|v_T|) F_N sign(v_T) t,
+  with v_T = (velocity of the journal's material point at Q - that of the bearing's) . t.
+- Force on the journal f_j = -F_N n + F_T (pulls it back towards the bearing centre); on the
+  bearing f_b = -f_j; both act at Q.  The normal part passes through P_b and P_j (Q - P_j =
+  (R_b - |e|) n), so only friction has a moment about the centres:
+  M_j = (R_b - |e|) F_T.t about P_j and M_b = -R_b F_T.t about P_b (N m, about +z).
+- e = 0 (journal centred, the initial state) is free flight: zero force, n = 0, delta_dot = 0.
+
+Sources: Flores & Ambrosio, Comput. Struct. 82 (2004); Li et al. (2020) Eqs. 1-13.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Callable, NamedTuple
+
+import numpy as np
+
+from weftsim.contact import friction_factor
+from weftsim.params import ClearanceJoint
+
+
+class ClearanceContact(NamedTuple):
+    """Everything about one contact evaluation (arrays over the leading axes of ``ecc``).
+
+    force_on_journal, force_on_bearing : (..., 2) N, acting at the contact point Q.
+    moment_on_journal : N m about +z, about the journal centre P_j (friction only).
+    moment_on_bearing : N m about +z, about the bearing centre P_b (friction only).
+    normal_force : F_N >= 0, N.          friction_force : F_T . t on the journal, N.
+    penetration : delta, m.              penetration_rate : delta_dot, m/s.
+    normal : n (..., 2), 0 at e = 0.     contact_offset : Q - P_b = R_b n (..., 2), m.
+    """
+
+    force_on_journal: np.ndarray
+    force_on_bearing: np.ndarray
+    moment_on_journal: np.ndarray
+    moment_on_bearing: np.ndarray
+    normal_force: np.ndarray
+    friction_force: np.ndarray
+    penetration: np.ndarray
+    penetration_rate: np.ndarray
+    normal: np.ndarray
+    contact_offset: np.ndarray
+
+
+def contact_geometry(ecc, ecc_rate, clearance: float):
+    """Penetration, its rate and the normal from the eccentricity (SPEC.md 2).
+
+    Parameters
+    ----------
+    ecc, ecc_rate : array_like (..., 2)
+        e = P_j - P_b (m) and its time derivative (m/s), in-plane.
+    clearance : float
+        c = R_b - R_j, m.
+
+    Returns
+    -------
+    penetration : (...,) delta = |e| - c, m.
+    penetration_rate : (...,) delta_dot = e_dot . n, m/s (0 where e = 0).
+    normal : (..., 2) n = e / |e| (0 where e = 0).
+    """
+    e = np.asarray(ecc, dtype=float)
+    e_dot = np.asarray(ecc_rate, dtype=float)
+    length = np.hypot(e[..., 0], e[..., 1])
+    safe = np.where(length > 0.0, length, 1.0)
+    normal = np.where((length > 0.0)[..., None], e / safe[..., None], 0.0)
+    rate = np.einsum("...i,...i->...", e_dot, normal)
+    return length - clearance, rate, normal
+
+
+def tangential_velocity(ecc, bearing_velocity, bearing_angular_velocity,
+                        journal_velocity, journal_angular_velocity, bearing_radius: float):
+    """Relative tangential velocity v_T of the contact points (journal relative to bearing), m/s.
+
+    Both material points sit at Q = P_b + R_b n:
+    v_Q,b = v_Pb + w_b R_b t,  v_Q,j = v_Pj + w_j (R_b - |e|) t, and
+    v_T = (v_Q,j - v_Q,b) . t = (v_Pj - v_Pb) . t + w_j (R_b - |e|) - w_b R_b.
+
+    Parameters
+    ----------
+    ecc : (..., 2) eccentricity e = P_j - P_b, m.
+    bearing_velocity, journal_velocity : (..., 2) velocities of the centres P_b, P_j, m/s.
+    bearing_angular_velocity, journal_angular_velocity : (...,) rad/s about +z.
+    bearing_radius : float, R_b, m.
+
+    Returns 0 where e = 0 (no normal, no contact).
+    """
+    e = np.asarray(ecc, dtype=float)
+    length = np.hypot(e[..., 0], e[..., 1])
+    _, _, n = contact_geometry(e, np.zeros_like(e), 0.0)
+    t = np.stack([-n[..., 1], n[..., 0]], axis=-1)
+    dv = np.asarray(journal_velocity, dtype=float) - np.asarray(bearing_velocity, dtype=float)
+    v_t = (np.einsum("...i,...i->...", dv, t)
+           + np.asarray(journal_angular_velocity, dtype=float) * (bearing_radius - length)
+           - np.asarray(bearing_angular_velocity, dtype=float) * bearing_radius)
+    return np.where(length > 0.0, v_t, 0.0)
+
+
+def clearance_contact(ecc, ecc_rate, rel_tangential_velocity, impact_velocity, law,
+                      joint: ClearanceJoint) -> ClearanceContact:
+    """Normal and friction force of the clearance joint, with moments (numpy, broadcasts).
+
+    Parameters
+    ----------
+    ecc, ecc_rate : array_like (..., 2)
+        Eccentricity e = P_j - P_b (m) and its rate (m/s).
+    rel_tangential_velocity : array_like (...,)
+        v_T, m/s: tangential component (along t) of the journal contact point's velocity
+        relative to the bearing's (:func:`tangential_velocity`).  Ignored when mu = 0.
+    impact_velocity : array_like (...,)
+        Held, floored impact velocity, m/s (> 0 wherever delta > 0).
+    law : contact law of :mod:`weftsim.contact` (from ``make_law(joint)``).
+    joint : ClearanceJoint
+        Supplies c, R_b, mu and the friction ramp (v0, v1).
+    """
+    delta, delta_dot, n = contact_geometry(ecc, ecc_rate, joint.clearance)
+    f_n = law.normal_force(delta, delta_dot, impact_velocity)
+    t = np.stack([-n[..., 1], n[..., 0]], axis=-1)
+    if joint.friction_coefficient > 0.0:
+        v_t = np.asarray(rel_tangential_velocity, dtype=float)
+        v0, v1 = joint.friction_velocities
+        f_t = -joint.friction_coefficient * friction_factor(v_t, v0, v1) * f_n * np.sign(v_t)
+    else:
+        f_t = np.zeros_like(f_n)
+    force_j = -f_n[..., None] * n + f_t[..., None] * t
+    r_b = joint.bearing_radius
+    lever_j = r_b - (delta + joint.clearance)  # R_b - |e|
+    return ClearanceContact(
+        force_on_journal=force_j,
+        force_on_bearing=-force_j,
+        moment_on_journal=lever_j * f_t,
+        moment_on_bearing=-r_b * f_t,
+        normal_force=f_n,
+        friction_force=f_t,
+        penetration=delta,
+        penetration_rate=delta_dot,
+        normal=n,
+        contact_offset=r_b * n,
+    )
+
+
+def clearance_force(ecc, ecc_rate, rel_tangential_velocity, impact_velocity, law, joint: ClearanceJoint):
+    """Force on the journal (..., 2) N, F_N (N), delta (m), delta_dot (m/s): the agreed short form.
+
+    See :func:`clearance_contact` for parameters, moments and the force on the bearing (-force).
+    """
+    r = clearance_contact(ecc, ecc_rate, rel_tangential_velocity, impact_velocity, law, joint)
+    return r.force_on_journal, r.normal_force, r.penetration, r.penetration_rate
+
+
+ClearanceKernel = Callable[[float, float, float, float, float, float], tuple]
+
+
+def make_clearance_kernel(law, joint: ClearanceJoint, jit: bool = False) -> ClearanceKernel:
+    """Scalar fast path of :func:`clearance_contact` for inner loops (plain ``math``).
+
+    Returns ``kernel(ex, ey, ex_dot, ey_dot, v_t, v_imp) -> (fx, fy, F_N, delta, delta_dot,
+    M_j, M_b)``: force on the journal (N), normal force, penetration (m) and its rate (m/s),
+    friction moments about P_j and P_b (N m); same values as :func:`clearance_contact`
+    (force on the bearing is (-fx, -fy)).  No argument checks: v_imp must be > 0 in contact.
+    ``jit=True`` compiles it with ``numba.njit`` (law compiled too; ImportError without numba).
+    """
+    normal_force = law.numba() if jit else law.scalar()
+    c = joint.clearance
+    r_b = joint.bearing_radius
+    mu = joint.friction_coefficient
+    v0, v1 = joint.friction_velocities
+    if not 0.0 <= v0 < v1:
+        raise ValueError(f"friction velocities must satisfy 0 <= v0 < v1, got {joint.friction_velocities}")
+
+    def kernel(ex: float, ey: float, ex_dot: float, ey_dot: float, v_t: float, v_imp: float):
+        length = math.sqrt(ex * ex + ey * ey)
+        delta = length - c
+        if length <= 0.0:
+            return 0.0, 0.0, 0.0, delta, 0.0, 0.0, 0.0
+        nx = ex / length
+        ny = ey / length
+        delta_dot = ex_dot * nx + ey_dot * ny
+        f_n = normal_force(delta, delta_dot, v_imp)
+        f_t = 0.0
+        if mu > 0.0 and f_n > 0.0:
+            s = abs(v_t)
+            if s > v0:
+                c_d = 1.0 if s >= v1 else (s - v0) / (v1 - v0)
+                f_t = -mu * c_d * f_n if v_t > 0.0 else mu * c_d * f_n
+        fx = -f_n * nx - f_t * ny
+        fy = -f_n * ny + f_t * nx
+        return fx, fy, f_n, delta, delta_dot, (r_b - length) * f_t, -r_b * f_t
+
+    if jit:
+        import numba
+
+        return numba.njit(cache=False)(kernel)
+    return kernel
