@@ -58,6 +58,8 @@ def _non_negative(text: str) -> float:
 def _add_scene_flags(p: argparse.ArgumentParser, full: bool = True) -> None:
     p.add_argument("scene", help="scene file (TOML), e.g. models/reference.toml")
     p.add_argument("-o", "--output", default=None, help="output directory (default: out/<scene name>)")
+    p.add_argument("--force", action="store_true",
+                   help="write into an output directory that holds files weftsim did not write")
     p.add_argument("--speed-rpm", type=_positive(float), help="override drive.speed_rpm")
     if full:
         p.add_argument("--clearance-mm", type=_non_negative, help="override joint_e.clearance_mm (0 = ideal joint)")
@@ -111,11 +113,11 @@ def cmd_kinematics(args) -> int:
     import numpy as np
 
     from weftsim.kinematics import linkage_state
-    from weftsim.output import prepare_directory, write_csv, write_figure
+    from weftsim.output import finish_directory, prepare_directory, write_csv, write_figure
     from weftsim.plots import plot_kinematics
 
     scene = _load(args)
-    outdir = prepare_directory(_outdir(args, scene, "-kinematics"))
+    outdir = prepare_directory(_outdir(args, scene, "-kinematics"), args.force)
     step = scene.output.sample_angle
     theta = np.linspace(0.0, 2.0 * math.pi, int(round(2.0 * math.pi / step)) + 1)
     state = linkage_state(theta, scene.geometry, scene.inertia.rocker_com)
@@ -137,6 +139,7 @@ def cmd_kinematics(args) -> int:
                           columns["rapier_velocity_m_s"], columns["rapier_acceleration_m_s2"],
                           f"{scene.name}: ideal rapier motion at {rpm:g} rpm")
     png = write_figure(outdir / "kinematics.png", fig)
+    finish_directory(outdir, {"csv": csv, "png": png}, {"kind": "kinematics", "scene": scene.name})
     s, v, a = columns["rapier_displacement_m"], columns["rapier_velocity_m_s"], columns["rapier_acceleration_m_s2"]
     print(f"scene {scene.name}: {rpm:g} rpm, ideal joints")
     print(f"  stroke        {s.max() - s.min():.6f} m at {columns['crank_angle_deg'][s.argmax()]:.1f} deg")
@@ -185,9 +188,9 @@ def cmd_run(args) -> int:
     from weftsim.output import prepare_directory, write_run
 
     scene = _load(args)
-    outdir = prepare_directory(_outdir(args, scene))
+    outdir = prepare_directory(_outdir(args, scene), args.force)
     result = _solve(scene, args.engine)
-    written = write_run(result, outdir, figure=not args.no_plot)
+    written = write_run(result, outdir, figure=not args.no_plot, force=args.force)
     _report_run(result, written)
     if not result.ok:
         raise CliError(f"simulation failed: {result.message} (results up to the failure written to {outdir}, "
@@ -199,7 +202,7 @@ def cmd_compare(args) -> int:
     from weftsim.compare import run_compare
 
     scene = _load(args)
-    return run_compare(scene, _outdir(args, scene, "-compare"), as_json=args.json, solve=_solve)
+    return run_compare(scene, _outdir(args, scene, "-compare"), as_json=args.json, solve=_solve, force=args.force)
 
 
 COMMANDS = {"kinematics": cmd_kinematics, "run": cmd_run, "compare": cmd_compare}

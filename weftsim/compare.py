@@ -148,21 +148,22 @@ def format_report(report: dict) -> str:
     return "\n".join(lines)
 
 
-def run_compare(scene, outdir, as_json: bool, solve) -> int:
+def run_compare(scene, outdir, as_json: bool, solve, force: bool = False) -> int:
     """Run both engines, write the overlay figure and both runs' files, print the report; exit status."""
     from weftsim.cli import EXIT_DISAGREE, EXIT_FAILED
-    from weftsim.output import prepare_directory, to_json, write_figure, write_json, write_run
+    from weftsim.output import finish_directory, prepare_directory, to_json, write_figure, write_json, write_run
     from weftsim.plots import plot_channels
 
-    outdir = prepare_directory(outdir)
+    outdir = prepare_directory(outdir, force)
     results = {engine: solve(scene, engine) for engine in ("reference", "exudyn")}
     for engine, result in results.items():
-        write_run(result, outdir / engine, figure=False)
+        write_run(result, outdir / engine, figure=False, force=force)
     report = compare_results(results["exudyn"], results["reference"])
-    write_json(outdir / "compare.json", report)
-    write_figure(outdir / "compare.png", plot_channels([results["reference"], results["exudyn"]],
-                                                       labels=["reference (closed form)", "exudyn"],
-                                                       title=f"{scene.name}: exudyn vs reference"))
+    written = {"json": write_json(outdir / "compare.json", report)}
+    written["figure"] = write_figure(outdir / "compare.png", plot_channels(
+        [results["reference"], results["exudyn"]], labels=["reference (closed form)", "exudyn"],
+        title=f"{scene.name}: exudyn vs reference"))
+    finish_directory(outdir, written, {"kind": "compare", "scene": scene.name, "agree": report["agree"]})
     print(to_json(report) if as_json else format_report(report), end="" if as_json else "\n")
     if not all(r.ok for r in results.values()):
         return EXIT_FAILED

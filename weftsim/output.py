@@ -23,9 +23,21 @@ class OutputError(OSError):
     """The output directory or a file in it cannot be written."""
 
 
-def prepare_directory(path: str | Path) -> Path:
-    """Create ``path`` (and parents) and check it is a writable directory."""
+MANIFEST = ".weftsim-output.json"
+
+
+def prepare_directory(path: str | Path, force: bool = False) -> Path:
+    """Create ``path`` (and parents) and check it is a writable directory of ours.
+
+    A directory that already holds files but no weftsim manifest was not written by
+    weftsim: it is refused (unless ``force``) so a run never mixes its files with others.
+    """
     path = Path(path)
+    if path.is_dir() and not force and not (path / MANIFEST).exists() and any(path.iterdir()):
+        raise OutputError(
+            f"output directory {path} is not empty and was not written by weftsim; "
+            "choose another directory with -o, or pass --force to write into it anyway"
+        )
     try:
         path.mkdir(parents=True, exist_ok=True)
     except FileExistsError:
@@ -104,16 +116,36 @@ def write_figure(target: Path, figure) -> Path:
         plt.close(figure)
 
 
-def write_run(result: RunResult, outdir: str | Path, figure: bool = True) -> dict[str, Path]:
-    """Write ``channels.csv``, ``summary.json`` and ``channels.png`` for one run."""
+def finish_directory(outdir: Path, written: dict[str, Path], what: dict) -> None:
+    """Write the manifest last, then delete files an earlier run left that this one did not rewrite.
+
+    Until the manifest is replaced, the previous run's files stay listed; afterwards the
+    directory holds exactly this run's files (plus anything weftsim did not write).
+    """
+    old = set()
+    try:
+        old = set(json.loads((outdir / MANIFEST).read_text()).get("files", []))
+    except (OSError, ValueError):
+        pass
+    names = sorted(p.name for p in written.values())
+    write_json(outdir / MANIFEST, {**what, "files": names})
+    for stale in old - set(names):
+        if "/" not in stale and stale != MANIFEST:
+            (outdir / stale).unlink(missing_ok=True)
+
+
+def write_run(result: RunResult, outdir: str | Path, figure: bool = True, force: bool = False) -> dict[str, Path]:
+    """Write ``channels.csv``, ``summary.json`` and ``channels.png`` for one run, atomically each."""
     from weftsim.analysis import summary
     from weftsim.plots import plot_channels
 
-    outdir = prepare_directory(outdir)
+    outdir = prepare_directory(outdir, force)
     written = {
         "channels": write_csv(outdir / "channels.csv", {n: result.samples[n] for n in CHANNELS}),
         "summary": write_json(outdir / "summary.json", summary(result)),
     }
     if figure and result.steps["time_s"].size:
         written["figure"] = write_figure(outdir / "channels.png", plot_channels([result]))
+    finish_directory(outdir, written, {"kind": "run", "engine": result.engine, "scene": result.scene.name,
+                                       "status": result.status})
     return written
