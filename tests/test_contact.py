@@ -259,3 +259,10 @@ def test_friction_factor_bounds_and_monotonicity():
     np.testing.assert_allclose(scalar, cd, rtol=1e-15, atol=0.0)  # same arithmetic
     with pytest.raises(ValueError):
         friction_factor(1.0, 2e-4, 1e-4)
+
+
+@pytest.mark.parametrize("kw, argument", [({"clearance": 0.0}, "clearance"), ({"restitution": 0.0}, "restitution"),
+                                          ({"law": "elastic_foundation", "bearing_length": 0.0}, "bearing_length")])
+def test_invalid_joint_parameters_name_the_argument(kw, argument):
+    with pytest.raises(ValueError, match=argument):
+        make_law(ClearanceJoint(**kw))

@@ -18,16 +18,16 @@ check (speed).
 
 Laws (chosen by name from :data:`LAWS`, built by :func:`make_law`):
 
-==========================  ================================  ==========================
-name                        stiffness                         xi
-==========================  ================================  ==========================
-``lankarani_nikravesh``     K_LN (constant, Hertz/Johnson)    3 (1 - ce^2) / 4
-``variable_kd``             K_BZ(delta) (Bai-Zhao)            3 (1 - ce^2) / 4
-``flores``                  K_LN                              8 (1 - ce) / (5 ce)
-``hunt_crossley``           K_LN                              3 (1 - ce) / 2
-``gonthier``                K_LN                              (1 - ce^2) / ce
-``elastic_foundation``      L_b pi E* / (2 sqrt(2 (c+delta)))  3 (1 - ce^2) / 4
-==========================  ================================  ==========================
+==========================  ===================================  ====================
+name                        stiffness K                          xi
+==========================  ===================================  ====================
+``lankarani_nikravesh``     K_LN (constant, Hertz/Johnson)       3 (1 - ce^2) / 4
+``variable_kd``             K_BZ(delta) (Bai-Zhao)               3 (1 - ce^2) / 4
+``flores``                  K_LN                                 8 (1 - ce) / (5 ce)
+``hunt_crossley``           K_LN                                 3 (1 - ce) / 2
+``gonthier``                K_LN                                 (1 - ce^2) / ce
+``elastic_foundation``      L_b pi E* / (2 sqrt(2 (c + delta)))  3 (1 - ce^2) / 4
+==========================  ===================================  ====================
 
 with sigma_k = (1 - nu_k^2) / E_k, E* = 1 / (sigma_b + sigma_j) and
 
@@ -42,7 +42,7 @@ F = L_b (pi/2) E* delta sqrt(delta / (2 (c + delta))), written here as K(delta)
 delta^1.5 with K(delta) = L_b pi E* / (2 sqrt(2 (c + delta))).
 
 Each law declares ``valid_restitution = (lo, hi)``: the range of ce for which a
-single-mass impact returns the requested ce within 0.05 (absolute).  For every law of
+single-mass impact returns the requested ce within 0.05 (absolute), lo <= ce <= hi.  For every law of
 this family (damping proportional to the elastic force) the restored ce depends on xi
 only, not on K(delta), mass or impact velocity: with W = integral F_el d(delta) and
 u = delta_dot / v_imp, m v_imp^2 u du/dW = -(1 + xi u), whence the exact relation of
@@ -172,7 +172,8 @@ class _Law:
         v = np.asarray(impact_velocity, dtype=float)
         _check_impact_velocity(d, v)
         v_safe = np.where(v > 0.0, v, 1.0)
-        f = self.elastic_force(d) * (1.0 + self.hysteresis * np.asarray(penetration_rate, dtype=float) / v_safe)
+        rate = np.asarray(penetration_rate, dtype=float)
+        f = self.elastic_force(d) * (1.0 + self.hysteresis * rate / v_safe)
         return np.where(d > 0.0, np.maximum(f, 0.0), 0.0)[()]
 
     def numba(self) -> ScalarLaw:
@@ -184,6 +185,17 @@ class _Law:
 
     @classmethod
     def from_joint(cls, joint: ClearanceJoint) -> "_Law":
+        """The law of ``joint`` (restitution, clearance, radii, materials, bearing length)."""
+        ce = joint.restitution
+        if not 0.0 < ce <= 1.0:
+            raise ValueError(f"`restitution` must be in (0, 1], got {ce}")
+        if joint.clearance <= 0.0:
+            raise ValueError(f"`clearance` must be > 0 for a contact law (0 is the ideal joint), "
+                             f"got {joint.clearance}")
+        return cls(hysteresis=cls.hysteresis_factor(ce), restitution=ce, **cls._parameters(joint))
+
+    @staticmethod
+    def _parameters(joint: ClearanceJoint) -> dict:
         raise NotImplementedError
 
 
@@ -221,16 +233,9 @@ class _ConstantStiffnessLaw(_Law):
 
         return normal_force
 
-    @classmethod
-    def from_joint(cls, joint: ClearanceJoint) -> "_ConstantStiffnessLaw":
-        ce = joint.restitution
-        if not 0.0 < ce <= 1.0:
-            raise ValueError(f"`restitution` must be in (0, 1], got {ce}")
-        return cls(
-            hysteresis=cls.hysteresis_factor(ce),
-            restitution=ce,
-            stiffness_constant=lankarani_nikravesh_stiffness(joint),
-        )
+    @staticmethod
+    def _parameters(joint: ClearanceJoint) -> dict:
+        return {"stiffness_constant": lankarani_nikravesh_stiffness(joint)}
 
 
 @dataclass(frozen=True)
@@ -346,19 +351,9 @@ class VariableKD(_Law):
 
         return normal_force
 
-    @classmethod
-    def from_joint(cls, joint: ClearanceJoint) -> "VariableKD":
-        ce = joint.restitution
-        if not 0.0 < ce <= 1.0:
-            raise ValueError(f"`restitution` must be in (0, 1], got {ce}")
-        if joint.clearance <= 0.0:
-            raise ValueError(f"`clearance` must be > 0 for a contact law, got {joint.clearance}")
-        return cls(
-            hysteresis=cls.hysteresis_factor(ce),
-            restitution=ce,
-            clearance=joint.clearance,
-            modulus_factor=math.pi / 8.0 * joint.effective_modulus,
-        )
+    @staticmethod
+    def _parameters(joint: ClearanceJoint) -> dict:
+        return {"clearance": joint.clearance, "modulus_factor": math.pi / 8.0 * joint.effective_modulus}
 
 
 @dataclass(frozen=True)
@@ -408,21 +403,12 @@ class ElasticFoundation(_Law):
 
         return normal_force
 
-    @classmethod
-    def from_joint(cls, joint: ClearanceJoint) -> "ElasticFoundation":
-        ce = joint.restitution
-        if not 0.0 < ce <= 1.0:
-            raise ValueError(f"`restitution` must be in (0, 1], got {ce}")
-        if joint.clearance <= 0.0:
-            raise ValueError(f"`clearance` must be > 0 for a contact law, got {joint.clearance}")
+    @staticmethod
+    def _parameters(joint: ClearanceJoint) -> dict:
         if joint.bearing_length <= 0.0:
             raise ValueError(f"`bearing_length` must be > 0, got {joint.bearing_length}")
-        return cls(
-            hysteresis=cls.hysteresis_factor(ce),
-            restitution=ce,
-            clearance=joint.clearance,
-            length_modulus=joint.bearing_length * math.pi / 2.0 * joint.effective_modulus,
-        )
+        return {"clearance": joint.clearance,
+                "length_modulus": joint.bearing_length * math.pi / 2.0 * joint.effective_modulus}
 
 
 LAWS: dict[str, type[_Law]] = {
