@@ -1,4 +1,4 @@
-"""Command line: ``weftsim kinematics | run | compare``.  Thin: parse, call, report.
+"""Command line: ``weftsim kinematics | run | compare | sweep``.  Thin: parse, call, report.
 
 Every expected failure (bad scene, bad flag, unwritable output, failed solve) is one
 line on stderr and a non-zero exit status; tracebacks only for real bugs.
@@ -87,6 +87,20 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("compare", help="run both engines on one scene and compare them")
     _add_scene_flags(p)
     p.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
+
+    p = sub.add_parser("sweep", help="run a grid of scene variants in parallel (table of peaks, plots)",
+                       description="Run every combination of the --vary values, each cell in its own process, "
+                       "into OUTPUT/<cell>/; rerunning skips finished cells.  See docs/sweeps.md.")
+    p.add_argument("scene", help="base scene file (TOML), e.g. models/reference.toml")
+    p.add_argument("--vary", action="append", required=True, metavar="KEY=VALUES",
+                   help="a scene key (clearance_mm, speed_rpm, law, ... or a dotted key) and its values: "
+                   "a list 0.01,0.25,0.5 or an inclusive range start:stop:count; repeat for more axes")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="fixed override for every cell")
+    p.add_argument("-o", "--output", default=None, help="sweep directory (default: out/<scene name>-sweep)")
+    p.add_argument("--engine", default="reference", help="reference (closed-form Lagrange) or exudyn")
+    p.add_argument("--jobs", type=_positive(int), help="local worker processes (default: number of CPUs)")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="run on an existing Dask cluster, e.g. tcp://host:8786")
+    p.add_argument("--cell-figures", action="store_true", help="also draw each cell's channels.png")
     return parser
 
 
@@ -205,7 +219,23 @@ def cmd_compare(args) -> int:
     return run_compare(scene, _outdir(args, scene, "-compare"), as_json=args.json, solve=_solve, force=args.force)
 
 
-COMMANDS = {"kinematics": cmd_kinematics, "run": cmd_run, "compare": cmd_compare}
+def cmd_sweep(args) -> int:
+    from weftsim.sweep import SweepError, format_report, plan_sweep, run_sweep
+
+    try:
+        plan = plan_sweep(args.scene, args.vary, args.set, args.engine)
+        outdir = Path(args.output) if args.output else Path("out") / (Path(args.scene).stem + "-sweep")
+        report = run_sweep(plan, outdir, jobs=args.jobs, scheduler=args.scheduler, cell_figures=args.cell_figures)
+    except SweepError as exc:
+        raise CliError(str(exc)) from None
+    print(format_report(report))
+    if report.failed:
+        raise CliError(f"{report.failed} of {report.total} cells failed (see {report.table} and each failed cell's "
+                       "error.txt)", EXIT_FAILED)
+    return 0
+
+
+COMMANDS = {"kinematics": cmd_kinematics, "run": cmd_run, "compare": cmd_compare, "sweep": cmd_sweep}
 
 
 def main(argv: list[str] | None = None) -> int:
