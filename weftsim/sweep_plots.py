@@ -1,0 +1,119 @@
+"""Sweep figures (no physics here): peaks across a 1-D grid (lines) or a 2-D grid (heat maps).
+
+Rows are those of :func:`weftsim.sweep_store.collect_rows`.  Failed or missing
+cells are left blank (grey in a heat map, a gap in a line).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from weftsim.sweep_cell import METRIC_CHANNELS
+
+PANEL_LABELS = {
+    "driving_torque_Nm": "peak |driving torque| [N·m]",
+    "rapier_acceleration_m_s2": "peak |rapier acceleration| [m/s²]",
+    "contact_force_N": "peak contact force at E [N]",
+}
+
+
+def _number(value) -> float:
+    try:
+        out = float(value)
+    except (TypeError, ValueError):
+        return math.nan
+    return out if math.isfinite(out) else math.nan
+
+
+def _axis_values(rows: list[dict], name: str) -> tuple[list, bool]:
+    """Distinct values of one parameter, sorted; and whether they are all numbers."""
+    values = list(dict.fromkeys(row[name] for row in rows))
+    numeric = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values)
+    return (sorted(values) if numeric else sorted(values, key=str)), numeric
+
+
+def _value(row: dict, channel: str, which: str) -> float:
+    return _number(row.get(f"{channel}_{which}_peak")) if row.get("status") == "success" else math.nan
+
+
+def _edges(centres: np.ndarray) -> np.ndarray:
+    """Cell edges half-way between centres (ends mirrored), so uneven grids draw honestly."""
+    if centres.size == 1:
+        return np.array([centres[0] - 0.5, centres[0] + 0.5])
+    mid = 0.5 * (centres[1:] + centres[:-1])
+    return np.concatenate([[2 * centres[0] - mid[0]], mid, [2 * centres[-1] - mid[-1]]])
+
+
+def plot_sweep_1d(rows: list[dict], name: str, title: str = ""):
+    """Three panels: peak torque, acceleration and contact force against the varied parameter."""
+    from weftsim.plots import _pyplot
+
+    plt = _pyplot()
+    values, numeric = _axis_values(rows, name)
+    x = np.array(values, dtype=float) if numeric else np.arange(len(values), dtype=float)
+    by_value = {row[name]: row for row in rows}
+    fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
+    for ax, channel in zip(axes, METRIC_CHANNELS):
+        for which, label, style in (("rev1", "first revolution", "o-"), ("last", "last revolution", "s--")):
+            y = [_value(by_value[v], channel, which) for v in values]
+            ax.plot(x, y, style, ms=4, lw=1, label=label)
+        ax.set_xlabel(name)
+        ax.set_ylabel(PANEL_LABELS[channel])
+        if not numeric:
+            ax.set_xticks(x, [str(v) for v in values], rotation=30)
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8)
+    fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def plot_sweep_2d(rows: list[dict], x_name: str, y_name: str, title: str = "", which: str = "last"):
+    """Three heat maps (torque, acceleration, contact force) over the (x, y) grid; values written in small grids."""
+    from weftsim.plots import _pyplot
+
+    plt = _pyplot()
+    xs, x_numeric = _axis_values(rows, x_name)
+    ys, y_numeric = _axis_values(rows, y_name)
+    xc = np.array(xs, dtype=float) if x_numeric else np.arange(len(xs), dtype=float)
+    yc = np.array(ys, dtype=float) if y_numeric else np.arange(len(ys), dtype=float)
+    index = {(row[x_name], row[y_name]): row for row in rows}
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.4), constrained_layout=True)
+    annotate = len(xs) * len(ys) <= 80
+    for ax, channel in zip(axes, METRIC_CHANNELS):
+        grid = np.full((len(ys), len(xs)), np.nan)
+        for i, yv in enumerate(ys):
+            for j, xv in enumerate(xs):
+                if (xv, yv) in index:
+                    grid[i, j] = _value(index[(xv, yv)], channel, which)
+        ax.set_facecolor("0.85")  # failed or missing cells show as grey
+        mesh = ax.pcolormesh(_edges(xc), _edges(yc), np.ma.masked_invalid(grid), cmap="viridis", shading="flat")
+        fig.colorbar(mesh, ax=ax, label=PANEL_LABELS[channel])
+        if annotate and np.isfinite(grid).any():
+            top = np.nanmax(grid)
+            for i in range(len(ys)):
+                for j in range(len(xs)):
+                    if np.isfinite(grid[i, j]):
+                        ax.text(xc[j], yc[i], f"{grid[i, j]:.3g}", ha="center", va="center", fontsize=7,
+                                color="white" if grid[i, j] < 0.6 * top else "black")
+        ax.set_xlabel(x_name)
+        ax.set_ylabel(y_name)
+        if not x_numeric:
+            ax.set_xticks(xc, [str(v) for v in xs], rotation=30)
+        if not y_numeric:
+            ax.set_yticks(yc, [str(v) for v in ys])
+    fig.suptitle(title)
+    return fig
+
+
+def plot_sweep(rows: list[dict], axis_names: list[str], title: str = ""):
+    """The figure for a 1-D or 2-D sweep, or None for more axes (the table still has every cell)."""
+    if not any(row.get("status") == "success" for row in rows):
+        return None
+    if len(axis_names) == 1:
+        return plot_sweep_1d(rows, axis_names[0], title)
+    if len(axis_names) == 2:
+        return plot_sweep_2d(rows, axis_names[0], axis_names[1], title)
+    return None

@@ -1,0 +1,167 @@
+"""The sweep directory: its manifest (``sweep.json``) and the table rebuilt from the cells.
+
+Layout::
+
+    OUT/sweep.json                        base scene, engine, varied keys and values
+    OUT/<cell name>/cell.json             one per cell, written last (see weftsim.sweep_cell)
+    OUT/<cell name>/summary.json, channels.csv[, channels.png, error.txt]
+    OUT/sweep.csv                         one row per cell, rebuilt from the cell.json files
+    OUT/sweep.png                         peaks across the grid (1-D lines or 2-D heat maps)
+
+Compatibility rule: a directory holds one sweep, defined by the base scene's content
+(after ``--set``), the engine and the *set* of varied keys.  Running again with the same
+three and other values extends it (cells already finished are reused; the table covers
+every cell on disk); anything else is refused, and a non-empty directory without
+``sweep.json`` is refused too, so results never mix silently.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+from pathlib import Path
+from typing import Any
+
+from weftsim import __version__
+from weftsim.sweep_cell import METRIC_CHANNELS, finite_or_none, read_record
+from weftsim.sweep_grid import Axis, SweepError, format_value
+
+SWEEP_FILE = "sweep.json"
+TABLE_FILE = "sweep.csv"
+SWEEP_FORMAT = "weftsim-sweep/1"
+
+METRIC_COLUMNS = tuple(
+    [f"{c}_rev1_peak" for c in METRIC_CHANNELS]
+    + [f"{c}_last_peak" for c in METRIC_CHANNELS]
+    + [f"{c}_p99" for c in METRIC_CHANNELS]
+)
+INFO_COLUMNS = ("status", "wall_time_s", "complete_revolutions", "last_revolution", "first_contact_deg")
+
+
+def manifest(scene_path: str, base_keys: dict, fixed: dict, engine: str, axes: list[Axis]) -> dict[str, Any]:
+    """The content of ``sweep.json`` for a planned sweep."""
+    return {
+        "format": SWEEP_FORMAT,
+        "scene_path": str(scene_path),
+        "base_scene": base_keys,
+        "fixed": fixed,
+        "engine": engine,
+        "axes": [{"name": a.name, "key": a.key, "values": list(a.values)} for a in axes],
+        "weftsim_version": __version__,
+    }
+
+
+def read_manifest(outdir: Path) -> dict | None:
+    path = Path(outdir) / SWEEP_FILE
+    if not path.exists():
+        return None
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise SweepError(f"{path} cannot be read ({exc}); move it away to start a new sweep there") from None
+    if not isinstance(data, dict) or data.get("format") != SWEEP_FORMAT:
+        raise SweepError(f"{path} is not a weftsim sweep manifest; choose another output directory")
+    return data
+
+
+def _differences(old: dict, new: dict) -> list[str]:
+    out = []
+    if old["engine"] != new["engine"]:
+        out.append(f"engine {old['engine']!r} there, {new['engine']!r} here")
+    old_keys = sorted(a["key"] for a in old["axes"])
+    new_keys = sorted(a["key"] for a in new["axes"])
+    if old_keys != new_keys:
+        out.append(f"varied keys {', '.join(old_keys)} there, {', '.join(new_keys)} here")
+    changed = sorted(k for k in set(old["base_scene"]) | set(new["base_scene"])
+                     if old["base_scene"].get(k) != new["base_scene"].get(k))
+    if changed:
+        shown = ", ".join(f"{k} = {old['base_scene'].get(k)!r} there, {new['base_scene'].get(k)!r} here"
+                          for k in changed[:4])
+        more = f" (and {len(changed) - 4} more)" if len(changed) > 4 else ""
+        out.append(f"base scene differs: {shown}{more}")
+    return out
+
+
+def merge_manifest(outdir: Path, new: dict) -> dict:
+    """Check ``outdir`` can hold this sweep and return the manifest to write (values: union of both grids).
+
+    Raises
+    ------
+    SweepError
+        If ``outdir`` holds a different sweep, or other files but no sweep manifest.
+    """
+    outdir = Path(outdir)
+    old = read_manifest(outdir)
+    if old is None:
+        if outdir.exists() and any(outdir.iterdir()):
+            raise SweepError(f"output directory {outdir} is not empty and holds no {SWEEP_FILE}; "
+                             "choose a new or empty directory")
+        return new
+    problems = _differences(old, new)
+    if problems:
+        raise SweepError(f"output directory {outdir} holds a different sweep ({'; '.join(problems)}); "
+                         "choose another output directory (-o) or remove that one")
+    merged = dict(new)
+    axes = []
+    old_values = {a["key"]: a["values"] for a in old["axes"]}
+    for axis in new["axes"]:
+        seen = {format_value(v) for v in axis["values"]}
+        extra = [v for v in old_values[axis["key"]] if format_value(v) not in seen]
+        axes.append({**axis, "values": list(axis["values"]) + extra})
+    merged["axes"] = axes
+    return merged
+
+
+def collect_rows(outdir: Path, axis_names: list[str], pending: dict[str, dict] | None = None) -> list[dict]:
+    """One row per cell directory holding a ``cell.json``, plus ``pending`` cells (name -> params) not yet run.
+
+    Rows are sorted by the parameters in axis order (numbers numerically).
+    """
+    outdir = Path(outdir)
+    rows = {}
+    for child in sorted(p for p in outdir.iterdir() if p.is_dir()) if outdir.exists() else []:
+        record = read_record(child)
+        if record is None:
+            continue
+        row = {"cell": child.name, **record.get("params", {}), "status": record.get("status"),
+               "wall_time_s": record.get("wall_time_s"), "error": record.get("error", "")}
+        metrics = record.get("metrics") or {}
+        row.update({c: metrics.get(c) for c in INFO_COLUMNS[2:] + METRIC_COLUMNS})
+        rows[child.name] = row
+    for name, params in (pending or {}).items():
+        rows.setdefault(name, {"cell": name, **params, "status": "pending"})
+
+    def order(row: dict):
+        return tuple((0, v, "") if isinstance(v, (int, float)) else (1, 0, str(v))
+                     for v in (row.get(n) for n in axis_names))
+
+    return sorted(rows.values(), key=order)
+
+
+def table_columns(axis_names: list[str]) -> list[str]:
+    return ["cell", *axis_names, *INFO_COLUMNS, *METRIC_COLUMNS, "error"]
+
+
+def table_text(rows: list[dict], axis_names: list[str]) -> str:
+    """CSV text: cell, parameters, status, wall time, peaks, percentiles, error (first line)."""
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=table_columns(axis_names), extrasaction="ignore", lineterminator="\n")
+    writer.writeheader()
+    for row in rows:
+        out = {}
+        for column in writer.fieldnames:
+            value = finite_or_none(row.get(column))
+            if isinstance(value, float):
+                value = f"{value:.10g}"
+            elif column == "error" and value:
+                value = str(value).splitlines()[0]
+            out[column] = "" if value is None else value
+        writer.writerow(out)
+    return buffer.getvalue()
+
+
+def read_table(path: Path) -> list[dict[str, str]]:
+    """Rows of a written ``sweep.csv`` (strings, as in the file)."""
+    with open(path, newline="", encoding="utf-8") as f:
+        return list(csv.DictReader(f))
