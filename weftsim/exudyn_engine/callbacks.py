@@ -1,0 +1,180 @@
+"""Force callbacks of the clearance connector: three routes to the same contact law.
+
+Exudyn calls ``springForceUserFunction(mbs, t, itemNumber, displacement, velocity,
+stiffness, damping, offset) -> [fx, fy, fz]`` of an ``ObjectConnectorCartesianSpringDamper``
+between the bearing centre (marker 0) and the journal centre (marker 1), so in a planar
+model in Exudyn's XY plane
+
+    e = displacement[0:2]           eccentricity P_j - P_b, m
+    e_dot = velocity[0:2]           its rate, m/s
+    stiffness = [v_held, delta0, rate0]   memory of the last accepted step (see onset.py)
+
+and the returned force f acts as -f on the journal and +f on the bearing, so
+f = F_N n with n = e/|e| pulls the journal back to the bearing centre::
+
+       bearing (marker 0)             delta = |e| - c,  delta_dot = e_dot . n
+        .---------.                   v_imp = v_held               if delta0 > 0
+       /  P_b --e--> P_j  \\  -> n            rate0 + s (delta_dot - rate0), s = delta0/(delta0 - delta)
+        '---------'                               otherwise (onset inside this step)
+                                      F_N = law(delta, delta_dot, max(v_imp, v_min))
+
+Routes (all compute the same force; tests check it):
+
+- ``"python"``: plain-``math`` closure around ``law.scalar()``.
+- ``"symbolic"``: an Exudyn symbolic user function (expression tree evaluated in C++,
+  no Python in the Newton loop) built from the law's coefficients by
+  :func:`symbolic_elastic_force`.
+- ``"numba"``: a Python wrapper around an ``@njit`` core (Exudyn passes ``MainSystem``
+  as first argument, so the jitted function cannot be the callback itself).
+"""
+
+from __future__ import annotations
+
+import math
+
+import exudyn as exu
+
+from weftsim.contact import ElasticFoundation, VariableKD
+
+# Smallest |e| used as a divisor in the symbolic route (which evaluates both branches of
+# IfThenElse): any positive value below round-off of a clearance works, m.
+_TINY_LENGTH = 1e-300
+
+
+def make_python_force(law, clearance: float, min_impact_velocity: float, counter: list | None = None):
+    """Plain-Python callback around ``law.scalar()`` (about 1.5 us per call).
+
+    ``counter``, if given, is a one-element list incremented per call (benchmarks only).
+    """
+    normal_force = law.scalar()
+    c, v_min, sqrt = clearance, min_impact_velocity, math.sqrt
+
+    def spring_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
+        ex = displacement[0]
+        ey = displacement[1]
+        length = sqrt(ex * ex + ey * ey)
+        delta = length - c
+        if delta <= 0.0:
+            return [0.0, 0.0, 0.0]
+        nx = ex / length
+        ny = ey / length
+        rate = velocity[0] * nx + velocity[1] * ny
+        delta0 = stiffness[1]
+        if delta0 > 0.0:
+            v_imp = stiffness[0]
+        else:
+            rate0 = stiffness[2]
+            s = delta0 / (delta0 - delta)
+            v_imp = rate0 + s * (rate - rate0)
+        if v_imp < v_min:
+            v_imp = v_min
+        f = normal_force(delta, rate, v_imp)
+        return [f * nx, f * ny, 0.0]
+
+    if counter is None:
+        return spring_force
+
+    def counted(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
+        counter[0] += 1
+        return spring_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset)
+
+    return counted
+
+
+def make_numba_force(law, clearance: float, min_impact_velocity: float):
+    """Python wrapper around an ``@njit`` core that computes the whole force (needs numba)."""
+    import numba  # optional dependency: only this route needs it
+
+    normal_force = law.numba()
+    c, v_min = clearance, min_impact_velocity
+
+    @numba.njit(cache=False)
+    def core(ex, ey, vx, vy, held, delta0, rate0):
+        length = math.sqrt(ex * ex + ey * ey)
+        delta = length - c
+        if delta <= 0.0:
+            return 0.0, 0.0
+        nx = ex / length
+        ny = ey / length
+        rate = vx * nx + vy * ny
+        if delta0 > 0.0:
+            v_imp = held
+        else:
+            v_imp = rate0 + delta0 / (delta0 - delta) * (rate - rate0)
+        if v_imp < v_min:
+            v_imp = v_min
+        f = normal_force(delta, rate, v_imp)
+        return f * nx, f * ny
+
+    core(1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0)  # compile now, not inside the first step
+
+    def spring_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
+        fx, fy = core(displacement[0], displacement[1], velocity[0], velocity[1],
+                      stiffness[0], stiffness[1], stiffness[2])  # fmt: skip
+        return [fx, fy, 0.0]
+
+    return spring_force
+
+
+def symbolic_elastic_force(law, penetration, esym):
+    """F_el = K(delta) delta^1.5 as an expression of ``esym`` (Exudyn symbolic or ``math``-like).
+
+    ``penetration`` must already be clamped to >= 0.  Supported: every constant-stiffness
+    law (``stiffness_constant``), :class:`~weftsim.contact.VariableKD` and
+    :class:`~weftsim.contact.ElasticFoundation`; the formulas are those of their docstrings,
+    with the coefficients taken from the law object.
+    """
+    d = penetration
+    d15 = d * esym.sqrt(d)
+    if isinstance(law, VariableKD):
+        a, c = law.modulus_factor, law.clearance
+        return a * esym.sqrt(2.0 * d * (3.0 * c + 2.0 * d) * (3.0 * c + 2.0 * d)
+                             / ((c + d) * (c + d) * (c + d))) * d15  # fmt: skip
+    if isinstance(law, ElasticFoundation):
+        return law.length_modulus / esym.sqrt(2.0 * (law.clearance + d)) * d15
+    if hasattr(law, "stiffness_constant"):
+        return law.stiffness_constant * d15
+    raise NotImplementedError(
+        f"no symbolic form for contact law {law.name!r}; use callback 'python' or 'numba'"
+    )
+
+
+def make_symbolic_force(mbs, law, clearance: float, min_impact_velocity: float):
+    """Exudyn symbolic user function of the clearance force (expression tree, C++ evaluation).
+
+    Both branches of every ``IfThenElse`` may be evaluated, so divisors and square roots
+    are guarded (clamped penetration, |e| >= tiny, onset fraction clamped to [0, 1]).
+    Keep the returned object alive as long as the system (Exudyn's requirement).
+    """
+    esym = exu.symbolic
+    from exudyn.advancedUtilities import CreateSymbolicUserFunction
+
+    c, v_min, xi = clearance, min_impact_velocity, law.hysteresis
+    real = esym.Real
+
+    def springForceUserFunction(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
+        ex = displacement[0]
+        ey = displacement[1]
+        length = esym.sqrt(ex * ex + ey * ey)
+        delta = length - real(c)
+        safe = esym.max(length, real(_TINY_LENGTH))
+        nx = ex / safe
+        ny = ey / safe
+        rate = velocity[0] * nx + velocity[1] * ny
+        held = stiffness[0]
+        delta0 = stiffness[1]
+        rate0 = stiffness[2]
+        span = esym.min(delta0 - delta, real(-_TINY_LENGTH))
+        s = esym.min(esym.max(delta0 / span, real(0.0)), real(1.0))
+        onset = rate0 + s * (rate - rate0)
+        v_imp = esym.max(esym.IfThenElse(delta0 > real(0.0), held, onset), real(v_min))
+        d = esym.max(delta, real(0.0))
+        f_el = symbolic_elastic_force(law, d, esym)
+        f = esym.max(f_el * (real(1.0) + real(xi) * rate / v_imp), real(0.0))
+        f = esym.IfThenElse(delta > real(0.0), f, real(0.0))
+        return [f * nx, f * ny, real(0.0)]
+
+    return CreateSymbolicUserFunction(
+        mbs, springForceUserFunction, "springForceUserFunction",
+        itemTypeName="ObjectConnectorCartesianSpringDamper",
+    )  # fmt: skip

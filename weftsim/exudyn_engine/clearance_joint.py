@@ -1,0 +1,191 @@
+"""A planar revolute clearance joint for any Exudyn mechanism (SPEC.md sections 2-3).
+
+:func:`add_clearance_joint` puts the joint between a bearing marker and a journal marker
+(``MarkerBodyPosition`` at the two joint centres, bodies moving in Exudyn's XY plane,
+joint axis = Exudyn Z) as an ``ObjectConnectorCartesianSpringDamper`` whose force callback
+applies a contact law of :mod:`weftsim.contact`.  The impact velocity is located at the
+true onset within the step and held until separation (:mod:`.onset`); the bookkeeping
+runs in a post-step user function, i.e. on accepted steps only.  Usage::
+
+    model = add_clearance_joint(mbs, marker_bearing, marker_journal, joint)
+    mbs.Assemble()
+    model.reset(mbs)            # only if the journal does not start centred
+    mbs.SolveDynamic(settings)
+    model.tracker.history()     # time, held impact velocity, contact flag per step
+
+Friction (``joint.friction_coefficient > 0``) is not implemented here: the Cartesian
+connector applies its force at the two centres and cannot carry the friction moments
+about them (docs/clearance-joint.md says what it would take).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import exudyn as exu
+from exudyn.itemInterface import ObjectConnectorCartesianSpringDamper
+
+from weftsim.contact import make_law
+from weftsim.exudyn_engine import callbacks
+from weftsim.exudyn_engine.onset import OnsetTracker, penetration_state
+from weftsim.params import ClearanceJoint
+
+ROUTES = ("python", "symbolic", "numba")
+# Fastest correct route on the loom model (scripts/bench_callbacks.py, docs/clearance-joint.md).
+DEFAULT_ROUTE = "symbolic"
+
+_HOOKS = "weftsim_post_step_hooks"
+
+
+def register_post_step(mbs, hook) -> None:
+    """Run ``hook(mbs, t)`` after every accepted step, alongside other registered hooks.
+
+    Exudyn has one post-step function per system; the first registration installs a
+    dispatcher (keeping a function the user had set) and later ones append to it.  A hook
+    returning ``False`` stops the simulation after the current step.
+    """
+    hooks = mbs.variables.get(_HOOKS)
+    if hooks is None:
+        hooks = []
+        previous = mbs.GetPostStepUserFunction()
+        if isinstance(previous, dict) and callable(previous.get("function")):
+            hooks.append(previous["function"])
+        mbs.variables[_HOOKS] = hooks
+
+        def post_step(mbs, t):
+            go = True
+            for h in hooks:
+                if h(mbs, t) is False:
+                    go = False
+            return go
+
+        mbs.SetPostStepUserFunction(post_step)
+    hooks.append(hook)
+
+
+@dataclass
+class ClearanceJointModel:
+    """Handle of one clearance joint in an Exudyn system.
+
+    Attributes
+    ----------
+    connector : exudyn ObjectIndex
+        The ``ObjectConnectorCartesianSpringDamper``; its ``Force`` output is F_N n (the
+        force on the bearing; the journal gets the opposite), ``Displacement`` is e.
+    joint : ClearanceJoint
+    law : contact law of :mod:`weftsim.contact`
+    route : str
+        Callback route in use (one of :data:`ROUTES`).
+    tracker : OnsetTracker
+        Contact state, held impact velocity, per-step history, first contact time.
+    """
+
+    connector: object
+    joint: ClearanceJoint
+    law: object
+    route: str
+    tracker: OnsetTracker
+    keep_alive: object = field(default=None, repr=False)  # symbolic function must outlive the system
+
+    def state(self, mbs) -> tuple[float, float]:
+        """Current (delta, delta_dot) of the joint, m and m/s."""
+        u = mbs.GetObjectOutput(self.connector, exu.OutputVariableType.Displacement)
+        v = mbs.GetObjectOutput(self.connector, exu.OutputVariableType.Velocity)
+        return penetration_state(u[0], u[1], v[0], v[1], self.joint.clearance)
+
+    def reset(self, mbs, t0: float = 0.0) -> None:
+        """Start the bookkeeping from the current (assembled, initial) state of ``mbs``."""
+        delta, rate = self.state(mbs)
+        self.tracker = OnsetTracker(self.joint.clearance, self.joint.min_impact_velocity, t0, delta, rate)
+        mbs.SetObjectParameter(self.connector, "stiffness", self.tracker.callback_state)
+
+
+def add_clearance_joint(mbs, marker_bearing, marker_journal, joint: ClearanceJoint, law=None,
+                        callback: str = "auto", call_counter: list | None = None) -> ClearanceJointModel:
+    """Add a planar revolute clearance joint between two position markers.
+
+    Parameters
+    ----------
+    mbs : exudyn.MainSystem
+        System in which both bodies move in the XY plane (joint axis = Z).
+    marker_bearing, marker_journal : exudyn MarkerIndex
+        Position markers at the bearing centre P_b and at the journal centre P_j.
+    joint : ClearanceJoint
+        Clearance c > 0, radii, materials, law name, restitution, v_min.
+    law : contact law, optional
+        Defaults to ``weftsim.contact.make_law(joint)``; any law of that library.
+    callback : {"auto", "python", "symbolic", "numba"}
+        Force callback route; "auto" = :data:`DEFAULT_ROUTE` (the fastest measured), or
+        "python" if the law has no symbolic form.
+    call_counter : list, optional
+        One-element list counting callback calls (python route only; benchmarks).
+
+    Returns
+    -------
+    ClearanceJointModel
+
+    Raises
+    ------
+    ValueError
+        For c <= 0 (use an ideal revolute joint) or an unknown route.
+    NotImplementedError
+        For friction_coefficient > 0.
+    """
+    if not joint.clearance > 0.0:
+        raise ValueError(f"`clearance` must be > 0 for a clearance joint, got {joint.clearance}; "
+                         "use ObjectJointRevolute2D for an ideal joint")  # fmt: skip
+    if joint.friction_coefficient > 0.0:
+        raise NotImplementedError(
+            "friction in the Exudyn clearance joint is not implemented (the Cartesian connector "
+            "cannot apply the friction moments about the joint centres); set "
+            "`friction_coefficient` = 0 or use the reference engine (docs/clearance-joint.md)"
+        )
+    if callback not in ROUTES + ("auto",):
+        raise ValueError(f"`callback` must be one of {('auto',) + ROUTES}, got {callback!r}")
+    law = make_law(joint) if law is None else law
+    route = callback
+    if route == "auto":
+        route = DEFAULT_ROUTE
+        if route == "symbolic":
+            try:
+                callbacks.symbolic_elastic_force(law, 0.0, _MathLike)
+            except NotImplementedError:
+                route = "python"
+    if call_counter is not None and route != "python":
+        raise ValueError("`call_counter` works with callback='python' only")
+    c, v_min = joint.clearance, joint.min_impact_velocity
+    keep = None
+    if route == "python":
+        force = callbacks.make_python_force(law, c, v_min, call_counter)
+    elif route == "numba":
+        force = callbacks.make_numba_force(law, c, v_min)
+    else:
+        keep = force = callbacks.make_symbolic_force(mbs, law, c, v_min)
+    tracker = OnsetTracker(c, v_min)
+    connector = mbs.AddObject(ObjectConnectorCartesianSpringDamper(
+        markerNumbers=[marker_bearing, marker_journal],
+        stiffness=tracker.callback_state, damping=[0.0, 0.0, 0.0], offset=[0.0, 0.0, 0.0],
+        springForceUserFunction=force,
+    ))  # fmt: skip
+    model = ClearanceJointModel(connector, joint, law, route, tracker, keep)
+    displacement = exu.OutputVariableType.Displacement
+    velocity = exu.OutputVariableType.Velocity
+
+    def accept(mbs, t):
+        u = mbs.GetObjectOutput(connector, displacement)
+        v = mbs.GetObjectOutput(connector, velocity)
+        delta, rate = penetration_state(u[0], u[1], v[0], v[1], c)
+        model.tracker.accept(t, delta, rate)
+        mbs.SetObjectParameter(connector, "stiffness", model.tracker.callback_state)
+        return True
+
+    register_post_step(mbs, accept)
+    return model
+
+
+class _MathLike:
+    """Stand-in namespace to probe whether a law has a symbolic form."""
+
+    @staticmethod
+    def sqrt(x):
+        return x**0.5

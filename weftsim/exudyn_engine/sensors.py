@@ -1,0 +1,161 @@
+"""Sensors of the mechanism and their conversion to the result channels.
+
+Every sensor stores internally at every accepted step (``storeInternal=True``,
+``writePeriod = 0``, no files).  Channels (SPEC.md 4 signs; Exudyn frame in mechanism.py)::
+
+    crank angle       theta = rz of the crank node
+    rapier s, v, a    (d5 d7/d6) x (angle, rate, acceleration of the sector node)
+    driving torque    T = -lambda_drive (the motor's torque on the crank about +z)
+    contact           e = connector Displacement (X, Y) = SPEC (y, z); F_N = |connector Force|;
+                      delta = |e| - c; held impact velocity and contact flag from the tracker
+    kinetic energy    sum of the bodies' KineticEnergy outputs
+    potential energy  sum of m g Y_com (gravity along -Y)
+    contact energy    law.elastic_energy(delta)
+    driving work      integral T dtheta (trapezoid over accepted steps; theta_dot = omega)
+    dissipated        integral (F_N - F_el(delta)) delta_dot dt (trapezoid over accepted steps),
+                      the energy the contact damping takes out
+
+The trapezoid rules have errors O(h^2) per step; the integrator's own numerical
+dissipation (generalized-alpha, spectral radius < 1) is not in any channel, so the
+balance W = dKE + dPE + contact + dissipated closes only up to it (tests bound it).
+"""
+
+from __future__ import annotations
+
+import exudyn as exu
+import numpy as np
+from exudyn.itemInterface import SensorBody, SensorNode, SensorObject
+
+from weftsim.exudyn_engine.mechanism import CRANK_COORDINATE, ROTATION_2D, MechanismModel
+from weftsim.results import CHANNELS
+
+OVT = exu.OutputVariableType
+
+
+def _sensor(mbs, item):
+    return mbs.AddSensor(item)
+
+
+def add_sensors(mbs, model: MechanismModel) -> dict:
+    """Add every sensor the channels need; returns name -> SensorIndex (or list of them)."""
+    store = {"storeInternal": True, "writeToFile": False}
+    sector = model.nodes["sector"]
+    s = {
+        "crank": _sensor(mbs, SensorNode(nodeNumber=model.nodes["crank"], outputVariableType=OVT.Coordinates, **store)),
+        "drive": _sensor(mbs, SensorObject(objectNumber=model.drive, outputVariableType=OVT.Force, **store)),
+        "sector_q": _sensor(mbs, SensorNode(nodeNumber=sector, outputVariableType=OVT.Coordinates, **store)),
+        "sector_v": _sensor(mbs, SensorNode(nodeNumber=sector, outputVariableType=OVT.Coordinates_t, **store)),
+        "sector_a": _sensor(mbs, SensorNode(nodeNumber=sector, outputVariableType=OVT.Coordinates_tt, **store)),
+    }
+    kinetic, heights = [], []
+    for name, body in model.bodies.items():
+        kinetic.append(_sensor(mbs, SensorBody(bodyNumber=body, outputVariableType=OVT.KineticEnergy, **store)))
+        obj = mbs.GetObject(body)
+        mass = obj["mass"]
+        com = (list(obj.get("centerOfMass", [])) + [0.0, 0.0, 0.0])[:3]
+        sensor = SensorBody(bodyNumber=body, outputVariableType=OVT.Position, localPosition=com, **store)
+        heights.append((float(mass), _sensor(mbs, sensor)))
+    s["kinetic"] = kinetic
+    s["heights"] = heights
+    if model.clearance is not None:
+        conn = model.clearance.connector
+        s["ecc"] = _sensor(mbs, SensorObject(objectNumber=conn, outputVariableType=OVT.Displacement, **store))
+        s["ecc_rate"] = _sensor(mbs, SensorObject(objectNumber=conn, outputVariableType=OVT.Velocity, **store))
+        s["force"] = _sensor(mbs, SensorObject(objectNumber=conn, outputVariableType=OVT.Force, **store))
+    return s
+
+
+def _cumtrapz(y, x):
+    out = np.zeros_like(y)
+    if len(y) > 1:
+        out[1:] = np.cumsum(0.5 * (y[1:] + y[:-1]) * np.diff(x))
+    return out
+
+
+def step_channels(mbs, model: MechanismModel, sensors: dict) -> dict[str, np.ndarray]:
+    """All :data:`~weftsim.results.CHANNELS` at every stored step (rows cut to a common length)."""
+    scene = model.scene
+    get = mbs.GetSensorStoredData
+    crank = get(sensors["crank"])
+    n = len(crank)
+    data = {k: get(v)[:n] for k, v in sensors.items() if k not in ("kinetic", "heights")}
+    kinetic = [get(k)[:n] for k in sensors["kinetic"]]
+    heights = [(m, get(k)[:n]) for m, k in sensors["heights"]]
+    n = min([len(crank)] + [len(v) for v in data.values()] + [len(k) for k in kinetic] + [len(h) for _, h in heights])
+    t = crank[:n, 0]
+    theta = crank[:n, 1 + CRANK_COORDINATE]
+    ratio = scene.geometry.rapier_ratio
+    torque = -data["drive"][:n, 1]
+    ch = {
+        "time_s": t,
+        "crank_angle_deg": np.degrees(theta),
+        "rapier_displacement_m": ratio * data["sector_q"][:n, 1 + ROTATION_2D],
+        "rapier_velocity_m_s": ratio * data["sector_v"][:n, 1 + ROTATION_2D],
+        "rapier_acceleration_m_s2": ratio * data["sector_a"][:n, 1 + ROTATION_2D],
+        "driving_torque_Nm": torque,
+        "kinetic_energy_J": np.sum([k[:n, 1] for k in kinetic], axis=0),
+        "potential_energy_J": np.sum([m * scene.inertia.gravity * h[:n, 2] for m, h in heights], axis=0),
+        "driving_work_J": _cumtrapz(torque, theta),
+    }
+    zeros = np.zeros(n)
+    if model.clearance is None:
+        for name in ("contact_force_N", "penetration_m", "eccentricity_y_m", "eccentricity_z_m",
+                     "impact_velocity_m_s", "in_contact", "contact_energy_J", "dissipated_energy_J"):  # fmt: skip
+            ch[name] = zeros
+        return ch
+    cl = model.clearance
+    ecc = data["ecc"][:n, 1:3]
+    rate_vec = data["ecc_rate"][:n, 1:3]
+    length = np.hypot(ecc[:, 0], ecc[:, 1])
+    delta = length - scene.joint.clearance
+    safe = np.where(length > 0.0, length, 1.0)
+    rate = np.where(length > 0.0, np.sum(ecc * rate_vec, axis=1) / safe, 0.0)
+    f_n = np.hypot(data["force"][:n, 1], data["force"][:n, 2])
+    f_el = np.where(delta > 0.0, cl.law.elastic_force(np.maximum(delta, 0.0)), 0.0)
+    hist = cl.tracker.history()
+    m = min(n, len(hist["time"]))
+    impact = np.zeros(n)
+    contact = np.zeros(n)
+    impact[:m] = hist["impact_velocity"][:m]
+    contact[:m] = hist["in_contact"][:m]
+    ch.update({
+        "contact_force_N": f_n,
+        "penetration_m": delta,
+        "eccentricity_y_m": ecc[:, 0],
+        "eccentricity_z_m": ecc[:, 1],
+        "impact_velocity_m_s": impact,
+        "in_contact": contact,
+        "contact_energy_J": np.where(delta > 0.0, cl.law.elastic_energy(np.maximum(delta, 0.0)), 0.0),
+        "dissipated_energy_J": _cumtrapz((f_n - f_el) * rate, t),
+    })  # fmt: skip
+    return ch
+
+
+def sample_channels(steps: dict[str, np.ndarray], times: np.ndarray) -> dict[str, np.ndarray]:
+    """Channels at the output times: linear interpolation between accepted steps.
+
+    The step is chosen so output times fall on steps (solver.py), so this mostly picks
+    stored values; ``in_contact`` takes the nearest step.  Times beyond the last step
+    (a failed run) are dropped.
+    """
+    t = steps["time_s"]
+    if len(t) == 0:
+        return {k: np.zeros(0) for k in CHANNELS}
+    times = times[times <= t[-1] * (1.0 + 1e-12)]
+    out = {k: np.interp(times, t, steps[k]) for k in CHANNELS}
+    nearest = np.clip(np.searchsorted(t, times), 0, len(t) - 1)
+    prev = np.clip(nearest - 1, 0, len(t) - 1)
+    nearest = np.where(np.abs(t[prev] - times) < np.abs(t[nearest] - times), prev, nearest)
+    out["in_contact"] = steps["in_contact"][nearest]
+    out["time_s"] = times
+    return out
+
+
+def first_nonfinite_row(steps: dict[str, np.ndarray]) -> int | None:
+    """Index of the first step with a NaN or inf in any channel, or None."""
+    bad = np.zeros(len(steps["time_s"]), dtype=bool)
+    for v in steps.values():
+        bad |= ~np.isfinite(v)
+    idx = np.flatnonzero(bad)
+    return int(idx[0]) if idx.size else None
+

@@ -1,0 +1,189 @@
+"""Entry point of the Exudyn engine: ``solve(scene, progress=None) -> RunResult``.
+
+Generalized-alpha (implicit, fixed step) with the settings of ``scene.exudyn_solver``:
+step size, spectral radius, modified Newton, Newton relative tolerance and maximum
+iterations.  The step is shortened (never lengthened) so that a whole number of steps
+fits between output samples; samples are then stored states, not interpolations.
+
+Failures never pass silently: Newton non-convergence (``discontinuous.ignoreMaxIterations``
+is off, so Exudyn stops instead of going on), NaN (``exudyn.SolverError``), an exception
+in a user function and non-finite channels all give ``status = "failed"`` with a message
+naming the time, the crank angle and what to try; the steps computed before are kept.
+No files are written (solution and sensor files off) and the solver prints nothing.
+"""
+
+from __future__ import annotations
+
+import math
+import time as _time
+
+import exudyn as exu
+
+from weftsim.exudyn_engine.clearance_joint import ROUTES, register_post_step
+from weftsim.exudyn_engine.mechanism import build_mechanism
+from weftsim.exudyn_engine.sensors import add_sensors, first_nonfinite_row, sample_channels, step_channels
+from weftsim.params import Scene
+from weftsim.reference.ideal import angle_grid
+from weftsim.results import RunResult, empty_channels
+
+MODELS = ("rigid_body",)
+# Modified Newton: iterations with one Jacobian before it is updated.  3 instead of
+# Exudyn's 8 cut the cost per step by ~20% on this model with identical results
+# (same tolerance; scripts/bench_callbacks.py).
+MODIFIED_NEWTON_ITERATIONS = 3
+_PROGRESS_CALLS = 100
+
+
+def check_settings(scene: Scene) -> str | None:
+    """Message naming the first invalid Exudyn-engine setting, or None."""
+    s = scene.exudyn_solver
+    if s.model not in MODELS:
+        return f"`exudyn_solver.model` must be one of {MODELS}, got {s.model!r}"
+    if not (s.step_size > 0.0 and math.isfinite(s.step_size)):
+        return f"`exudyn_solver.step_size` must be > 0, got {s.step_size}"
+    if not 0.0 <= s.spectral_radius <= 1.0:
+        return f"`exudyn_solver.spectral_radius` must be in [0, 1], got {s.spectral_radius}"
+    if not s.newton_relative_tolerance > 0.0:
+        return f"`exudyn_solver.newton_relative_tolerance` must be > 0, got {s.newton_relative_tolerance}"
+    if not s.newton_max_iterations >= 1:
+        return f"`exudyn_solver.newton_max_iterations` must be >= 1, got {s.newton_max_iterations}"
+    if s.callback not in ROUTES + ("auto",):
+        return f"`exudyn_solver.callback` must be one of {('auto',) + ROUTES}, got {s.callback!r}"
+    if not scene.output.sample_angle > 0.0:
+        return f"`output.sample_angle` must be > 0, got {scene.output.sample_angle}"
+    if scene.joint.friction_coefficient > 0.0 and not scene.joint.is_ideal:
+        return ("the Exudyn engine has no friction in the clearance joint (docs/clearance-joint.md); "
+                "set `friction_coefficient` = 0 or use the reference engine")  # fmt: skip
+    return None
+
+
+def step_plan(scene: Scene) -> tuple[float, int]:
+    """(step size, number of steps): the requested step shortened to divide the sample period."""
+    omega, t_end = scene.drive.speed, scene.drive.end_time
+    sample_dt = scene.output.sample_angle / omega
+    per_sample = max(1, math.ceil(sample_dt / scene.exudyn_solver.step_size * (1.0 - 1e-12)))
+    n_steps = max(1, round(t_end / (sample_dt / per_sample)))
+    return t_end / n_steps, n_steps
+
+
+def simulation_settings(scene: Scene, n_steps: int) -> exu.SimulationSettings:
+    """Exudyn settings: generalized-alpha from ``scene.exudyn_solver``, no files, no console output."""
+    s = scene.exudyn_solver
+    ss = exu.SimulationSettings()
+    ti = ss.timeIntegration
+    ti.endTime = scene.drive.end_time
+    ti.numberOfSteps = n_steps
+    ti.generalizedAlpha.spectralRadius = s.spectral_radius
+    ti.newton.useModifiedNewton = s.modified_newton
+    ti.newton.maxModifiedNewtonIterations = MODIFIED_NEWTON_ITERATIONS
+    ti.newton.relativeTolerance = s.newton_relative_tolerance
+    ti.newton.maxIterations = s.newton_max_iterations
+    ti.discontinuous.ignoreMaxIterations = False
+    ti.verboseMode = 0
+    ss.solution.file.write = False
+    ss.solution.sensors.writePeriod = 0.0
+    ss.solution.solverInformationFileName = ""
+    ss.displayStatistics = False
+    ss.displayComputationTime = False
+    return ss
+
+
+def _failed(scene: Scene, message: str, wall: float) -> RunResult:
+    return RunResult(scene, "exudyn", "failed", message, empty_channels(), empty_channels(),
+                     {"wall_time_s": wall}, {"first_contact_time_s": None})  # fmt: skip
+
+
+def _what_to_try(scene: Scene, h: float) -> str:
+    s = scene.exudyn_solver
+    return (f"try a smaller `exudyn_solver.step_size` (now {h:.3g} s), a spectral radius below "
+            f"{s.spectral_radius} or more `newton_max_iterations` (now {s.newton_max_iterations})")  # fmt: skip
+
+
+def solve(scene: Scene, progress=None, callback: str | None = None) -> RunResult:
+    """Simulate a scene with Exudyn.
+
+    Parameters
+    ----------
+    scene : Scene
+    progress : callable, optional
+        Called with the completed fraction in [0, 1] about 100 times per run.
+    callback : str, optional
+        Override of ``scene.exudyn_solver.callback`` (clearance force route).
+
+    Returns
+    -------
+    RunResult
+        Channels at every accepted step and on the output grid; ``solver_stats`` with
+        steps, Newton iterations, Jacobians, contact events, route, step size and wall
+        time; ``events["first_contact_time_s"]`` located within its step.
+    """
+    wall0 = _time.perf_counter()
+    problem = check_settings(scene)
+    if problem is not None:
+        return _failed(scene, problem, 0.0)
+    h, n_steps = step_plan(scene)
+    omega = scene.drive.speed
+    sc = exu.SystemContainer()
+    mbs = sc.AddSystem()
+    model = build_mechanism(mbs, scene, callback=callback)
+    sensors = add_sensors(mbs, model)
+    counter = {"steps": 0}
+    report_every = max(1, n_steps // _PROGRESS_CALLS)
+
+    def count(mbs, t):
+        counter["steps"] += 1
+        if progress is not None and counter["steps"] % report_every == 0:
+            progress(min(1.0, counter["steps"] / n_steps))
+        return True
+
+    register_post_step(mbs, count)
+    mbs.Assemble()
+    if model.clearance is not None:
+        model.clearance.reset(mbs)
+    if progress is not None:
+        progress(0.0)
+    status, message = "success", ""
+    wall_solve = _time.perf_counter()
+    try:
+        ok = mbs.SolveDynamic(simulation_settings(scene, n_steps))
+        if ok is False:
+            status, message = "failed", "Exudyn's solver returned failure (Newton did not converge)"
+    except exu.ExudynError as exc:
+        status, message = "failed", f"{type(exc).__name__}: {str(exc).strip().splitlines()[-1] if str(exc).strip() else ''}"
+    wall_solve = _time.perf_counter() - wall_solve
+
+    steps = step_channels(mbs, model, sensors)
+    bad = first_nonfinite_row(steps)
+    if bad is not None:
+        steps = {k: v[:bad] for k, v in steps.items()}
+        if status == "success":
+            status, message = "failed", "non-finite values (NaN or inf) in the results"
+    if status == "failed":
+        t_fail = float(steps["time_s"][-1]) if len(steps["time_s"]) else 0.0
+        message = (f"Exudyn engine failed after t = {t_fail:.6g} s, crank angle "
+                   f"{math.degrees(omega * t_fail):.3f} deg: {message}; {_what_to_try(scene, h)}")  # fmt: skip
+    elif len(steps["time_s"]) and abs(steps["time_s"][-1] - scene.drive.end_time) > 1e-6 * h:
+        status = "failed"
+        message = (f"Exudyn stopped at t = {steps['time_s'][-1]:.6g} s before the end time "
+                   f"{scene.drive.end_time:.6g} s; {_what_to_try(scene, h)}")  # fmt: skip
+    samples = sample_channels(steps, angle_grid(scene.drive.end_time, omega, scene.output.sample_angle))
+    it = mbs.sys["dynamicSolver"].it if "dynamicSolver" in mbs.sys else None
+    n_done = max(len(steps["time_s"]) - 1, 0)
+    stats = {
+        "method": "generalized_alpha",
+        "step_size_s": h,
+        "steps": n_done,
+        "rejected_steps": int(getattr(it, "rejectedModifiedNewtonSteps", 0)) if it is not None else 0,
+        "newton_iterations": int(it.newtonStepsCount) if it is not None else 0,
+        "jacobian_evaluations": int(it.newtonJacobiCount) if it is not None else 0,
+        "function_evaluations": int(it.newtonStepsCount) if it is not None else 0,
+        "contact_events": model.clearance.tracker.contact_events if model.clearance else 0,
+        "callback": model.clearance.route if model.clearance else None,
+        "solve_time_s": wall_solve,
+        "wall_time_s": _time.perf_counter() - wall0,
+    }
+    stats["time_per_step_us"] = 1e6 * wall_solve / max(n_done, 1)
+    first = model.clearance.tracker.first_contact_time if model.clearance else None
+    if progress is not None:
+        progress(1.0)
+    return RunResult(scene, "exudyn", status, message, samples, steps, stats, {"first_contact_time_s": first})
