@@ -34,6 +34,7 @@ log = logging.getLogger(__name__)
 
 FIGURE_FILE = "sweep.png"
 TABLE_INTERVAL_S = 10.0  # rewrite sweep.csv at most this often while cells complete
+CONNECT_TIMEOUT_S = 20.0  # how long to keep trying to reach a Dask scheduler (it may be starting up)
 DEATHS_BEFORE_FAILED = 2  # a cell whose worker died this often (the second time alone) is recorded as failed
 
 
@@ -143,21 +144,30 @@ class SweepProgress:
 
 
 def _executor(jobs: int | None, scheduler: str | None, n_cells: int):
-    """(executor, in-flight window, closer): a local process pool, or a Dask client's executor."""
+    """(executor, in-flight window, stop): a local process pool, or a Dask client's executor.
+
+    ``stop()`` cancels what has not started and returns without waiting for running cells.
+    """
     if scheduler:
         try:
             from dask.distributed import Client
         except ImportError:
             raise SweepError("--scheduler needs dask.distributed: pip install 'weftsim[distributed]'") from None
         try:
-            client = Client(scheduler, timeout="20s")
+            client = Client(scheduler, timeout=CONNECT_TIMEOUT_S)
         except (OSError, TimeoutError, ValueError) as exc:
             raise SweepError(f"--scheduler: cannot reach the Dask scheduler at {scheduler} ({exc})") from None
         threads = sum(client.nthreads().values()) or 1
         executor = client.get_executor(pure=False)
-        return executor, max(threads, 1) * 2, client.close  # a short queue per worker keeps them busy
+
+        def stop_dask() -> None:
+            executor.shutdown(wait=False)  # cancels the cells still on the cluster
+            client.close()
+
+        return executor, threads * 2, stop_dask  # a short queue per worker keeps them busy
     workers = max(1, min(jobs or os.cpu_count() or 1, n_cells))
-    return cf.ProcessPoolExecutor(max_workers=workers), workers, lambda: None
+    pool = cf.ProcessPoolExecutor(max_workers=workers)
+    return pool, workers, lambda: pool.shutdown(wait=False, cancel_futures=True)
 
 
 def _record_lost(outdir: Path, planned: PlannedCell, engine: str, error: str) -> dict:
@@ -249,7 +259,7 @@ def _run_cells(plan, outdir, todo, remaining, report, jobs, scheduler, cell_figu
     queue = collections.deque(todo)
     retry: collections.deque = collections.deque()  # cells whose worker died: rerun one at a time
     deaths: collections.Counter = collections.Counter()
-    executor, window, close = _executor(jobs, scheduler, len(todo))
+    executor, window, stop = _executor(jobs, scheduler, len(todo))
     in_flight: dict[cf.Future, PlannedCell] = {}
     last_table = time.perf_counter()
 
@@ -297,16 +307,15 @@ def _run_cells(plan, outdir, todo, remaining, report, jobs, scheduler, cell_figu
                 for future, planned in list(in_flight.items()):
                     retry.append(planned)  # lost with the pool without being to blame
                     in_flight.pop(future)
-                executor.shutdown(wait=False, cancel_futures=True)
-                executor, window, close = _executor(jobs, scheduler, len(remaining))
+                stop()
+                executor, window, stop = _executor(jobs, scheduler, len(remaining))
             if bar:
                 bar.update(report.succeeded + report.failed, report.failed)
             if time.perf_counter() - last_table > TABLE_INTERVAL_S:
                 write_table(plan, outdir, remaining)
                 last_table = time.perf_counter()
     finally:
-        executor.shutdown(wait=False, cancel_futures=True)
-        close()
+        stop()
 
 
 def format_report(report: SweepReport) -> str:
