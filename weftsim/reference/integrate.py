@@ -48,13 +48,19 @@ _START_EVALS = 2
 
 _ROOT_XTOL = 1e-13  # s: event time accuracy (delta_dot ~ 1 m/s -> 1e-13 m in delta)
 _PROGRESS_EVERY = 0.01  # report progress every 1 % of the run
+# Dense-output points recorded inside every step of a contact segment (besides the step ends):
+# an impact pulse spans a few tens of steps, and its peak read at the step ends alone is low by
+# up to ~1e-4 relative (DOP853, rtol 1e-9); 3 interior points cut that ~16-fold.
+_CONTACT_SUBSTEPS = 3
+_SUBSTEP_FRACTIONS = np.arange(1, _CONTACT_SUBSTEPS + 1) / (_CONTACT_SUBSTEPS + 1.0)
 
 
 @dataclass
 class Trajectory:
     """Raw states of a clearance-mode run (filled by :func:`integrate`).
 
-    ``step_*`` hold every accepted step and every located event; ``sample_*`` the
+    ``step_*`` hold every accepted step, every located event and, in contact segments,
+    ``_CONTACT_SUBSTEPS`` dense-output points inside each step; ``sample_*`` the
     uniform output grid.  ``*_contact`` is the segment's mode, ``*_impact`` the held,
     floored impact velocity of the segment (0 in free flight).
     """
@@ -224,6 +230,14 @@ def integrate(scene: Scene, progress=None) -> Trajectory:
                 ts = sample_times[next_sample:stop]
                 traj.add_samples(ts, dense(ts).T, contact, impact)
                 next_sample = stop
+            if contact and _CONTACT_SUBSTEPS:
+                # Impacts last tens of steps: read the pulse between steps too, for its peaks.
+                if dense is None:
+                    dense = solver.dense_output()
+                    n_dense += 1
+                ts = t_old + (t_stop - t_old) * _SUBSTEP_FRACTIONS
+                for t_sub, y_sub in zip(ts, dense(ts).T):
+                    traj.add_step(t_sub, y_sub, contact, impact)
             if event is not None:
                 t, y = event, dense(event)
                 break
