@@ -113,11 +113,11 @@ def step_channels(mbs, model: MechanismModel, sensors: dict) -> dict[str, np.nda
     f_n = np.hypot(data["force"][:n, 1], data["force"][:n, 2])
     f_el = np.where(delta > 0.0, cl.law.elastic_force(np.maximum(delta, 0.0)), 0.0)
     hist = cl.tracker.history()
-    m = min(n, len(hist["time"]))
-    impact = np.zeros(n)
-    contact = np.zeros(n)
-    impact[:m] = hist["impact_velocity"][:m]
-    contact[:m] = hist["in_contact"][:m]
+    # The tracker records every post-step call (Exudyn also calls it once at t = 0): take,
+    # for each stored step, the tracker's last record at that time.
+    row = np.clip(np.searchsorted(hist["time"], t * (1.0 + 1e-12), side="right") - 1, 0, len(hist["time"]) - 1)
+    impact = hist["impact_velocity"][row]
+    contact = hist["in_contact"][row]
     ch.update({
         "contact_force_N": f_n,
         "penetration_m": delta,

@@ -83,8 +83,8 @@ def simulation_settings(scene: Scene, n_steps: int) -> exu.SimulationSettings:
     ss.solution.file.write = False
     ss.solution.sensors.writePeriod = 0.0
     ss.solution.solverInformationFileName = ""
-    ss.displayStatistics = False
-    ss.displayComputationTime = False
+    ss.show.statistics = False
+    ss.show.computationTime = False
     return ss
 
 
@@ -97,6 +97,17 @@ def _what_to_try(scene: Scene, h: float) -> str:
     s = scene.exudyn_solver
     return (f"try a smaller `exudyn_solver.step_size` (now {h:.3g} s), a spectral radius below "
             f"{s.spectral_radius} or more `newton_max_iterations` (now {s.newton_max_iterations})")  # fmt: skip
+
+
+def _failure_reason(solver) -> str:
+    conv = solver.conv
+    if conv.massMatrixNotInvertible or conv.linearSolverFailed:
+        return f"singular system matrix (equation {conv.linearSolverCausingRow})"
+    if conv.newtonSolutionDiverged:
+        return "Newton diverged"
+    if conv.stepReductionFailed:
+        return "Newton did not converge even at the minimum step size"
+    return "Newton did not converge"
 
 
 def solve(scene: Scene, progress=None, callback: str | None = None) -> RunResult:
@@ -143,13 +154,14 @@ def solve(scene: Scene, progress=None, callback: str | None = None) -> RunResult
     if progress is not None:
         progress(0.0)
     status, message = "success", ""
+    solver = exu.MainSolverImplicitSecondOrder()
     wall_solve = _time.perf_counter()
     try:
-        ok = mbs.SolveDynamic(simulation_settings(scene, n_steps))
-        if ok is False:
-            status, message = "failed", "Exudyn's solver returned failure (Newton did not converge)"
-    except exu.ExudynError as exc:
-        status, message = "failed", f"{type(exc).__name__}: {str(exc).strip().splitlines()[-1] if str(exc).strip() else ''}"
+        if not solver.SolveSystem(mbs, simulation_settings(scene, n_steps)):
+            status, message = "failed", _failure_reason(solver)
+    except exu.ExudynError as exc:  # NaN (SolverError), user-function exception (ModelError), ...
+        text = str(exc).strip().splitlines()
+        status, message = "failed", f"{type(exc).__name__}: {text[-1] if text else ''}"
     wall_solve = _time.perf_counter() - wall_solve
 
     steps = step_channels(mbs, model, sensors)
@@ -167,16 +179,16 @@ def solve(scene: Scene, progress=None, callback: str | None = None) -> RunResult
         message = (f"Exudyn stopped at t = {steps['time_s'][-1]:.6g} s before the end time "
                    f"{scene.drive.end_time:.6g} s; {_what_to_try(scene, h)}")  # fmt: skip
     samples = sample_channels(steps, angle_grid(scene.drive.end_time, omega, scene.output.sample_angle))
-    it = mbs.sys["dynamicSolver"].it if "dynamicSolver" in mbs.sys else None
+    it = solver.it
     n_done = max(len(steps["time_s"]) - 1, 0)
     stats = {
         "method": "generalized_alpha",
         "step_size_s": h,
         "steps": n_done,
-        "rejected_steps": int(getattr(it, "rejectedModifiedNewtonSteps", 0)) if it is not None else 0,
-        "newton_iterations": int(it.newtonStepsCount) if it is not None else 0,
-        "jacobian_evaluations": int(it.newtonJacobiCount) if it is not None else 0,
-        "function_evaluations": int(it.newtonStepsCount) if it is not None else 0,
+        "rejected_steps": int(it.rejectedModifiedNewtonSteps),
+        "newton_iterations": int(it.newtonStepsCount),
+        "jacobian_evaluations": int(it.newtonJacobiCount),
+        "function_evaluations": int(it.newtonStepsCount),
         "contact_events": model.clearance.tracker.contact_events if model.clearance else 0,
         "callback": model.clearance.route if model.clearance else None,
         "solve_time_s": wall_solve,
