@@ -22,10 +22,10 @@ import time as _time
 import numpy as np
 
 from weftsim.params import Scene
-from weftsim.reference.integrate import METHODS
+from weftsim.reference.integrate import AUTO, METHODS
 from weftsim.results import RunResult, empty_channels
 
-__all__ = ["solve", "METHODS"]
+__all__ = ["solve", "METHODS", "AUTO"]
 
 # Steps of the ideal-joint run: the closed form evaluated on a grid this many times finer
 # than the output grid (peaks of smooth curves then err by ~(step/2)^2 |f''|/2, < 1e-6 relative).
@@ -34,8 +34,8 @@ IDEAL_STEP_REFINEMENT = 5
 
 def _check(scene: Scene) -> str | None:
     settings = scene.reference_solver
-    if settings.method not in METHODS:
-        return f"`reference_solver.method` must be one of {sorted(METHODS)}, got {settings.method!r}"
+    if settings.method not in METHODS and settings.method != AUTO:
+        return f"`reference_solver.method` must be one of {[AUTO] + sorted(METHODS)}, got {settings.method!r}"
     for name in ("rtol", "atol", "max_step"):
         value = getattr(settings, name)
         if not (value > 0.0 and math.isfinite(value)):
@@ -94,7 +94,8 @@ def solve(scene: Scene, progress=None) -> RunResult:
     scene : Scene
         ``scene.joint.clearance == 0`` selects the ideal joint (closed form); otherwise the
         clearance mode is integrated with ``scene.reference_solver`` (method by name from
-        :data:`METHODS`, rtol, atol, max_step as crank angle).
+        :data:`METHODS` or ``"auto"``: DOP853 without friction, LSODA with friction; rtol,
+        atol, max_step as crank angle).
     progress : callable, optional
         Called with the completed fraction in [0, 1].
 
