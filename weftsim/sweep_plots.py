@@ -19,6 +19,22 @@ PANEL_LABELS = {
 }
 
 
+UNITS = {"mm": "mm", "rpm": "rpm", "deg": "deg", "gpa": "GPa", "kg": "kg", "s": "s", "kg_m2": "kg m²"}
+
+
+def axis_label(name: str) -> str:
+    """``clearance_mm`` -> ``clearance [mm]``; names without a known unit suffix stay as they are."""
+    for suffix in sorted(UNITS, key=len, reverse=True):
+        if name.endswith("_" + suffix):
+            return f"{name[: -len(suffix) - 1].replace('_', ' ')} [{UNITS[suffix]}]"
+    return name
+
+
+def _short(value: float) -> str:
+    """Three digits, thousands as k: 2.02k, 870k."""
+    return f"{value:.3g}" if abs(value) < 1e3 else f"{value / 1e3:.3g}k"
+
+
 def _number(value) -> float:
     try:
         out = float(value)
@@ -59,7 +75,7 @@ def plot_sweep_1d(rows: list[dict], name: str, title: str = ""):
         for which, label, style in (("rev1", "first revolution", "o-"), ("last", "last revolution", "s--")):
             y = [_value(by_value[v], channel, which) for v in values]
             ax.plot(x, y, style, ms=4, lw=1, label=label)
-        ax.set_xlabel(name)
+        ax.set_xlabel(axis_label(name))
         ax.set_ylabel(PANEL_LABELS[channel])
         if not numeric:
             ax.set_xticks(x, [str(v) for v in values], rotation=30)
@@ -96,10 +112,10 @@ def plot_sweep_2d(rows: list[dict], x_name: str, y_name: str, title: str = "", w
             for i in range(len(ys)):
                 for j in range(len(xs)):
                     if np.isfinite(grid[i, j]):
-                        ax.text(xc[j], yc[i], f"{grid[i, j]:.3g}", ha="center", va="center", fontsize=7,
+                        ax.text(xc[j], yc[i], _short(grid[i, j]), ha="center", va="center", fontsize=7,
                                 color="white" if grid[i, j] < 0.6 * top else "black")
-        ax.set_xlabel(x_name)
-        ax.set_ylabel(y_name)
+        ax.set_xlabel(axis_label(x_name))
+        ax.set_ylabel(axis_label(y_name))
         if not x_numeric:
             ax.set_xticks(xc, [str(v) for v in xs], rotation=30)
         if not y_numeric:
