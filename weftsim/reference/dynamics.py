@@ -217,8 +217,9 @@ def chain_dynamics(xp, p: ChainConstants, t, a, psi, da, dpsi, contact, impact_v
         # what the elastic energy (rate F_el delta_dot) does not store is dissipated.
         dissipated = -(f_y * v_y + f_z * v_z + m_j * dpsi + m_b * p.omega * dphi) - f_el * delta_dot
     else:
-        delta = xp.hypot(ecc_y, ecc_z) - p.clearance
-        delta_dot = f_n = f_el = dissipated = f_y = f_z = m_j = m_b = 0.0 * delta
+        ecc = xp.hypot(ecc_y, ecc_z)
+        delta = ecc - p.clearance
+        delta_dot = f_n = f_el = dissipated = f_y = f_z = m_j = m_b = 0.0 * ecc  # +0.0 (ecc >= 0)
     # Generalized forces and the 2x2 solve.
     sa, ca, sp, cp = xp.sin(a), xp.cos(a), xp.sin(psi), xp.cos(psi)
     s, c = xp.sin(psi - a), xp.cos(psi - a)
