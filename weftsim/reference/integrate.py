@@ -308,8 +308,8 @@ def _integrate(scene: Scene, progress) -> Trajectory:
         "wall_time_s": wall,
     }
     traj.events = {
-        "first_contact_time_s": first_contact,
-        "max_impact_velocity_m_s": max_penetration_rate,
+        "first_contact_time_s": None if first_contact is None else float(first_contact),
+        "max_impact_velocity_m_s": float(max_penetration_rate),
     }
     if progress is not None and traj.status == "success":
         progress(1.0)
