@@ -162,7 +162,7 @@ class ClearanceJoint:
 class Drive:
     """Constant crank speed and run length."""
 
-    speed: float = 400.0 * 2.0 * math.pi / 60.0  # omega, rad/s
+    speed: float = 400.0 * (2.0 * math.pi / 60.0)  # omega, rad/s (same rounding as a scene file's 400 rpm)
     revolutions: float = 2.0
 
     @property
@@ -179,7 +179,7 @@ class Drive:
 class ReferenceSolver:
     """Settings of the closed-form Lagrange solver (scipy)."""
 
-    method: str = "DOP853"
+    method: str = "auto"  # DOP853 without friction, LSODA with friction (stiff sticking)
     rtol: float = 1e-9
     atol: float = 1e-12
     max_step: float = math.radians(0.5)  # crank angle, rad
