@@ -53,6 +53,8 @@ def test_ideal_rapier_motion_matches_kinematics_at_every_sample(ideal_400):
     sm = r.samples
     s, v, a = rapier_motion(np.radians(sm["crank_angle_deg"]), r.scene.drive.speed, r.scene.geometry)
     np.testing.assert_allclose(sm["crank_angle_deg"][:3], [0.0, 0.5, 1.0], atol=1e-9)  # output grid
+    assert sm["crank_angle_deg"][-1] == pytest.approx(360.0, abs=1e-6)  # the end time is a sample
+    assert len(sm["time_s"]) == 721
     # Positions satisfy the constraints to Newton tolerance: far below a micrometre.
     assert np.max(np.abs(sm["rapier_displacement_m"] - s)) < 1e-9
     # Velocities and accelerations relative to their peaks (21.8 m/s, 1142 m/s^2): integration

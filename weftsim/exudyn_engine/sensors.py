@@ -141,7 +141,9 @@ def sample_channels(steps: dict[str, np.ndarray], times: np.ndarray) -> dict[str
     t = steps["time_s"]
     if len(t) == 0:
         return {k: np.zeros(0) for k in CHANNELS}
-    times = times[times <= t[-1] * (1.0 + 1e-12)]
+    # Exudyn accumulates t += h: the last step may fall short of the end time by round-off.
+    last_step = t[-1] - t[-2] if len(t) > 1 else 0.0
+    times = times[times <= t[-1] + 0.5 * last_step]
     out = {k: np.interp(times, t, steps[k]) for k in CHANNELS}
     nearest = np.clip(np.searchsorted(t, times), 0, len(t) - 1)
     prev = np.clip(nearest - 1, 0, len(t) - 1)
