@@ -195,8 +195,7 @@ def write_figure(plan: SweepPlan, outdir: Path, rows: list[dict]) -> Path | None
 
     base = plan.base_keys
     title = (f"{Path(plan.scene_path).name}, {plan.engine} engine, {base['joint_e.law']}, "
-             f"{base['drive.revolutions']:g} revolutions: peaks over the last complete revolution "
-             "(the first, if shorter)")
+             f"{base['drive.revolutions']:g} revolutions: largest magnitude over a crank revolution")
     figure = plot_sweep(rows, plan.axis_names, title)
     return save(outdir / FIGURE_FILE, figure) if figure is not None else None
 

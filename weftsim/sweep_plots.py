@@ -15,8 +15,9 @@ from weftsim.sweep_cell import METRIC_CHANNELS
 PANEL_LABELS = {
     "driving_torque_Nm": "peak |driving torque| [N·m]",
     "rapier_acceleration_m_s2": "peak |rapier acceleration| [m/s²]",
-    "contact_force_N": "peak contact force at E [N]",
+    "contact_force_N": "peak contact force at E [kN]",
 }
+SCALES = {"contact_force_N": 1e-3}  # contact forces reach 1e5 N: shown in kN
 
 
 UNITS = {"mm": "mm", "rpm": "rpm", "deg": "deg", "gpa": "GPa", "kg": "kg", "s": "s", "kg_m2": "kg m²"}
@@ -62,6 +63,29 @@ def _edges(centres: np.ndarray) -> np.ndarray:
     return np.concatenate([[2 * centres[0] - mid[0]], mid, [2 * centres[-1] - mid[-1]]])
 
 
+def windows(rows: list[dict]) -> list[tuple[str, str]]:
+    """Which peaks to draw: the first revolution, and the last one when some run has more than one."""
+    last = max((int(_number(r.get("last_revolution"))) for r in rows
+                if r.get("status") == "success" and math.isfinite(_number(r.get("last_revolution")))), default=1)
+    first = [("rev1", "first revolution")]
+    return first + [("last", f"last revolution ({last})" if last > 1 else "last revolution")] if last > 1 else first
+
+
+def _grid_panel(fig, ax, grid, xc, yc, channel, annotate):
+    ax.set_facecolor("0.85")  # failed or missing cells show as grey
+    scale = SCALES.get(channel, 1.0)
+    mesh = ax.pcolormesh(_edges(xc), _edges(yc), np.ma.masked_invalid(grid * scale), cmap="viridis",
+                         shading="flat")
+    fig.colorbar(mesh, ax=ax, label=PANEL_LABELS[channel])
+    if annotate and np.isfinite(grid).any():
+        top = np.nanmax(grid)
+        for i in range(grid.shape[0]):
+            for j in range(grid.shape[1]):
+                if np.isfinite(grid[i, j]):
+                    ax.text(xc[j], yc[i], _short(grid[i, j] * scale), ha="center", va="center", fontsize=7,
+                            color="white" if grid[i, j] < 0.6 * top else "black")
+
+
 def plot_sweep_1d(rows: list[dict], name: str, title: str = ""):
     """Three panels: peak torque, acceleration and contact force against the varied parameter."""
     from weftsim.plots import _pyplot
@@ -72,8 +96,8 @@ def plot_sweep_1d(rows: list[dict], name: str, title: str = ""):
     by_value = {row[name]: row for row in rows}
     fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
     for ax, channel in zip(axes, METRIC_CHANNELS):
-        for which, label, style in (("rev1", "first revolution", "o-"), ("last", "last revolution", "s--")):
-            y = [_value(by_value[v], channel, which) for v in values]
+        for (which, label), style in zip(windows(rows), ("o-", "s--")):
+            y = np.array([_value(by_value[v], channel, which) for v in values]) * SCALES.get(channel, 1.0)
             ax.plot(x, y, style, ms=4, lw=1, label=label)
         ax.set_xlabel(axis_label(name))
         ax.set_ylabel(PANEL_LABELS[channel])
@@ -86,8 +110,12 @@ def plot_sweep_1d(rows: list[dict], name: str, title: str = ""):
     return fig
 
 
-def plot_sweep_2d(rows: list[dict], x_name: str, y_name: str, title: str = "", which: str = "last"):
-    """Three heat maps (torque, acceleration, contact force) over the (x, y) grid; values written in small grids."""
+def plot_sweep_2d(rows: list[dict], x_name: str, y_name: str, title: str = ""):
+    """Heat maps of peak torque, acceleration and contact force over the (x, y) grid.
+
+    One row for the first revolution and, when the runs are longer, one for the last
+    complete revolution; values are written into the cells of small grids.
+    """
     from weftsim.plots import _pyplot
 
     plt = _pyplot()
@@ -96,30 +124,24 @@ def plot_sweep_2d(rows: list[dict], x_name: str, y_name: str, title: str = "", w
     xc = np.array(xs, dtype=float) if x_numeric else np.arange(len(xs), dtype=float)
     yc = np.array(ys, dtype=float) if y_numeric else np.arange(len(ys), dtype=float)
     index = {(row[x_name], row[y_name]): row for row in rows}
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.4), constrained_layout=True)
-    annotate = len(xs) * len(ys) <= 80
-    for ax, channel in zip(axes, METRIC_CHANNELS):
-        grid = np.full((len(ys), len(xs)), np.nan)
-        for i, yv in enumerate(ys):
-            for j, xv in enumerate(xs):
-                if (xv, yv) in index:
-                    grid[i, j] = _value(index[(xv, yv)], channel, which)
-        ax.set_facecolor("0.85")  # failed or missing cells show as grey
-        mesh = ax.pcolormesh(_edges(xc), _edges(yc), np.ma.masked_invalid(grid), cmap="viridis", shading="flat")
-        fig.colorbar(mesh, ax=ax, label=PANEL_LABELS[channel])
-        if annotate and np.isfinite(grid).any():
-            top = np.nanmax(grid)
-            for i in range(len(ys)):
-                for j in range(len(xs)):
-                    if np.isfinite(grid[i, j]):
-                        ax.text(xc[j], yc[i], _short(grid[i, j]), ha="center", va="center", fontsize=7,
-                                color="white" if grid[i, j] < 0.6 * top else "black")
-        ax.set_xlabel(axis_label(x_name))
-        ax.set_ylabel(axis_label(y_name))
-        if not x_numeric:
-            ax.set_xticks(xc, [str(v) for v in xs], rotation=30)
-        if not y_numeric:
-            ax.set_yticks(yc, [str(v) for v in ys])
+    shown = windows(rows)
+    fig, axes = plt.subplots(len(shown), 3, figsize=(15, 4.2 * len(shown)), constrained_layout=True,
+                             squeeze=False)
+    for (which, label), axes_row in zip(shown, axes):
+        for ax, channel in zip(axes_row, METRIC_CHANNELS):
+            grid = np.full((len(ys), len(xs)), np.nan)
+            for i, yv in enumerate(ys):
+                for j, xv in enumerate(xs):
+                    if (xv, yv) in index:
+                        grid[i, j] = _value(index[(xv, yv)], channel, which)
+            _grid_panel(fig, ax, grid, xc, yc, channel, annotate=len(xs) * len(ys) <= 80)
+            ax.set_title(label, fontsize=10)
+            ax.set_xlabel(axis_label(x_name))
+            ax.set_ylabel(axis_label(y_name))
+            if not x_numeric:
+                ax.set_xticks(xc, [str(v) for v in xs], rotation=30)
+            if not y_numeric:
+                ax.set_yticks(yc, [str(v) for v in ys])
     fig.suptitle(title)
     return fig
 
