@@ -247,24 +247,29 @@ def test_a_directory_holding_another_sweep_is_refused(tmp_path):
         sweep(other, ["clearance_mm=0.1"])
 
 
-def test_killed_sweep_resumes_without_losing_or_redoing_finished_cells(tmp_path):
-    """SIGKILL the whole `weftsim sweep` process group mid-sweep, then run the same command again."""
+@pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGINT], ids=["SIGKILL", "Ctrl-C"])
+def test_interrupted_sweep_resumes_without_losing_or_redoing_finished_cells(tmp_path, sig):
+    """Kill (or Ctrl-C) the whole `weftsim sweep` process group mid-sweep, then run the same command again."""
     outdir = tmp_path / "sweep"
     command = [sys.executable, "-m", "weftsim.cli", "sweep", str(REFERENCE), "--vary", "clearance_mm=0.1,0.2,0.3",
                "--vary", "speed_rpm=300:600:4", "--set", "revolutions=0.5", "--engine", FAKE, "--jobs", "2",
                "-o", str(outdir)]
     env = {**os.environ, "PYTHONPATH": str(ROOT / "tests"), "WEFTSIM_FAKE_DELAY_S": "0.4"}
     process = subprocess.Popen(command, env=env, start_new_session=True, stdout=subprocess.DEVNULL,
-                               stderr=subprocess.DEVNULL)
+                               stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 60  # generous: a loaded 2-core machine; the loop normally takes ~2 s
     try:
         while len(list(outdir.glob(f"*/{CELL_FILE}"))) < 4:
-            assert process.poll() is None, "the sweep ended before it could be killed"
+            assert process.poll() is None, "the sweep ended before it could be interrupted"
             assert time.monotonic() < deadline, "no cell finished in time"
             time.sleep(0.05)
     finally:
-        os.killpg(process.pid, signal.SIGKILL)
-        process.wait()
+        os.killpg(process.pid, sig)  # the whole group, as a terminal's Ctrl-C does: workers too
+        _, err = process.communicate(timeout=60)
+    if sig == signal.SIGINT:
+        assert process.returncode == 130 and "interrupted" in err
+        statuses = [r["status"] for r in read_table(outdir / TABLE_FILE)]  # rewritten on the way out
+        assert len(statuses) == 12 and "pending" in statuses
     finished = sorted(p.parent for p in outdir.glob(f"*/{CELL_FILE}"))
     assert 4 <= len(finished) < 12
     before = {p: p.stat().st_mtime_ns for d in finished for p in d.iterdir()}
