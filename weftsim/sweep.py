@@ -279,14 +279,19 @@ def _run_cells(plan, outdir, todo, remaining, report, jobs, scheduler, cell_figu
 
     try:
         while queue or retry or in_flight:
-            if retry:
-                if not in_flight:
-                    submit(retry.popleft())
-            else:
-                while queue and len(in_flight) < window:
-                    submit(queue.popleft())
-            done, _ = cf.wait(in_flight, return_when=cf.FIRST_COMPLETED)
             broken = False
+            try:
+                if retry:
+                    if not in_flight:
+                        submit(retry[0])
+                        retry.popleft()
+                else:
+                    while queue and len(in_flight) < window:
+                        submit(queue[0])
+                        queue.popleft()
+            except cf.process.BrokenProcessPool:
+                broken = True  # the pool broke before its futures said so: replaced below, the cell stays queued
+            done, _ = cf.wait(in_flight, return_when=cf.FIRST_COMPLETED) if in_flight else (set(), set())
             for future in done:
                 planned = in_flight.pop(future)
                 try:
@@ -321,7 +326,7 @@ def _run_cells(plan, outdir, todo, remaining, report, jobs, scheduler, cell_figu
 def format_report(report: SweepReport) -> str:
     """A few lines for the command line."""
     lines = [f"sweep {report.outdir}: {report.total} cells, {report.skipped} already finished, "
-             f"{report.succeeded} run, {report.failed} failed, {report.wall_time_s:.1f} s wall time"]
+             f"{report.succeeded} succeeded, {report.failed} failed, {report.wall_time_s:.1f} s wall time"]
     for name, error in list(report.failures.items())[:10]:
         lines.append(f"  failed {name}: {error.splitlines()[0] if error else ''}")
     if len(report.failures) > 10:
