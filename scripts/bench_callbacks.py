@@ -8,8 +8,9 @@ Runs the reference scene (c = 0.25 mm, 400 rpm, default solver settings) for par
 revolution once per route and repeat, and prints the median cost per step, callback calls
 per step (counted on the python route), the cost per call measured outside Exudyn, the
 ideal-joint model as the floor, and the agreement of the routes' peak contact force.
-``--profile`` adds Exudyn's own timer breakdown for the default route.  Times on a shared
-machine are noisy (+-20 %); compare routes within one run.
+``--profile`` adds Exudyn's own timer breakdown for the default route.  Times are CPU times
+(``time.process_time``); on a shared machine they still vary by +-20 %: compare routes
+within one run.
 """
 
 from __future__ import annotations
@@ -33,7 +34,7 @@ from weftsim.params import ClearanceJoint, Drive, Scene
 
 
 def run(scene: Scene, route: str | None, count: bool = False, profile: bool = False):
-    """One simulation; returns (seconds per step, calls per step or None, peak F_N)."""
+    """One simulation; returns (CPU s per step, calls per step or None, peak F_N, Newton it/step)."""
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
     counter = [0] if count else None
@@ -46,9 +47,9 @@ def run(scene: Scene, route: str | None, count: bool = False, profile: bool = Fa
     settings = simulation_settings(scene, n)
     settings.show.computationTime = profile  # fills the timers (and prints a summary)
     solver = exu.MainSolverImplicitSecondOrder()
-    t0 = time.perf_counter()
+    t0 = time.process_time()  # CPU time: less disturbed by other processes than wall time
     solver.SolveSystem(mbs, settings)
-    wall = time.perf_counter() - t0
+    wall = time.process_time() - t0
     ch = step_channels(mbs, model, sensors)
     if profile:
         _print_timers(solver.timer, n)
@@ -104,7 +105,8 @@ def main() -> None:
             else:
                 per_step, calls, peak, its = run(scene, route, count=(route == "python"))
             rows.setdefault(route, []).append((per_step, calls, peak, its))
-    print(f"{'route':10s} {'us/step (median)':>17s} {'all runs':>24s} {'calls/step':>11s} {'Newton it/step':>15s} {'peak F_N [N]':>16s}")
+    print(f"{'route':10s} {'us/step (median)':>17s} {'all runs':>24s} {'calls/step':>11s} "
+          f"{'Newton it/step':>15s} {'peak F_N [N]':>16s}")  # fmt: skip
     for route, vals in rows.items():
         times = [1e6 * v[0] for v in vals]
         calls = vals[0][1]

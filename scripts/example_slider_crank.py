@@ -84,16 +84,19 @@ def build(mbs, joint: ClearanceJoint, callback: str = "auto"):
     mbs.AddLoad(LoadForceVector(markerNumber=bearing, loadVector=[-LOAD, 0.0, 0.0]))
     clearance = add_clearance_joint(mbs, bearing, journal, joint, callback=callback)
 
+    ovt = exu.OutputVariableType
+    rod_body, conn = rod["bodyNumber"], clearance.connector
     sensors = {
-        "crank": mbs.AddSensor(SensorNode(nodeNumber=crank["nodeNumber"], outputVariableType=exu.OutputVariableType.Coordinates, **store)),
-        "slider_a": mbs.AddSensor(SensorNode(nodeNumber=slider_node, outputVariableType=exu.OutputVariableType.Coordinates_tt, **store)),
-        "pin_a": mbs.AddSensor(SensorBody(bodyNumber=rod["bodyNumber"], localPosition=[-ROD / 2.0, 0.0, 0.0],
-                                          outputVariableType=exu.OutputVariableType.Position, **store)),  # fmt: skip
-        "pin_b": mbs.AddSensor(SensorBody(bodyNumber=rod["bodyNumber"], localPosition=[ROD / 2.0, 0.0, 0.0],
-                                          outputVariableType=exu.OutputVariableType.Position, **store)),  # fmt: skip
-        "ecc": mbs.AddSensor(SensorObject(objectNumber=clearance.connector, outputVariableType=exu.OutputVariableType.Displacement, **store)),
-        "force": mbs.AddSensor(SensorObject(objectNumber=clearance.connector, outputVariableType=exu.OutputVariableType.Force, **store)),
+        "crank": SensorNode(nodeNumber=crank["nodeNumber"], outputVariableType=ovt.Coordinates, **store),
+        "slider_a": SensorNode(nodeNumber=slider_node, outputVariableType=ovt.Coordinates_tt, **store),
+        "pin_a": SensorBody(bodyNumber=rod_body, localPosition=[-ROD / 2.0, 0.0, 0.0],
+                            outputVariableType=ovt.Position, **store),
+        "pin_b": SensorBody(bodyNumber=rod_body, localPosition=[ROD / 2.0, 0.0, 0.0],
+                            outputVariableType=ovt.Position, **store),
+        "ecc": SensorObject(objectNumber=conn, outputVariableType=ovt.Displacement, **store),
+        "force": SensorObject(objectNumber=conn, outputVariableType=ovt.Force, **store),
     }  # fmt: skip
+    sensors = {name: mbs.AddSensor(sensor) for name, sensor in sensors.items()}
     return clearance, sensors
 
 
@@ -146,8 +149,9 @@ def main(end_time: float = 0.25, step: float = 5e-6) -> None:
     print(f"clearance {c * 1e3} mm, law {clearance.law.name}, callback route {clearance.route}, "
           f"contact events {clearance.tracker.contact_events}")  # fmt: skip
     print(f"second half of the run ({len(length)} steps):")
-    print(f"  |e| - c            {1e6 * (length - c).min():7.3f} .. {1e6 * (length - c).max():7.3f} um   "
-          f"statics {1e6 * closed['penetration'].min():7.3f} .. {1e6 * closed['penetration'].max():7.3f} um")  # fmt: skip
+    pen, stat = 1e6 * (length - c), 1e6 * closed["penetration"]
+    print(f"  |e| - c            {pen.min():7.3f} .. {pen.max():7.3f} um   "
+          f"statics {stat.min():7.3f} .. {stat.max():7.3f} um")  # fmt: skip
     rel = np.abs(result["normal_force"] / closed["normal_force"] - 1.0)
     print(f"  F_N / statics - 1  max {rel.max():.2e}")
     print(f"  angle(e, rod)      max {angle.max():.3f} deg")

@@ -90,8 +90,9 @@ def test_reflected_gear_inertia_equals_separate_gear_bodies():
         s = exu.SystemContainer()
         mbs = s.AddSystem()
         model = build_mechanism(mbs, sc, reflect_gears=reflect)
+        force = exu.OutputVariableType.Force
         sensor = mbs.AddSensor(exu.itemInterface.SensorObject(objectNumber=model.drive, storeInternal=True,
-                                                              outputVariableType=exu.OutputVariableType.Force))  # fmt: skip
+                                                              outputVariableType=force))  # fmt: skip
         mbs.Assemble()
         from weftsim.exudyn_engine.solver import simulation_settings, step_plan
 
@@ -226,3 +227,11 @@ def test_first_revolution_peaks_converge_when_the_step_is_halved():
         # Start-up impact (F_N, a): O(h^2), measured 3e-5.  The torque maximum comes from the
         # impact sequence near 48 deg, already sensitive to the step (SPEC.md 6): measured 2.3e-3.
         assert a == pytest.approx(b, rel=tol), name
+
+
+def test_progress_is_reported_from_zero_to_one():
+    seen = []
+    r = solve(scene(0.0, 400.0, 5.0 / 360.0, step_size=IDEAL_STEP), progress=seen.append)
+    assert r.ok
+    assert seen[0] == 0.0 and seen[-1] == 1.0
+    assert all(b >= a for a, b in zip(seen, seen[1:])) and len(seen) > 10  # ~100 reports per run

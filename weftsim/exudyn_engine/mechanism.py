@@ -178,7 +178,8 @@ def build_mechanism(mbs, scene: Scene, callback: str | None = None, reflect_gear
         bodies.update(_gear_train(mbs, scene, ground, sector, gravity))
 
     # Joint E: bearing on the rocker, journal on the rod.
-    marker_bearing = mbs.AddMarker(MarkerBodyPosition(bodyNumber=rocker["bodyNumber"], localPosition=[g.l_oe, 0.0, 0.0]))
+    marker_bearing = mbs.AddMarker(MarkerBodyPosition(bodyNumber=rocker["bodyNumber"],
+                                                      localPosition=[g.l_oe, 0.0, 0.0]))  # fmt: skip
     marker_journal = mbs.AddMarker(MarkerBodyPosition(bodyNumber=rod["bodyNumber"], localPosition=[-half, 0.0, 0.0]))
     clearance = None
     if scene.joint.is_ideal:
@@ -188,7 +189,8 @@ def build_mechanism(mbs, scene: Scene, callback: str | None = None, reflect_gear
         clearance = add_clearance_joint(mbs, marker_bearing, marker_journal, scene.joint,
                                         callback=route, call_counter=call_counter)  # fmt: skip
 
-    drive = mbs.CreateCoordinateConstraint(itemNumbers=[None, crank["nodeNumber"]], coordinates=[None, CRANK_COORDINATE],
+    drive = mbs.CreateCoordinateConstraint(itemNumbers=[None, crank["nodeNumber"]],
+                                           coordinates=[None, CRANK_COORDINATE],
                                            offset=omega, velocityLevel=True)  # fmt: skip
     return MechanismModel(
         scene=scene,
