@@ -20,7 +20,8 @@ import shutil
 import sys
 from pathlib import Path
 
-from weftsim.sweep import format_report, plan_sweep, run_sweep
+from weftsim.scene import SceneError
+from weftsim.sweep import SweepError, format_report, plan_sweep, run_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "models" / "reference.toml"
@@ -56,8 +57,12 @@ def main(argv: list[str] | None = None) -> int:
         vary, fixed = STUDIES[study]
         outdir = Path(args.out) / study
         print(f"== {study}: {command(study, outdir, args.engine)}", flush=True)
-        plan = plan_sweep(SCENE, vary, fixed, args.engine)
-        report = run_sweep(plan, outdir, jobs=args.jobs, scheduler=args.scheduler)
+        try:
+            plan = plan_sweep(SCENE, vary, fixed, args.engine)
+            report = run_sweep(plan, outdir, jobs=args.jobs, scheduler=args.scheduler)
+        except (SweepError, SceneError) as exc:
+            print(f"paper_sweeps {study}: error: {exc}", file=sys.stderr)
+            return 2
         print(format_report(report), flush=True)
         failed += report.failed
         if study == "map" and report.figure and not args.no_image:
