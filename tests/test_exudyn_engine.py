@@ -177,6 +177,14 @@ def test_invalid_settings_and_friction_fail_naming_the_setting():
     assert r.status == "failed" and "friction" in r.message
 
 
+def test_newton_failure_is_reported_not_passed_over():
+    # One Newton iteration at a 10x larger step cannot converge at the start-up free flight.
+    r = solve(scene(0.25e-3, 400.0, 2.0 / 360.0, step_size=2e-5, newton_max_iterations=1))
+    assert r.status == "failed"
+    assert "Newton" in r.message and "crank angle" in r.message and "newton_max_iterations" in r.message
+    assert len(r.steps["time_s"]) >= 1
+
+
 def test_nan_in_the_contact_force_fails_with_time_and_angle(monkeypatch):
     make = cb.make_python_force
 

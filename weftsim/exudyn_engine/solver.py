@@ -49,6 +49,11 @@ def check_settings(scene: Scene) -> str | None:
         return f"`exudyn_solver.newton_max_iterations` must be >= 1, got {s.newton_max_iterations}"
     if s.callback not in ROUTES + ("auto",):
         return f"`exudyn_solver.callback` must be one of {('auto',) + ROUTES}, got {s.callback!r}"
+    if s.callback == "numba" and not scene.joint.is_ideal:
+        try:
+            import numba  # noqa: F401 - optional dependency of this route only
+        except ImportError:
+            return "`exudyn_solver.callback` = 'numba' needs numba installed; use 'auto' or 'python'"
     if not scene.output.sample_angle > 0.0:
         return f"`output.sample_angle` must be > 0, got {scene.output.sample_angle}"
     if scene.joint.friction_coefficient > 0.0 and not scene.joint.is_ideal:
