@@ -1,0 +1,157 @@
+"""Shared parts of the studies: scene files, engine runs, the reproducible numbers of a run.
+
+SPEC.md section 6: after the first impacts the impact sequence depends on round-off,
+step and tolerance, so each run is summarised by quantities that do not:
+
+- ``first_revolution``: min and max of each peak channel over revolution 1 (the start-up
+  impact from the centred journal dominates them);
+- ``statistics``: time-weighted mean, RMS and percentiles over revolutions 2..N;
+- ``last_revolution``: min and max over the last revolution, reported as an illustration
+  (the paper's single-cycle curves), not as a reproducible number.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+
+log = logging.getLogger(__name__)
+
+RPM = 60.0 / (2.0 * math.pi)  # rad/s -> rpm
+
+
+class StudyError(ValueError):
+    """A study cannot run: missing scene file, bad setting, or a failed simulation."""
+
+
+def scene_path(models: str | Path, name: str) -> Path:
+    """``models/<name>``, with an error that says where the scene files are expected."""
+    path = Path(models) / name
+    if not path.is_file():
+        raise StudyError(f"scene file {path} not found; run from the repository root or pass the "
+                         "models directory (--models DIR)")
+    return path
+
+
+def load(models: str | Path, name: str, overrides: dict | None = None):
+    """Load ``models/<name>`` with file-unit overrides (e.g. ``{"drive.revolutions": 10}``)."""
+    from weftsim.scene import load_scene
+
+    return load_scene(scene_path(models, name), overrides)
+
+
+def solve(scene, engine: str = "reference", label: str | None = None, progress: bool = True):
+    """Run one engine on a scene (progress on stderr for long runs); failures raise StudyError."""
+    from weftsim.progress import Progress
+
+    if engine == "reference":
+        from weftsim.reference import solve as engine_solve
+    elif engine == "exudyn":
+        from weftsim.exudyn_engine import solve as engine_solve
+    else:
+        raise StudyError(f"engine must be 'reference' or 'exudyn', got {engine!r}")
+    reporter = Progress(label or f"{engine} {scene.name}") if progress else None
+    start = time.perf_counter()
+    try:
+        result = engine_solve(scene, progress=reporter)
+    finally:
+        if reporter is not None:
+            reporter.close()
+    log.info("%s %s: %s in %.1f s", engine, scene.name, result.status, time.perf_counter() - start)
+    if not result.ok:
+        raise StudyError(f"{engine} engine failed on scene {scene.name}: {result.message}")
+    return result
+
+
+def speed_rpm(scene) -> float:
+    return round(scene.drive.speed * RPM, 9)
+
+
+def clearance_mm(scene) -> float:
+    return round(scene.joint.clearance * 1e3, 12)
+
+
+def percentile(result, channel: str, q: float, skip_revolutions: int = 1) -> float | None:
+    """Time-weighted percentile q of a channel over the whole revolutions after ``skip_revolutions``."""
+    from weftsim.analysis import complete_revolutions, time_weights, weighted_percentile
+
+    n = complete_revolutions(result)
+    if n <= skip_revolutions:
+        return None
+    period = result.scene.drive.period
+    t = result.steps["time_s"]
+    keep = (t >= skip_revolutions * period - 1e-12) & (t <= n * period + 1e-12)
+    return weighted_percentile(result.steps[channel][keep], time_weights(t[keep]), q)
+
+
+def run_metrics(result) -> dict:
+    """The numbers of one run that the studies and the report use (JSON-ready).
+
+    ``statistics`` (revolutions 2..N) adds ``p1`` (1st percentile) to the fields of
+    :func:`weftsim.analysis.channel_statistics`; it is None for runs of fewer than 2 revolutions.
+    """
+    from weftsim.analysis import complete_revolutions, peaks, statistics
+
+    n = complete_revolutions(result)
+    stats = statistics(result)
+    if stats is not None:
+        for channel, values in stats.items():
+            values["p1"] = percentile(result, channel, 1.0)
+    return {
+        "scene": result.scene.name,
+        "engine": result.engine,
+        "clearance_mm": clearance_mm(result.scene),
+        "speed_rpm": speed_rpm(result.scene),
+        "law": result.scene.joint.law,
+        "revolutions": n,
+        "wall_time_s": result.wall_time_s,
+        "first_contact_crank_angle_deg": result.first_contact_angle_deg,
+        "first_revolution": peaks(result, 0) if n >= 1 else None,
+        "last_revolution": peaks(result, n - 1) if n >= 1 else None,
+        "statistics": stats,
+    }
+
+
+def magnitude(peak: dict | None) -> float | None:
+    """Largest magnitude max(|min|, |max|) of a {min, max} peak entry."""
+    if peak is None:
+        return None
+    return max(abs(peak["min"]), abs(peak["max"]))
+
+
+def ratio(a: float | None, b: float | None) -> float | None:
+    if a is None or b is None or b == 0:
+        return None
+    return a / b
+
+
+def revolution_steps(result, revolution: int) -> dict[str, np.ndarray]:
+    """Per-step channels of one (0-based) revolution, crank angle folded to 0..360 deg."""
+    period = result.scene.drive.period
+    t = result.steps["time_s"]
+    keep = (t >= revolution * period - 1e-12) & (t <= (revolution + 1) * period + 1e-12)
+    data = {name: values[keep] for name, values in result.steps.items()}
+    data["crank_angle_deg"] = data["crank_angle_deg"] - 360.0 * revolution
+    return data
+
+
+CURVE_CHANNELS = ("time_s", "crank_angle_deg", "rapier_displacement_m", "rapier_velocity_m_s",
+                  "rapier_acceleration_m_s2", "driving_torque_Nm", "contact_force_N", "penetration_m")
+
+
+def write_curves(outdir: Path, name: str, data: dict[str, np.ndarray]) -> Path:
+    """The per-step curves a figure shows, as ``<name>.csv`` (crank angle folded to 0..360 deg)."""
+    from weftsim.output import write_csv
+
+    return write_csv(Path(outdir) / f"{name}.csv", {channel: data[channel] for channel in CURVE_CHANNELS})
+
+
+def revolutions_override(revolutions: float | None, default: float) -> dict:
+    value = default if revolutions is None else revolutions
+    if not (value > 0 and math.isfinite(value)):
+        raise StudyError(f"revolutions must be > 0, got {value}")
+    return {"drive.revolutions": value}

@@ -1,0 +1,187 @@
+"""Contact-law study, like the paper's Fig. 7-9 (c = 0.01 mm, 500 rpm).
+
+(a) K(delta) of the scene's law against penetration (paper Fig. 7), with the constant
+    Lankarani-Nikravesh stiffness for reference;
+(b) K(delta) at every solver step in contact along the last simulated revolution
+    (paper Fig. 8: "contact stiffness with time");
+(c) the damping coefficient D = xi K(delta) delta^n / v_imp (paper Eqs. 19, 23) at the
+    same steps, against penetration (paper Fig. 9), with D(delta) of the law at fixed
+    impact velocities.
+
+K and D come from the contact-law library (:mod:`weftsim.contact`) evaluated on the
+per-step penetration and held impact velocity of a reference-engine run.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from weftsim.studies import common
+
+SCENE = "paper/clearance_0p01mm_400rpm.toml"
+SPEED_RPM = 500.0  # paper Fig. 7-9
+REVOLUTIONS = 2.0  # the start-up revolution and one more, which is plotted
+CURVE_POINTS = 601
+CURVE_RANGE = 3.0  # stiffness curve up to 3 c (the paper's Fig. 7 spans ~0.02 mm at c = 0.01 mm)
+FLATTENING_MM = 0.005  # paper: K(delta) flattens after 0.005 mm
+DAMPING_LINEAR_MM = 0.015  # paper: D(delta) nonlinear up to ~0.015 mm, then closer to linear
+
+
+def log_slope(function, x: float, h: float = 1e-4) -> float:
+    """d ln f / d ln x at x by a central difference in ln x (relative step h)."""
+    return float((math.log(function(x * (1 + h))) - math.log(function(x * (1 - h)))) /
+                 (math.log1p(h) - math.log1p(-h)))
+
+
+def stiffness_curve(joint, points: int = CURVE_POINTS, extent: float = CURVE_RANGE) -> dict:
+    """K(delta) of ``joint``'s law on 0..extent x c, and the numbers quoted against the paper."""
+    from dataclasses import replace
+
+    from weftsim.contact import lankarani_nikravesh_stiffness, make_law
+
+    law = make_law(joint)
+    c = joint.clearance
+    penetration = np.linspace(0.0, extent * c, points)
+    stiffness = np.asarray(law.stiffness(penetration), dtype=float)
+    ln_joint = replace(joint, law="lankarani_nikravesh")
+    at_flattening = float(law.stiffness(FLATTENING_MM * 1e-3))
+    far = float(law.stiffness(1e3 * c))  # the plateau: K(delta >> c)
+    stiff = lambda d: float(law.stiffness(d))  # noqa: E731
+    damp = lambda d: float(law.damping(d, 1.0))  # noqa: E731  (D at fixed v_imp: v_imp only scales it)
+    return {
+        "law": law.name,
+        "exponent": law.exponent,
+        "hysteresis": law.hysteresis,
+        "clearance_mm": c * 1e3,
+        "penetration_mm": penetration * 1e3,
+        "stiffness": stiffness,
+        "stiffness_constant": lankarani_nikravesh_stiffness(ln_joint),
+        "numbers": {
+            "stiffness_at_0p005mm": at_flattening,
+            "stiffness_plateau": far,
+            "stiffness_at_0p005mm_over_plateau": at_flattening / far,
+            "stiffness_at_end_over_plateau": float(stiffness[-1] / far),
+            "stiffness_log_slope": {f"{d:g}": log_slope(stiff, d * 1e-3) for d in (0.0005, 0.005, 0.015, 0.03)},
+            "damping_log_slope": {f"{d:g}": log_slope(damp, d * 1e-3) for d in (0.0005, 0.005, 0.015, 0.03)},
+        },
+    }
+
+
+def contact_steps(result, revolution: int) -> dict[str, np.ndarray]:
+    """Steps in contact of one revolution with K(delta) and D(delta, v_imp) from the scene's law."""
+    from weftsim.contact import make_law
+
+    law = make_law(result.scene.joint)
+    data = common.revolution_steps(result, revolution)
+    keep = (data["in_contact"] > 0.5) & (data["penetration_m"] > 0.0)
+    penetration = data["penetration_m"][keep]
+    impact = data["impact_velocity_m_s"][keep]
+    return {
+        "time_s": data["time_s"][keep],
+        "crank_angle_deg": data["crank_angle_deg"][keep],
+        "penetration_mm": penetration * 1e3,
+        "impact_velocity_m_s": impact,
+        "stiffness": np.asarray(law.stiffness(penetration), dtype=float),
+        "damping": np.asarray(law.damping(penetration, impact), dtype=float),
+        "contact_force_N": data["contact_force_N"][keep],
+    }
+
+
+def run(outdir: str | Path, models: str | Path = "models", revolutions: float | None = None,
+        force: bool = False, progress: bool = True) -> dict:
+    """Run the contact-law study into ``outdir``; returns what ``contact-law.json`` holds."""
+    from weftsim.contact import make_law
+    from weftsim.output import finish_directory, prepare_directory, write_csv, write_figure, write_json
+    from weftsim.studies.figures import contact_law_panels
+
+    outdir = prepare_directory(outdir, force)
+    scene = common.load(models, SCENE, {"drive.speed_rpm": SPEED_RPM,
+                                        "drive.revolutions": revolutions or REVOLUTIONS})
+    curve = stiffness_curve(scene.joint)
+    result = common.solve(scene, "reference", progress=progress)
+    from weftsim.analysis import complete_revolutions
+
+    n = complete_revolutions(result)
+    revolution = max(n - 1, 0)
+    steps = contact_steps(result, revolution)
+    law = make_law(scene.joint)
+    written = {
+        "curve": write_csv(outdir / "contact-law-stiffness.csv", {
+            "penetration_mm": curve["penetration_mm"],
+            "stiffness_N_m1p5": curve["stiffness"],
+            "stiffness_lankarani_nikravesh_N_m1p5": np.full_like(curve["stiffness"], curve["stiffness_constant"]),
+        }),
+        "steps": write_csv(outdir / "contact-law-revolution.csv", {
+            "time_s": steps["time_s"], "crank_angle_deg": steps["crank_angle_deg"],
+            "penetration_mm": steps["penetration_mm"], "impact_velocity_m_s": steps["impact_velocity_m_s"],
+            "stiffness_N_m1p5": steps["stiffness"], "damping_N_s_m": steps["damping"],
+            "contact_force_N": steps["contact_force_N"]}),
+    }
+    law_lines = []
+    if steps["impact_velocity_m_s"].size:
+        delta = np.linspace(0.0, max(float(steps["penetration_mm"].max()), CURVE_RANGE * curve["clearance_mm"]), 300)
+        for q, what in ((100, "largest"), (50, "median")):
+            v = float(np.percentile(steps["impact_velocity_m_s"], q))
+            law_lines.append((f"law at v_imp = {v:.3g} m/s ({what})", delta, law.damping(delta * 1e-3, v)))
+    rpm = common.speed_rpm(scene)
+    title = (f"contact law {law.name}, c = {curve['clearance_mm']:g} mm, {rpm:g} rpm "
+             f"(revolution {revolution + 1} of {n}, reference engine)")
+    written["figure"] = write_figure(outdir / "study-contact-law.png",
+                                     contact_law_panels(curve, steps, law_lines, title))
+    in_contact = {}
+    if steps["stiffness"].size:
+        data = common.revolution_steps(result, revolution)
+        from weftsim.analysis import time_weights
+
+        w = time_weights(data["time_s"])
+        in_contact = {
+            "steps_in_contact": int(steps["stiffness"].size),
+            "time_fraction_in_contact": float(np.dot(w, data["in_contact"] > 0.5) / w.sum()),
+            "stiffness_min": float(steps["stiffness"].min()),
+            "stiffness_median": float(np.median(steps["stiffness"])),
+            "stiffness_max": float(steps["stiffness"].max()),
+            "penetration_max_mm": float(steps["penetration_mm"].max()),
+            "damping_min": float(steps["damping"].min()),
+            "damping_max": float(steps["damping"].max()),
+            "impact_velocity_min_m_s": float(steps["impact_velocity_m_s"].min()),
+            "impact_velocity_max_m_s": float(steps["impact_velocity_m_s"].max()),
+        }
+    report = {
+        "study": "contact-law",
+        "scene": scene.name,
+        "clearance_mm": curve["clearance_mm"],
+        "speed_rpm": rpm,
+        "law": curve["law"],
+        "hysteresis": curve["hysteresis"],
+        "exponent": curve["exponent"],
+        "stiffness_lankarani_nikravesh": curve["stiffness_constant"],
+        "curve": curve["numbers"],
+        "plotted_revolution": revolution + 1,
+        "revolution": in_contact,
+        "run": common.run_metrics(result),
+        "files": sorted(p.name for p in written.values()),
+    }
+    written["json"] = write_json(outdir / "contact-law.json", report)
+    finish_directory(outdir, written, {"kind": "study", "study": "contact-law"})
+    return report
+
+
+def format_report(report: dict) -> str:
+    """The lines ``weftsim study contact-law`` prints."""
+    c, r = report["curve"], report.get("revolution") or {}
+    lines = [
+        f"contact-law study: {report['law']}, c = {report['clearance_mm']:g} mm, {report['speed_rpm']:g} rpm",
+        f"  K(0.005 mm) = {c['stiffness_at_0p005mm']:.4g} N/m^1.5 = {c['stiffness_at_0p005mm_over_plateau']:.3f} "
+        f"of the plateau K(delta >> c) = {c['stiffness_plateau']:.4g}",
+        "  d ln K / d ln delta at " + ", ".join(f"{k} mm: {v:.3f}" for k, v in c["stiffness_log_slope"].items()),
+        "  d ln D / d ln delta at " + ", ".join(f"{k} mm: {v:.3f}" for k, v in c["damping_log_slope"].items()),
+    ]
+    if r:
+        lines.append(f"  revolution {report['plotted_revolution']}: in contact {100 * r['time_fraction_in_contact']:.1f}% "
+                     f"of the time, K {r['stiffness_min']:.3g} .. {r['stiffness_max']:.3g} N/m^1.5, "
+                     f"delta up to {r['penetration_max_mm']:.4g} mm, D {r['damping_min']:.3g} .. "
+                     f"{r['damping_max']:.3g} N s/m")
+    return "\n".join(lines)
