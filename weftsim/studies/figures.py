@@ -77,22 +77,22 @@ def spectrum_panels(spectra, title: str, low_band_hz: float = 100.0):
 
     Parameters
     ----------
-    spectra : list of (label, Spectrum)
+    spectra : list of (label, Spectrum, style)
     """
     plt = _pyplot()
     fig, (near, full) = plt.subplots(2, 1, figsize=(10, 8))
-    for label, spectrum in spectra:
+    for label, spectrum, style in spectra:
         f, a = spectrum.frequency_hz, spectrum.amplitude
         keep = f <= low_band_hz
-        near.plot(f[keep], a[keep], "-", marker=".", ms=3, lw=0.8, label=label)
-        full.semilogy(f[1:], a[1:], lw=0.6, label=label)
+        near.plot(f[keep], a[keep], "-", marker=".", ms=3, lw=0.8, label=label, **style)
+        full.semilogy(f[1:], a[1:], lw=0.6, label=label, **style)
     near.axvspan(0.0, 10.0, color="0.85", zorder=0, label="0-10 Hz (paper: main content)")
     near.set_xlim(0, low_band_hz)
     near.set_xlabel("frequency [Hz]")
     near.set_ylabel("rapier acceleration amplitude [m/s²]")
     full.set_xlabel("frequency [Hz]")
     full.set_ylabel("rapier acceleration amplitude [m/s²]")
-    full.set_xlim(0, max(s.frequency_hz[-1] for _, s in spectra))
+    full.set_xlim(0, max(s.frequency_hz[-1] for _, s, _ in spectra))
     for ax in (near, full):
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8, loc="best")
