@@ -1,4 +1,4 @@
-"""Command line: ``weftsim kinematics | run | compare | sweep``.  Thin: parse, call, report.
+"""Command line: ``weftsim kinematics | run | compare | sweep | study``.  Thin: parse, call, report.
 
 Every expected failure (bad scene, bad flag, unwritable output, failed solve) is one
 line on stderr and a non-zero exit status; tracebacks only for real bugs.
@@ -103,6 +103,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--jobs", type=_positive(int), help="local worker processes (default: number of CPUs)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="run on an existing Dask cluster, e.g. tcp://host:8786")
     p.add_argument("--cell-figures", action="store_true", help="also draw each cell's channels.png")
+
+    p = sub.add_parser("study", help="one of the paper's studies: figures, CSV and JSON (docs/paper-comparison.md)",
+                       description="Run a study of the paper: contact-law (Fig. 7-9), clearance (Fig. 12), "
+                       "speed (Fig. 13, with the acceleration spectrum), engines (Fig. 16), or all of them.")
+    p.add_argument("name", help="contact-law, clearance, speed, engines or all")
+    p.add_argument("-o", "--output", default=None,
+                   help="output directory (default: out/study-NAME; with 'all': parent of one directory per study)")
+    p.add_argument("--models", default="models", help="directory of the scene files (default: models)")
+    p.add_argument("--revolutions", type=_positive(float), help="override the study's crank revolutions per run")
+    p.add_argument("--force", action="store_true",
+                   help="write into an output directory that holds files weftsim did not write")
     return parser
 
 
@@ -237,7 +248,24 @@ def cmd_sweep(args) -> int:
     return 0
 
 
-COMMANDS = {"kinematics": cmd_kinematics, "run": cmd_run, "compare": cmd_compare, "sweep": cmd_sweep}
+def cmd_study(args) -> int:
+    from weftsim.studies import STUDIES, SimulationFailed, StudyError, format_study, run_study
+
+    names = list(STUDIES) if args.name == "all" else [args.name]
+    for name in names:
+        outdir = Path(args.output) / name if args.output and args.name == "all" else args.output
+        try:
+            report = run_study(name, outdir, args.models, args.revolutions, args.force)
+        except SimulationFailed as exc:
+            raise CliError(str(exc), EXIT_FAILED) from None
+        except StudyError as exc:
+            raise CliError(str(exc)) from None
+        print(format_study(name, report))
+    return 0
+
+
+COMMANDS = {"kinematics": cmd_kinematics, "run": cmd_run, "compare": cmd_compare, "sweep": cmd_sweep,
+            "study": cmd_study}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -25,7 +25,11 @@ RPM = 60.0 / (2.0 * math.pi)  # rad/s -> rpm
 
 
 class StudyError(ValueError):
-    """A study cannot run: missing scene file, bad setting, or a failed simulation."""
+    """A study cannot run: unknown name, missing scene file or bad setting."""
+
+
+class SimulationFailed(StudyError):
+    """A simulation of a study ended with ``status = "failed"``."""
 
 
 def scene_path(models: str | Path, name: str) -> Path:
@@ -45,7 +49,7 @@ def load(models: str | Path, name: str, overrides: dict | None = None):
 
 
 def solve(scene, engine: str = "reference", label: str | None = None, progress: bool = True):
-    """Run one engine on a scene (progress on stderr for long runs); failures raise StudyError."""
+    """Run one engine on a scene (progress on stderr for long runs); a failed run raises SimulationFailed."""
     from weftsim.progress import Progress
 
     if engine == "reference":
@@ -63,7 +67,7 @@ def solve(scene, engine: str = "reference", label: str | None = None, progress: 
             reporter.close()
     log.info("%s %s: %s in %.1f s", engine, scene.name, result.status, time.perf_counter() - start)
     if not result.ok:
-        raise StudyError(f"{engine} engine failed on scene {scene.name}: {result.message}")
+        raise SimulationFailed(f"{engine} engine failed on scene {scene.name}: {result.message}")
     return result
 
 
