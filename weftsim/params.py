@@ -217,6 +217,36 @@ class CompareTolerance:
 
 
 @dataclass(frozen=True)
+class Limits:
+    """Run-time failure criteria and budgets, checked by both engines (:mod:`weftsim.guards`).
+
+    A run that crosses one ends with ``status = "failed"``, a message saying what, when
+    (time and crank angle) and what to try, and keeps what it computed up to then.
+    docs/hard-cases.md gives the reasons for the defaults.
+
+    Attributes
+    ----------
+    max_wall_time : float
+        Wall-clock budget of one run, s; 0 = no limit.
+    max_steps : int
+        Budget of accepted solver steps; 0 = no limit.
+    max_penetration : float
+        Largest penetration delta allowed, as a fraction of the journal radius R_j.
+        Beyond about a tenth of R_j the rigid bodies with a local contact compliance are
+        no model of the joint any more (the journal would be flattened by R_j / 10).
+    min_step : float
+        Step-size collapse, s: the reference engine fails on an accepted step shorter
+        than this; the Exudyn engine uses it as the floor of its step reduction after
+        Newton failures.  Far below the ~1e-7 s that the stiffest impacts need.
+    """
+
+    max_wall_time: float = 0.0
+    max_steps: int = 0
+    max_penetration: float = 0.1
+    min_step: float = 1e-12
+
+
+@dataclass(frozen=True)
 class Scene:
     """Everything one simulation needs; produced by :func:`weftsim.scene.load_scene`."""
 
@@ -229,4 +259,5 @@ class Scene:
     exudyn_solver: ExudynSolver = field(default_factory=ExudynSolver)
     output: Output = field(default_factory=Output)
     compare: CompareTolerance = field(default_factory=CompareTolerance)
+    limits: Limits = field(default_factory=Limits)
     source: str = ""

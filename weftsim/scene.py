@@ -2,7 +2,9 @@
 
 A scene file may ``extends = "other.toml"`` (path relative to the file) and then
 holds only what differs; tables merge key by key.  Units live in the key names
-(``_mm``, ``_deg``, ``_rpm``, ``_gpa``, ...) and are converted to SI here.  Every
+(``_mm``, ``_deg``, ``_rpm``, ``_gpa``, ...) and are converted to SI here.  A scene
+must give every key of the sections that describe the machine (:data:`REQUIRED_SECTIONS`),
+itself or through ``extends``; settings (solver, output, compare, limits) default.  Every
 problem is reported as one :class:`SceneError` naming the file, the key, the bad
 value and what is allowed.  :data:`SCHEMA` is the single list of keys; the README's
 scene reference is written from it.
@@ -127,9 +129,22 @@ SCHEMA: tuple[Key, ...] = (
     Key("compare.percentile_99", "compare.percentile_99", "float", 1, 0, doc="relative tolerance on 99th percentiles"),
     Key("compare.ideal_curves", "compare.ideal_curves", "float", 1, 0,
         doc="ideal joint: largest difference at any sample, relative to the peak"),
+    Key("limits.max_wall_time_s", "limits.max_wall_time", "float", 1, 0, None, False,
+        doc="wall-clock budget of one run; 0 = no limit (the run fails when it is spent)"),
+    Key("limits.max_steps", "limits.max_steps", "int", 1, 0, None, False,
+        doc="budget of accepted solver steps; 0 = no limit"),
+    Key("limits.max_penetration_ratio", "limits.max_penetration", "float", 1, 0, 1, True, False,
+        doc="the run fails when the penetration exceeds this fraction of the journal radius"),
+    Key("limits.min_step_s", "limits.min_step", "float", 1, 0, 1e-4,
+        doc="step-size collapse: the smallest step either engine may take"),
 )
 _BY_PATH = {key.path: key for key in SCHEMA}
 TOP_LEVEL = ("name", "description", "extends")
+# Sections that describe the machine: a scene must give all their keys, itself or through
+# `extends` (a missing one is an error, never a silent default).  Solver settings, output,
+# compare tolerances and limits fall back to the defaults of weftsim.params.
+REQUIRED_SECTIONS = ("mechanism", "inertia", "joint_e", "drive")
+REQUIRED = tuple(key.path for key in SCHEMA if key.path.partition(".")[0] in REQUIRED_SECTIONS)
 
 
 def _flatten(table: dict, prefix: str = "") -> dict[str, Any]:
@@ -206,8 +221,12 @@ def _convert(key: Key, value: Any, where: str) -> Any:
     for number in numbers:
         if isinstance(number, bool) or not isinstance(number, (int, float)):
             raise fail("must be a number")
-        if not math.isfinite(number):
-            raise fail("must be a finite number")
+        try:
+            finite = math.isfinite(number) and math.isfinite(float(number) * key.scale)
+        except OverflowError:  # an integer beyond any float
+            finite = False
+        if not finite:
+            raise fail("must be a finite number (also in SI units)")
         low_bad = key.low is not None and (number <= key.low if key.low_open else number < key.low)
         high_bad = key.high is not None and (number >= key.high if key.high_open else number > key.high)
         if low_bad or high_bad:
@@ -256,6 +275,18 @@ def _check_scene(scene: params.Scene, where: str, origin: dict[str, Path]) -> No
         )
 
 
+def _known(path: str, where: str) -> Key:
+    """The schema key of a dotted path, or a SceneError listing the keys allowed there."""
+    key = _BY_PATH.get(path)
+    if key is None:
+        section = path.rpartition(".")[0]
+        near = [k.path for k in SCHEMA if k.path.rpartition(".")[0] == section] or sorted(
+            {k.path.partition(".")[0] for k in SCHEMA}
+        )
+        raise SceneError(f"{where}: unknown key '{path}'; allowed here: {', '.join(near)}")
+    return key
+
+
 def scene_from_keys(flat: dict[str, Any], where: str = "scene", origin: dict[str, Path] | None = None) -> params.Scene:
     """Validated :class:`Scene` from flattened dotted keys (file values, file units)."""
     origin = origin or {}
@@ -267,13 +298,7 @@ def scene_from_keys(flat: dict[str, Any], where: str = "scene", origin: dict[str
         if path in TOP_LEVEL:
             continue
         src = str(origin.get(path, where))
-        key = _BY_PATH.get(path)
-        if key is None:
-            section = path.rpartition(".")[0]
-            near = [k.path for k in SCHEMA if k.path.rpartition(".")[0] == section] or sorted(
-                {k.path.partition(".")[0] for k in SCHEMA}
-            )
-            raise SceneError(f"{src}: unknown key '{path}'; allowed here: {', '.join(near)}")
+        key = _known(path, src)
         value = _convert(key, value, src)
         if key.path == "mechanism.fourbar_branch":
             value = BRANCHES[value]
@@ -296,7 +321,9 @@ def load_scene(path: str | Path, overrides: dict[str, Any] | None = None) -> par
     Raises
     ------
     SceneError
-        Naming the file (or "command line"), the key, the bad value and what is allowed.
+        Naming the file (or "command line"), the key, the bad value and what is allowed;
+        or the required keys (sections :data:`REQUIRED_SECTIONS`) that neither the file
+        nor the files it extends give.
     """
     path = Path(path)
     flat, origin = _read_merged(path)
@@ -306,6 +333,16 @@ def load_scene(path: str | Path, overrides: dict[str, Any] | None = None) -> par
             continue
         flat[dotted] = value
         origin[dotted] = Path("command line")
+    for dotted in flat:  # a misspelt key is reported as such, not as the missing one it stands for
+        if dotted not in TOP_LEVEL:
+            _known(dotted, str(origin.get(dotted, path)))
+    missing = [key for key in REQUIRED if key not in flat]
+    if missing:
+        raise SceneError(
+            f"{path}: missing required keys {', '.join(missing)}; a scene must give every key of "
+            f"[{'], ['.join(REQUIRED_SECTIONS)}] itself or through `extends = \"reference.toml\"` "
+            "(then it holds only what differs)"
+        )
     return scene_from_keys(flat, str(path), origin)
 
 
