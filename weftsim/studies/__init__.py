@@ -47,7 +47,7 @@ def run_study(name: str, outdir: str | Path | None = None, models: str | Path = 
         A simulation of the study failed (a subclass of StudyError).
     """
     if name not in STUDIES:
-        raise StudyError(f"unknown study {name!r}; choose one of {', '.join(STUDIES)}")
+        raise StudyError(f"unknown study {name!r}; choose one of {', '.join(STUDIES)} (or all)")
     run, _ = STUDIES[name]
     return run(Path(outdir) if outdir is not None else Path("out") / f"study-{name}", models=models,
                revolutions=revolutions, force=force, progress=progress)

@@ -98,8 +98,8 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
     from weftsim.studies.figures import contact_law_panels
 
     outdir = prepare_directory(outdir, force)
-    scene = common.load(models, SCENE, {"drive.speed_rpm": SPEED_RPM,
-                                        "drive.revolutions": revolutions or REVOLUTIONS})
+    scene = common.load(models, SCENE, {"drive.speed_rpm": SPEED_RPM, "name": "contact_law_0p01mm_500rpm",
+                                        **common.revolutions_override(revolutions, REVOLUTIONS)})
     curve = stiffness_curve(scene.joint)
     result = common.solve(scene, "reference", progress=progress)
     from weftsim.analysis import complete_revolutions

@@ -170,7 +170,8 @@ def deviation_panel(bin_centres, deviations, markers, title: str):
             ax.axvline(angle, label=label if k == 0 else None, **style)
     ax.set_xlim(0, 360)
     ax.set_xticks(range(0, 361, 30))
-    ax.set_yscale("log")
+    if any(np.any(np.asarray(values) > 0) for _, values, _ in deviations):
+        ax.set_yscale("log")
     ax.set_xlabel(f"crank angle [deg] ({width:g} deg bins)")
     ax.set_ylabel("RMS of a − a_ideal [m/s²]")
     ax.grid(alpha=0.3)

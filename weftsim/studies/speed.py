@@ -45,7 +45,10 @@ def amplitude_measures(metrics: dict, channel: str) -> dict[str, float | None]:
 def spectrum_summary(spectrum, speed_rpm: float) -> dict:
     f_rev = speed_rpm / 60.0
     peak_f, peak_a = spectrum.peak()
-    band_f, band_a = spectrum.peak(0.0, PAPER_BAND_HZ)
+    try:
+        band_f, band_a = spectrum.peak(0.0, PAPER_BAND_HZ)
+    except ValueError:  # lines every f_rev / revolutions may all lie above 10 Hz
+        band_f = band_a = None
     line = int(np.argmin(np.abs(spectrum.frequency_hz - f_rev)))
     return {
         "crank_frequency_hz": f_rev,
@@ -72,7 +75,8 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
     overrides = common.revolutions_override(revolutions, REVOLUTIONS)
     results, ideals = {}, {}
     for rpm, name in SCENES.items():
-        ideals[rpm] = common.solve(common.load(models, IDEAL_SCENE, {**overrides, "drive.speed_rpm": rpm}),
+        ideals[rpm] = common.solve(common.load(models, IDEAL_SCENE, {**overrides, "drive.speed_rpm": rpm,
+                                                                    "name": f"ideal_{rpm:g}rpm"}),
                                    progress=progress)
         results[rpm] = common.solve(common.load(models, name, overrides), progress=progress)
     metrics = {rpm: common.run_metrics(r) for rpm, r in results.items()}
@@ -171,8 +175,8 @@ def format_report(report: dict) -> str:
         s, i = row["clearance"], row["ideal"]
         lines.append(f"  {rpm:>4s} rpm: max {s['max_amplitude_m_s2']:.1f} m/s^2 at {s['max_amplitude_frequency_hz']:.2f} Hz "
                      f"(harmonic {s['max_amplitude_harmonic']:.2f}; ideal {i['max_amplitude_m_s2']:.1f}), "
-                     f"max in 0-10 Hz {s['band_0_10hz_max_amplitude_m_s2']:.1f} at "
-                     f"{s['band_0_10hz_max_frequency_hz']:.2f} Hz, mean-square share 0-10 Hz "
+                     f"max in 0-10 Hz {f(s['band_0_10hz_max_amplitude_m_s2'], '.1f')} at "
+                     f"{f(s['band_0_10hz_max_frequency_hz'], '.2f')} Hz, mean-square share 0-10 Hz "
                      f"{100 * s['power_fraction_0_10hz']:.1f}%, first 5 harmonics "
                      f"{100 * s['power_fraction_first_5_harmonics']:.1f}%")
     return "\n".join(lines)
