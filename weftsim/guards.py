@@ -1,0 +1,161 @@
+"""Run-time failure criteria shared by both engines (the scene's ``[limits]``).
+
+A run must never end as a success after it went wrong.  Each engine makes one
+:class:`RunGuard` per run and calls :meth:`RunGuard.check` after every accepted step
+(or once per block of steps, with the block's extremes).  The first criterion crossed
+comes back as a :class:`Breach`; the engine then stops, keeps what it computed and
+returns ``status = "failed"`` with :func:`failure_message`: what failed, at which time
+and crank angle, and what to try.  The criteria, in the order they are checked:
+
+==============  ==========================================  ==============================
+kind            fails when                                  limit (scene ``[limits]``)
+==============  ==========================================  ==============================
+``non_finite``  a state or channel is NaN or inf            always on
+``penetration`` delta > max_penetration_ratio * R_j         ``max_penetration_ratio`` (0.1)
+``step_size``   an accepted step h < min_step               ``min_step_s`` (1e-12 s)
+``steps``       more than max_steps accepted steps          ``max_steps`` (0 = none)
+``wall_time``   wall-clock time since the start > budget    ``max_wall_time_s`` (0 = none)
+==============  ==========================================  ==============================
+
+Newton non-convergence is the engines' own (Exudyn's convergence flags; scipy's implicit
+methods shrink the step until it collapses).  Why the defaults are what they are, and the
+penetrations the hard cases reach, is in docs/hard-cases.md.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from typing import Callable
+
+from weftsim.params import Scene
+
+KINDS = ("non_finite", "penetration", "step_size", "steps", "wall_time")
+
+
+@dataclass(frozen=True)
+class Breach:
+    """A failure criterion that a run crossed.
+
+    Attributes
+    ----------
+    kind : str
+        One of :data:`KINDS`.
+    what : str
+        What failed, with the value and the limit (naming its scene key).
+    hint : str
+        What to try.
+    """
+
+    kind: str
+    what: str
+    hint: str
+
+
+def where(t: float, omega: float) -> str:
+    """``"t = 0.0123 s, crank angle 29.520 deg"`` (with the revolution after the first one)."""
+    deg = math.degrees(omega * t)
+    text = f"t = {t:.6g} s, crank angle {deg:.3f} deg"
+    if deg >= 360.0:
+        revolution = int(deg // 360.0)
+        text += f" (revolution {revolution + 1} at {deg - 360.0 * revolution:.3f} deg)"
+    return text
+
+
+def failure_message(engine: str, t: float, omega: float, what: str, hint: str) -> str:
+    """One-line failure message: ``"<engine> failed at <where>: <what>; <hint>"``."""
+    return f"{engine} failed at {where(t, omega)}: {what}; {hint}"
+
+
+def non_finite_breach(what: str = "the state became non-finite (NaN or inf)") -> Breach:
+    return Breach(
+        "non_finite", what,
+        "the forces or the state left the floating-point range: check the materials, clearance and law "
+        "of [joint_e] (an absurd stiffness?) or try a smaller step / tighter tolerance",
+    )  # fmt: skip
+
+
+class RunGuard:
+    """The ``[limits]`` of one run, checked step by step.
+
+    Parameters
+    ----------
+    scene : Scene
+        Its ``limits`` and journal radius set the bounds.
+    clock : callable, optional
+        Wall clock in seconds (tests pass a fake one); started here.
+    """
+
+    def __init__(self, scene: Scene, clock: Callable[[], float] = time.perf_counter):
+        limits = scene.limits
+        self.clock = clock
+        self.start = clock()
+        self.steps = 0
+        self.max_wall_time = limits.max_wall_time if limits.max_wall_time > 0.0 else math.inf
+        self.max_steps = limits.max_steps if limits.max_steps > 0 else None
+        self.ratio = limits.max_penetration
+        self.journal_radius = scene.joint.journal_radius
+        self.max_penetration = limits.max_penetration * scene.joint.journal_radius
+        self.min_step = limits.min_step
+
+    @property
+    def elapsed(self) -> float:
+        """Wall-clock seconds since the guard was made."""
+        return self.clock() - self.start
+
+    def check(self, penetration: float | None = None, step_size: float | None = None, steps: int = 1,
+              finite: bool = True) -> Breach | None:
+        """Count ``steps`` accepted steps and check every criterion.
+
+        Parameters
+        ----------
+        penetration : float, optional
+            Penetration delta = e - c of the joint after the step(s) (the largest one of a
+            block), m; None for the ideal joint.
+        step_size : float, optional
+            Length of the accepted step (the shortest of a block), s; None for a fixed-step
+            engine (its step floor is the solver's own setting).
+        steps : int
+            Accepted steps since the last call.
+        finite : bool
+            False if the engine found a NaN or inf in the state.
+
+        Returns
+        -------
+        Breach or None
+        """
+        self.steps += steps
+        if not finite or (penetration is not None and not math.isfinite(penetration)):
+            return non_finite_breach()
+        if penetration is not None and penetration > self.max_penetration:
+            return Breach(
+                "penetration",
+                f"the penetration {penetration * 1e3:.4f} mm exceeds {self.ratio:g} of the journal radius "
+                f"({self.max_penetration * 1e3:.4f} mm, limits.max_penetration_ratio)",
+                "the joint is too soft for its load or the contact law is used far outside its range: check "
+                "the materials, clearance and law of [joint_e]; raise limits.max_penetration_ratio only if "
+                "such a deformation is meant",
+            )  # fmt: skip
+        if step_size is not None and step_size < self.min_step:
+            return Breach(
+                "step_size",
+                f"the step size collapsed to {step_size:.3g} s (below limits.min_step_s = {self.min_step:.3g} s)",
+                "the equations became too stiff or discontinuous for the method: try method 'Radau' or "
+                "'LSODA', a looser rtol/atol, or check the joint's stiffness and the contact law",
+            )  # fmt: skip
+        if self.max_steps is not None and self.steps > self.max_steps:
+            return Breach(
+                "steps",
+                f"the run needs more than limits.max_steps = {self.max_steps} accepted steps",
+                "raise limits.max_steps, simulate fewer revolutions, or use a larger step or looser tolerance",
+            )
+        elapsed = self.elapsed
+        if elapsed > self.max_wall_time:
+            return Breach(
+                "wall_time",
+                f"the wall-time budget limits.max_wall_time_s = {self.max_wall_time:g} s is spent "
+                f"({elapsed:.3g} s, {self.steps} steps)",
+                "raise limits.max_wall_time_s or simulate fewer revolutions",
+            )
+        return None
