@@ -29,6 +29,7 @@ import numpy as np
 from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, Radau
 
 from weftsim.contact import make_law
+from weftsim.guards import RunGuard, failure_message, non_finite_breach
 from weftsim.params import Scene
 from weftsim.reference.dynamics import (
     ChainConstants,
@@ -188,6 +189,8 @@ def _integrate(scene: Scene, progress) -> Trajectory:
 
     traj = Trajectory()
     wall0 = _time.perf_counter()
+    guard = RunGuard(scene)
+    min_step = math.inf
     t, y = 0.0, initial_state(scene)
     contact, impact = False, 0.0
     next_sample = 0
@@ -200,13 +203,14 @@ def _integrate(scene: Scene, progress) -> Trajectory:
     if progress is not None:
         progress(0.0)
 
-    def fail(text):
+    def fail(text, hint=None, kind="solver"):
         traj.status = "failed"
-        traj.message = (
-            f"reference solver ({name}) failed at t = {t:.6g} s, crank angle "
-            f"{math.degrees(omega * t):.3f} deg: {text}. Try a smaller `max_step`, a looser "
-            f"`rtol`/`atol`, or method 'Radau' or 'LSODA' (scene [reference_solver])."
-        )
+        traj.stats["failure"] = kind
+        traj.message = failure_message(
+            f"reference solver ({name})", t, omega, text,
+            hint or "try a smaller `max_step`, a looser `rtol`/`atol`, or method 'Radau' or 'LSODA' "
+            "(scene [solver.reference])",
+        )  # fmt: skip
 
     while t < t_end and traj.status == "success":
         fun = contact_rhs(impact) if contact else free_rhs
@@ -225,16 +229,31 @@ def _integrate(scene: Scene, progress) -> Trajectory:
                 fail(f"{type(exc).__name__}: {exc}")
                 break
             if solver.status == "failed":
+                # scipy gives up when the step it needs falls below the spacing of floats at t:
+                # a collapse of the step size, often from a right-hand side that is NaN or inf.
                 t = solver.t
-                fail(message or "step failed")
-                break
-            if not np.all(np.isfinite(solver.y)):
-                t = solver.t
-                fail("the state became non-finite")
+                if not np.all(np.isfinite(fun(t, solver.y))):
+                    breach = non_finite_breach("the right-hand side is non-finite (NaN or inf) at this state")
+                    fail(breach.what, breach.hint, breach.kind)
+                else:
+                    breach = guard.check(step_size=0.0, steps=0)
+                    fail(f"{breach.what} ({message or 'step failed'})", breach.hint, breach.kind)
                 break
             n_steps += 1
             t_new, y_new = solver.t, solver.y
-            g_new, _ = penetration(p, t_new, y_new)
+            finite = bool(np.all(np.isfinite(y_new)))
+            g_new = penetration(p, t_new, y_new)[0] if finite else math.nan
+            # The step that lands on the end time is cut to fit and may be arbitrarily short.
+            h = t_new - t_old if t_new < t_end else None
+            if h is not None:
+                min_step = min(min_step, h)
+            breach = guard.check(penetration=None if joint.is_ideal else g_new, step_size=h, finite=finite)
+            if breach is not None:
+                t = t_new
+                if finite:
+                    traj.add_step(t, y_new, contact, impact)
+                fail(breach.what, breach.hint, breach.kind)
+                break
             crossed = (g_new < 0.0) if contact else (g_new > 0.0)
             t_stop = t_new
             dense = None
@@ -305,7 +324,9 @@ def _integrate(scene: Scene, progress) -> Trajectory:
         "segments": n_segments,
         "contact_events": n_events,
         "impacts": n_impacts,
+        "min_step_s": min_step if math.isfinite(min_step) else None,
         "wall_time_s": wall,
+        **({"failure": traj.stats["failure"]} if "failure" in traj.stats else {}),
     }
     traj.events = {
         "first_contact_time_s": None if first_contact is None else float(first_contact),
