@@ -22,6 +22,7 @@ import exudyn as exu
 from weftsim.exudyn_engine.clearance_joint import ROUTES, register_post_step
 from weftsim.exudyn_engine.mechanism import build_mechanism
 from weftsim.exudyn_engine.sensors import add_sensors, first_nonfinite_row, sample_channels, step_channels
+from weftsim.guards import RunGuard, failure_message, non_finite_breach
 from weftsim.params import Scene
 from weftsim.reference.ideal import angle_grid
 from weftsim.results import RunResult, empty_channels
@@ -84,6 +85,8 @@ def simulation_settings(scene: Scene, n_steps: int) -> exu.SimulationSettings:
     ti.newton.relativeTolerance = s.newton_relative_tolerance
     ti.newton.maxIterations = s.newton_max_iterations
     ti.discontinuous.ignoreMaxIterations = False
+    # Newton failures halve the step down to this floor; then the run fails (step-size collapse).
+    ti.minimumStepSize = scene.limits.min_step
     ti.verboseMode = 0
     ss.solution.file.write = False
     ss.solution.sensors.writePeriod = 0.0
@@ -104,15 +107,17 @@ def _what_to_try(scene: Scene, h: float) -> str:
             f"{s.spectral_radius} or more `newton_max_iterations` (now {s.newton_max_iterations})")  # fmt: skip
 
 
-def _failure_reason(solver) -> str:
+def _failure_reason(solver, scene: Scene) -> tuple[str, str]:
+    """(failure kind, reason) from Exudyn's convergence flags after SolveSystem returned False."""
     conv = solver.conv
     if conv.massMatrixNotInvertible or conv.linearSolverFailed:
-        return f"singular system matrix (equation {conv.linearSolverCausingRow})"
+        return "singular", f"singular system matrix (equation {conv.linearSolverCausingRow})"
     if conv.newtonSolutionDiverged:
-        return "Newton diverged"
+        return "newton", "Newton diverged"
     if conv.stepReductionFailed:
-        return "Newton did not converge even at the minimum step size"
-    return "Newton did not converge"
+        return "newton", (f"Newton did not converge, even with the step cut down to limits.min_step_s = "
+                          f"{scene.limits.min_step:.3g} s (step-size collapse)")  # fmt: skip
+    return "newton", "Newton did not converge"
 
 
 def solve(scene: Scene, progress=None, callback: str | None = None) -> RunResult:
@@ -145,11 +150,20 @@ def solve(scene: Scene, progress=None, callback: str | None = None) -> RunResult
     sensors = add_sensors(mbs, model)
     counter = {"steps": 0}
     report_every = max(1, n_steps // _PROGRESS_CALLS)
+    guard = RunGuard(scene)
+    breach = []
 
     def count(mbs, t):
         counter["steps"] += 1
         if progress is not None and counter["steps"] % report_every == 0:
             progress(min(1.0, counter["steps"] / n_steps))
+        # Exudyn also calls this once at t = 0: not a step.  Runs after the clearance
+        # joint's own post-step hook, so the tracker holds this step's penetration.
+        found = guard.check(penetration=model.clearance.tracker.delta if model.clearance else None,
+                            steps=1 if t > 0.0 else 0)  # fmt: skip
+        if found is not None:
+            breach.append(found)
+            return False  # Exudyn stops after this step
         return True
 
     register_post_step(mbs, count)
@@ -158,15 +172,17 @@ def solve(scene: Scene, progress=None, callback: str | None = None) -> RunResult
         model.clearance.reset(mbs)
     if progress is not None:
         progress(0.0)
-    status, message = "success", ""
+    status, message, kind = "success", "", None
     solver = exu.MainSolverImplicitSecondOrder()
     wall_solve = _time.perf_counter()
     try:
         if not solver.SolveSystem(mbs, simulation_settings(scene, n_steps)):
-            status, message = "failed", _failure_reason(solver)
+            status = "failed"
+            kind, message = _failure_reason(solver, scene)
     except exu.ExudynError as exc:  # NaN (SolverError), user-function exception (ModelError), ...
         text = str(exc).strip().splitlines()
         status, message = "failed", f"{type(exc).__name__}: {text[-1] if text else ''}"
+        kind = "non_finite" if isinstance(exc, exu.SolverError) else "model"
     wall_solve = _time.perf_counter() - wall_solve
 
     steps = step_channels(mbs, model, sensors)
@@ -174,15 +190,19 @@ def solve(scene: Scene, progress=None, callback: str | None = None) -> RunResult
     if bad is not None:
         steps = {k: v[:bad] for k, v in steps.items()}
         if status == "success":
-            status, message = "failed", "non-finite values (NaN or inf) in the results"
-    if status == "failed":
-        t_fail = float(steps["time_s"][-1]) if len(steps["time_s"]) else 0.0
-        message = (f"Exudyn engine failed after t = {t_fail:.6g} s, crank angle "
-                   f"{math.degrees(omega * t_fail):.3f} deg: {message}; {_what_to_try(scene, h)}")  # fmt: skip
+            found = non_finite_breach("non-finite values (NaN or inf) in the results")
+            status, message, kind = "failed", found.what, found.kind
+    t_last = float(steps["time_s"][-1]) if len(steps["time_s"]) else 0.0
+    if breach and (status == "success" or kind is None):
+        # A [limits] criterion stopped the run; its own message says what to try.
+        status, kind = "failed", breach[0].kind
+        message = failure_message("Exudyn engine", t_last, omega, breach[0].what, breach[0].hint)
+    elif status == "failed":
+        message = failure_message("Exudyn engine", t_last, omega, message, _what_to_try(scene, h))
     elif len(steps["time_s"]) and scene.drive.end_time - steps["time_s"][-1] > 0.5 * h:
         # Fixed steps: a premature stop misses at least one whole step; the time sum itself
         # drifts by ~n_steps * eps * t_end (2.5e-10 s after 10 revolutions), far above 1e-6 h.
-        status = "failed"
+        status, kind = "failed", "stopped"
         message = (f"Exudyn stopped at t = {steps['time_s'][-1]:.6g} s before the end time "
                    f"{scene.drive.end_time:.6g} s; {_what_to_try(scene, h)}")  # fmt: skip
     samples = sample_channels(steps, angle_grid(scene.drive.end_time, omega, scene.output.sample_angle))
@@ -201,6 +221,8 @@ def solve(scene: Scene, progress=None, callback: str | None = None) -> RunResult
         "solve_time_s": wall_solve,
         "wall_time_s": _time.perf_counter() - wall0,
     }
+    if kind is not None:
+        stats["failure"] = kind
     stats["time_per_step_us"] = 1e6 * wall_solve / max(n_done, 1)
     first = model.clearance.tracker.first_contact_time if model.clearance else None
     if progress is not None:
