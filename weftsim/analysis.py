@@ -130,6 +130,9 @@ def summary(result: RunResult) -> dict:
         "scene": to_file_keys(result.scene),
         "engine": result.engine,
         "status": result.status,
+        # False for a failed run: what it holds ends where the run stopped (simulated_time_s).
+        "complete": result.ok,
+        "simulated_time_s": float(result.steps["time_s"][-1]) if result.steps["time_s"].size else 0.0,
         "message": result.message,
         "complete_revolutions": n,
         "peaks": per_revolution[-1] if per_revolution else None,
