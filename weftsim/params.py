@@ -238,12 +238,17 @@ class Limits:
         Step-size collapse, s: the reference engine fails on an accepted step shorter
         than this; the Exudyn engine uses it as the floor of its step reduction after
         Newton failures.  Far below the ~1e-7 s that the stiffest impacts need.
+    max_energy_error : float
+        Largest residual of the energy balance W = dKE + dPE + E_contact + E_dissipated
+        at any step, as a fraction of the largest kinetic energy of the run.  Sound runs
+        stay below 1e-5; a step that does not resolve the impacts creates energy.
     """
 
     max_wall_time: float = 0.0
     max_steps: int = 0
     max_penetration: float = 0.1
     min_step: float = 1e-12
+    max_energy_error: float = 0.01
 
 
 @dataclass(frozen=True)

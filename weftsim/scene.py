@@ -137,6 +137,8 @@ SCHEMA: tuple[Key, ...] = (
         doc="the run fails when the penetration exceeds this fraction of the journal radius"),
     Key("limits.min_step_s", "limits.min_step", "float", 1, 0, 1e-4,
         doc="step-size collapse: the smallest step either engine may take"),
+    Key("limits.max_energy_error", "limits.max_energy_error", "float", 1, 0, 1, True, False,
+        doc="the run fails when the energy balance misses by more than this fraction of the largest kinetic energy"),
 )
 _BY_PATH = {key.path: key for key in SCHEMA}
 TOP_LEVEL = ("name", "description", "extends")
