@@ -15,7 +15,11 @@ kind            fails when                                  limit (scene ``[limi
 ``step_size``   an accepted step h < min_step               ``min_step_s`` (1e-12 s)
 ``steps``       more than max_steps accepted steps          ``max_steps`` (0 = none)
 ``wall_time``   wall-clock time since the start > budget    ``max_wall_time_s`` (0 = none)
+``energy``      W - dKE - dPE - E_contact - E_diss > limit  ``max_energy_error`` (0.01)
 ==============  ==========================================  ==============================
+
+The last one needs the whole run's channels: :func:`vet_result` checks it (and again the
+first two) on every run an engine considers a success.
 
 Newton non-convergence is the engines' own (Exudyn's convergence flags; scipy's implicit
 methods shrink the step until it collapses).  Why the defaults are what they are, and the
@@ -26,12 +30,14 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable
+
+import numpy as np
 
 from weftsim.params import Scene
 
-KINDS = ("non_finite", "penetration", "step_size", "steps", "wall_time")
+KINDS = ("non_finite", "penetration", "step_size", "steps", "wall_time", "energy")
 
 
 @dataclass(frozen=True)
@@ -159,3 +165,81 @@ class RunGuard:
                 "raise limits.max_wall_time_s or simulate fewer revolutions",
             )
         return None
+
+
+_ENGINE_LABELS = {"reference": "reference solver", "exudyn": "Exudyn engine"}
+
+
+def _first(mask) -> int | None:
+    idx = np.flatnonzero(mask)
+    return int(idx[0]) if idx.size else None
+
+
+def energy_residual(steps: dict):
+    """W - dKE - dPE - dE_contact - dE_dissipated at every step, J (zero for exact conservation)."""
+    return (
+        steps["driving_work_J"] - steps["driving_work_J"][0]
+        - (steps["kinetic_energy_J"] - steps["kinetic_energy_J"][0])
+        - (steps["potential_energy_J"] - steps["potential_energy_J"][0])
+        - (steps["contact_energy_J"] - steps["contact_energy_J"][0])
+        - (steps["dissipated_energy_J"] - steps["dissipated_energy_J"][0])
+    )  # fmt: skip
+
+
+def result_breach(result) -> tuple[int, Breach] | None:
+    """The first step of a finished run's channels that crosses a criterion, and the breach.
+
+    Checked on the per-step channels, in this order: non-finite values, the penetration
+    bound, the energy balance (``limits.max_energy_error`` of the largest kinetic energy).
+    The last one catches what no step-by-step check sees: a step too long for the impacts
+    (e.g. a joint 5e8 times stiffer than steel at Exudyn's 2e-6 s step made 1.5e11 N and
+    created 3 times the kinetic energy, with Newton converging at every step).
+    """
+    st = result.steps
+    if st["time_s"].size == 0:
+        return None
+    finite = np.ones(st["time_s"].size, dtype=bool)
+    for values in st.values():
+        finite &= np.isfinite(values)
+    i = _first(~finite)
+    if i is not None:
+        return i, non_finite_breach("non-finite values (NaN or inf) in the results")
+    scene = result.scene
+    if not scene.joint.is_ideal:
+        guard = RunGuard(scene)
+        i = _first(st["penetration_m"] > guard.max_penetration)
+        if i is not None:
+            return i, guard.check(penetration=float(st["penetration_m"][i]), steps=0)
+    residual = energy_residual(st)
+    scale = float(np.max(np.abs(st["kinetic_energy_J"]))) or 1.0
+    limit = scene.limits.max_energy_error
+    i = _first(np.abs(residual) > limit * scale)
+    if i is not None:
+        return i, Breach(
+            "energy",
+            f"the energy balance misses by {residual[i]:.4g} J, {abs(residual[i]) / scale:.3g} of the largest kinetic "
+            f"energy {scale:.4g} J (limits.max_energy_error = {limit:g})",
+            "the steps do not resolve the contact (too long a step for this stiffness): try a smaller step or "
+            "tighter tolerance, or check the materials of [joint_e]",
+        )  # fmt: skip
+    return None
+
+
+def vet_result(result):
+    """``result`` itself, or a copy with ``status = "failed"`` if :func:`result_breach` finds one.
+
+    Applied by both engines to every run that they consider a success, so a criterion
+    crossed without the step-by-step checks seeing it still fails the run.  The channels
+    are kept whole (the run did finish); the message names the first step concerned.
+    """
+    if not result.ok:
+        return result
+    found = result_breach(result)
+    if found is None:
+        return result
+    i, breach = found
+    t = float(result.steps["time_s"][i])
+    message = failure_message(_ENGINE_LABELS.get(result.engine, result.engine), t, result.scene.drive.speed,
+                              breach.what, breach.hint)  # fmt: skip
+    stats = {**result.solver_stats, "failure": breach.kind}
+    return replace(result, status="failed", message=message, solver_stats=stats)

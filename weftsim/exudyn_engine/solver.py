@@ -22,7 +22,7 @@ import exudyn as exu
 from weftsim.exudyn_engine.clearance_joint import ROUTES, register_post_step
 from weftsim.exudyn_engine.mechanism import build_mechanism
 from weftsim.exudyn_engine.sensors import add_sensors, first_nonfinite_row, sample_channels, step_channels
-from weftsim.guards import RunGuard, failure_message, non_finite_breach
+from weftsim.guards import RunGuard, failure_message, non_finite_breach, vet_result
 from weftsim.params import Scene
 from weftsim.reference.ideal import angle_grid
 from weftsim.results import RunResult, empty_channels
@@ -227,4 +227,6 @@ def solve(scene: Scene, progress=None, callback: str | None = None) -> RunResult
     first = model.clearance.tracker.first_contact_time if model.clearance else None
     if progress is not None:
         progress(1.0)
-    return RunResult(scene, "exudyn", status, message, samples, steps, stats, {"first_contact_time_s": first})
+    # Post-run criteria (energy balance, ...) that no single step shows; see weftsim.guards.
+    return vet_result(RunResult(scene, "exudyn", status, message, samples, steps, stats,
+                                {"first_contact_time_s": first}))  # fmt: skip

@@ -21,6 +21,7 @@ import time as _time
 
 import numpy as np
 
+from weftsim.guards import vet_result
 from weftsim.params import Scene
 from weftsim.reference.integrate import AUTO, METHODS
 from weftsim.results import RunResult, empty_channels
@@ -110,6 +111,6 @@ def solve(scene: Scene, progress=None) -> RunResult:
     if problem is not None:
         return RunResult(scene, "reference", "failed", problem, empty_channels(), empty_channels(),
                          {"wall_time_s": 0.0}, {"first_contact_time_s": None})  # fmt: skip
-    if scene.joint.is_ideal:
-        return _solve_ideal(scene, progress)
-    return _solve_clearance(scene, progress)
+    result = _solve_ideal(scene, progress) if scene.joint.is_ideal else _solve_clearance(scene, progress)
+    # Post-run criteria (energy balance, ...) that no single step shows; see weftsim.guards.
+    return vet_result(result)
