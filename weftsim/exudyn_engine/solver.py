@@ -110,6 +110,11 @@ def _what_to_try(scene: Scene, h: float) -> str:
 def _failure_reason(solver, scene: Scene) -> tuple[str, str]:
     """(failure kind, reason) from Exudyn's convergence flags after SolveSystem returned False."""
     conv = solver.conv
+    if not math.isfinite(conv.residual):
+        # Exudyn reports a NaN force (e.g. from a user function) as Newton non-convergence.
+        return "non_finite", (f"the Newton residual is {conv.residual}: a force or the state became NaN or inf, "
+                              f"and cutting the step down to limits.min_step_s = {scene.limits.min_step:.3g} s "
+                              "did not help")  # fmt: skip
     if conv.massMatrixNotInvertible or conv.linearSolverFailed:
         return "singular", f"singular system matrix (equation {conv.linearSolverCausingRow})"
     if conv.newtonSolutionDiverged:
@@ -182,7 +187,8 @@ def solve(scene: Scene, progress=None, callback: str | None = None) -> RunResult
     except exu.ExudynError as exc:  # NaN (SolverError), user-function exception (ModelError), ...
         text = str(exc).strip().splitlines()
         status, message = "failed", f"{type(exc).__name__}: {text[-1] if text else ''}"
-        kind = "non_finite" if isinstance(exc, exu.SolverError) else "model"
+        kind = ("non_finite" if isinstance(exc, exu.SolverError)
+                else "model" if isinstance(exc, exu.ModelError) else "solver")  # fmt: skip
     wall_solve = _time.perf_counter() - wall_solve
 
     steps = step_channels(mbs, model, sensors)

@@ -20,6 +20,7 @@ scheme); with max_step = 0.5 deg of crank it would need a graze shorter than 0.2
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time as _time
 import warnings
@@ -114,7 +115,8 @@ def make_rhs(p: ChainConstants, backend, counter: list):
     """Right-hand sides y' = f(t, y) for free flight and for contact with held v_imp.
 
     y = [a, psi, a', psi', W3, D]: W3' = -Q3 omega (contact power drawn through the
-    rocker), D' = dissipated power.  ``counter[0]`` counts the evaluations.
+    rocker), D' = dissipated power.  ``counter[0]`` counts the evaluations, ``counter[1]``
+    those that came out NaN or inf (scipy rejects such a step and shrinks it).
     """
 
     def evaluate(t, y, in_contact, impact_velocity):
@@ -132,12 +134,16 @@ def make_rhs(p: ChainConstants, backend, counter: list):
     def free(t, y):
         counter[0] += 1
         out = evaluate(t, y, False, 0.0)
+        if not math.isfinite(out[0] + out[1]):
+            counter[1] += 1
         return np.array([y[2], y[3], out[0], out[1], 0.0, 0.0])
 
     def contact_factory(impact_velocity):
         def contact(t, y):
             counter[0] += 1
             out = evaluate(t, y, True, impact_velocity)
+            if not math.isfinite(out[0] + out[1] + out[2] + out[3]):
+                counter[1] += 1
             return np.array([y[2], y[3], out[0], out[1], out[2], out[3]])
 
         return contact
@@ -193,7 +199,7 @@ def _integrate(scene: Scene, progress) -> Trajectory:
     p = ChainConstants.from_scene(scene)
     joint = scene.joint
     backend = math_backend(make_law(joint), joint)
-    counter = [0]
+    counter = [0, 0]
     free_rhs, contact_rhs = make_rhs(p, backend, counter)
     max_step = settings.max_step / omega
     sample_dt = scene.output.sample_angle / omega
@@ -238,6 +244,7 @@ def _integrate(scene: Scene, progress) -> Trajectory:
         event = None
         while solver.status == "running":
             t_old, y_old = solver.t, np.array(solver.y)
+            non_finite_before = counter[1]
             try:
                 message = solver.step()
             except Exception as exc:  # noqa: BLE001
@@ -247,12 +254,15 @@ def _integrate(scene: Scene, progress) -> Trajectory:
                 # scipy gives up when the step it needs falls below the spacing of floats at t:
                 # a collapse of the step size, often from a right-hand side that is NaN or inf.
                 t = solver.t
-                if not np.all(np.isfinite(fun(t, solver.y))):
-                    breach = non_finite_breach("the right-hand side is non-finite (NaN or inf) at this state")
-                    fail(breach.what, breach.hint, breach.kind)
+                if counter[1] > non_finite_before:
+                    breach = non_finite_breach(
+                        "the right-hand side turned non-finite (NaN or inf) in the trials of the next step, "
+                        f"which scipy shrank down to the float resolution of t ({message})"
+                    )  # fmt: skip
                 else:
-                    breach = guard.check(step_size=0.0, steps=0)
-                    fail(f"{breach.what} ({message or 'step failed'})", breach.hint, breach.kind)
+                    breach = guard.check(step_size=10.0 * np.spacing(t), steps=0)
+                    breach = dataclasses.replace(breach, what=f"{breach.what}; scipy: {message or 'step failed'}")
+                fail(breach.what, breach.hint, breach.kind)
                 break
             n_steps += 1
             t_new, y_new = solver.t, solver.y
@@ -263,6 +273,11 @@ def _integrate(scene: Scene, progress) -> Trajectory:
             if h is not None:
                 min_step = min(min_step, h)
             breach = guard.check(penetration=None if joint.is_ideal else g_new, step_size=h, finite=finite)
+            if breach is not None and breach.kind == "step_size" and counter[1] > non_finite_before:
+                breach = non_finite_breach(
+                    f"the right-hand side turned non-finite (NaN or inf) in the trials of this step, which "
+                    f"shrank to {h:.3g} s (below limits.min_step_s = {scene.limits.min_step:.3g} s)"
+                )  # fmt: skip
             if breach is not None:
                 t = t_new
                 if finite:
