@@ -1,0 +1,302 @@
+"""Failure detection (issue 7, part 2): every way a run can go wrong ends as ``status = "failed"``
+with one message saying what failed, when (time and crank angle) and what to try; what was
+computed before is kept; the command line exits with status 3 and marks summary.json incomplete.
+
+Each failure is provoked for real on both engines where it applies: step and wall-time budgets,
+a bushing so soft that the journal sinks through the penetration bound, a stiffness that makes the
+step collapse, a Newton that cannot converge at its step, a contact force poisoned with NaN, and a
+joint so stiff that Exudyn's fixed step cannot resolve it (only the energy balance shows it).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from weftsim import exudyn_engine, reference
+from weftsim.guards import RunGuard, failure_message, vet_result, where
+from weftsim.params import ClearanceJoint, Drive, ExudynSolver, Limits, Material, Scene
+from weftsim.results import CHANNELS
+
+RPM = math.pi / 30.0
+MODELS = Path(__file__).resolve().parents[1] / "models"
+SOLVERS = {"reference": reference.solve, "exudyn": exudyn_engine.solve}
+FIRST_CONTACT_DEG = 6.637  # reference scene: onset of the start-up impact (docs/clearance-joint.md)
+
+
+def scene(degrees=20.0, youngs_modulus=207e9, exudyn=None, reference_solver=None, **limits) -> Scene:
+    """The reference scene over the first ``degrees`` of crank, both materials of the given modulus."""
+    steel = Scene()
+    material = Material(youngs_modulus, 0.3)
+    return dataclasses.replace(
+        steel,
+        joint=dataclasses.replace(steel.joint, journal_material=material, bearing_material=material),
+        drive=Drive(speed=400.0 * RPM, revolutions=degrees / 360.0),
+        exudyn_solver=exudyn or steel.exudyn_solver,
+        reference_solver=reference_solver or steel.reference_solver,
+        limits=Limits(**limits),
+    )
+
+
+def assert_failed(result, kind: str, *words: str) -> None:
+    """Failed with the given kind; the message names time, crank angle, the words; partial data kept."""
+    assert result.status == "failed" and not result.ok, result.message
+    assert result.solver_stats.get("failure") == kind, (result.solver_stats.get("failure"), result.message)
+    message = result.message
+    assert "\n" not in message and " at t = " in message and "crank angle" in message, message
+    for word in words:
+        assert word in message, (word, message)
+    steps = result.steps
+    assert steps["time_s"].size >= 1
+    assert all(np.all(np.isfinite(steps[name])) for name in CHANNELS)  # what is kept is sound
+    assert steps["time_s"][-1] <= result.scene.drive.end_time
+
+
+def failure_angle(result) -> float:
+    """Crank angle (deg) named in the message."""
+    return float(result.message.split("crank angle ")[1].split(" deg")[0])
+
+
+# --- The guard itself --------------------------------------------------------------------
+
+
+class FakeClock:
+    def __init__(self):
+        self.now = 100.0
+
+    def __call__(self):
+        return self.now
+
+
+def test_guard_criteria_and_their_order():
+    clock = FakeClock()
+    guard = RunGuard(scene(max_steps=3, max_wall_time=2.0, max_penetration=0.05, min_step=1e-9), clock)
+    bound = 0.05 * 10e-3  # 0.05 of the 10 mm journal radius
+    assert guard.check(penetration=0.99 * bound, step_size=1e-6) is None
+    assert guard.check(penetration=1.01 * bound).kind == "penetration"
+    assert guard.check(step_size=1e-10).kind == "step_size"
+    assert guard.check(penetration=math.nan).kind == "non_finite"
+    assert guard.check(finite=False, penetration=2 * bound).kind == "non_finite"  # checked first
+    assert guard.steps == 5 and guard.check(steps=0).kind == "steps"  # more than 3 steps
+    relaxed = RunGuard(scene(max_wall_time=2.0), clock)
+    clock.now += 2.5
+    breach = relaxed.check()
+    assert breach.kind == "wall_time" and "limits.max_wall_time_s = 2 s" in breach.what
+
+
+def test_zero_budgets_mean_no_limit():
+    clock = FakeClock()
+    guard = RunGuard(scene(max_steps=0, max_wall_time=0.0), clock)
+    clock.now += 1e9
+    assert guard.check(steps=10**9) is None
+
+
+def test_message_names_time_angle_and_revolution():
+    omega = 400.0 * RPM
+    assert where(0.01, omega) == "t = 0.01 s, crank angle 24.000 deg"
+    # Beyond the first revolution the angle within the revolution is given too.
+    assert "(revolution 3 at 90.000 deg)" in where(2.25 * 0.15, omega)
+    text = failure_message("Exudyn engine", 0.01, omega, "what failed", "what to try")
+    assert text == "Exudyn engine failed at t = 0.01 s, crank angle 24.000 deg: what failed; what to try"
+
+
+# --- Budgets -----------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("engine", SOLVERS)
+def test_step_budget(engine):
+    r = SOLVERS[engine](scene(max_steps=100))
+    assert_failed(r, "steps", "limits.max_steps = 100", "raise limits.max_steps")
+    assert r.steps["time_s"][-1] < r.scene.drive.end_time
+    assert r.solver_stats["steps"] == 101  # stopped on the first step beyond the budget
+
+
+@pytest.mark.parametrize("engine", SOLVERS)
+def test_wall_time_budget(engine):
+    budget = 0.5  # s: a tenth of what one revolution takes either engine
+    r = SOLVERS[engine](scene(degrees=360.0, max_wall_time=budget))
+    assert_failed(r, "wall_time", "limits.max_wall_time_s = 0.5 s", "fewer revolutions")
+    assert r.steps["time_s"][-1] < r.scene.drive.end_time
+    # Post-processing of the kept steps comes on top of the budget; 2 s covers it on a busy machine.
+    assert r.wall_time_s < budget + 2.0
+
+
+# --- Penetration beyond the bound --------------------------------------------------------
+
+
+def test_penetration_bound_on_both_engines():
+    """A bushing of E = 0.05 GPa (a soft rubber) under the start-up impact: the journal sinks 1 mm
+    (a tenth of its radius) into it at about 15 deg, and both engines stop there."""
+    results = {name: solve(scene(youngs_modulus=0.05e9)) for name, solve in SOLVERS.items()}
+    for r in results.values():
+        assert_failed(r, "penetration", "exceeds 0.1 of the journal radius (1.0000 mm", "[joint_e]")
+        assert r.steps["penetration_m"].max() <= 1.0e-3 * 1.05  # stopped at the first step beyond it
+        assert FIRST_CONTACT_DEG < failure_angle(r) < 20.0
+    # The same physics up to the stop: the two engines cross the bound within a fraction of a degree
+    # (measured 15.06 and 14.90 deg; the Exudyn check runs on its fixed 2e-6 s steps).
+    assert abs(failure_angle(results["reference"]) - failure_angle(results["exudyn"])) < 0.5
+
+
+# --- Step-size collapse and Newton non-convergence ---------------------------------------
+
+
+def test_reference_step_size_collapse():
+    """E = 1e40 Pa: the impact asks for ever shorter steps; an accepted step of ~1e-17 s is far below
+    limits.min_step_s and the run fails at the first contact saying the step collapsed."""
+    r = reference.solve(scene(youngs_modulus=1e40))
+    assert_failed(r, "step_size", "step size collapsed", "limits.min_step_s = 1e-12 s", "'Radau'")
+    assert failure_angle(r) == pytest.approx(FIRST_CONTACT_DEG, abs=0.01)
+
+
+@pytest.mark.parametrize("engine", SOLVERS)
+def test_absurd_stiffness_overflows_at_the_first_contact(engine):
+    """E = 1e305 Pa: the contact force overflows to inf at the first contact.  The reference engine
+    names the non-finite right-hand side (scipy rejected every trial step); Exudyn cannot factorize
+    its iteration matrix.  Both stop at the onset of the start-up impact with what came before."""
+    r = SOLVERS[engine](scene(youngs_modulus=1e305))
+    if engine == "reference":
+        assert_failed(r, "non_finite", "right-hand side turned non-finite", "[joint_e]")
+    else:
+        assert_failed(r, "solver", "not factorized", "exudyn_solver.step_size")
+    assert failure_angle(r) == pytest.approx(FIRST_CONTACT_DEG, abs=0.01)
+    assert r.steps["penetration_m"][:-1].max() <= 0.0  # all kept steps but the last are free flight
+
+
+def test_reference_step_size_floor_from_limits():
+    """limits.min_step_s above the steps the start-up impact takes (1.6e-6 s at the smallest)."""
+    r = reference.solve(scene(min_step=1e-5))
+    assert_failed(r, "step_size", "below limits.min_step_s = 1e-05 s")
+    assert r.steps["time_s"][-1] > 0.0
+
+
+def test_exudyn_newton_non_convergence():
+    """Three modified-Newton iterations at a step of 1e-4 s: Newton fails, Exudyn halves the step down
+    to limits.min_step_s and gives up; the message says both and what to try."""
+    settings = ExudynSolver(step_size=2e-4, newton_max_iterations=3)
+    r = exudyn_engine.solve(scene(exudyn=settings))
+    assert_failed(r, "newton", "Newton did not converge", "step-size collapse", "exudyn_solver.step_size",
+                  "newton_max_iterations")  # fmt: skip
+
+
+# --- NaN and inf -------------------------------------------------------------------------
+
+
+def test_reference_non_finite_right_hand_side(monkeypatch):
+    """A right-hand side that turns NaN at t > 2 ms: scipy rejects every step, the step collapses and
+    the message names the cause (a non-finite right-hand side)."""
+    import weftsim.reference.integrate as integrate
+
+    real = integrate.chain_dynamics
+
+    def poisoned(xp, p, t, *args):
+        out = real(xp, p, t, *args)
+        return tuple(math.nan for _ in out) if t > 2e-3 else out
+
+    monkeypatch.setattr(integrate, "chain_dynamics", poisoned)
+    r = reference.solve(scene())
+    assert_failed(r, "non_finite", "right-hand side turned non-finite")
+    assert r.steps["time_s"][-1] == pytest.approx(2e-3, abs=1e-4)
+
+
+def test_exudyn_nan_contact_force(monkeypatch):
+    """The contact force callback returns NaN at the first contact: Exudyn takes it for a Newton
+    failure; the engine reads the NaN residual and says so, at the start-up impact."""
+    from weftsim.exudyn_engine import callbacks
+
+    make = callbacks.make_python_force
+
+    def poisoned(law, clearance, v_min, counter=None):
+        force = make(law, clearance, v_min, counter)
+
+        def nan_in_contact(mbs, t, *args):
+            out = force(mbs, t, *args)
+            return [math.nan] * 3 if out[0] != 0.0 else out
+
+        return nan_in_contact
+
+    monkeypatch.setattr(callbacks, "make_python_force", poisoned)
+    r = exudyn_engine.solve(scene(), callback="python")
+    assert_failed(r, "non_finite", "Newton residual is nan", "exudyn_solver.step_size")
+    assert failure_angle(r) == pytest.approx(FIRST_CONTACT_DEG, abs=0.1)
+
+
+# --- A run that converges at every step and is still wrong -------------------------------
+
+
+def test_unresolved_stiff_joint_fails_on_the_energy_balance():
+    """E = 1e20 Pa (5e8 x steel): at Exudyn's 2e-6 s the impact lasts less than a step.  Newton converges
+    at every step, but the contact force comes out 1000x too large and the run creates more energy
+    than the mechanism holds: the energy balance fails it.  The reference engine, whose adaptive step
+    resolves the impact, passes the same check: the criterion is not spurious."""
+    stiff = scene(youngs_modulus=1e20)
+    r = exudyn_engine.solve(stiff)
+    assert_failed(r, "energy", "energy balance misses", "limits.max_energy_error", "smaller step")
+    ref = reference.solve(stiff)
+    assert ref.ok, ref.message
+    # The failed run keeps its channels for inspection; its force is off by orders of magnitude.
+    assert r.steps["contact_force_N"].max() > 100 * ref.steps["contact_force_N"].max()
+
+
+def test_vet_result_passes_sound_runs_and_catches_a_doctored_one():
+    r = reference.solve(scene(degrees=12.0))
+    assert vet_result(r) is r and r.ok
+    doctored = dict(r.steps)
+    doctored["dissipated_energy_J"] = doctored["dissipated_energy_J"] * 0.5  # half the dissipation "lost"
+    bad = vet_result(dataclasses.replace(r, steps=doctored))
+    assert bad.status == "failed" and bad.solver_stats["failure"] == "energy" and "crank angle" in bad.message
+
+
+# --- Through the command line ------------------------------------------------------------
+
+
+def run_cli(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "weftsim.cli", *map(str, args)], capture_output=True, text=True,
+                          cwd=cwd)  # fmt: skip
+
+
+def write_scene(path: Path, body: str) -> Path:
+    path.write_text(f'extends = "{(MODELS / "reference.toml").as_posix()}"\nname = "limited"\n{body}\n')
+    return path
+
+
+@pytest.mark.parametrize("engine", SOLVERS)
+def test_cli_failed_run_exits_3_and_writes_what_it_computed_marked_incomplete(tmp_path, engine):
+    budget = {"reference": 100, "exudyn": 1000}[engine]  # steps: about 4 deg of crank either way
+    path = write_scene(tmp_path / "limited.toml", f"[drive]\nrevolutions = 0.05\n[limits]\nmax_steps = {budget}\n")
+    out = tmp_path / "out"
+    done = run_cli("run", path, "-o", out, "--engine", engine, "--no-plot")
+    assert done.returncode == 3, done.stderr
+    assert "Traceback" not in done.stderr
+    error = done.stderr.strip().splitlines()
+    assert len(error) == 1 and "simulation failed" in error[0] and f"limits.max_steps = {budget}" in error[0]
+    assert "crank angle" in error[0] and "marked incomplete" in error[0]
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "failed" and summary["complete"] is False
+    assert summary["solver"]["failure"] == "steps" and "limits.max_steps" in summary["message"]
+    assert 0.0 < summary["simulated_time_s"] < 0.05 * Scene().drive.period
+    rows = (out / "channels.csv").read_text().splitlines()
+    assert rows[0].startswith("time_s,") and len(rows) > 2  # the samples before the stop
+    assert json.loads((out / ".weftsim-output.json").read_text())["status"] == "failed"
+
+
+def test_cli_successful_run_is_marked_complete(tmp_path):
+    out = tmp_path / "out"
+    done = run_cli("run", MODELS / "reference.toml", "-o", out, "--revolutions", "0.02", "--no-plot")
+    assert done.returncode == 0, done.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "success" and summary["complete"] is True and summary["message"] == ""
+    assert summary["simulated_time_s"] == pytest.approx(0.02 * Scene().drive.period, rel=1e-9)
+
+
+def test_cli_compare_with_a_failed_engine_exits_3(tmp_path):
+    path = write_scene(tmp_path / "limited.toml", "[drive]\nrevolutions = 0.05\n[limits]\nmax_steps = 100\n")
+    done = run_cli("compare", path, "-o", tmp_path / "cmp")
+    assert done.returncode == 3, (done.stdout, done.stderr)
+    assert "failed" in done.stdout and "Traceback" not in done.stderr
