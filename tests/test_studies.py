@@ -21,6 +21,21 @@ ROOT = Path(__file__).resolve().parents[1]
 MODELS = ROOT / "models"
 
 
+# Reduced settings: 18 deg of crank (0.05 revolution) covers the first contacts; the speed study needs
+# 2 revolutions for its spectrum (revolution 2 after the start-up one).
+REDUCED_REVOLUTIONS = {"contact-law": 0.05, "clearance": 0.05, "speed": 2.0, "engines": 0.05}
+
+
+@pytest.fixture(scope="module")
+def reduced(tmp_path_factory):
+    """Every study once on reduced settings: name -> (report, output directory)."""
+    out = {}
+    for name, revolutions in REDUCED_REVOLUTIONS.items():
+        outdir = tmp_path_factory.mktemp(name)
+        out[name] = (run_study(name, outdir, MODELS, revolutions=revolutions, progress=False), outdir)
+    return out
+
+
 def _uneven_times(t_end: float, count: int, seed: int = 1) -> np.ndarray:
     rng = np.random.default_rng(seed)
     return np.sort(np.concatenate([[0.0, t_end], rng.uniform(0.0, t_end, count)]))
@@ -143,13 +158,13 @@ def test_stiffness_curve_is_the_law_and_its_log_slope_the_analytic_one():
     assert curve["numbers"]["stiffness_plateau"] == pytest.approx(plateau, rel=2e-3)  # evaluated at 1000 c
 
 
-def test_contact_law_study_writes_its_files_and_the_damping_is_the_law(tmp_path):
-    report = run_study("contact-law", tmp_path, MODELS, revolutions=0.05, progress=False)
-    files = {p.name for p in tmp_path.iterdir() if not p.name.startswith(".")}
+def test_contact_law_study_writes_its_files_and_the_damping_is_the_law(reduced):
+    report, outdir = reduced["contact-law"]
+    files = {p.name for p in outdir.iterdir() if not p.name.startswith(".")}
     assert {"study-contact-law.png", "contact-law.json", "contact-law-stiffness.csv",
             "contact-law-revolution.csv"} <= files
     assert report["speed_rpm"] == pytest.approx(500.0) and report["clearance_mm"] == pytest.approx(0.01)
-    with open(tmp_path / "contact-law-revolution.csv") as fh:
+    with open(outdir / "contact-law-revolution.csv") as fh:
         rows = list(csv.DictReader(fh))
     assert rows, "the journal touches within 18 deg at c = 0.01 mm (first contact ~1.3 deg)"
     xi = report["hysteresis"]
@@ -157,7 +172,7 @@ def test_contact_law_study_writes_its_files_and_the_damping_is_the_law(tmp_path)
         delta = float(row["penetration_mm"]) * 1e-3
         expected = xi * float(row["stiffness_N_m1p5"]) * delta**1.5 / float(row["impact_velocity_m_s"])
         assert float(row["damping_N_s_m"]) == pytest.approx(expected, rel=1e-8)  # CSV written with 10 digits
-    assert json.loads((tmp_path / "contact-law.json").read_text())["curve"] == report["curve"]
+    assert json.loads((outdir / "contact-law.json").read_text())["curve"] == report["curve"]
 
 
 # ---------------------------------------------------------------- clearance, speed, engines
@@ -177,19 +192,19 @@ def test_acceleration_deviation_of_the_ideal_run_is_round_off():
     assert features["acceleration_max_deg"] == pytest.approx([0.0], abs=0.01)  # grid spacing 0.01 deg
 
 
-def test_clearance_study_writes_its_files(tmp_path):
-    report = run_study("clearance", tmp_path, MODELS, revolutions=0.05, progress=False)
+def test_clearance_study_writes_its_files(reduced):
+    report, outdir = reduced["clearance"]
     for name in report["files"]:
-        assert (tmp_path / name).is_file(), name
+        assert (outdir / name).is_file(), name
     assert [row["clearance_mm"] for row in report["trend"]] == pytest.approx([0.01, 0.25, 0.5])
     angles = [row["first_contact_crank_angle_deg"] for row in report["trend"]]
     assert angles == sorted(angles)  # a larger clearance takes longer to cross
 
 
-def test_speed_study_ratios_and_spectrum(tmp_path):
-    report = run_study("speed", tmp_path, MODELS, revolutions=2, progress=False)
+def test_speed_study_ratios_and_spectrum(reduced):
+    report, outdir = reduced["speed"]
     for name in report["files"]:
-        assert (tmp_path / name).is_file(), name
+        assert (outdir / name).is_file(), name
     ratio = report["ratios"]["800/500"]
     assert ratio["ideal_kinematics"] == pytest.approx(2.56)
     assert ratio["acceleration"]["ideal_peak"] == pytest.approx(2.56, rel=1e-9)  # a = omega^2 s''(theta)
@@ -199,10 +214,10 @@ def test_speed_study_ratios_and_spectrum(tmp_path):
         assert ideal["revolutions"] == 1
 
 
-def test_engine_study_writes_both_engines_and_agrees_on_the_start(tmp_path):
-    report = run_study("engines", tmp_path, MODELS, revolutions=0.05, progress=False)
+def test_engine_study_writes_both_engines_and_agrees_on_the_start(reduced):
+    report, outdir = reduced["engines"]
     for name in report["files"]:
-        assert (tmp_path / name).is_file(), name
+        assert (outdir / name).is_file(), name
     assert set(report["runs"]) == {"reference", "exudyn"}
     assert report["compare"]["agree"], report["compare"]["checks"]
 
@@ -224,3 +239,20 @@ def test_cli_study_command(tmp_path, capsys):
     assert main(["study", "contact-law", "-o", str(out), "--models", str(MODELS), "--revolutions", "0.05"]) == 0
     assert "K(0.005 mm)" in capsys.readouterr().out
     assert (out / "study-contact-law.png").is_file()
+
+
+def test_report_has_a_row_per_paper_statement_and_links_existing_figures(reduced):
+    import re
+
+    from weftsim.studies.report import render
+
+    reports = {name: report for name, (report, _) in reduced.items()}
+    text = render(reports, {name: 1.0 for name in reports},
+                  {**{name: f"weftsim study {name}" for name in reports}, "report": "make"}, {"numpy": "x"})
+    for statement in ("barely changes", "larger clearance", "higher speed", "high-frequency oscillation",
+                      "800 vs 500 rpm: torque", "800 vs 500 rpm: acceleration", "main content 0-10 Hz",
+                      "maximum amplitudes", "peak acceleration", "peak torque", "Fig. 7", "Fig. 9"):
+        assert statement in text, statement
+    produced = {p.name for _, outdir in reduced.values() for p in outdir.glob("study-*.png")}
+    linked = set(re.findall(r"\(img/(study-[a-z-]+\.png)\)", text))
+    assert linked == produced
