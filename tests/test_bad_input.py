@@ -1,0 +1,262 @@
+"""Bad input (issue 7, part 3) through the real command line: every malformed scene, flag or output
+directory gets one clear line on stderr and exit status 2, before anything is simulated or written.
+Output files are atomic (a run killed with SIGKILL in the middle of writing leaves the previous
+complete files) and an output directory is never silently mixed with another run's files.
+
+All command lines of the table run at once in a few worker threads (each is a separate Python
+process of ~0.5 s); the parametrized tests then read their outcome.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import pytest
+
+from weftsim.cli import EXIT_USAGE
+
+MODELS = Path(__file__).resolve().parents[1] / "models"
+REFERENCE = MODELS / "reference.toml"
+EXTENDS = f'extends = "{REFERENCE.as_posix()}"\n'
+
+
+def cli(*args, cwd=None) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "weftsim.cli", *map(str, args)], capture_output=True, text=True,
+                          cwd=cwd, timeout=300)  # fmt: skip
+
+
+def _without(key_line: str) -> str:
+    """The reference scene (no extends) with one line removed."""
+    lines = REFERENCE.read_text().splitlines()
+    kept = [line for line in lines if not line.startswith(key_line)]
+    assert len(kept) == len(lines) - 1, key_line
+    return "\n".join(kept) + "\n"
+
+
+# Scene files: (id, file text, words the one-line message must hold).  "{dir}" is the test directory.
+SCENES = [
+    ("missing-keys-top-level", '[drive]\nspeed_rpm = 400.0\n',
+     ["missing required keys", "mechanism.l_oe_mm", "joint_e.clearance_mm", "drive.revolutions", "extends"]),
+    ("missing-one-key", _without("clearance_mm"), ["missing required keys joint_e.clearance_mm;"]),
+    ("empty-file", "", ["missing required keys", "inertia.rod_mass_kg"]),
+    ("unknown-key", EXTENDS + "[joint_e]\nclearence_mm = 0.1\n",
+     ["unknown key 'joint_e.clearence_mm'", "joint_e.clearance_mm"]),
+    ("unknown-section", EXTENDS + "[limit]\nmax_steps = 10\n", ["unknown key 'limit.max_steps'", "limits"]),
+    ("unknown-top-level-key", EXTENDS + 'nmae = "x"\n', ["unknown key 'nmae'"]),
+    ("misspelt-key-in-partial-scene", '[joint_e]\nclearence_mm = 0.1\n', ["unknown key 'joint_e.clearence_mm'"]),
+    ("string-for-number", EXTENDS + '[drive]\nspeed_rpm = "fast"\n', ["drive.speed_rpm", "'fast'", "number"]),
+    ("bool-for-number", EXTENDS + "[drive]\nspeed_rpm = true\n", ["drive.speed_rpm", "True", "number"]),
+    ("list-for-number", EXTENDS + "[joint_e]\nclearance_mm = [0.1]\n", ["joint_e.clearance_mm", "number"]),
+    ("table-for-number", EXTENDS + "[joint_e.clearance_mm]\nvalue = 0.1\n",
+     ["unknown key 'joint_e.clearance_mm.value'"]),
+    ("float-for-int", EXTENDS + "[limits]\nmax_steps = 10.5\n", ["limits.max_steps", "whole number"]),
+    ("number-for-string", EXTENDS + "[joint_e]\nlaw = 3\n", ["joint_e.law", "string"]),
+    ("name-not-string", EXTENDS + "name = 3\n", ["key 'name' must be a string"]),
+    ("nan", EXTENDS + "[drive]\nspeed_rpm = nan\n", ["drive.speed_rpm", "nan", "finite"]),
+    ("inf", EXTENDS + "[joint_e]\nrestitution = inf\n", ["joint_e.restitution", "inf", "finite"]),
+    ("overflows-in-si", EXTENDS + "[joint_e.bearing_material]\nyoungs_modulus_gpa = 1e300\n",
+     ["youngs_modulus_gpa", "finite number (also in SI units)"]),
+    ("integer-beyond-float", EXTENDS + "[drive]\nspeed_rpm = 1" + "0" * 400 + "\n", ["drive.speed_rpm", "finite"]),
+    ("negative", EXTENDS + "[joint_e]\nclearance_mm = -0.1\n", ["joint_e.clearance_mm", "-0.1", ">= 0"]),
+    ("zero-length", EXTENDS + "[mechanism]\nl_oe_mm = 0\n", ["mechanism.l_oe_mm", "> 0"]),
+    ("zero-revolutions", EXTENDS + "[drive]\nrevolutions = 0\n", ["drive.revolutions", "> 0"]),
+    ("zero-restitution", EXTENDS + "[joint_e]\nrestitution = 0.0\n", ["joint_e.restitution", "> 0"]),
+    ("negative-budget", EXTENDS + "[limits]\nmax_wall_time_s = -1\n", ["limits.max_wall_time_s", ">= 0"]),
+    ("penetration-bound-above-1", EXTENDS + "[limits]\nmax_penetration_ratio = 2\n",
+     ["limits.max_penetration_ratio", "<= 1"]),
+    ("impossible-four-bar", EXTENDS + "[mechanism]\nl_ef_mm = 100\n", ["cannot be assembled", "crank angle"]),
+    ("crank-inclination-90", EXTENDS + "[mechanism]\ncrank_inclination_deg = 90\n",
+     ["mechanism.crank_inclination_deg", "< 90"]),
+    ("clearance-beyond-journal", EXTENDS + "[joint_e]\nclearance_mm = 4\njournal_radius_mm = 3\n",
+     ["joint_e.clearance_mm", "smaller than the journal radius"]),
+    ("unknown-law", EXTENDS + '[joint_e]\nlaw = "hertz_magic"\n', ["joint_e.law", "hertz_magic", "variable_kd"]),
+    ("friction-ramp-reversed", EXTENDS + "[joint_e]\nfriction_velocities_m_s = [2e-4, 1e-4]\n",
+     ["friction_velocities_m_s", "v0 < v1"]),
+    ("unknown-method", EXTENDS + '[solver.reference]\nmethod = "Euler"\n', ["solver.reference.method", "'Euler'"]),
+    ("unknown-callback", EXTENDS + '[solver.exudyn]\ncallback = "fortran"\n', ["solver.exudyn.callback", "'fortran'"]),
+    ("extends-missing-file", 'extends = "nowhere.toml"\n', ["nowhere.toml", "not found"]),
+    ("extends-not-a-path", "extends = 3\n", ["'extends' must be a path string"]),
+    ("extends-itself", 'extends = "scene.toml"\n', ["loops back"]),
+    ("not-toml", "this is = = not toml\n", ["not valid TOML"]),
+    ("duplicate-key", EXTENDS + "[drive]\nspeed_rpm = 400\nspeed_rpm = 500\n", ["not valid TOML"]),
+]
+
+# Command lines: (id, arguments after the program, words).  "{scene}" is the reference scene,
+# "{dir}" the test directory.
+FLAGS = [
+    ("no-command", [], ["required"]),
+    ("unknown-command", ["fly", "{scene}"], ["invalid choice", "'fly'"]),
+    ("no-scene-argument", ["run"], ["required", "scene"]),
+    ("unknown-flag", ["run", "{scene}", "--rpm", "400"], ["unrecognized arguments", "--rpm"]),
+    ("scene-not-found", ["run", "{dir}/nope.toml"], ["nope.toml", "not found"]),
+    ("scene-is-a-directory", ["run", "{dir}"], ["is a directory"]),
+    ("scene-not-utf8", ["run", "{dir}/latin1.toml"], ["cannot be read"]),
+    ("unknown-engine", ["run", "{scene}", "--engine", "adams", "-o", "{dir}/engine-out"], ["--engine", "adams"]),
+    ("negative-speed", ["run", "{scene}", "--speed-rpm", "-5"], ["--speed-rpm", "> 0"]),
+    ("nan-speed", ["run", "{scene}", "--speed-rpm", "nan"], ["--speed-rpm", "finite"]),
+    ("inf-speed", ["run", "{scene}", "--speed-rpm", "inf"], ["--speed-rpm", "finite"]),
+    ("word-speed", ["run", "{scene}", "--speed-rpm", "fast"], ["--speed-rpm", "number"]),
+    ("speed-beyond-range", ["run", "{scene}", "--speed-rpm", "6000"], ["command line", "drive.speed_rpm", "<= 5000"]),
+    ("zero-revolutions", ["run", "{scene}", "--revolutions", "0"], ["--revolutions", "> 0"]),
+    ("negative-clearance", ["run", "{scene}", "--clearance-mm", "-1"], ["--clearance-mm", ">= 0"]),
+    ("clearance-beyond-range", ["run", "{scene}", "--clearance-mm", "20"],
+     ["command line", "joint_e.clearance_mm", "<= 5", "20"]),
+    ("unknown-law-flag", ["run", "{scene}", "--law", "magic"], ["command line", "joint_e.law", "magic"]),
+    ("output-uncreatable", ["run", "{scene}", "-o", "/proc/forbidden"], ["cannot create output directory"]),
+    ("output-under-a-file", ["run", "{scene}", "-o", "{dir}/blocker/sub"], ["cannot create output directory"]),
+    ("output-is-a-file", ["run", "{scene}", "-o", "{dir}/blocker"], ["exists and is not a directory"]),
+    ("output-foreign-directory", ["run", "{scene}", "-o", "{dir}/thesis"],
+     ["not written by weftsim", "--force"]),
+    ("compare-foreign-directory", ["compare", "{scene}", "-o", "{dir}/thesis"], ["not written by weftsim"]),
+    ("kinematics-bad-scene", ["kinematics", "{dir}/nan.toml"], ["drive.speed_rpm", "finite"]),
+    ("sweep-bad-key", ["sweep", "{scene}", "--vary", "clearence_mm=0.1,0.2", "-o", "{dir}/sweep-out"],
+     ["clearence_mm"]),
+]
+
+
+@pytest.fixture(scope="module")
+def outcomes(tmp_path_factory):
+    """Run every row of SCENES and FLAGS (4 at a time); id -> (CompletedProcess, directory)."""
+    jobs = {}
+    for name, text, _ in SCENES:
+        directory = tmp_path_factory.mktemp(name)
+        (directory / "scene.toml").write_text(text)
+        jobs[f"scene:{name}"] = (["run", directory / "scene.toml", "-o", directory / "out"], directory)
+    for name, args, _ in FLAGS:
+        directory = tmp_path_factory.mktemp(name)
+        (directory / "blocker").write_text("x")
+        (directory / "thesis").mkdir()
+        (directory / "thesis" / "chapter1.tex").write_text("mine")
+        (directory / "latin1.toml").write_bytes("name = \"caf\xe9\"\n".encode("latin-1"))
+        (directory / "nan.toml").write_text(EXTENDS + "[drive]\nspeed_rpm = nan\n")
+        subst = [str(a).replace("{scene}", str(REFERENCE)).replace("{dir}", str(directory)) for a in args]
+        jobs[f"flag:{name}"] = (subst, directory)
+    with ThreadPoolExecutor(max_workers=4) as pool:
+        futures = {key: pool.submit(cli, *args, cwd=directory) for key, (args, directory) in jobs.items()}
+        return {key: (future.result(), jobs[key][1]) for key, future in futures.items()}
+
+
+def assert_one_clear_line(done: subprocess.CompletedProcess, words) -> None:
+    assert done.returncode == EXIT_USAGE, (done.returncode, done.stderr, done.stdout)
+    assert "Traceback" not in done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1, done.stderr
+    assert "error" in lines[0]
+    for word in words:
+        assert word in lines[0], (word, lines[0])
+
+
+@pytest.mark.parametrize("name, text, words", SCENES, ids=[row[0] for row in SCENES])
+def test_bad_scene_file(outcomes, name, text, words):
+    done, directory = outcomes[f"scene:{name}"]
+    assert_one_clear_line(done, words)
+    assert str(directory) in done.stderr  # the file is named (the scene or the one it extends)
+    assert not (directory / "out").exists()  # refused before anything is written
+
+
+@pytest.mark.parametrize("name, args, words", FLAGS, ids=[row[0] for row in FLAGS])
+def test_bad_flag_or_output(outcomes, name, args, words):
+    done, directory = outcomes[f"flag:{name}"]
+    assert_one_clear_line(done, words)
+    # A refused directory keeps exactly what it held.
+    assert (directory / "blocker").read_text() == "x"
+    assert [p.name for p in (directory / "thesis").iterdir()] == ["chapter1.tex"]
+
+
+def test_every_scene_key_section_is_covered_by_the_table():
+    """The table reaches every section of the schema with at least one bad value."""
+    from weftsim.scene import SCHEMA
+
+    sections = {key.path.split(".")[0] for key in SCHEMA}
+    text = "".join(text for _, text, _ in SCENES)
+    missing = [s for s in sections if f"[{s}" not in text and s != "compare"]
+    assert not missing, missing
+
+
+# --- Output directories: no mixing, atomic files ----------------------------------------
+
+
+def test_foreign_directory_is_used_only_with_force_and_its_files_stay(tmp_path):
+    out = tmp_path / "thesis"
+    out.mkdir()
+    (out / "chapter1.tex").write_text("mine")
+    done = cli("run", REFERENCE, "-o", out, "--revolutions", "0.01", "--no-plot", "--force")
+    assert done.returncode == 0, done.stderr
+    assert (out / "chapter1.tex").read_text() == "mine"  # --force writes beside, never deletes others' files
+    assert {"channels.csv", "summary.json", "chapter1.tex"} <= {p.name for p in out.iterdir()}
+
+
+def test_rerun_replaces_the_previous_run_and_drops_its_stale_files(tmp_path):
+    out = tmp_path / "run"
+    first = cli("run", REFERENCE, "-o", out, "--revolutions", "0.01")
+    assert first.returncode == 0, first.stderr
+    assert (out / "channels.png").exists()
+    second = cli("run", REFERENCE, "-o", out, "--revolutions", "0.02", "--no-plot")
+    assert second.returncode == 0, second.stderr
+    # The figure of the first run would describe other data: it is gone, and the manifest lists
+    # exactly this run's files.
+    assert not (out / "channels.png").exists()
+    manifest = json.loads((out / ".weftsim-output.json").read_text())
+    assert manifest["files"] == ["channels.csv", "summary.json"]
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["scene"]["drive.revolutions"] == 0.02
+
+
+# A run whose CSV writer stops half way through the temporary file, tells the test it is there,
+# and waits to be killed.
+_SLOW_WRITER = r"""
+import sys, time
+from pathlib import Path
+import numpy as np
+import weftsim.output as output
+
+real = np.savetxt
+def half_then_hang(path, table, **kw):
+    real(path, table[: len(table) // 2], **kw)
+    Path(sys.argv[1]).write_text(str(path))
+    time.sleep(600)
+output.np.savetxt = half_then_hang
+from weftsim.cli import main
+sys.exit(main(sys.argv[2:]))
+"""
+
+
+def test_sigkill_while_writing_leaves_the_previous_complete_files(tmp_path):
+    out = tmp_path / "run"
+    first = cli("run", REFERENCE, "-o", out, "--revolutions", "0.02", "--no-plot")
+    assert first.returncode == 0, first.stderr
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    ready = tmp_path / "ready"
+    child = subprocess.Popen([sys.executable, "-c", _SLOW_WRITER, str(ready), "run", str(REFERENCE), "-o", str(out),
+                              "--revolutions", "0.05", "--no-plot"], stdout=subprocess.DEVNULL,
+                             stderr=subprocess.DEVNULL)  # fmt: skip
+    try:
+        deadline = time.monotonic() + 120
+        while not ready.exists():
+            assert child.poll() is None, "the run ended before it wrote"
+            assert time.monotonic() < deadline, "the run never reached its CSV"
+            time.sleep(0.05)
+        os.kill(child.pid, signal.SIGKILL)
+        child.wait(timeout=30)
+    finally:
+        if child.poll() is None:
+            child.kill()
+    assert child.returncode == -signal.SIGKILL
+    # Killed in the middle of channels.csv: every file under its final name is the previous run's,
+    # complete and byte for byte; the half-written data sits in a hidden temporary file only.
+    after = {p.name: p for p in out.iterdir()}
+    for name, data in before.items():
+        assert after[name].read_bytes() == data, name
+    partial = [name for name in after if name not in before]
+    assert partial and all(name.startswith(".channels.csv.") and name.endswith(".part") for name in partial)
+    # The next run into the directory works and leaves its own complete files.
+    again = cli("run", REFERENCE, "-o", out, "--revolutions", "0.03", "--no-plot")
+    assert again.returncode == 0, again.stderr
+    assert json.loads((out / "summary.json").read_text())["scene"]["drive.revolutions"] == 0.03
