@@ -39,7 +39,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--report", default=str(REPORT), help="Markdown file to write")
     args = parser.parse_args(argv)
     out = Path(args.out)
-    reports, timings, commands = {}, {}, {}
+    reports, commands = {}, {}
+    timing_file = out / "timings.json"  # wall time of each study's last run, kept for --reuse
+    timings = json.loads(timing_file.read_text()) if timing_file.exists() else {}
     for name in STUDIES:
         outdir = out / name
         commands[name] = f"weftsim study {name} -o {outdir.as_posix()}"
@@ -49,7 +51,7 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"{path} is missing: run without --reuse first", file=sys.stderr)
                 return 2
             reports[name] = json.loads(path.read_text())
-            timings[name] = None
+            timings.setdefault(name, None)
         else:
             print(f"== {commands[name]}", flush=True)
             start = time.perf_counter()
@@ -57,6 +59,7 @@ def main(argv: list[str] | None = None) -> int:
             timings[name] = time.perf_counter() - start
             print(format_study(name, reports[name]), flush=True)
             print(f"({timings[name]:.0f} s)", flush=True)
+            write_text(timing_file, json.dumps(timings, indent=2) + "\n")
         for figure in sorted(outdir.glob("study-*.png")):
             shutil.copyfile(figure, IMAGES / figure.name)
     commands["report"] = "python scripts/make_paper_comparison.py" + (" --reuse" if args.reuse else "")

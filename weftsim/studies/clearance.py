@@ -157,16 +157,19 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
                 f"{metrics[0.25]['revolutions']} revolutions (cf. paper Fig. 12)"))
     rows = [trend_row(metrics[c], ideal) for c in SCENES]
     x = list(SCENES)
+    def lines(*pairs):
+        return [(label, [r[key] for r in rows]) for label, key in pairs]
+
     written["trend"] = write_figure(outdir / "study-clearance-trend.png", trend_panels(x, "radial clearance c [mm]", [
-        ("rapier acceleration [m/s²]", [("max |a|, revolution 1", [r["first_revolution_acceleration_peak_m_s2"] for r in rows]),
-                                        ("99th pct |a|, rev. 2..N", [r["acceleration_p99_abs_m_s2"] for r in rows]),
-                                        ("RMS, rev. 2..N", [r["acceleration_rms_m_s2"] for r in rows])]),
-        ("driving torque [N·m]", [("max |T|, revolution 1", [r["first_revolution_torque_peak_Nm"] for r in rows]),
-                                  ("99th pct |T|, rev. 2..N", [r["torque_p99_abs_Nm"] for r in rows]),
-                                  ("RMS, rev. 2..N", [r["torque_rms_Nm"] for r in rows])]),
-        ("contact force at E [N]", [("max, revolution 1", [r["first_revolution_contact_force_max_N"] for r in rows]),
-                                    ("99th percentile, rev. 2..N", [r["contact_force_p99_N"] for r in rows]),
-                                    ("mean, rev. 2..N", [r["contact_force_mean_N"] for r in rows])]),
+        ("rapier acceleration [m/s²]", lines(("max |a|, revolution 1", "first_revolution_acceleration_peak_m_s2"),
+                                             ("99th pct |a|, rev. 2..N", "acceleration_p99_abs_m_s2"),
+                                             ("RMS, rev. 2..N", "acceleration_rms_m_s2"))),
+        ("driving torque [N·m]", lines(("max |T|, revolution 1", "first_revolution_torque_peak_Nm"),
+                                       ("99th pct |T|, rev. 2..N", "torque_p99_abs_Nm"),
+                                       ("RMS, rev. 2..N", "torque_rms_Nm"))),
+        ("contact force at E [N]", lines(("max, revolution 1", "first_revolution_contact_force_max_N"),
+                                         ("99th percentile, rev. 2..N", "contact_force_p99_N"),
+                                         ("mean, rev. 2..N", "contact_force_mean_N"))),
     ], f"clearance trend at {rpm:g} rpm (reproducible quantities; reference engine)", x_ticks=x))
     markers = [("ideal a extremes", features["acceleration_max_deg"] + features["acceleration_min_deg"],
                 {"color": "k", "ls": "-", "lw": 0.8}),

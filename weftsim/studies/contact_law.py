@@ -180,8 +180,9 @@ def format_report(report: dict) -> str:
         "  d ln D / d ln delta at " + ", ".join(f"{k} mm: {v:.3f}" for k, v in c["damping_log_slope"].items()),
     ]
     if r:
-        lines.append(f"  revolution {report['plotted_revolution']}: in contact {100 * r['time_fraction_in_contact']:.1f}% "
-                     f"of the time, K {r['stiffness_min']:.3g} .. {r['stiffness_max']:.3g} N/m^1.5, "
+        lines.append(f"  revolution {report['plotted_revolution']}: in contact "
+                     f"{100 * r['time_fraction_in_contact']:.1f}% of the time, "
+                     f"K {r['stiffness_min']:.3g} .. {r['stiffness_max']:.3g} N/m^1.5, "
                      f"delta up to {r['penetration_max_mm']:.4g} mm, D {r['damping_min']:.3g} .. "
                      f"{r['damping_max']:.3g} N s/m")
     return "\n".join(lines)

@@ -136,8 +136,8 @@ def contact_law_panels(curve, revolution, law_lines, title: str):
         points = ax.scatter(revolution["penetration_mm"], revolution["damping"], s=2,
                             c=np.log10(revolution["impact_velocity_m_s"]), cmap="viridis")
         fig.colorbar(points, ax=ax, label="log10 impact velocity [m/s]")
-    for label, penetration, damping in law_lines:
-        ax.plot(penetration, damping, lw=0.9, label=label)
+    for (label, penetration, damping), ls in zip(law_lines, ("--", ":", "-.")):
+        ax.plot(penetration, damping, color="k", ls=ls, lw=0.8, label=label)
     ax.set_xlabel("penetration δ [mm]")
     ax.set_ylabel("contact damping D [N·s/m]")
     ax.set_title("(c) damping against penetration (Fig. 9)", fontsize=10)

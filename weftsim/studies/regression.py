@@ -12,8 +12,9 @@ Only reproducible quantities are stored (SPEC.md section 6):
 Tolerances are measured, not guessed: each case is rerun with perturbations of the
 solver that change nothing but round-off and the error control (reference: rtol x (1 +
 1e-7), rtol / 10; exudyn: the numba callback route instead of the symbolic one, Newton
-tolerance / 10; statistics cases a few more, :data:`STATISTICS_PERTURBATIONS`) and each quantity's tolerance is ``SAFETY[kind]`` times its largest
-relative shift, but at least ``FLOOR[kind]``.  The table records the shifts, the
+tolerance / 10; statistics cases a few more, :data:`STATISTICS_PERTURBATIONS`) and
+each quantity's tolerance is ``SAFETY[kind]`` times its largest relative shift, but at
+least ``FLOOR[kind]``.  The table records the shifts, the
 perturbations and the rule next to each value.  ``scripts/regenerate_regression.py``
 rebuilds the table; ``tests/test_regression.py`` recomputes every case and compares.
 """

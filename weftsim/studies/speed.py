@@ -121,7 +121,8 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
     for kind, unit in (("acceleration", "rapier acceleration [m/s²]"), ("torque", "driving torque [N·m]")):
         rows = [table[f"{rpm:g}"][kind] for rpm in speeds]
         panels.append((unit, [("ideal joint, peak", [r["ideal_peak"] for r in rows]),
-                              ("c = 0.25 mm, max revolution 1", [r["clearance"]["first_revolution_peak"] for r in rows]),
+                              ("c = 0.25 mm, max revolution 1",
+                               [r["clearance"]["first_revolution_peak"] for r in rows]),
                               ("c = 0.25 mm, 99th pct |.|, rev. 2..N", [r["clearance"]["p99_abs"] for r in rows]),
                               ("c = 0.25 mm, RMS, rev. 2..N", [r["clearance"]["rms"] for r in rows])]))
     written["trend"] = write_figure(outdir / "study-speed-trend.png", trend_panels(
@@ -154,8 +155,10 @@ def format_report(report: dict) -> str:
     def f(value, spec):
         return format(value, spec) if value is not None else "-"
 
-    lines = [f"speed study at c = {report['clearance_mm']:g} mm, {report['revolutions']} revolutions (reference engine)",
-             f"{'rpm':>5s} {'channel':>12s} {'ideal pk':>9s} {'rev1 pk':>9s} {'p99|.|':>9s} {'RMS':>9s} {'last pk':>9s}"]
+    lines = [f"speed study at c = {report['clearance_mm']:g} mm, {report['revolutions']} revolutions "
+             "(reference engine)",
+             f"{'rpm':>5s} {'channel':>12s} {'ideal pk':>9s} {'rev1 pk':>9s} {'p99|.|':>9s} {'RMS':>9s} "
+             f"{'last pk':>9s}"]
     for rpm, row in report["amplitudes"].items():
         for kind, values in row.items():
             c = values["clearance"]
@@ -173,7 +176,8 @@ def format_report(report: dict) -> str:
     lines.append("acceleration spectrum over revolutions 2..N (single-sided amplitude 2|X|/N)")
     for rpm, row in report["spectrum"].items():
         s, i = row["clearance"], row["ideal"]
-        lines.append(f"  {rpm:>4s} rpm: max {s['max_amplitude_m_s2']:.1f} m/s^2 at {s['max_amplitude_frequency_hz']:.2f} Hz "
+        lines.append(f"  {rpm:>4s} rpm: max {s['max_amplitude_m_s2']:.1f} m/s^2 at "
+                     f"{s['max_amplitude_frequency_hz']:.2f} Hz "
                      f"(harmonic {s['max_amplitude_harmonic']:.2f}; ideal {i['max_amplitude_m_s2']:.1f}), "
                      f"max in 0-10 Hz {f(s['band_0_10hz_max_amplitude_m_s2'], '.1f')} at "
                      f"{f(s['band_0_10hz_max_frequency_hz'], '.2f')} Hz, mean-square share 0-10 Hz "
