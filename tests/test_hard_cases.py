@@ -55,7 +55,9 @@ CASES = {
     "steel_reference": Case(),  # the reference scene: the baseline the others are compared with
     "tiny_clearance_800rpm": Case(clearance=0.01e-3, rpm=800.0, exudyn_step=1e-6),
     **{f"{law}_ce0.3": Case(joint={"law": law, "restitution": LOW_RESTITUTION}) for law in LOW_RESTITUTION_LAWS},
-    "stiff_1000gpa": Case(joint={"journal_material": Material(1000e9, 0.3), "bearing_material": Material(1000e9, 0.3)}),
+    # 4.8x steel's modulus: impacts ~(4.8)^(2/5) = 1.9x shorter (Hertz), so half the step.
+    "stiff_1000gpa": Case(joint={"journal_material": Material(1000e9, 0.3), "bearing_material": Material(1000e9, 0.3)},
+                          exudyn_step=1e-6),
     "polymer_bushing_3gpa": Case(joint={"bearing_material": Material(3e9, 0.4)}),
     "large_clearance_1mm": Case(clearance=1e-3),
 }
@@ -198,7 +200,8 @@ def test_exudyn_engine(name, reference_runs):
     half = exudyn_engine.solve(make_scene(case, WINDOW_DEG, step=case.exudyn_step / 2))
     assert half.ok, half.message
     for key, value in window(half).items():
-        # Start-up impact O(h^2) (tests/test_exudyn_engine.py): measured <= 3e-4; 1e-3 = SPEC.md 6.
+        # Start-up impact O(h^2) (tests/test_exudyn_engine.py): measured <= 3.3e-4 (torque, flores);
+        # the stiff joint at 2e-6 s was 7.5e-4 off, hence its 1e-6 s.  1e-3 = SPEC.md 6.
         assert window(r)[key] == pytest.approx(value, rel=1e-3), key
     ref = reference_runs[name]
     # Issue 4's tolerances between the engines: first contact within 0.1 deg, peaks within 1 %.
