@@ -186,7 +186,8 @@ def solve(scene: Scene, progress=None, callback: str | None = None) -> RunResult
             kind, message = _failure_reason(solver, scene)
     except exu.ExudynError as exc:  # NaN (SolverError), user-function exception (ModelError), ...
         text = str(exc).strip().splitlines()
-        status, message = "failed", f"{type(exc).__name__}: {text[-1] if text else ''}"
+        last = text[-1].split(" [Python file ")[0] if text else ""  # Exudyn appends where it was called from
+        status, message = "failed", f"{type(exc).__name__}: {last}"
         kind = ("non_finite" if isinstance(exc, exu.SolverError)
                 else "model" if isinstance(exc, exu.ModelError) else "solver")  # fmt: skip
     wall_solve = _time.perf_counter() - wall_solve
