@@ -20,7 +20,7 @@ from typing import Any, Callable
 
 from weftsim import params
 
-INTEGRATORS = ("auto", "DOP853", "RK45", "RK23", "Radau", "LSODA", "BDF")
+INTEGRATORS = ("auto", "DOP853", "RK45", "RK23", "Radau", "LSODA", "BDF", "numba_DOP853", "numba_RK45")
 EXUDYN_MODELS = ("rigid_body",)
 CALLBACK_ROUTES = ("auto", "python", "symbolic", "numba")
 BRANCHES = {"+": 1, "-": -1}
@@ -105,7 +105,8 @@ SCHEMA: tuple[Key, ...] = (
     Key("drive.speed_rpm", "drive.speed", "float", RPM, 0, 5000, doc="constant crank speed"),
     Key("drive.revolutions", "drive.revolutions", "float", 1, 0, 1000, doc="crank revolutions to simulate"),
     Key("solver.reference.method", "reference_solver.method", "str", choices=INTEGRATORS,
-        doc="scipy method of the reference engine; auto = DOP853, or LSODA when friction is on"),
+        doc="method of the reference engine: scipy's, or numba_* (compiled, docs/performance.md); "
+            "auto = DOP853, or LSODA when friction is on"),
     Key("solver.reference.rtol", "reference_solver.rtol", "float", 1, 0, 1e-2, doc="relative tolerance"),
     Key("solver.reference.atol", "reference_solver.atol", "float", 1, 0, 1e-2, doc="absolute tolerance"),
     Key("solver.reference.max_step_deg", "reference_solver.max_step", "float", DEG, 0, 90,

@@ -26,17 +26,26 @@ from weftsim.params import Scene
 from weftsim.reference.integrate import AUTO, METHODS
 from weftsim.results import RunResult, empty_channels
 
-__all__ = ["solve", "METHODS", "AUTO"]
+__all__ = ["solve", "METHODS", "AUTO", "COMPILED_METHODS"]
 
 # Steps of the ideal-joint run: the closed form evaluated on a grid this many times finer
 # than the output grid (peaks of smooth curves then err by ~(step/2)^2 |f''|/2, < 1e-6 relative).
 IDEAL_STEP_REFINEMENT = 5
 
 
+COMPILED_METHODS = ("numba_DOP853", "numba_RK45")  # weftsim.reference.compiled (needs numba)
+
+
 def _check(scene: Scene) -> str | None:
     settings = scene.reference_solver
-    if settings.method not in METHODS and settings.method != AUTO:
-        return f"`reference_solver.method` must be one of {[AUTO] + sorted(METHODS)}, got {settings.method!r}"
+    allowed = [AUTO] + sorted(METHODS) + list(COMPILED_METHODS)
+    if settings.method not in allowed:
+        return f"`reference_solver.method` must be one of {allowed}, got {settings.method!r}"
+    if settings.method in COMPILED_METHODS:
+        try:
+            import numba  # noqa: F401 - optional dependency of the compiled methods only
+        except ImportError:
+            return f"`reference_solver.method` = {settings.method!r} needs numba installed; use 'auto' or 'DOP853'"
     for name in ("rtol", "atol", "max_step"):
         value = getattr(settings, name)
         if not (value > 0.0 and math.isfinite(value)):
@@ -68,6 +77,10 @@ def _solve_ideal(scene: Scene, progress) -> RunResult:
 
 
 def _solve_clearance(scene: Scene, progress) -> RunResult:
+    if scene.reference_solver.method in COMPILED_METHODS:
+        from weftsim.reference.compiled import solve_compiled
+
+        return solve_compiled(scene, progress)
     from weftsim.reference.channels import clearance_channels
     from weftsim.reference.integrate import integrate
 

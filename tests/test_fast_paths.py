@@ -1,0 +1,209 @@
+"""Fast paths: the compiled reference integrator against the scipy path, its kernels against the
+Python equations and contact laws."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+pytest.importorskip("numba")
+
+from weftsim.analysis import peaks  # noqa: E402
+from weftsim.contact import LAWS, make_law  # noqa: E402
+from weftsim.params import Scene  # noqa: E402
+from weftsim.reference import solve  # noqa: E402
+from weftsim.reference.channels import clearance_channels  # noqa: E402
+from weftsim.reference.compiled_channels import compiled_channels, crank_side_eval, crank_side_table  # noqa: E402
+from weftsim.reference.compiled_channels import elastic_energy as compiled_energy  # noqa: E402
+from weftsim.reference.compiled_kernel import chain, elastic_force, normal_force, pack_parameters  # noqa: E402
+from weftsim.reference.dynamics import ChainConstants, chain_dynamics, initial_state, numpy_backend  # noqa: E402
+from weftsim.reference.ideal import crank_side_inertia, crank_side_potential  # noqa: E402
+
+BASE = Scene()
+PEAK_CHANNELS = ("contact_force_N", "rapier_acceleration_m_s2", "driving_torque_Nm")
+
+
+def _scene(law="variable_kd", friction=0.0, clearance=BASE.joint.clearance, revolutions=0.1, **solver):
+    return dataclasses.replace(
+        BASE,
+        joint=dataclasses.replace(BASE.joint, law=law, friction_coefficient=friction, clearance=clearance),
+        drive=dataclasses.replace(BASE.drive, revolutions=revolutions),
+        reference_solver=dataclasses.replace(BASE.reference_solver, **solver),
+    )
+
+
+@pytest.mark.parametrize("law", sorted(LAWS))
+def test_compiled_laws_equal_the_library(law):
+    scene = _scene(law=law)
+    prm = pack_parameters(scene)
+    lib = make_law(scene.joint)
+    c = scene.joint.clearance
+    for delta in (-1e-6, 0.0, 1e-9, 1e-6, 0.2 * c, 0.3 * c, 2.0 * c):  # both sides of the series limit c/4
+        for rate in (-0.5, 0.0, 0.3):
+            expect = float(lib.normal_force(delta, rate, 0.2))
+            # Same formula, operations in another order: a few ulps.
+            assert normal_force(prm, delta, rate, 0.2) == pytest.approx(expect, rel=1e-13, abs=1e-300)
+        assert elastic_force(prm, delta) == pytest.approx(float(lib.elastic_force(delta)), rel=1e-13, abs=1e-300)
+        energy = float(lib.elastic_energy(delta)) if delta > 0 else 0.0
+        # The series stops at round-off instead of after 40 terms: 1e-15 relative.
+        assert compiled_energy(prm, delta) == pytest.approx(energy, rel=1e-13, abs=1e-300)
+
+
+@pytest.mark.parametrize("friction", [0.0, 0.1])
+@pytest.mark.parametrize("law", ["variable_kd", "flores", "elastic_foundation"])
+def test_compiled_right_hand_side_equals_chain_dynamics(law, friction):
+    scene = _scene(law=law, friction=friction)
+    prm = pack_parameters(scene)
+    p = ChainConstants.from_scene(scene)
+    backend = numpy_backend(make_law(scene.joint), scene.joint)
+    rng = np.random.default_rng(1)
+    y0 = initial_state(scene)
+    out = np.empty(6)
+    for _ in range(20):
+        t = rng.uniform(0.0, 0.15)
+        y = y0 + np.concatenate([rng.normal(0.0, 2e-3, 2), rng.normal(0.0, 2.0, 2), [0.0, 0.0]])
+        y[2:4] += rng.normal(0.0, 5.0, 2)
+        for contact in (False, True):
+            ref = chain_dynamics(backend, p, np.array([t]), y[:1], y[1:2], y[2:3], y[3:4], contact, np.array([0.3]))
+            q3, f_n, delta, ecc_y, ecc_z = chain(prm, t, y, contact, 0.3, out)
+            expect = [float(np.ravel(ref[k])[0]) for k in (0, 1, 2, 3)]
+            scale = [abs(e) + 1e-9 * (abs(f_n) + 1.0) for e in expect]  # accelerations of ~1e3, forces of ~1e5
+            for k in range(4):
+                # sin/cos of theta_OE from atan identities: ~1e-15 relative, times lever arms.
+                assert abs(out[2 + k] - expect[k]) <= 1e-10 * scale[k] + 1e-9, (k, contact)
+            assert f_n == pytest.approx(float(np.ravel(ref[4])[0]), rel=1e-10, abs=1e-6)
+            assert delta == pytest.approx(float(np.ravel(ref[6])[0]), rel=1e-9, abs=1e-15)
+            assert (ecc_y, ecc_z) == pytest.approx((float(np.ravel(ref[8])[0]), float(np.ravel(ref[9])[0])),
+                                                   rel=1e-9, abs=1e-15)  # fmt: skip
+            assert q3 == pytest.approx(float(np.ravel(ref[13])[0]), rel=1e-10, abs=1e-6)
+
+
+def test_crank_side_table_reproduces_the_closed_form():
+    table = crank_side_table(BASE)
+    theta = np.random.default_rng(2).uniform(-3.0, 40.0, 500)
+    j13, dj13 = crank_side_inertia(theta, BASE)
+    u13, du13 = crank_side_potential(theta, BASE)
+    exact = np.stack([j13, dj13, u13, du13], axis=1)
+    got = np.array([_eval(table, th) for th in theta])
+    span = np.abs(exact).max(axis=0)
+    # Periodic cubic spline, 4096 knots: h^4 error ~1e-12 of the range (measured 4e-15).
+    assert np.all(np.abs(got - exact).max(axis=0) <= 1e-11 * span)
+
+
+def _eval(table, theta):
+    out = np.empty(4)
+    crank_side_eval(table, theta, out)
+    return out
+
+
+@pytest.fixture(scope="module")
+def start_up_runs():
+    """The start-up impact (first contact at 6.6 deg) by both paths, 36 deg of crank."""
+    return {m: solve(_scene(method=m, revolutions=0.1)) for m in ("DOP853", "numba_DOP853", "numba_RK45")}
+
+
+def test_compiled_path_follows_the_scipy_path(start_up_runs):
+    scipy_run, fast = start_up_runs["DOP853"], start_up_runs["numba_DOP853"]
+    assert scipy_run.ok and fast.ok, fast.message
+    assert fast.solver_stats["method"] == "numba_DOP853"
+    # Same algorithm step for step: same step counts up to round-off-driven differences near events.
+    assert fast.solver_stats["steps"] == pytest.approx(scipy_run.solver_stats["steps"], rel=0.02)
+    assert fast.first_contact_angle_deg == pytest.approx(scipy_run.first_contact_angle_deg, abs=1e-9)
+    # The trajectories agree to the integration tolerance (rtol 1e-9 on states of ~1 rad, ~10 rad/s)
+    # amplified by the impacts in between: 1e-7 of the range on every sample.
+    for name in ("rapier_displacement_m", "rapier_velocity_m_s", "eccentricity_y_m", "eccentricity_z_m"):
+        a, b = scipy_run.samples[name], fast.samples[name]
+        assert a.shape == b.shape
+        assert np.abs(a - b).max() <= 1e-7 * np.abs(a).max(), name
+    pa, pb = peaks(scipy_run, 0), peaks(fast, 0)
+    for name in PEAK_CHANNELS:
+        # Peaks of ~0.1 ms pulses read at discrete points: 1e-5 (docs/reference-solver.md).
+        assert pb[name]["max"] == pytest.approx(pa[name]["max"], rel=1e-5), name
+
+
+def test_compiled_methods_agree(start_up_runs):
+    a, b = start_up_runs["numba_DOP853"], start_up_runs["numba_RK45"]
+    assert b.ok, b.message
+    assert b.first_contact_angle_deg == pytest.approx(a.first_contact_angle_deg, abs=1e-6)
+    pa, pb = peaks(a, 0), peaks(b, 0)
+    for name in PEAK_CHANNELS:
+        # Two methods of order 8 and 5 at rtol 1e-9: peaks within the docs' 1e-4 spread.
+        assert pb[name]["max"] == pytest.approx(pa[name]["max"], rel=1e-4), name
+
+
+def test_compiled_channels_equal_the_numpy_channels(start_up_runs):
+    r = start_up_runs["numba_DOP853"]
+    scene = r.scene
+    steps = r.steps
+    contact = steps["impact_velocity_m_s"] > 0.0
+    # Rebuild the integrated states from the channels' own inputs is not possible; run the
+    # integrator once more and compare both channel functions on its rows.
+    from weftsim.reference.compiled import integrate_compiled
+
+    rows = integrate_compiled(scene, None, "numba_DOP853")[0]
+    a, b = clearance_channels(scene, *rows), compiled_channels(scene, *rows)
+    assert contact.sum() > 0
+    for name in a:
+        if name == "in_contact":
+            differ = a[name] != b[name]
+            # Only at located events, where delta is 0 to round-off (1e-18 m).
+            assert np.all(np.abs(a["penetration_m"][differ]) < 1e-15)
+            continue
+        span = np.abs(a[name]).max() or 1.0
+        # Same equations; crank-side terms from the spline table (1e-12) and trig identities.
+        assert np.abs(a[name] - b[name]).max() <= 1e-10 * span, name
+
+
+def test_compiled_energy_balance(start_up_runs):
+    r = start_up_runs["numba_DOP853"]
+    s = r.steps
+    residual = s["driving_work_J"] - (s["kinetic_energy_J"] - s["kinetic_energy_J"][0]) \
+        - (s["potential_energy_J"] - s["potential_energy_J"][0]) - s["contact_energy_J"] - s["dissipated_energy_J"]
+    # As tests/test_reference_integrate.py: 100 rtol of the largest kinetic energy.
+    assert np.abs(residual).max() < 100 * r.scene.reference_solver.rtol * s["kinetic_energy_J"].max()
+    assert s["dissipated_energy_J"][-1] > 1.0
+
+
+def test_compiled_friction_run_closes_the_energy_balance():
+    r = solve(_scene(friction=0.1, revolutions=0.05, method="numba_DOP853", rtol=1e-7, atol=1e-10))
+    assert r.ok, r.message
+    s = r.steps
+    residual = s["driving_work_J"] - (s["kinetic_energy_J"] - s["kinetic_energy_J"][0]) \
+        - (s["potential_energy_J"] - s["potential_energy_J"][0]) - s["contact_energy_J"] - s["dissipated_energy_J"]
+    # Looser rtol (explicit method on the stiff friction ramp): 100 rtol of the kinetic energy.
+    assert np.abs(residual).max() < 100 * 1e-7 * s["kinetic_energy_J"].max()
+
+
+def test_compiled_progress_and_failure():
+    calls = []
+    r = solve(_scene(method="numba_DOP853", revolutions=0.05, rtol=1e-6, atol=1e-9), progress=calls.append)
+    assert r.ok
+    assert calls[0] == 0.0 and calls[-1] == 1.0 and calls == sorted(calls) and len(calls) > 10
+    bad = solve(_scene(method="numba_DOP853", rtol=1e-30, atol=1e-300))
+    # atol 1e-300 cannot be met: every step is rejected until it collapses below limits.min_step.
+    assert bad.status == "failed"
+    assert "crank angle" in bad.message and "numba_DOP853" in bad.message and "min_step" in bad.message
+    assert bad.solver_stats["failure"] == "step_size"
+    assert bad.steps["time_s"].size >= 1
+
+
+def test_unknown_method_names_the_compiled_ones():
+    r = solve(_scene(method="numba_Euler"))
+    assert r.status == "failed" and "numba_DOP853" in r.message
+
+
+@pytest.mark.parametrize(("limit", "kind"), [({"max_penetration": 0.001}, "penetration"), ({"max_steps": 50}, "steps")])
+def test_compiled_path_applies_the_run_guards(limit, kind):
+    scene = _scene(method="numba_DOP853")
+    scene = dataclasses.replace(scene, limits=dataclasses.replace(scene.limits, **limit))
+    r = solve(scene)
+    assert r.status == "failed" and r.solver_stats["failure"] == kind, r.message
+    assert "limits." in r.message
+    if kind == "penetration":
+        # Fails at the step that crosses 10 um, inside the start-up impact (first contact at 6.6 deg).
+        assert r.steps["penetration_m"][-1] > 1e-5 and 6.6 < r.steps["crank_angle_deg"][-1] < 10.0
+    else:
+        assert r.solver_stats["steps"] == 51

@@ -1,0 +1,483 @@
+"""Compiled path of the reference engine: the event-driven integration of
+:mod:`weftsim.reference.integrate` with the whole integrator in numba.
+
+scipy's ``DOP853`` and ``RK45`` are re-implemented step for step (same tableaux, taken from
+scipy; same initial step, error norm, step-size control and dense output), with the
+right-hand side and the contact law of :mod:`weftsim.reference.compiled_kernel`.  What
+the scipy path pays per step in Python (stage combinations, error norm, dense-output
+objects, event location; ~50 us per step attempt, docs/reference-solver.md section 4)
+becomes a few microseconds.  Events, impact velocity, recorded steps (accepted steps,
+events, ``_CONTACT_SUBSTEPS`` dense points inside contact steps) and output samples
+follow :mod:`weftsim.reference.integrate` exactly, so both paths agree to the integration
+tolerance (``tests/test_fast_paths.py``).
+
+Every function is module-level ``@njit(cache=True, error_model="numpy")`` and takes the scene as a parameter
+array: numba compiles once per machine (~10-20 s) and loads from its cache afterwards.
+The loop returns to Python every 1 % of the run (progress) or when its step buffer is full.
+
+Methods (``reference_solver.method``): ``"numba_DOP853"``, ``"numba_RK45"``.
+"""
+
+from __future__ import annotations
+
+import math
+import time as _time
+
+import numpy as np
+from numba import njit
+from scipy.integrate import RK45 as _SCIPY_RK45
+from scipy.integrate._ivp import dop853_coefficients as _D853
+
+from weftsim.guards import RunGuard, failure_message, non_finite_breach
+from weftsim.params import Scene
+from weftsim.reference.compiled_kernel import V_MIN, pack_parameters, penetration, rhs
+from weftsim.reference.dynamics import initial_state
+from weftsim.reference.integrate import _CONTACT_SUBSTEPS, _PROGRESS_EVERY, _ROOT_XTOL
+from weftsim.results import RunResult
+
+DOP853, RK45 = 0, 1
+METHODS = {"numba_DOP853": DOP853, "numba_RK45": RK45}
+
+# Tableaux (scipy's own coefficients; DOP853 stages 12, f_new at row 12, 3 extra dense stages).
+_A853 = np.ascontiguousarray(_D853.A[: _D853.N_STAGES, : _D853.N_STAGES])
+_B853, _C853 = _D853.B.copy(), _D853.C[: _D853.N_STAGES].copy()
+_E3, _E5, _D = _D853.E3.copy(), _D853.E5.copy(), np.ascontiguousarray(_D853.D)
+_A853X = np.ascontiguousarray(_D853.A[_D853.N_STAGES + 1:])
+_C853X = _D853.C[_D853.N_STAGES + 1:].copy()
+_A45, _B45, _C45 = _SCIPY_RK45.A.copy(), _SCIPY_RK45.B.copy(), _SCIPY_RK45.C.copy()
+_E45, _P45 = _SCIPY_RK45.E.copy(), np.ascontiguousarray(_SCIPY_RK45.P)
+_SAFETY, _MIN_FACTOR, _MAX_FACTOR = 0.9, 0.2, 10.0  # scipy's step-size control
+N = 6  # state size
+
+# Return codes of the core.
+DONE, PAUSED, BUFFER_FULL, STEP_TOO_SMALL, NON_FINITE, GUARD = 0, 1, 2, -1, -2, -3
+_ROWS_PER_STEP = _CONTACT_SUBSTEPS + 2  # substeps + step or event + new segment's first row
+_STEP_BUFFER = 1 << 15
+_SUBSTEPS = np.arange(1, _CONTACT_SUBSTEPS + 1) / (_CONTACT_SUBSTEPS + 1.0)
+
+# Float state: t, h_abs, held impact velocity, max penetration rate, first contact time (-1: none),
+# last accepted step, its penetration and length (for the guards of weftsim.guards).
+T, H_ABS, IMPACT, MAX_RATE, FIRST_CONTACT, LAST_PENETRATION, LAST_STEP = range(7)
+# Guard limits: penetration bound (m), shortest accepted step (s), step budget (0: none).
+PENETRATION_LIMIT, MIN_STEP_LIMIT, STEP_BUDGET = range(3)
+# Int state: mode, segment to start, counters, next output sample.
+CONTACT, START, STEPS, REJECTED, NFEV, DENSE, SEGMENTS, EVENTS, IMPACTS, NEXT_SAMPLE = range(10)
+
+
+@njit(cache=True, error_model="numpy")
+def _rms(v):
+    s = 0.0
+    for i in range(v.size):
+        s += v[i] * v[i]
+    return math.sqrt(s / v.size)
+
+
+@njit(cache=True, error_model="numpy")
+def _f(prm, t, y, contact, impact, out, ist):
+    ist[NFEV] += 1
+    rhs(prm, t, y, contact, impact, out)
+
+
+@njit(cache=True, error_model="numpy")
+def _initial_step(prm, t0, y0, f0, t_end, max_step, order, rtol, atol, contact, impact, ist, tmp):
+    """scipy.integrate._ivp.common.select_initial_step (one extra evaluation)."""
+    scale = atol + np.abs(y0) * rtol
+    d0 = _rms(y0 / scale)
+    d1 = _rms(f0 / scale)
+    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    h0 = min(h0, t_end - t0)
+    _f(prm, t0 + h0, y0 + h0 * f0, contact, impact, tmp, ist)
+    d2 = _rms((tmp - f0) / scale) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / (order + 1))
+    return min(100.0 * h0, h1, t_end - t0, max_step)
+
+
+@njit(cache=True, error_model="numpy")
+def _stages(prm, method, t, y, h, K, contact, impact, ist, y_new, tmp):
+    """One explicit RK step from K[0] = f(t, y): fills K (stages, f_new last), y_new."""
+    if method == DOP853:
+        A, B, C, n_st = _A853, _B853, _C853, 12
+    else:
+        A, B, C, n_st = _A45, _B45, _C45, 6
+    for s in range(1, n_st):
+        for j in range(N):
+            acc = 0.0
+            for r in range(s):
+                acc += K[r, j] * A[s, r]
+            tmp[j] = y[j] + acc * h
+        _f(prm, t + C[s] * h, tmp, contact, impact, K[s], ist)
+    for j in range(N):
+        acc = 0.0
+        for r in range(n_st):
+            acc += K[r, j] * B[r]
+        y_new[j] = y[j] + h * acc
+    _f(prm, t + h, y_new, contact, impact, K[n_st], ist)
+
+
+@njit(cache=True, error_model="numpy")
+def _error_norm(method, K, h, scale):
+    if method == DOP853:
+        e5 = 0.0
+        e3 = 0.0
+        for j in range(N):
+            a5 = 0.0
+            a3 = 0.0
+            for r in range(13):
+                a5 += K[r, j] * _E5[r]
+                a3 += K[r, j] * _E3[r]
+            a5 /= scale[j]
+            a3 /= scale[j]
+            e5 += a5 * a5
+            e3 += a3 * a3
+        if e5 == 0.0 and e3 == 0.0:
+            return 0.0
+        return abs(h) * e5 / math.sqrt((e5 + 0.01 * e3) * N)
+    s = 0.0
+    for j in range(N):
+        a = 0.0
+        for r in range(7):
+            a += K[r, j] * _E45[r]
+        a *= h / scale[j]
+        s += a * a
+    return math.sqrt(s / N)
+
+
+@njit(cache=True, error_model="numpy")
+def _dense_coefficients(prm, method, t_old, y_old, y_new, f_new, h, K, contact, impact, ist, F, tmp):
+    """Interpolant of the last step into F (DOP853: 7 rows of scipy's F; RK45: Q^T, 4 rows)."""
+    ist[DENSE] += 1
+    if method == DOP853:
+        for s in range(13, 16):
+            for j in range(N):
+                acc = 0.0
+                for r in range(s):
+                    acc += K[r, j] * _A853X[s - 13, r]
+                tmp[j] = y_old[j] + acc * h
+            _f(prm, t_old + _C853X[s - 13] * h, tmp, contact, impact, K[s], ist)
+        for j in range(N):
+            dy = y_new[j] - y_old[j]
+            F[0, j] = dy
+            F[1, j] = h * K[0, j] - dy
+            F[2, j] = 2.0 * dy - h * (f_new[j] + K[0, j])
+            for i in range(4):
+                acc = 0.0
+                for r in range(16):
+                    acc += _D[i, r] * K[r, j]
+                F[3 + i, j] = h * acc
+    else:
+        for i in range(4):
+            for j in range(N):
+                acc = 0.0
+                for r in range(7):
+                    acc += K[r, j] * _P45[r, i]
+                F[i, j] = acc
+
+
+@njit(cache=True, error_model="numpy")
+def _dense(method, F, t_old, h, y_old, t, out):
+    x = (t - t_old) / h
+    if method == DOP853:
+        for j in range(N):
+            acc = 0.0
+            for i in range(7):
+                acc += F[6 - i, j]
+                acc *= x if i % 2 == 0 else 1.0 - x
+            out[j] = acc + y_old[j]
+    else:
+        for j in range(N):
+            acc = 0.0
+            p = x
+            for i in range(4):
+                acc += F[i, j] * p
+                p *= x
+            out[j] = y_old[j] + h * acc
+
+
+@njit(cache=True, error_model="numpy")
+def _locate(prm, method, F, t_old, h, y_old, lo, hi, g_lo, g_hi, to_contact, tmp):
+    """Illinois regula falsi on the dense output (integrate._locate); root on the new side."""
+    last = 0
+    for _ in range(200):
+        if hi - lo <= _ROOT_XTOL:
+            break
+        m = hi - g_hi * (hi - lo) / (g_hi - g_lo)
+        if not lo < m < hi:
+            m = 0.5 * (lo + hi)
+        _dense(method, F, t_old, h, y_old, m, tmp)
+        g_m = penetration(prm, m, tmp)[0]
+        if (g_m > 0.0) if to_contact else (g_m < 0.0):
+            hi, g_hi = m, g_m
+            if last == -1:
+                g_lo *= 0.5
+            last = -1
+        else:
+            lo, g_lo = m, g_m
+            if last == 1:
+                g_hi *= 0.5
+            last = 1
+    return hi
+
+
+@njit(cache=True, error_model="numpy")
+def _record(buf_t, buf_y, buf_c, buf_i, n, t, y, contact, impact):
+    buf_t[n] = t
+    buf_y[n, :] = y
+    buf_c[n] = 1 if contact else 0
+    buf_i[n] = impact
+    return n + 1
+
+
+@njit(cache=True, error_model="numpy")
+def advance(prm, method, rtol, atol, max_step, t_end, t_pause, limits, y, f, fst, ist, sample_times,
+            smp_t, smp_y, smp_c, smp_i, stp_t, stp_y, stp_c, stp_i):
+    """Integrate from fst[T] until t_end, t >= t_pause, the step buffer is nearly full, or a guard.
+
+    Steps, events and contact substeps go to ``stp_*`` from row 0 (count returned),
+    samples to ``smp_*`` at rows ist[NEXT_SAMPLE]...  Returns (code, rows written).
+    After every accepted step (as :mod:`weftsim.reference.integrate` with ``RunGuard``): the
+    penetration bound, the shortest step (not the step cut to land on t_end) and the step
+    budget of ``limits``; a crossing records the step and returns GUARD.
+    """
+    K = np.zeros((16, N))
+    F = np.zeros((7, N))
+    y_new = np.empty(N)
+    tmp = np.empty(N)
+    scale = np.empty(N)
+    order = 7 if method == DOP853 else 4
+    f_row = 12 if method == DOP853 else 6
+    exponent = -1.0 / (order + 1)
+    n_rows = 0
+    capacity = stp_t.size
+    n_samples = sample_times.size
+    v_min = prm[V_MIN]
+    t = fst[T]
+    while t < t_end:
+        contact = ist[CONTACT] == 1
+        impact = fst[IMPACT]
+        if ist[START] == 1:
+            _f(prm, t, y, contact, impact, f, ist)
+            fst[H_ABS] = _initial_step(prm, t, y, f, t_end, max_step, order, rtol, atol, contact, impact, ist, tmp)
+            if not math.isfinite(fst[H_ABS]):
+                return NON_FINITE, n_rows
+            ist[START] = 0
+            ist[SEGMENTS] += 1
+        if n_rows + _ROWS_PER_STEP > capacity:
+            return BUFFER_FULL, n_rows
+        # One accepted step (scipy RungeKutta._step_impl).
+        min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
+        h_abs = min(max(fst[H_ABS], min_step), max_step)
+        rejected = False
+        while True:
+            if h_abs < min_step:
+                return STEP_TOO_SMALL, n_rows
+            if not math.isfinite(h_abs):
+                return NON_FINITE, n_rows
+            t_new = t + h_abs
+            if t_new > t_end:
+                t_new = t_end
+            h = t_new - t
+            h_abs = abs(h)
+            K[0, :] = f
+            _stages(prm, method, t, y, h, K, contact, impact, ist, y_new, tmp)
+            for j in range(N):
+                scale[j] = atol + max(abs(y[j]), abs(y_new[j])) * rtol
+            err = _error_norm(method, K, h, scale)
+            if not err == err:  # NaN from a non-finite stage: reject and shrink
+                err = math.inf
+            if err < 1.0:
+                factor = _MAX_FACTOR if err == 0.0 else min(_MAX_FACTOR, _SAFETY * err ** exponent)
+                if rejected:
+                    factor = min(1.0, factor)
+                h_abs *= factor
+                break
+            h_abs *= max(_MIN_FACTOR, _SAFETY * err ** exponent)
+            rejected = True
+            ist[REJECTED] += 1
+        fst[H_ABS] = h_abs
+        for j in range(N):
+            if not math.isfinite(y_new[j]):
+                return NON_FINITE, n_rows
+        ist[STEPS] += 1
+        f_new = K[f_row]
+        g_new = penetration(prm, t_new, y_new)[0]
+        fst[LAST_PENETRATION] = g_new
+        fst[LAST_STEP] = h if t_new < t_end else math.inf
+        if (g_new > limits[PENETRATION_LIMIT] or fst[LAST_STEP] < limits[MIN_STEP_LIMIT]
+                or (limits[STEP_BUDGET] > 0.0 and ist[STEPS] > limits[STEP_BUDGET])):
+            fst[T] = t_new
+            y[:] = y_new
+            n_rows = _record(stp_t, stp_y, stp_c, stp_i, n_rows, t_new, y_new, contact, impact)
+            return GUARD, n_rows
+        crossed = (g_new < 0.0) if contact else (g_new > 0.0)
+        t_stop = t_new
+        dense = False
+        if crossed:
+            _dense_coefficients(prm, method, t, y, y_new, f_new, h, K, contact, impact, ist, F, tmp)
+            dense = True
+            g_old = penetration(prm, t, y)[0]
+            t_stop = _locate(prm, method, F, t, h, y, t, t_new, g_old, g_new, not contact, tmp)
+        k = ist[NEXT_SAMPLE]
+        while k < n_samples and sample_times[k] <= t_stop:
+            if not dense:
+                _dense_coefficients(prm, method, t, y, y_new, f_new, h, K, contact, impact, ist, F, tmp)
+                dense = True
+            _dense(method, F, t, h, y, sample_times[k], tmp)
+            _record(smp_t, smp_y, smp_c, smp_i, k, sample_times[k], tmp, contact, impact)
+            k += 1
+        ist[NEXT_SAMPLE] = k
+        if contact and _CONTACT_SUBSTEPS > 0:
+            if not dense:
+                _dense_coefficients(prm, method, t, y, y_new, f_new, h, K, contact, impact, ist, F, tmp)
+                dense = True
+            for i in range(_CONTACT_SUBSTEPS):
+                t_sub = t + (t_stop - t) * _SUBSTEPS[i]
+                _dense(method, F, t, h, y, t_sub, tmp)
+                n_rows = _record(stp_t, stp_y, stp_c, stp_i, n_rows, t_sub, tmp, contact, impact)
+        if crossed:
+            _dense(method, F, t, h, y, t_stop, tmp)
+            t = t_stop
+            y[:] = tmp
+            ist[EVENTS] += 1
+            if contact:
+                ist[CONTACT] = 0
+                fst[IMPACT] = 0.0
+            else:
+                rate = penetration(prm, t, y)[1]
+                fst[MAX_RATE] = max(fst[MAX_RATE], rate)
+                ist[CONTACT] = 1
+                fst[IMPACT] = max(rate, v_min)
+                ist[IMPACTS] += 1
+                if fst[FIRST_CONTACT] < 0.0:
+                    fst[FIRST_CONTACT] = t
+            ist[START] = 1
+            n_rows = _record(stp_t, stp_y, stp_c, stp_i, n_rows, t, y, ist[CONTACT] == 1, fst[IMPACT])
+        else:
+            t = t_new
+            y[:] = y_new
+            f[:] = f_new
+            n_rows = _record(stp_t, stp_y, stp_c, stp_i, n_rows, t, y, contact, impact)
+        fst[T] = t
+        if t >= t_pause:
+            return PAUSED, n_rows
+    fst[T] = t
+    return DONE, n_rows
+
+
+def _empty_buffers(n: int):
+    return np.zeros(n), np.zeros((n, N)), np.zeros(n, dtype=np.uint8), np.zeros(n)
+
+
+def integrate_compiled(scene: Scene, progress=None, method: str = "numba_DOP853"):
+    """Run the compiled integrator; returns (steps, samples, stats, events, status, message).
+
+    ``steps`` and ``samples`` are tuples (t, y (n, 6), contact (bool), impact) as
+    :func:`weftsim.reference.channels.clearance_channels` takes them.
+    """
+    settings = scene.reference_solver
+    omega, t_end = scene.drive.speed, scene.drive.end_time
+    code_method = METHODS[method]
+    wall0 = _time.perf_counter()
+    prm = pack_parameters(scene)
+    sample_dt = scene.output.sample_angle / omega
+    n_samples = int(math.floor(t_end / sample_dt * (1.0 + 1e-12))) + 1
+    sample_times = np.arange(n_samples) * sample_dt
+    if t_end - sample_times[-1] > 1e-9 * sample_dt:
+        sample_times = np.append(sample_times, t_end)
+    y = initial_state(scene).astype(float)
+    f = np.zeros(N)
+    fst = np.array([0.0, 0.0, 0.0, 0.0, -1.0, -math.inf, math.inf])
+    ist = np.zeros(10, dtype=np.int64)
+    ist[START] = 1
+    guard = RunGuard(scene)
+    limits = np.array([math.inf if scene.joint.is_ideal else guard.max_penetration, guard.min_step,
+                       float(guard.max_steps or 0)])  # fmt: skip
+    smp = _empty_buffers(sample_times.size)
+    stp = _empty_buffers(_STEP_BUFFER)
+    chunks = [(np.zeros(1), y[None, :].copy(), np.zeros(1, dtype=np.uint8), np.zeros(1))]
+    if progress is not None:
+        progress(0.0)
+    # Pause every 1 % of the run for progress reports and the wall-time budget only if needed.
+    pausing = progress is not None or math.isfinite(guard.max_wall_time)
+    next_report = _PROGRESS_EVERY
+    status, message, failure = "success", "", None
+    # scipy raises rtol below 100 eps to it (a warning); the compiled path does the same, silently.
+    rtol = max(settings.rtol, 100.0 * np.finfo(float).eps)
+    steps_seen = 0
+    while True:
+        t_pause = next_report * t_end if pausing else 2.0 * t_end
+        code, rows = advance(prm, code_method, rtol, settings.atol, settings.max_step / omega, t_end,
+                             t_pause, limits, y, f, fst, ist, sample_times, *smp, *stp)  # fmt: skip
+        chunks.append(tuple(b[:rows].copy() for b in stp))
+        t = fst[T]
+        breach = None
+        if code == GUARD:
+            breach = guard.check(penetration=None if scene.joint.is_ideal else fst[LAST_PENETRATION],
+                                 step_size=fst[LAST_STEP], steps=int(ist[STEPS]) - steps_seen)  # fmt: skip
+        elif code == STEP_TOO_SMALL:
+            breach = guard.check(step_size=10.0 * np.spacing(t), steps=0)
+        elif code == NON_FINITE:
+            breach = non_finite_breach("the right-hand side or the state turned non-finite (NaN or inf)")
+        elif code != DONE:
+            breach = guard.check(steps=int(ist[STEPS]) - steps_seen)  # the wall-time budget
+        steps_seen = int(ist[STEPS])
+        if breach is not None:
+            status, failure = "failed", breach.kind
+            message = failure_message(f"reference solver ({method})", t, omega, breach.what, breach.hint)
+            break
+        if code == DONE:
+            break
+        if code == PAUSED and progress is not None:
+            progress(min(t / t_end, 1.0))
+        if code == PAUSED:
+            next_report = math.floor(t / t_end / _PROGRESS_EVERY + 1.0) * _PROGRESS_EVERY
+    wall = _time.perf_counter() - wall0
+    steps = tuple(np.concatenate([c[i] for c in chunks]) for i in range(4))
+    n_done = int(ist[NEXT_SAMPLE])
+    samples = tuple(b[:n_done] for b in smp)
+    steps = (steps[0], steps[1], steps[2].astype(bool), steps[3])
+    samples = (samples[0], samples[1], samples[2].astype(bool), samples[3])
+    stats = {
+        "method": method,
+        "rtol": settings.rtol,
+        "atol": settings.atol,
+        "max_step_rad": settings.max_step,
+        "steps": int(ist[STEPS]),
+        "rejected_steps": int(ist[REJECTED]),
+        "function_evaluations": int(ist[NFEV]),
+        "jacobian_evaluations": 0,
+        "lu_decompositions": 0,
+        "dense_output_calls": int(ist[DENSE]),
+        "segments": int(ist[SEGMENTS]),
+        "contact_events": int(ist[EVENTS]),
+        "impacts": int(ist[IMPACTS]),
+        "wall_time_s": wall,
+    }
+    events = {
+        "first_contact_time_s": None if fst[FIRST_CONTACT] < 0.0 else float(fst[FIRST_CONTACT]),
+        "max_impact_velocity_m_s": float(fst[MAX_RATE]),
+    }
+    if failure is not None:
+        stats["failure"] = failure
+    if progress is not None and status == "success":
+        progress(1.0)
+    return steps, samples, stats, events, status, message
+
+
+def solve_compiled(scene: Scene, progress=None) -> RunResult:
+    """The reference engine's clearance mode through the compiled integrator (method by name)."""
+    from weftsim.reference.compiled_channels import compiled_channels
+    from weftsim.results import empty_channels
+
+    steps, samples, stats, events, status, message = integrate_compiled(scene, progress, scene.reference_solver.method)
+    wall0 = _time.perf_counter()
+
+    def channels(arrays):
+        return compiled_channels(scene, *arrays) if arrays[0].size else empty_channels()
+
+    step_channels, sample_channels = channels(steps), channels(samples)
+    stats["postprocess_time_s"] = _time.perf_counter() - wall0
+    stats["wall_time_s"] += stats["postprocess_time_s"]
+    return RunResult(scene, "reference", status, message, sample_channels, step_channels, stats, events)
