@@ -261,7 +261,10 @@ def _integrate(scene: Scene, progress) -> Trajectory:
                     )  # fmt: skip
                 else:
                     breach = guard.check(step_size=10.0 * np.spacing(t), steps=0)
-                    breach = dataclasses.replace(breach, what=f"{breach.what}; scipy: {message or 'step failed'}")
+                    why = f"scipy: {message or 'step failed'}"
+                    if name in ("Radau", "BDF"):
+                        why += f"; {name} also halves the step when its Newton iterations do not converge"
+                    breach = dataclasses.replace(breach, what=f"{breach.what}; {why}")
                 fail(breach.what, breach.hint, breach.kind)
                 break
             n_steps += 1
