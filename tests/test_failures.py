@@ -22,7 +22,7 @@ import pytest
 
 from weftsim import exudyn_engine, reference
 from weftsim.guards import RunGuard, failure_message, vet_result, where
-from weftsim.params import ClearanceJoint, Drive, ExudynSolver, Limits, Material, Scene
+from weftsim.params import Drive, ExudynSolver, Limits, Material, ReferenceSolver, Scene
 from weftsim.results import CHANNELS
 
 RPM = math.pi / 30.0
@@ -152,6 +152,14 @@ def test_reference_step_size_collapse():
     limits.min_step_s and the run fails at the first contact saying the step collapsed."""
     r = reference.solve(scene(youngs_modulus=1e40))
     assert_failed(r, "step_size", "step size collapsed", "limits.min_step_s = 1e-12 s", "'Radau'")
+    assert failure_angle(r) == pytest.approx(FIRST_CONTACT_DEG, abs=0.01)
+
+
+def test_reference_implicit_method_newton_failure_shows_as_step_collapse():
+    """Radau on the same scene: its Newton iterations fail and it halves the step until scipy gives up;
+    the message names the method and says so."""
+    r = reference.solve(scene(youngs_modulus=1e40, reference_solver=ReferenceSolver(method="Radau")))
+    assert_failed(r, "step_size", "reference solver (Radau)", "step size collapsed", "Newton iterations")
     assert failure_angle(r) == pytest.approx(FIRST_CONTACT_DEG, abs=0.01)
 
 
