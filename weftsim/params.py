@@ -187,7 +187,13 @@ class ReferenceSolver:
 
 @dataclass(frozen=True)
 class ExudynSolver:
-    """Settings of the Exudyn engine."""
+    """Settings of the Exudyn engine.
+
+    ``model``: "rigid_body" (members 1-8 as bodies and joints, generalized-alpha with
+    ``step_size``, ``spectral_radius`` and the Newton settings) or "kinematic_tree" (members
+    1-3 prescribed, 4-8 in minimal coordinates, explicit ``explicit_method`` with automatic
+    step size to ``relative_tolerance`` / ``absolute_tolerance``; docs/performance.md).
+    """
 
     model: str = "rigid_body"
     step_size: float = 2e-6  # s
@@ -196,6 +202,9 @@ class ExudynSolver:
     newton_relative_tolerance: float = 1e-8
     newton_max_iterations: int = 25
     callback: str = "auto"
+    explicit_method: str = "DOPRI5"  # kinematic_tree only
+    relative_tolerance: float = 1e-6  # kinematic_tree: error control of the explicit solver
+    absolute_tolerance: float = 1e-9  # kinematic_tree: on joint angles (rad) and rates (rad/s)
 
 
 @dataclass(frozen=True)

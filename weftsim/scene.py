@@ -21,7 +21,8 @@ from typing import Any, Callable
 from weftsim import params
 
 INTEGRATORS = ("auto", "DOP853", "RK45", "RK23", "Radau", "LSODA", "BDF", "numba_DOP853", "numba_RK45")
-EXUDYN_MODELS = ("rigid_body",)
+EXUDYN_MODELS = ("rigid_body", "kinematic_tree")
+EXPLICIT_METHODS = ("DOPRI5", "ODE23")
 CALLBACK_ROUTES = ("auto", "python", "symbolic", "numba")
 BRANCHES = {"+": 1, "-": -1}
 
@@ -111,7 +112,8 @@ SCHEMA: tuple[Key, ...] = (
     Key("solver.reference.atol", "reference_solver.atol", "float", 1, 0, 1e-2, doc="absolute tolerance"),
     Key("solver.reference.max_step_deg", "reference_solver.max_step", "float", DEG, 0, 90,
         doc="largest step, as crank angle"),
-    Key("solver.exudyn.model", "exudyn_solver.model", "str", choices=EXUDYN_MODELS, doc="Exudyn model variant"),
+    Key("solver.exudyn.model", "exudyn_solver.model", "str", choices=EXUDYN_MODELS,
+        doc="Exudyn model: rigid_body (members 1-8, general) or kinematic_tree (members 1-3 prescribed)"),
     Key("solver.exudyn.step_size_s", "exudyn_solver.step_size", "float", 1, 0, 1e-2,
         doc="generalized-alpha step size"),
     Key("solver.exudyn.spectral_radius", "exudyn_solver.spectral_radius", "float", 1, 0, 1, False, False,
@@ -121,6 +123,12 @@ SCHEMA: tuple[Key, ...] = (
     Key("solver.exudyn.newton_max_iterations", "exudyn_solver.newton_max_iterations", "int", 1, 0, 1000),
     Key("solver.exudyn.callback", "exudyn_solver.callback", "str", choices=CALLBACK_ROUTES,
         doc="contact callback route; auto = fastest measured"),
+    Key("solver.exudyn.explicit_method", "exudyn_solver.explicit_method", "str", choices=EXPLICIT_METHODS,
+        doc="kinematic_tree model: explicit solver with automatic step size"),
+    Key("solver.exudyn.relative_tolerance", "exudyn_solver.relative_tolerance", "float", 1, 0, 1e-2,
+        doc="kinematic_tree model: relative tolerance of the step-size control"),
+    Key("solver.exudyn.absolute_tolerance", "exudyn_solver.absolute_tolerance", "float", 1, 0, 1e-2,
+        doc="kinematic_tree model: absolute tolerance (joint angles in rad, rates in rad/s)"),
     Key("output.sample_deg", "output.sample_angle", "float", DEG, 0, 0.5, True, False,
         doc="output grid spacing in crank angle (0.5 deg or finer)"),
     Key("compare.first_contact_angle_deg", "compare.first_contact_angle", "float", DEG, 0),

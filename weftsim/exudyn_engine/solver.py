@@ -27,7 +27,7 @@ from weftsim.params import Scene
 from weftsim.reference.ideal import angle_grid
 from weftsim.results import RunResult, empty_channels
 
-MODELS = ("rigid_body",)
+MODELS = ("rigid_body", "kinematic_tree")  # kinematic_tree: tree.py, tree_solve.py
 # Modified Newton: iterations with one Jacobian before it is updated.  3 instead of
 # Exudyn's 8: 3.75 instead of 5.9 iterations per step, ~30 % less time, identical results
 # at the same tolerance (2: 2.97 iterations but 4x the Jacobians, slower).
@@ -40,6 +40,12 @@ def check_settings(scene: Scene) -> str | None:
     s = scene.exudyn_solver
     if s.model not in MODELS:
         return f"`exudyn_solver.model` must be one of {MODELS}, got {s.model!r}"
+    if s.model == "kinematic_tree":
+        from weftsim.exudyn_engine.tree_solve import check_tree_settings
+
+        problem = check_tree_settings(scene)
+        if problem is not None:
+            return problem
     if not (s.step_size > 0.0 and math.isfinite(s.step_size)):
         return f"`exudyn_solver.step_size` must be > 0, got {s.step_size}"
     if not 0.0 <= s.spectral_radius <= 1.0:
@@ -147,6 +153,10 @@ def solve(scene: Scene, progress=None, callback: str | None = None) -> RunResult
     problem = check_settings(scene)
     if problem is not None:
         return _failed(scene, problem, 0.0)
+    if scene.exudyn_solver.model == "kinematic_tree":
+        from weftsim.exudyn_engine.tree_solve import solve_tree
+
+        return solve_tree(scene, progress, callback)
     h, n_steps = step_plan(scene)
     omega = scene.drive.speed
     sc = exu.SystemContainer()

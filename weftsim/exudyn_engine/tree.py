@@ -1,0 +1,315 @@
+"""Kinematic-tree model of the loom: only the free members in minimal coordinates, explicit solver.
+
+With members 1-3 ideal and rigid, their motion is known in closed form from the crank
+angle theta = omega t (SPEC.md section 1); only the chain 4-8 behind the clearance joint
+moves freely.  This model integrates that chain alone, as an ``ObjectKinematicTree`` with
+two revolute joints about Exudyn Z (the four-bar plane is Exudyn's XY plane, as in
+:mod:`.mechanism`)::
+
+    base at G = (L_OG, 0)
+    joint 0 (RevoluteZ)  q0 = a = theta_FG    link 0: sector 5 with gears 6/7 and rapier 8
+                                              reflected (J_FG about G, balanced)
+    joint 1 (RevoluteZ)  at F = G + L_FG u(q0)
+                         q1 = psi + pi - a    link 1: rod 4, x axis from F to the journal,
+                                              centre of mass at L_EF/2, journal at L_EF
+
+(psi = theta_EF of :mod:`weftsim.reference.dynamics`: P_j = F - L_EF u(psi)).  The bearing
+centre P_b(t) = E of the prescribed rocker is not a body: the clearance connector joins
+the journal to a ground marker at O, and its force callback subtracts P_b(t) and its
+velocity (closed form) from the connector's displacement and velocity,
+
+    e = (P_j - O) - P_b(t),   e_dot = v_j - V_b(t),
+
+then applies the same law, onset interpolation and held impact velocity as
+:mod:`.callbacks` / :mod:`.onset`.  No constraints remain, so an error-controlled explicit
+solver (DOPRI5 with automatic step size) integrates it; there is no Jacobian and no
+Newton iteration.
+
+The driving torque comes from the contact force in closed form, with the crank-side
+terms of :mod:`weftsim.reference.ideal` (SPEC.md 4, docs/reference-solver.md):
+
+    T = 1/2 J13'(theta) omega^2 + U13'(theta) - Q3,   Q3 = F_b . dP_b/dtheta
+
+(F_b = F_N n, the force on the bearing, the connector's ``Force``).  The full rigid-body
+model (:mod:`.mechanism`) stays the general path; ``tests/test_fast_paths.py`` checks the
+two against each other.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import exudyn as exu
+import numpy as np
+from exudyn.itemInterface import (
+    MarkerBodyPosition,
+    MarkerKinematicTreeRigid,
+    NodeGenericODE2,
+    ObjectConnectorCartesianSpringDamper,
+    ObjectGround,
+    ObjectKinematicTree,
+)
+
+from weftsim.contact import make_law
+from weftsim.exudyn_engine.callbacks import _TINY_LENGTH, symbolic_elastic_force
+from weftsim.exudyn_engine.onset import OnsetTracker, penetration_state
+from weftsim.params import Scene
+from weftsim.reference.dynamics import initial_state
+from weftsim.reference.ideal import sector_chain_inertia
+
+UNSPECIFIED_MASS = 1.0  # sector mass (balanced, on its fixed axis: no effect), kg
+# "auto" route of this model: the symbolic route's expression tree repeats the bearing motion in
+# every use of e (Exudyn evaluates it as a tree, not a graph): 51 us per call against 3.4 us for
+# the fixed-bearing expression of callbacks.py; the plain-Python callback is ~1.5 us.
+AUTO_ROUTE = "python"
+
+
+@dataclass(frozen=True)
+class BearingMotion:
+    """Closed-form motion of the bearing centre P_b = E of the rocker (SPEC.md section 1).
+
+    phi = -atan(u), u = tan(beta) cos(theta); theta_OE = theta_OE0 + phi;
+    P_b = L_OE (cos theta_OE, sin theta_OE);  dP_b/dtheta = L_OE phi' (-sin, cos);
+    phi' = tan(beta) sin(theta) / (1 + u^2).  Plane coordinates (Y, Z) = Exudyn (X, Y).
+    """
+
+    omega: float
+    tan_beta: float
+    cos_oe0: float
+    sin_oe0: float
+    l_oe: float
+
+    @classmethod
+    def from_scene(cls, scene: Scene) -> "BearingMotion":
+        g = scene.geometry
+        return cls(scene.drive.speed, math.tan(g.crank_inclination), math.cos(g.rocker_arm_angle),
+                   math.sin(g.rocker_arm_angle), g.l_oe)  # fmt: skip
+
+    def terms(self, t, xp=math):
+        """(P_b, dP_b/dtheta) components (m, m/rad) at time t; ``xp`` = math, numpy or esym."""
+        theta = self.omega * t
+        u = self.tan_beta * xp.cos(theta)
+        w = 1.0 + u * u
+        r = 1.0 / xp.sqrt(w)
+        sq = self.sin_oe0 * r - self.cos_oe0 * u * r  # sin(theta_OE0 - atan u)
+        cq = self.cos_oe0 * r + self.sin_oe0 * u * r
+        dphi = self.tan_beta * xp.sin(theta) / w
+        return self.l_oe * cq, self.l_oe * sq, -self.l_oe * sq * dphi, self.l_oe * cq * dphi
+
+    def __call__(self, t: float):
+        """P_b (m) and its velocity (m/s) at time t, floats."""
+        by, bz, dby, dbz = self.terms(t)
+        return by, bz, self.omega * dby, self.omega * dbz
+
+
+def make_python_force(law, clearance: float, min_impact_velocity: float, bearing: BearingMotion,
+                      memory: list, stash: list, counter: list | None = None):
+    """Plain-Python force callback with the moving bearing (see :mod:`.callbacks`).
+
+    ``memory`` = [v_held, delta0, rate0] of the last accepted step (written by the post-step
+    bookkeeping; the connector's ``stiffness`` parameter is not needed); every call leaves
+    [t, delta, delta_dot] in ``stash``: the last call of a step is at the accepted state
+    (end-of-step accelerations), so the bookkeeping needs no ``GetObjectOutput``.
+    """
+    normal_force = law.scalar()
+    c, v_min, sqrt = clearance, min_impact_velocity, math.sqrt
+
+    def spring_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
+        if counter is not None:
+            counter[0] += 1
+        by, bz, vby, vbz = bearing(t)
+        ex = displacement[0] - by
+        ey = displacement[1] - bz
+        length = sqrt(ex * ex + ey * ey)
+        delta = length - c
+        if length <= 0.0:
+            stash[0], stash[1], stash[2] = t, delta, 0.0
+            return [0.0, 0.0, 0.0]
+        nx = ex / length
+        ny = ey / length
+        rate = (velocity[0] - vby) * nx + (velocity[1] - vbz) * ny
+        stash[0], stash[1], stash[2] = t, delta, rate
+        if delta <= 0.0:
+            return [0.0, 0.0, 0.0]
+        delta0 = memory[1]
+        if delta0 > 0.0:
+            v_imp = memory[0]
+        else:
+            rate0 = memory[2]
+            v_imp = rate0 + delta0 / (delta0 - delta) * (rate - rate0)
+        if v_imp < v_min:
+            v_imp = v_min
+        f = normal_force(delta, rate, v_imp)
+        return [f * nx, f * ny, 0.0]
+
+    return spring_force
+
+
+def make_numba_force(law, clearance: float, min_impact_velocity: float, bearing: BearingMotion,
+                     memory: list, stash: list):
+    """Python wrapper around an ``@njit`` core of the whole force, bearing motion included.
+
+    ``memory`` and ``stash`` as in :func:`make_python_force`.
+    """
+    import numba
+
+    normal_force = law.numba()
+    c, v_min = clearance, min_impact_velocity
+    omega, tb, c0, s0, l_oe = bearing.omega, bearing.tan_beta, bearing.cos_oe0, bearing.sin_oe0, bearing.l_oe
+
+    @numba.njit(cache=False)
+    def core(t, px, py, vx, vy, held, delta0, rate0):
+        theta = omega * t
+        u = tb * math.cos(theta)
+        w = 1.0 + u * u
+        r = 1.0 / math.sqrt(w)
+        sq = s0 * r - c0 * u * r
+        cq = c0 * r + s0 * u * r
+        dphi = tb * math.sin(theta) / w
+        ex = px - l_oe * cq
+        ey = py - l_oe * sq
+        length = math.sqrt(ex * ex + ey * ey)
+        delta = length - c
+        if length <= 0.0:
+            return 0.0, 0.0, delta, 0.0
+        nx = ex / length
+        ny = ey / length
+        rate = (vx + omega * l_oe * sq * dphi) * nx + (vy - omega * l_oe * cq * dphi) * ny
+        if delta <= 0.0:
+            return 0.0, 0.0, delta, rate
+        v_imp = held if delta0 > 0.0 else rate0 + delta0 / (delta0 - delta) * (rate - rate0)
+        if v_imp < v_min:
+            v_imp = v_min
+        f = normal_force(delta, rate, v_imp)
+        return f * nx, f * ny, delta, rate
+
+    core(0.0, 1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0)  # compile now, not inside the first step
+
+    def spring_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
+        fx, fy, delta, rate = core(t, displacement[0], displacement[1], velocity[0], velocity[1],
+                                   memory[0], memory[1], memory[2])  # fmt: skip
+        stash[0], stash[1], stash[2] = t, delta, rate
+        return [fx, fy, 0.0]
+
+    return spring_force
+
+
+def make_symbolic_force(mbs, law, clearance: float, min_impact_velocity: float, bearing: BearingMotion):
+    """Exudyn symbolic user function (C++ expression tree) of the force with the moving bearing.
+
+    Same guards as :func:`weftsim.exudyn_engine.callbacks.make_symbolic_force` (both branches of
+    ``IfThenElse`` are evaluated).  Keep the returned object alive as long as the system.
+    """
+    esym = exu.symbolic
+    from exudyn.advancedUtilities import CreateSymbolicUserFunction
+
+    c, v_min, xi, omega = clearance, min_impact_velocity, law.hysteresis, bearing.omega
+    real = esym.Real
+
+    def springForceUserFunction(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
+        by, bz, dby, dbz = bearing.terms(t, esym)
+        ex = displacement[0] - by
+        ey = displacement[1] - bz
+        length = esym.sqrt(ex * ex + ey * ey)
+        delta = length - real(c)
+        safe = esym.max(length, real(_TINY_LENGTH))
+        nx = ex / safe
+        ny = ey / safe
+        rate = (velocity[0] - real(omega) * dby) * nx + (velocity[1] - real(omega) * dbz) * ny
+        held = stiffness[0]
+        delta0 = stiffness[1]
+        rate0 = stiffness[2]
+        span = esym.min(delta0 - delta, real(-_TINY_LENGTH))
+        s = esym.min(esym.max(delta0 / span, real(0.0)), real(1.0))
+        onset = rate0 + s * (rate - rate0)
+        v_imp = esym.max(esym.IfThenElse(delta0 > real(0.0), held, onset), real(v_min))
+        f_el = symbolic_elastic_force(law, esym.max(delta, real(0.0)), esym)
+        f = esym.max(f_el * (real(1.0) + real(xi) * rate / v_imp), real(0.0))
+        f = esym.IfThenElse(delta > real(0.0), f, real(0.0))
+        return [f * nx, f * ny, real(0.0)]
+
+    return CreateSymbolicUserFunction(
+        mbs, springForceUserFunction, "springForceUserFunction",
+        itemTypeName="ObjectConnectorCartesianSpringDamper",
+    )  # fmt: skip
+
+
+@dataclass
+class TreeModel:
+    """Items of the kinematic-tree model and the clearance bookkeeping."""
+
+    scene: Scene
+    node: object  # NodeGenericODE2 with q = [a, psi + pi - a]
+    tree: object  # ObjectKinematicTree
+    connector: object  # ObjectConnectorCartesianSpringDamper, Force = F_N n on the bearing side
+    bearing: BearingMotion
+    tracker: OnsetTracker
+    route: str
+    memory: list  # [v_held, delta0, rate0] read by the python and numba callbacks
+    stash: list  # [t, delta, delta_dot] of the last callback (python, numba)
+    callback_calls: list = field(default_factory=lambda: [0])
+    keep_alive: object = field(default=None, repr=False)
+
+    def accept(self, mbs, t: float) -> None:
+        """Post-step bookkeeping: onset, held impact velocity, callback memory."""
+        if self.stash[0] == t:  # the callback's last call was at this accepted state
+            delta, rate = self.stash[1], self.stash[2]
+        else:
+            u = mbs.GetObjectOutput(self.connector, exu.OutputVariableType.Displacement)
+            v = mbs.GetObjectOutput(self.connector, exu.OutputVariableType.Velocity)
+            by, bz, vby, vbz = self.bearing(t)
+            delta, rate = penetration_state(u[0] - by, u[1] - bz, v[0] - vby, v[1] - vbz,
+                                            self.scene.joint.clearance)  # fmt: skip
+        self.tracker.accept(t, delta, rate)
+        self.memory[:] = self.tracker.callback_state
+        if self.route == "symbolic":
+            mbs.SetObjectParameter(self.connector, "stiffness", self.memory)
+
+
+def build_tree(mbs, scene: Scene, callback: str = "auto") -> TreeModel:
+    """Add the kinematic tree of members 4-8, gravity and the clearance connector to ``mbs``.
+
+    Initial state: the ideal mechanism at theta = 0, journal centred
+    (:func:`weftsim.reference.dynamics.initial_state`).  ``callback``: "auto" (= :data:`AUTO_ROUTE`),
+    "symbolic", "python" or "numba".  Needs ``scene.joint.clearance > 0`` and no friction.
+    """
+    g, m, joint = scene.geometry, scene.inertia, scene.joint
+    a0, psi0, da0, dpsi0 = initial_state(scene)[:4]
+    node = mbs.AddNode(NodeGenericODE2(
+        referenceCoordinates=[0.0, 0.0], initialCoordinates=[a0, psi0 + math.pi - a0],
+        initialCoordinates_t=[da0, dpsi0 - da0], numberOfODE2Coordinates=2,
+    ))  # fmt: skip
+    tree = mbs.AddObject(ObjectKinematicTree(
+        nodeNumber=node, jointTypes=[exu.JointType.RevoluteZ] * 2, linkParents=[-1, 0],
+        jointTransformations=exu.Matrix3DList([np.eye(3)] * 2),
+        jointOffsets=exu.Vector3DList([[0.0, 0.0, 0.0], [g.l_fg, 0.0, 0.0]]),
+        linkInertiasCOM=exu.Matrix3DList([np.eye(3) * sector_chain_inertia(scene), np.eye(3) * m.rod_inertia]),
+        linkCOMs=exu.Vector3DList([[0.0, 0.0, 0.0], [0.5 * g.l_ef, 0.0, 0.0]]),
+        linkMasses=[UNSPECIFIED_MASS, m.rod_mass], baseOffset=[g.l_og, 0.0, 0.0], gravity=[0.0, -m.gravity, 0.0],
+    ))  # fmt: skip
+    ground = mbs.AddObject(ObjectGround())
+    m_origin = mbs.AddMarker(MarkerBodyPosition(bodyNumber=ground, localPosition=[0.0, 0.0, 0.0]))
+    m_journal = mbs.AddMarker(MarkerKinematicTreeRigid(objectNumber=tree, linkNumber=1, localPosition=[g.l_ef, 0, 0]))
+    law = make_law(joint)
+    bearing = BearingMotion.from_scene(scene)
+    route = AUTO_ROUTE if callback == "auto" else callback
+    calls = [0]
+    keep = None
+    c, v_min = joint.clearance, joint.min_impact_velocity
+    tracker = OnsetTracker(c, v_min)
+    memory = list(tracker.callback_state)
+    stash = [math.nan, 0.0, 0.0]
+    if route == "python":
+        force = make_python_force(law, c, v_min, bearing, memory, stash, calls)
+    elif route == "numba":
+        force = make_numba_force(law, c, v_min, bearing, memory, stash)
+    elif route == "symbolic":
+        keep = force = make_symbolic_force(mbs, law, c, v_min, bearing)
+    else:
+        raise ValueError(f"`callback` must be one of 'auto', 'python', 'symbolic', 'numba', got {callback!r}")
+    connector = mbs.AddObject(ObjectConnectorCartesianSpringDamper(
+        markerNumbers=[m_origin, m_journal], stiffness=tracker.callback_state, damping=[0.0, 0.0, 0.0],
+        offset=[0.0, 0.0, 0.0], springForceUserFunction=force,
+    ))  # fmt: skip
+    return TreeModel(scene, node, tree, connector, bearing, tracker, route, memory, stash, calls, keep)

@@ -1,0 +1,237 @@
+"""``solve`` of the kinematic-tree model (:mod:`.tree`): explicit solver, channels, failures.
+
+Solver: Exudyn's explicit ``exudyn_solver.explicit_method`` (DOPRI5 or ODE23) with
+automatic step size, ``relative_tolerance`` and ``absolute_tolerance`` (on the joint
+angles, rad, and rates, rad/s), end-of-step accelerations on (else the rapier acceleration
+lags a stage), largest step = one output sample period.  Output samples are interpolated
+linearly between accepted steps (peaks and statistics use the steps themselves).
+
+Channels, at every accepted step (SPEC.md 4 signs):
+
+    a, psi           q0, q0 + q1 - pi;   rapier s, v, a = (d5 d7/d6) (a - a(0), a', a'')
+    e, delta, F_N    from a, psi and the closed-form bearing motion
+                     (:func:`weftsim.reference.dynamics.eccentricity`); F_N = |connector Force|
+    torque           1/2 J13' omega^2 + U13' - Q3, Q3 = F_b . dP_b/dtheta (:mod:`weftsim.reference.ideal`)
+    energies         kinetic 1/2 J13 omega^2 + chain (:func:`~weftsim.reference.dynamics.chain_energy`),
+                     potential U13 + m4 g z4, contact law.elastic_energy(delta), driving work
+                     [1/2 J13 omega^2 + U13]_0^t + integral -Q3 omega dt, dissipated
+                     integral (F_N - F_el) delta_dot dt (trapezoids over accepted steps)
+
+Failures as in :mod:`.solver`: the run guards of :mod:`weftsim.guards` after every step,
+Exudyn exceptions, non-finite values, a premature stop; :func:`weftsim.guards.vet_result`.
+"""
+
+from __future__ import annotations
+
+import math
+import time as _time
+
+import exudyn as exu
+import numpy as np
+from exudyn.itemInterface import SensorNode, SensorObject
+
+from weftsim.contact import make_law
+from weftsim.exudyn_engine.sensors import first_nonfinite_row, sample_channels
+from weftsim.exudyn_engine.tree import TreeModel, build_tree
+from weftsim.guards import RunGuard, failure_message, non_finite_breach, vet_result
+from weftsim.params import Scene
+from weftsim.reference.dynamics import NUMPY, ChainConstants, chain_energy, eccentricity, initial_state
+from weftsim.reference.ideal import angle_grid, crank_side_inertia, crank_side_potential
+from weftsim.results import RunResult, empty_channels
+
+OVT = exu.OutputVariableType
+EXPLICIT_METHODS = {"DOPRI5": exu.DynamicSolverType.DOPRI5, "ODE23": exu.DynamicSolverType.ODE23}
+_PROGRESS_EVERY = 0.01
+
+
+def check_tree_settings(scene: Scene) -> str | None:
+    """Message naming the first setting the kinematic-tree model cannot run with, or None."""
+    s = scene.exudyn_solver
+    if scene.joint.is_ideal:
+        return ("the 'kinematic_tree' Exudyn model needs a clearance joint (with an ideal joint nothing moves "
+                "freely); use `exudyn_solver.model` = 'rigid_body' or the reference engine")  # fmt: skip
+    if s.explicit_method not in EXPLICIT_METHODS:
+        return f"`exudyn_solver.explicit_method` must be one of {tuple(EXPLICIT_METHODS)}, got {s.explicit_method!r}"
+    for name in ("relative_tolerance", "absolute_tolerance"):
+        value = getattr(s, name)
+        if not (value > 0.0 and math.isfinite(value)):
+            return f"`exudyn_solver.{name}` must be > 0, got {value}"
+    return None
+
+
+def _cumtrapz(y, x):
+    out = np.zeros_like(y)
+    if len(y) > 1:
+        out[1:] = np.cumsum(0.5 * (y[1:] + y[:-1]) * np.diff(x))
+    return out
+
+
+def tree_settings(scene: Scene) -> exu.SimulationSettings:
+    """Explicit solver with automatic step size; no files, no console output."""
+    s = scene.exudyn_solver
+    omega, t_end = scene.drive.speed, scene.drive.end_time
+    ss = exu.SimulationSettings()
+    ti = ss.timeIntegration
+    ti.solverType = EXPLICIT_METHODS[s.explicit_method]
+    ti.endTime = t_end
+    ti.numberOfSteps = max(1, math.ceil(t_end / (scene.output.sample_angle / omega) * (1.0 - 1e-12)))
+    ti.automaticStepSize = True
+    ti.relativeTolerance = s.relative_tolerance
+    ti.absoluteTolerance = s.absolute_tolerance
+    ti.minimumStepSize = scene.limits.min_step
+    ti.explicit.computeEndOfStepAccelerations = True
+    ti.verboseMode = 0
+    ss.solution.file.write = False
+    ss.solution.sensors.writePeriod = 0.0
+    ss.solution.solverInformationFileName = ""
+    ss.show.statistics = False
+    ss.show.computationTime = False
+    return ss
+
+
+def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
+    """All channels at the stored steps from the sensors' data (rows cut to a common length)."""
+    scene = model.scene
+    n = min(len(v) for v in data.values())
+    q, q_t, q_tt, force = (data[k][:n] for k in ("q", "q_t", "q_tt", "force"))
+    t = q[:, 0]
+    a, psi = q[:, 1], q[:, 1] + q[:, 2] - math.pi
+    da, dpsi = q_t[:, 1], q_t[:, 1] + q_t[:, 2]
+    p = ChainConstants.from_scene(scene)
+    omega = p.omega
+    ecc_y, ecc_z, v_y, v_z, _, db_y, db_z = eccentricity(NUMPY, p, t, a, psi, da, dpsi)
+    length = np.hypot(ecc_y, ecc_z)
+    delta = length - p.clearance
+    rate = np.where(length > 0.0, (ecc_y * v_y + ecc_z * v_z) / np.where(length > 0.0, length, 1.0), 0.0)
+    f_b = force[:, 1:3]  # F_N n, the force on the bearing
+    f_n = np.hypot(f_b[:, 0], f_b[:, 1])
+    q3 = f_b[:, 0] * db_y + f_b[:, 1] * db_z
+    theta = omega * t
+    j13, dj13 = crank_side_inertia(theta, scene)
+    u13, du13 = crank_side_potential(theta, scene)
+    j13_0, _ = crank_side_inertia(0.0, scene)
+    u13_0, _ = crank_side_potential(0.0, scene)
+    kin48, pot48 = chain_energy(p, a, psi, da, dpsi)
+    law = make_law(scene.joint)
+    inside = delta > 0.0
+    f_el = np.zeros(n)
+    energy = np.zeros(n)
+    f_el[inside] = law.elastic_force(delta[inside])
+    energy[inside] = law.elastic_energy(delta[inside])
+    hist = model.tracker.history()
+    row = np.clip(np.searchsorted(hist["time"], t * (1.0 + 1e-12), side="right") - 1, 0, len(hist["time"]) - 1)
+    ratio = scene.geometry.rapier_ratio
+    kin13 = 0.5 * j13 * omega**2
+    return {
+        "time_s": t,
+        "crank_angle_deg": np.degrees(theta),
+        "rapier_displacement_m": ratio * (a - initial_state(scene)[0]),
+        "rapier_velocity_m_s": ratio * da,
+        "rapier_acceleration_m_s2": ratio * q_tt[:, 1],
+        "driving_torque_Nm": 0.5 * dj13 * omega**2 + du13 - q3,
+        "contact_force_N": f_n,
+        "penetration_m": delta,
+        "eccentricity_y_m": ecc_y,
+        "eccentricity_z_m": ecc_z,
+        "impact_velocity_m_s": hist["impact_velocity"][row],
+        "in_contact": hist["in_contact"][row],
+        "kinetic_energy_J": kin13 + kin48,
+        "potential_energy_J": u13 + pot48,
+        "contact_energy_J": energy,
+        "driving_work_J": kin13 + u13 - (0.5 * float(j13_0) * omega**2 + float(u13_0)) + _cumtrapz(-q3 * omega, t),
+        "dissipated_energy_J": _cumtrapz((f_n - f_el) * rate, t),
+    }
+
+
+def solve_tree(scene: Scene, progress=None, callback: str | None = None) -> RunResult:
+    """Simulate a scene with the kinematic-tree model (settings checked by the caller)."""
+    wall0 = _time.perf_counter()
+    omega, t_end = scene.drive.speed, scene.drive.end_time
+    sc = exu.SystemContainer()
+    mbs = sc.AddSystem()
+    model = build_tree(mbs, scene, scene.exudyn_solver.callback if callback is None else callback)
+    store = {"storeInternal": True, "writeToFile": False}
+    sensors = {
+        "q": mbs.AddSensor(SensorNode(nodeNumber=model.node, outputVariableType=OVT.Coordinates, **store)),
+        "q_t": mbs.AddSensor(SensorNode(nodeNumber=model.node, outputVariableType=OVT.Coordinates_t, **store)),
+        "q_tt": mbs.AddSensor(SensorNode(nodeNumber=model.node, outputVariableType=OVT.Coordinates_tt, **store)),
+        "force": mbs.AddSensor(SensorObject(objectNumber=model.connector, outputVariableType=OVT.Force, **store)),
+    }
+    guard = RunGuard(scene)
+    breach = []
+    state = {"t": 0.0, "next_report": _PROGRESS_EVERY, "min_step": math.inf}
+
+    def post_step(mbs, t):
+        model.accept(mbs, t)
+        if t <= 0.0:  # Exudyn also calls this once at t = 0: not a step
+            return True
+        h = t - state["t"]
+        state["t"] = t
+        if t < t_end * (1.0 - 1e-12):  # the last step is cut to land on the end time
+            state["min_step"] = min(state["min_step"], h)
+        if progress is not None and t >= state["next_report"] * t_end:
+            progress(min(1.0, t / t_end))
+            state["next_report"] = math.floor(t / t_end / _PROGRESS_EVERY + 1.0) * _PROGRESS_EVERY
+        found = guard.check(penetration=model.tracker.delta, step_size=h if t < t_end * (1.0 - 1e-12) else None)
+        if found is not None:
+            breach.append(found)
+            return False
+        return True
+
+    mbs.SetPostStepUserFunction(post_step)
+    mbs.Assemble()
+    if progress is not None:
+        progress(0.0)
+    solver = exu.MainSolverExplicit()
+    status, message, kind = "success", "", None
+    wall_solve = _time.perf_counter()
+    try:
+        if not solver.SolveSystem(mbs, tree_settings(scene)):
+            status, kind, message = "failed", "solver", solver.GetErrorString() or "the explicit solver stopped"
+    except exu.ExudynError as exc:
+        text = str(exc).strip().splitlines()
+        last = text[-1].split(" [Python file ")[0] if text else ""
+        status, message = "failed", f"{type(exc).__name__}: {last}"
+        kind = "non_finite" if isinstance(exc, exu.SolverError) else "model" if isinstance(exc, exu.ModelError) else "solver"
+    wall_solve = _time.perf_counter() - wall_solve
+    data = {k: mbs.GetSensorStoredData(v) for k, v in sensors.items()}
+    steps = tree_channels(model, data) if min(len(v) for v in data.values()) else empty_channels()
+    bad = first_nonfinite_row(steps)
+    if bad is not None:
+        steps = {k: v[:bad] for k, v in steps.items()}
+        if status == "success":
+            found = non_finite_breach("non-finite values (NaN or inf) in the results (explicit solvers do not stop on NaN)")
+            status, message, kind = "failed", found.what, found.kind
+    t_last = float(steps["time_s"][-1]) if len(steps["time_s"]) else 0.0
+    hint = ("try a tighter `exudyn_solver.relative_tolerance`, the 'rigid_body' model, or the reference engine")
+    if breach and (status == "success" or kind is None):
+        status, kind = "failed", breach[0].kind
+        message = failure_message("Exudyn engine (kinematic_tree)", t_last, omega, breach[0].what, breach[0].hint)
+    elif status == "failed":
+        message = failure_message("Exudyn engine (kinematic_tree)", t_last, omega, message, hint)
+    elif t_end - t_last > 1e-9 * t_end:
+        status, kind = "failed", "stopped"
+        message = f"Exudyn stopped at t = {t_last:.6g} s before the end time {t_end:.6g} s; {hint}"
+    samples = sample_channels(steps, angle_grid(t_end, omega, scene.output.sample_angle))
+    it = solver.it
+    n_done = max(len(steps["time_s"]) - 1, 0)
+    stats = {
+        "method": scene.exudyn_solver.explicit_method,
+        "model": "kinematic_tree",
+        "relative_tolerance": scene.exudyn_solver.relative_tolerance,
+        "steps": n_done,
+        "rejected_steps": int(it.rejectedAutomaticStepSizeSteps),
+        "min_step_s": state["min_step"],
+        "callback": model.route,
+        "callback_calls": model.callback_calls[0] if model.route == "python" else None,
+        "contact_events": model.tracker.contact_events,
+        "solve_time_s": wall_solve,
+        "wall_time_s": _time.perf_counter() - wall0,
+    }
+    if kind is not None:
+        stats["failure"] = kind
+    stats["time_per_step_us"] = 1e6 * wall_solve / max(n_done, 1)
+    if progress is not None:
+        progress(1.0)
+    return vet_result(RunResult(scene, "exudyn", status, message, samples, steps, stats,
+                                {"first_contact_time_s": model.tracker.first_contact_time}))  # fmt: skip
