@@ -8,7 +8,7 @@ exit status are the reproducible quantities:
 - clearance, first revolution: crank angle of the first contact, maxima of contact force, rapier
   acceleration and driving torque;
 - clearance, 10 or more revolutions: RMS of rapier acceleration and driving torque and mean contact
-  force over revolutions 2..N, and their 99th percentiles.
+  force over revolutions 2..N, and the 99th percentiles of their magnitudes.
 
 The side-by-side table (min, max, RMS over the last revolution and the exudyn/reference
 ratio of each peak, as the paper reports 1.035 and 1.099 against ADAMS) is information.
@@ -85,8 +85,11 @@ def agreement_checks(exudyn: RunResult, reference: RunResult) -> list[dict]:
         for name, stat in (("rapier_acceleration_m_s2", "rms"), ("driving_torque_Nm", "rms"),
                            ("contact_force_N", "mean")):
             checks.append(_check(f"{name}: {stat} over revolutions 2..{n}", se[name][stat], sr[name][stat], tol.rms))
-            checks.append(_check(f"{name}: 99th percentile over revolutions 2..{n}", se[name]["p99"],
-                                 sr[name]["p99"], tol.percentile_99))
+            # The 99th percentile of the magnitude: for two-sided channels the signed p99 sits in one
+            # tail, decided by a handful of impacts, and moved by 14-39% under tolerance changes of
+            # one engine alone (docs/paper-comparison.md); the magnitude's moved by 2-14%.
+            checks.append(_check(f"{name}: 99th percentile of the magnitude over revolutions 2..{n}",
+                                 se[name]["p99_abs"], sr[name]["p99_abs"], tol.percentile_99))
     return checks
 
 
