@@ -20,6 +20,8 @@ from pathlib import Path
 
 import pytest
 
+from weftsim.output import MANIFEST
+
 from weftsim.cli import EXIT_USAGE
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
@@ -249,14 +251,19 @@ def test_sigkill_while_writing_leaves_the_previous_complete_files(tmp_path):
         if child.poll() is None:
             child.kill()
     assert child.returncode == -signal.SIGKILL
-    # Killed in the middle of channels.csv: every file under its final name is the previous run's,
-    # complete and byte for byte; the half-written data sits in a hidden temporary file only.
+    # Killed in the middle of channels.csv: every result file under its final name is the previous
+    # run's, complete and byte for byte; the half-written data sits in a hidden temporary file only,
+    # and the manifest says the directory was being written when the run died.
     after = {p.name: p for p in out.iterdir()}
     for name, data in before.items():
-        assert after[name].read_bytes() == data, name
+        if name != MANIFEST:
+            assert after[name].read_bytes() == data, name
+    assert json.loads(after[MANIFEST].read_text())["state"] == "writing"
     partial = [name for name in after if name not in before]
     assert partial and all(name.startswith(".channels.csv.") and name.endswith(".part") for name in partial)
     # The next run into the directory works and leaves its own complete files.
     again = cli("run", REFERENCE, "-o", out, "--revolutions", "0.03", "--no-plot")
     assert again.returncode == 0, again.stderr
     assert json.loads((out / "summary.json").read_text())["scene"]["drive.revolutions"] == 0.03
+    assert json.loads((out / MANIFEST).read_text())["state"] == "complete"
+    assert not [p for p in out.iterdir() if p.name.endswith(".part")]  # the killed run's leftovers are gone

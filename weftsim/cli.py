@@ -26,7 +26,12 @@ class CliError(Exception):
 
 
 class _Parser(argparse.ArgumentParser):
-    """argparse with one-line errors (the usage stays behind --help)."""
+    """argparse with one-line errors (the usage stays behind --help) and no abbreviated flags
+    (``--speed 400`` must not silently mean ``--speed-rpm``)."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("allow_abbrev", False)
+        super().__init__(*args, **kwargs)
 
     def error(self, message: str):
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
@@ -81,7 +86,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("run", help="simulate a scene with one engine (CSV, summary.json, figure)")
     _add_scene_flags(p)
-    p.add_argument("--engine", default="exudyn",
+    p.add_argument("--engine", default="exudyn", choices=("exudyn", "reference"),
                    help="exudyn (multibody model, default) or reference (closed-form Lagrange cross-check)")
     p.add_argument("--no-plot", action="store_true", help="skip the figure")
 
@@ -98,7 +103,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "a list 0.01,0.25,0.5 or an inclusive range start:stop:count; repeat for more axes")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="fixed override for every cell")
     p.add_argument("-o", "--output", default=None, help="sweep directory (default: out/<scene name>-sweep)")
-    p.add_argument("--engine", default="exudyn",
+    p.add_argument("--engine", default="exudyn", choices=("exudyn", "reference"),
                    help="exudyn (multibody model, default) or reference (closed-form Lagrange cross-check)")
     p.add_argument("--jobs", type=_positive(int), help="local worker processes (default: number of CPUs)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="run on an existing Dask cluster, e.g. tcp://host:8786")

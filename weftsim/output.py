@@ -116,19 +116,32 @@ def write_figure(target: Path, figure) -> Path:
         plt.close(figure)
 
 
-def finish_directory(outdir: Path, written: dict[str, Path], what: dict) -> None:
-    """Write the manifest last, then delete files an earlier run left that this one did not rewrite.
-
-    Until the manifest is replaced, the previous run's files stay listed; afterwards the
-    directory holds exactly this run's files (plus anything weftsim did not write).
-    """
-    old = set()
+def _manifest_files(outdir: Path) -> set[str]:
     try:
-        old = set(json.loads((outdir / MANIFEST).read_text()).get("files", []))
+        return set(json.loads((outdir / MANIFEST).read_text()).get("files", []))
     except (OSError, ValueError):
-        pass
+        return set()
+
+
+def begin_directory(outdir: Path, what: dict) -> None:
+    """Mark the directory as being written: a run killed between two files leaves this mark.
+
+    Each file is atomic on its own; this manifest (``"state": "writing"``) tells a reader that
+    the directory may hold a mix of the previous run's and this run's complete files.
+    """
+    write_json(outdir / MANIFEST, {**what, "state": "writing", "files": sorted(_manifest_files(outdir))})
+    for leftover in outdir.glob(".*.part"):  # temporary files of a run that was killed while writing
+        leftover.unlink(missing_ok=True)
+
+
+def finish_directory(outdir: Path, written: dict[str, Path], what: dict) -> None:
+    """Write the manifest last (``"state": "complete"``), then delete files an earlier run left.
+
+    Afterwards the directory holds exactly this run's files (plus anything weftsim did not write).
+    """
+    old = _manifest_files(outdir)
     names = sorted(p.name for p in written.values())
-    write_json(outdir / MANIFEST, {**what, "files": names})
+    write_json(outdir / MANIFEST, {**what, "state": "complete", "files": names})
     for stale in old - set(names):
         if "/" not in stale and stale != MANIFEST:
             (outdir / stale).unlink(missing_ok=True)
@@ -140,12 +153,13 @@ def write_run(result: RunResult, outdir: str | Path, figure: bool = True, force:
     from weftsim.plots import plot_channels
 
     outdir = prepare_directory(outdir, force)
+    what = {"kind": "run", "engine": result.engine, "scene": result.scene.name, "status": result.status}
+    begin_directory(outdir, what)
     written = {
         "channels": write_csv(outdir / "channels.csv", {n: result.samples[n] for n in CHANNELS}),
         "summary": write_json(outdir / "summary.json", summary(result)),
     }
     if figure and result.steps["time_s"].size:
         written["figure"] = write_figure(outdir / "channels.png", plot_channels([result]))
-    finish_directory(outdir, written, {"kind": "run", "engine": result.engine, "scene": result.scene.name,
-                                       "status": result.status})
+    finish_directory(outdir, written, what)
     return written
