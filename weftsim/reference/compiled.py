@@ -30,7 +30,7 @@ from scipy.integrate._ivp import dop853_coefficients as _D853
 
 from weftsim.guards import RunGuard, failure_message, non_finite_breach
 from weftsim.params import Scene
-from weftsim.reference.compiled_kernel import V_MIN, pack_parameters, penetration, rhs
+from weftsim.reference.compiled_kernel import V_MIN, chain, pack_parameters, penetration
 from weftsim.reference.dynamics import initial_state
 from weftsim.reference.integrate import _CONTACT_SUBSTEPS, _PROGRESS_EVERY, _ROOT_XTOL
 from weftsim.results import RunResult
@@ -74,8 +74,9 @@ def _rms(v):
 
 @njit(cache=True, error_model="numpy")
 def _f(prm, t, y, contact, impact, out, ist):
+    """y' into out; returns delta at (t, y) (the kernel computes it anyway)."""
     ist[NFEV] += 1
-    rhs(prm, t, y, contact, impact, out)
+    return chain(prm, t, y, contact, impact, out)[2]
 
 
 @njit(cache=True, error_model="numpy")
@@ -97,24 +98,31 @@ def _initial_step(prm, t0, y0, f0, t_end, max_step, order, rtol, atol, contact, 
 
 @njit(cache=True, error_model="numpy")
 def _stages(prm, method, t, y, h, K, contact, impact, ist, y_new, tmp):
-    """One explicit RK step from K[0] = f(t, y): fills K (stages, f_new last), y_new."""
+    """One explicit RK step from K[0] = f(t, y): fills K (stages, f_new last), y_new.
+
+    Returns delta at the end of the step (from the last evaluation, f_new).
+    """
     if method == DOP853:
         A, B, C, n_st = _A853, _B853, _C853, 12
     else:
         A, B, C, n_st = _A45, _B45, _C45, 6
-    for s in range(1, n_st):
+    for s in range(1, n_st):  # as scipy's rk_step: y + (K^T a) h, y + h (K^T b)
+        tmp[:] = 0.0
+        for r in range(s):
+            a = A[s, r]
+            for j in range(N):
+                tmp[j] += K[r, j] * a
         for j in range(N):
-            acc = 0.0
-            for r in range(s):
-                acc += K[r, j] * A[s, r]
-            tmp[j] = y[j] + acc * h
+            tmp[j] = y[j] + tmp[j] * h
         _f(prm, t + C[s] * h, tmp, contact, impact, K[s], ist)
+    y_new[:] = 0.0
+    for r in range(n_st):
+        b = B[r]
+        for j in range(N):
+            y_new[j] += K[r, j] * b
     for j in range(N):
-        acc = 0.0
-        for r in range(n_st):
-            acc += K[r, j] * B[r]
-        y_new[j] = y[j] + h * acc
-    _f(prm, t + h, y_new, contact, impact, K[n_st], ist)
+        y_new[j] = y[j] + h * y_new[j]
+    return _f(prm, t + h, y_new, contact, impact, K[n_st], ist)
 
 
 @njit(cache=True, error_model="numpy")
@@ -281,7 +289,7 @@ def advance(prm, method, rtol, atol, max_step, t_end, t_pause, limits, y, f, fst
             h = t_new - t
             h_abs = abs(h)
             K[0, :] = f
-            _stages(prm, method, t, y, h, K, contact, impact, ist, y_new, tmp)
+            g_new = _stages(prm, method, t, y, h, K, contact, impact, ist, y_new, tmp)
             for j in range(N):
                 scale[j] = atol + max(abs(y[j]), abs(y_new[j])) * rtol
             err = _error_norm(method, K, h, scale)
@@ -302,7 +310,6 @@ def advance(prm, method, rtol, atol, max_step, t_end, t_pause, limits, y, f, fst
                 return NON_FINITE, n_rows
         ist[STEPS] += 1
         f_new = K[f_row]
-        g_new = penetration(prm, t_new, y_new)[0]
         fst[LAST_PENETRATION] = g_new
         fst[LAST_STEP] = h if t_new < t_end else math.inf
         if (g_new > limits[PENETRATION_LIMIT] or fst[LAST_STEP] < limits[MIN_STEP_LIMIT]

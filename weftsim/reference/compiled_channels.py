@@ -32,7 +32,6 @@ from weftsim.results import CHANNELS
 
 TABLE_POINTS = 4096  # spline knots per revolution: interpolation error ~ 5/384 h^4 |f''''| ~ 1e-12 relative
 _SERIES_LIMIT = 0.25  # as weftsim.contact: binomial series below x = delta/c = 1/4
-_SERIES_TERMS = 40
 
 
 @functools.lru_cache(maxsize=16)
@@ -74,20 +73,30 @@ def crank_side_eval(table, theta, out):
         out[k] = ((table[k, i, 0] * x + table[k, i, 1]) * x + table[k, i, 2]) * x + table[k, i, 3]
 
 
-@njit(cache=True, error_model="numpy")
-def _binomial_moment(y, m, p):
-    """sum_k C(p, k) y^(m+k+1) / (m+k+1), k < 40 (weftsim.contact._binomial_moment)."""
-    total = 0.0
+def _moment_coefficients(m: float, p: float) -> np.ndarray:
+    """c_k = C(p, k) / (m + k + 1): integral_0^y x^m (1 + x)^p dx = y^(m+1) sum_k c_k y^k (|y| < 1)."""
+    out = np.empty(_SERIES_TERMS)
     coeff = 1.0
-    power = y ** (m + 1.0)
     for k in range(_SERIES_TERMS):
-        term = coeff * power / (m + k + 1.0)
-        total += term
-        if abs(term) < 1e-17 * abs(total):  # the rest is below round-off (|y| <= 1/4)
-            break
+        out[k] = coeff / (m + k + 1.0)
         coeff *= (p - k) / (k + 1.0)
-        power *= y
-    return total
+    return out
+
+
+# The binomial series of weftsim.contact (variable_kd: 3 M(2) + 2 M(3); elastic_foundation: M(1.5),
+# p = -1.5 and -0.5), as polynomials for Horner's rule: 32 terms reach round-off for y <= 1/4.
+_SERIES_TERMS = 32
+_VKD_3 = _moment_coefficients(2.0, -1.5) * 3.0
+_VKD_4 = _moment_coefficients(3.0, -1.5) * 2.0
+_EF = _moment_coefficients(1.5, -0.5)
+
+
+@njit(cache=True, error_model="numpy")
+def _horner(c, y):
+    acc = 0.0
+    for k in range(c.size - 1, -1, -1):
+        acc = acc * y + c[k]
+    return acc
 
 
 @njit(cache=True, error_model="numpy")
@@ -101,13 +110,13 @@ def elastic_energy(prm, delta):
     x = delta / c
     if law == LAW_VARIABLE_KD:
         if x <= _SERIES_LIMIT:
-            g = 3.0 * _binomial_moment(x, 2.0, -1.5) + 2.0 * _binomial_moment(x, 3.0, -1.5)
+            g = x * x * x * (_horner(_VKD_3, x) + x * _horner(_VKD_4, x))
         else:
             u = 1.0 + x
             g = 0.8 * u**2.5 - 2.0 * u**1.5 - 2.0 / math.sqrt(u) + 3.2
         return coef * math.sqrt(2.0) * c**2.5 * g
     if x <= _SERIES_LIMIT:
-        h = _binomial_moment(x, 1.5, -0.5)
+        h = x * x * math.sqrt(x) * _horner(_EF, x)
     else:
         h = 0.25 * math.sqrt(x * (1.0 + x)) * (2.0 * x - 3.0) + 0.75 * math.asinh(math.sqrt(x))
     return coef / math.sqrt(2.0) * c * c * h
@@ -115,7 +124,7 @@ def elastic_energy(prm, delta):
 
 @njit(cache=True, error_model="numpy")
 def _fill(prm, table, a0, ratio, time, states, contact, impact, out):
-    """Rows of :data:`CHANNELS` (in that order) into out (17, n)."""
+    """Rows of :data:`CHANNELS` (in that order) into out (n, 17)."""
     omega = prm[OMEGA]
     d = np.empty(6)
     start = np.empty(4)
@@ -125,37 +134,37 @@ def _fill(prm, table, a0, ratio, time, states, contact, impact, out):
     for i in range(time.size):
         t = time[i]
         y = states[i]
-        q3, f_n, delta, ecc_y, ecc_z = chain(prm, t, y, contact[i], impact[i], d)
+        q3, f_n, delta, ecc_y, ecc_z, sa, ca, sp, cp = chain(prm, t, y, contact[i], impact[i], d)
         crank_side_eval(table, omega * t, crank)
-        a, psi, da, dpsi = y[0], y[1], y[2], y[3]
-        m12 = -prm[COUPLING] * math.cos(psi - a)
+        a, da, dpsi = y[0], y[2], y[3]
+        m12 = -prm[COUPLING] * (cp * ca + sp * sa)  # -k cos(psi - a)
         kin48 = 0.5 * (prm[M11] * da * da + 2.0 * m12 * da * dpsi + prm[M22] * dpsi * dpsi)
-        pot48 = prm[ROD_MASS] * prm[GRAVITY] * (prm[L_FG] * math.sin(a) - 0.5 * prm[L_EF] * math.sin(psi))
+        pot48 = prm[ROD_MASS] * prm[GRAVITY] * (prm[L_FG] * sa - 0.5 * prm[L_EF] * sp)
         kin13 = 0.5 * crank[0] * omega * omega
-        out[0, i] = t
-        out[1, i] = omega * t * (180.0 / math.pi)
-        out[2, i] = ratio * (a - a0)
-        out[3, i] = ratio * da
-        out[4, i] = ratio * d[2]
-        out[5, i] = 0.5 * crank[1] * omega * omega + crank[3] - q3
-        out[6, i] = f_n
-        out[7, i] = delta
-        out[8, i] = ecc_y
-        out[9, i] = ecc_z
-        out[10, i] = impact[i] if contact[i] else 0.0
-        out[11, i] = 1.0 if (contact[i] and delta > 0.0) else 0.0
-        out[12, i] = kin13 + kin48
-        out[13, i] = crank[2] + pot48
-        out[14, i] = elastic_energy(prm, delta)
-        out[15, i] = kin13 + crank[2] - work0 + y[4]
-        out[16, i] = y[5]
+        out[i, 0] = t
+        out[i, 1] = omega * t * (180.0 / math.pi)
+        out[i, 2] = ratio * (a - a0)
+        out[i, 3] = ratio * da
+        out[i, 4] = ratio * d[2]
+        out[i, 5] = 0.5 * crank[1] * omega * omega + crank[3] - q3
+        out[i, 6] = f_n
+        out[i, 7] = delta
+        out[i, 8] = ecc_y
+        out[i, 9] = ecc_z
+        out[i, 10] = impact[i] if contact[i] else 0.0
+        out[i, 11] = 1.0 if (contact[i] and delta > 0.0) else 0.0
+        out[i, 12] = kin13 + kin48
+        out[i, 13] = crank[2] + pot48
+        out[i, 14] = elastic_energy(prm, delta)
+        out[i, 15] = kin13 + crank[2] - work0 + y[4]
+        out[i, 16] = y[5]
 
 
 def compiled_channels(scene: Scene, time, states, contact, impact) -> dict[str, np.ndarray]:
     """All :data:`~weftsim.results.CHANNELS` at the given rows (arguments as ``clearance_channels``)."""
     time = np.ascontiguousarray(time, dtype=float)
-    out = np.empty((len(CHANNELS), time.size))
+    out = np.empty((time.size, len(CHANNELS)))
     _fill(pack_parameters(scene), crank_side_table(scene), float(initial_state(scene)[0]),
           scene.geometry.rapier_ratio, time, np.ascontiguousarray(states, dtype=float).reshape(time.size, 6),
           np.asarray(contact, dtype=np.bool_), np.asarray(impact, dtype=float), out)  # fmt: skip
-    return dict(zip(CHANNELS, out))
+    return dict(zip(CHANNELS, np.ascontiguousarray(out.T)))

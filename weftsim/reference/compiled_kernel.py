@@ -141,7 +141,8 @@ def chain(prm, t, y, contact, impact_velocity, out):
 
     Returns
     -------
-    q3 (N m, contact generalized force on the crank side), F_N (N), delta (m), e_Y, e_Z (m).
+    q3 (N m, contact generalized force on the crank side), F_N (N), delta (m), e_Y, e_Z (m),
+    sin a, cos a, sin psi, cos psi.
     """
     ecc_y, ecc_z, v_y, v_z, db_y, db_z, dphi, sa, ca, sp, cp = eccentricity(prm, t, y)
     da, dpsi, omega = y[2], y[3], prm[OMEGA]
@@ -185,7 +186,7 @@ def chain(prm, t, y, contact, impact_velocity, out):
     out[3] = (m11 * q_psi - m12 * q_a) / det
     out[4] = -q3 * omega
     out[5] = dissipated
-    return q3, f_n, delta, ecc_y, ecc_z
+    return q3, f_n, delta, ecc_y, ecc_z, sa, ca, sp, cp
 
 
 @njit(cache=True, error_model="numpy")
