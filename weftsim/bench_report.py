@@ -160,9 +160,10 @@ def figure(report: dict, case: str):
 
 def write_report(report: dict, outdir, force: bool = False) -> list[Path]:
     """bench.json, bench.md and one figure per case into ``outdir``; returns the files."""
-    from weftsim.output import finish_directory, prepare_directory, write_figure, write_json, write_text
+    from weftsim.output import begin_directory, finish_directory, prepare_directory, write_figure, write_json, write_text
 
     outdir = prepare_directory(outdir, force)
+    begin_directory(outdir, {"kind": "bench", "mode": report["mode"]})
     written = {"md": write_text(outdir / "bench.md", markdown(report))}
     for case in report["cases"]:
         written[case] = write_figure(outdir / f"bench-{case.replace('.', 'p')}.png", figure(report, case))

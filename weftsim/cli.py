@@ -119,6 +119,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--revolutions", type=_positive(float), help="override the study's crank revolutions per run")
     p.add_argument("--force", action="store_true",
                    help="write into an output directory that holds files weftsim did not write")
+
+    p = sub.add_parser("bench", help="work-precision benchmark of every engine setting (docs/performance.md)",
+                       description="Time every engine setting on an easy and two hard scenes against a converged "
+                       "solution: tables, log-log figures and JSON.  The full mode takes ~30 min on 2 cores.")
+    p.add_argument("--quick", action="store_true", help="a few settings, 2 revolutions (a few minutes)")
+    p.add_argument("-o", "--output", default=None, help="output directory (default: out/bench or out/bench-quick)")
+    p.add_argument("--case", action="append", help="only this case (repeatable): c0.25mm-400rpm, c0.01mm-800rpm, "
+                   "c0.50mm-800rpm")
+    p.add_argument("--models", default="models", help="directory of the scene files (default: models)")
+    p.add_argument("--repeats", type=_positive(int), default=5, help="timed runs per setting (median; default 5)")
+    p.add_argument("--force", action="store_true",
+                   help="write into an output directory that holds files weftsim did not write")
     return parser
 
 
@@ -269,8 +281,20 @@ def cmd_study(args) -> int:
     return 0
 
 
+def cmd_bench(args) -> int:
+    from weftsim.bench import CASES, run_benchmark
+
+    unknown = [c for c in args.case or [] if c not in CASES]
+    if unknown:
+        raise CliError(f"unknown --case {', '.join(unknown)}; choose from {', '.join(CASES)}")
+    outdir = args.output or ("out/bench-quick" if args.quick else "out/bench")
+    report = run_benchmark(outdir, args.models, args.quick, args.case, repeats=args.repeats, force=args.force)
+    print(f"benchmark done in {report['total_time_s']:.0f} s; wrote " + ", ".join(map(str, report["files"])))
+    return 0
+
+
 COMMANDS = {"kinematics": cmd_kinematics, "run": cmd_run, "compare": cmd_compare, "sweep": cmd_sweep,
-            "study": cmd_study}
+            "study": cmd_study, "bench": cmd_bench}
 
 
 def main(argv: list[str] | None = None) -> int:
