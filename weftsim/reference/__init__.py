@@ -76,11 +76,22 @@ def _solve_ideal(scene: Scene, progress) -> RunResult:
     return RunResult(scene, "reference", "success", "", samples, steps, stats, {"first_contact_time_s": None})
 
 
+def compiled_method(scene: Scene) -> str | None:
+    """The compiled method (:data:`COMPILED_METHODS`) a clearance scene names, or None for scipy.
+
+    ``"auto"`` stays on scipy (DOP853 / LSODA); ``numba_DOP853`` is the same DOP853 step for
+    step, 10-20x faster (docs/performance.md).
+    """
+    method = scene.reference_solver.method
+    return method if method in COMPILED_METHODS else None
+
+
 def _solve_clearance(scene: Scene, progress) -> RunResult:
-    if scene.reference_solver.method in COMPILED_METHODS:
+    method = compiled_method(scene)
+    if method is not None:
         from weftsim.reference.compiled import solve_compiled
 
-        return solve_compiled(scene, progress)
+        return solve_compiled(scene, progress, method)
     from weftsim.reference.channels import clearance_channels
     from weftsim.reference.integrate import integrate
 
@@ -108,8 +119,8 @@ def solve(scene: Scene, progress=None) -> RunResult:
     scene : Scene
         ``scene.joint.clearance == 0`` selects the ideal joint (closed form); otherwise the
         clearance mode is integrated with ``scene.reference_solver`` (method by name from
-        :data:`METHODS` or ``"auto"``: DOP853 without friction, LSODA with friction; rtol,
-        atol, max_step as crank angle).
+        :data:`METHODS` or :data:`COMPILED_METHODS`, or ``"auto"``: DOP853 without friction,
+        LSODA with friction; rtol, atol, max_step as crank angle).
     progress : callable, optional
         Called with the completed fraction in [0, 1].
 

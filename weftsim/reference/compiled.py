@@ -473,12 +473,16 @@ def integrate_compiled(scene: Scene, progress=None, method: str = "numba_DOP853"
     return steps, samples, stats, events, status, message
 
 
-def solve_compiled(scene: Scene, progress=None) -> RunResult:
-    """The reference engine's clearance mode through the compiled integrator (method by name)."""
+def solve_compiled(scene: Scene, progress=None, method: str | None = None) -> RunResult:
+    """The reference engine's clearance mode through the compiled integrator.
+
+    ``method``: one of :data:`METHODS`; default ``scene.reference_solver.method``.
+    """
     from weftsim.reference.compiled_channels import compiled_channels
     from weftsim.results import empty_channels
 
-    steps, samples, stats, events, status, message = integrate_compiled(scene, progress, scene.reference_solver.method)
+    steps, samples, stats, events, status, message = integrate_compiled(
+        scene, progress, method or scene.reference_solver.method)
     wall0 = _time.perf_counter()
 
     def channels(arrays):
