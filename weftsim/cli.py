@@ -103,8 +103,8 @@ def build_parser() -> argparse.ArgumentParser:
                    "a list 0.01,0.25,0.5 or an inclusive range start:stop:count; repeat for more axes")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="fixed override for every cell")
     p.add_argument("-o", "--output", default=None, help="sweep directory (default: out/<scene name>-sweep)")
-    p.add_argument("--engine", default="exudyn", choices=("exudyn", "reference"),
-                   help="exudyn (multibody model, default) or reference (closed-form Lagrange cross-check)")
+    p.add_argument("--engine", default="exudyn",
+                   help="exudyn (default), reference, or module:function of your own engine (checked by the sweep)")
     p.add_argument("--jobs", type=_positive(int), help="local worker processes (default: number of CPUs)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="run on an existing Dask cluster, e.g. tcp://host:8786")
     p.add_argument("--cell-figures", action="store_true", help="also draw each cell's channels.png")
