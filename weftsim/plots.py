@@ -16,7 +16,7 @@ PANELS = (
 )
 
 
-def _pyplot():
+def pyplot():
     import matplotlib
 
     matplotlib.use("Agg")
@@ -39,17 +39,22 @@ def last_revolution(result):
     return {k: v[keep] for k, v in steps.items()}, n - 1
 
 
-def plot_channels(results, labels=None, title=None):
-    """Six panels like the paper's Fig. 12 / Fig. 16, over the last complete revolution of each result."""
-    plt = _pyplot()
+def channel_panels(curves, title: str):
+    """Six panels like the paper's Fig. 12/13/16 against crank angle over one revolution.
+
+    Parameters
+    ----------
+    curves : list of (label, data, style)
+        ``data`` holds per-step channels with ``crank_angle_deg`` folded to 0..360;
+        ``style`` is a dict of matplotlib line options (may be empty).
+    """
+    plt = pyplot()
     fig, axes = plt.subplots(3, 2, figsize=(11, 9), sharex=True)
-    labels = labels or [f"{r.engine}, c = {r.scene.joint.clearance * 1e3:g} mm, "
-                        f"{r.scene.drive.speed * 30 / math.pi:g} rpm" for r in results]
-    for result, label in zip(results, labels):
-        data, k = last_revolution(result)
-        angle = data["crank_angle_deg"] - 360.0 * k
+    for label, data, style in curves:
+        angle = data["crank_angle_deg"]
         for ax, (name, ylabel, scale) in zip(axes.flat, PANELS):
-            ax.plot(angle, data[name] * scale, lw=0.8, label=label, rasterized=len(angle) > 20000)
+            ax.plot(angle, data[name] * scale, label=label, rasterized=len(angle) > 20000,
+                    **({"lw": 0.8} | style))
             ax.set_ylabel(ylabel)
             ax.grid(alpha=0.3)
     for ax in axes[-1]:
@@ -57,14 +62,25 @@ def plot_channels(results, labels=None, title=None):
         ax.set_xlim(0, 360)
         ax.set_xticks(range(0, 361, 60))
     axes.flat[0].legend(fontsize=8, loc="best")
-    fig.suptitle(title or (results[0].scene.name + (" (last revolution)" if results else "")))
+    fig.suptitle(title)
     fig.tight_layout()
     return fig
 
 
+def plot_channels(results, labels=None, title=None):
+    """Six panels over the last complete revolution of each result."""
+    labels = labels or [f"{r.engine}, c = {r.scene.joint.clearance * 1e3:g} mm, "
+                        f"{r.scene.drive.speed * 30 / math.pi:g} rpm" for r in results]
+    curves = []
+    for result, label in zip(results, labels):
+        data, k = last_revolution(result)
+        curves.append((label, {**data, "crank_angle_deg": data["crank_angle_deg"] - 360.0 * k}, {}))
+    return channel_panels(curves, title or (results[0].scene.name + " (last revolution)"))
+
+
 def plot_kinematics(angle_deg, s, v, a, title=""):
     """Ideal rapier displacement, velocity and acceleration over one revolution."""
-    plt = _pyplot()
+    plt = pyplot()
     fig, axes = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
     for ax, y, label in zip(axes, (s * 1e3, v, a), ("displacement [mm]", "velocity [m/s]", "acceleration [m/s²]")):
         ax.plot(angle_deg, y, lw=1.2)

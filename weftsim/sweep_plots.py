@@ -88,9 +88,9 @@ def _grid_panel(fig, ax, grid, xc, yc, channel, annotate):
 
 def plot_sweep_1d(rows: list[dict], name: str, title: str = ""):
     """Three panels: peak torque, acceleration and contact force against the varied parameter."""
-    from weftsim.plots import _pyplot
+    from weftsim.plots import pyplot
 
-    plt = _pyplot()
+    plt = pyplot()
     values, numeric = _axis_values(rows, name)
     x = np.array(values, dtype=float) if numeric else np.arange(len(values), dtype=float)
     by_value = {row[name]: row for row in rows}
@@ -116,9 +116,9 @@ def plot_sweep_2d(rows: list[dict], x_name: str, y_name: str, title: str = ""):
     One row for the first revolution and, when the runs are longer, one for the last
     complete revolution; values are written into the cells of small grids.
     """
-    from weftsim.plots import _pyplot
+    from weftsim.plots import pyplot
 
-    plt = _pyplot()
+    plt = pyplot()
     xs, x_numeric = _axis_values(rows, x_name)
     ys, y_numeric = _axis_values(rows, y_name)
     xc = np.array(xs, dtype=float) if x_numeric else np.arange(len(xs), dtype=float)

@@ -7,44 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from weftsim.plots import PANELS
-
-
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-def channel_panels(curves, title: str):
-    """Six panels like the paper's Fig. 12/13/16 against crank angle over one revolution.
-
-    Parameters
-    ----------
-    curves : list of (label, data, style)
-        ``data`` holds per-step channels with ``crank_angle_deg`` folded to 0..360;
-        ``style`` is a dict of matplotlib line options (may be empty).
-    """
-    plt = _pyplot()
-    fig, axes = plt.subplots(3, 2, figsize=(11, 9), sharex=True)
-    for label, data, style in curves:
-        angle = data["crank_angle_deg"]
-        for ax, (name, ylabel, scale) in zip(axes.flat, PANELS):
-            ax.plot(angle, data[name] * scale, label=label, rasterized=len(angle) > 20000,
-                    **({"lw": 0.8} | style))
-            ax.set_ylabel(ylabel)
-            ax.grid(alpha=0.3)
-    for ax in axes[-1]:
-        ax.set_xlabel("crank angle [deg]")
-        ax.set_xlim(0, 360)
-        ax.set_xticks(range(0, 361, 60))
-    axes.flat[0].legend(fontsize=8, loc="best")
-    fig.suptitle(title)
-    fig.tight_layout()
-    return fig
+from weftsim.plots import pyplot, channel_panels  # noqa: F401 - channel_panels re-exported for the studies
 
 
 def trend_panels(x, x_label: str, panels, title: str, x_ticks=None):
@@ -55,7 +18,7 @@ def trend_panels(x, x_label: str, panels, title: str, x_ticks=None):
     x : sequence of float
     panels : list of (y_label, [(label, values), ...])
     """
-    plt = _pyplot()
+    plt = pyplot()
     fig, axes = plt.subplots(1, len(panels), figsize=(4.2 * len(panels), 3.8))
     for ax, (y_label, lines) in zip(np.atleast_1d(axes), panels):
         for label, values in lines:
@@ -79,7 +42,7 @@ def spectrum_panels(spectra, title: str, low_band_hz: float = 100.0):
     ----------
     spectra : list of (label, Spectrum, style)
     """
-    plt = _pyplot()
+    plt = pyplot()
     fig, (near, full) = plt.subplots(2, 1, figsize=(10, 8))
     for label, spectrum, style in spectra:
         f, a = spectrum.frequency_hz, spectrum.amplitude
@@ -114,7 +77,7 @@ def contact_law_panels(curve, revolution, law_lines, title: str):
     law_lines : list of (label, penetration_mm, damping)
         D(delta) of the law at fixed impact velocities.
     """
-    plt = _pyplot()
+    plt = pyplot()
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
     ax = axes[0]
     ax.plot(curve["penetration_mm"], curve["stiffness"], label="variable_kd K(δ) (Bai-Zhao)")
@@ -160,7 +123,7 @@ def deviation_panel(bin_centres, deviations, markers, title: str):
     markers : list of (label, angles_deg, style)
         Vertical lines, e.g. the ideal acceleration extremes and velocity zeros.
     """
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(10, 4.2))
     width = bin_centres[1] - bin_centres[0] if len(bin_centres) > 1 else 10.0
     for label, values, style in deviations:
