@@ -298,3 +298,56 @@ def test_tree_model_settings_and_guards():
     calls = []
     r = exudyn_solve(_exudyn_scene(revolutions=0.02), progress=calls.append)
     assert r.ok and calls[0] == 0.0 and calls[-1] == 1.0 and calls == sorted(calls)
+
+
+# --- The benchmark's bookkeeping (no timing is asserted anywhere) ---
+
+
+def test_bench_errors_are_relative_and_means_relative_to_the_rms():
+    from weftsim.bench import QUANTITY_CHANNELS, errors
+
+    ref = {"revolutions": 10, "first_contact_deg": 6.6,
+           "peak": {ch: 100.0 for ch in QUANTITY_CHANNELS},
+           "rms": {ch: 50.0 for ch in QUANTITY_CHANNELS}, "mean": {ch: 0.0 for ch in QUANTITY_CHANNELS}}  # fmt: skip
+    run = {"revolutions": 10, "first_contact_deg": 6.7,
+           "peak": {ch: 101.0 for ch in QUANTITY_CHANNELS},
+           "rms": {ch: 49.0 for ch in QUANTITY_CHANNELS}, "mean": {ch: 1.5 for ch in QUANTITY_CHANNELS}}  # fmt: skip
+    e = errors(run, ref)
+    assert e["peak_max"] == pytest.approx(0.01)
+    # A mean of ~0 (rapier acceleration over whole revolutions) is compared against the RMS.
+    assert e["stats_max"] == pytest.approx(0.03)
+    assert e["first_contact_deg"] == pytest.approx(0.1)
+    short = dict(run, revolutions=5)
+    assert errors(short, ref)["stats_max"] is None  # fewer revolutions: no statistics to compare
+    assert errors(None, ref) is None
+
+
+def test_bench_measures_a_setting_and_reports_failures(tmp_path):
+    from weftsim import bench
+    from weftsim.bench_report import markdown
+
+    ref = bench.converged_solution("c0.25mm-400rpm", "models", 1.0, log=lambda text: None)
+    ok = bench.measure("c0.25mm-400rpm", bench._ref("numba_DOP853", 1e-6), ref, "models", 1.0, 2, 10.0, 0.5)
+    assert ok["status"] == "success" and ok["timing"]["runs"] == 2 and len(ok["timing"]["wall_s"]) == 2
+    assert ok["errors"]["peak_max"] < 1e-3  # rtol 1e-6 against 1e-12: the docs' 1e-4 spread
+    assert ok["realtime_ratio"] > 0.0 and ok["steps"] > 0
+    # A run that fails is kept with its reason; a too-long run is timed on the short scene.
+    bad_setting = bench.Setting("reference", "reference numba_DOP853", "capped", {
+        "solver.reference.method": "numba_DOP853", "limits.max_steps": 20})
+    bad = bench.measure("c0.25mm-400rpm", bad_setting, ref, "models", 1.0, 2, 0.0, 0.5)
+    assert bad["status"] == "failed" and bad["failure"] == "steps" and "limits.max_steps" in bad["message"]
+    assert bad["timing"]["runs"] == 1  # a failed run is not repeated
+    assert bad["errors"] is None  # no whole revolution before the failure: nothing to compare
+    slow = bench.measure("c0.25mm-400rpm", bench._ref("numba_DOP853", 1e-6), ref, "models", 1.0, 2, 0.0, 0.5)
+    assert slow["timing"]["revolutions"] == pytest.approx(0.5)  # over the repeat limit: timed on 0.5 rev
+    report = {"mode": "test", "revolutions": 1.0, "repeats": 2, "repeat_limit_s": 10.0, "timing_revolutions": 0.5,
+              "targets": bench.TARGETS, "total_time_s": 1.0, "machine_start": _machine(), "machine_end": _machine(),
+              "startup": {}, "cases": {"c0.25mm-400rpm": {"converged": ref, "runs": [ok, bad]}}}  # fmt: skip
+    text = markdown(report)
+    assert "**failed** (steps)" in text and "limits.max_steps" in text and ok["setting"] in text
+
+
+def _machine():
+    from weftsim.bench_report import machine_info
+
+    return machine_info()

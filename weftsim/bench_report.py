@@ -1,7 +1,8 @@
 """Report of the work-precision benchmark (:mod:`weftsim.bench`): JSON, Markdown tables, figures.
 
 Figures (one per case, ``bench-<case>.png``): error against wall time, log-log, one series
-per engine family; failed runs are drawn as crosses at the top edge; dashed lines mark
+per engine family, its points joined from the coarsest to the finest setting; failed runs are
+drawn as crosses at the top edge; dashed lines mark
 the targets (1 % peaks, 2 % statistics), the dotted line the converged ensemble's own
 spread (the error floor), the vertical line real time (wall time = loom time).
 """
@@ -124,17 +125,24 @@ def figure(report: dict, case: str):
     import matplotlib.pyplot as plt
 
     data = report["cases"][case]
-    fig, axes = plt.subplots(1, 2, figsize=(12, 5), sharex=True)
-    families = sorted({r["family"] for r in data["runs"]})
-    colors = plt.get_cmap("tab10")
+    fig, axes = plt.subplots(1, 2, figsize=(13, 5.5), sharex=True)
+    families = list(dict.fromkeys(r["family"] for r in data["runs"]))  # in run order
+    styles = {}
+    palettes = {"reference": ["tab:blue", "tab:cyan", "navy", "slateblue", "steelblue"],
+                "exudyn tree": ["tab:red", "tab:orange", "salmon", "brown"],
+                "exudyn rigid_body": ["tab:green", "olive", "limegreen"]}  # fmt: skip
+    markers = ["o", "s", "^", "v", "D"]
+    for fam in families:
+        group = next(g for g in palettes if fam.startswith(g))
+        k = sum(1 for f in styles if f.startswith(group))
+        styles[fam] = {"color": palettes[group][k % len(palettes[group])], "marker": markers[k % len(markers)]}
     for panel, (key, title, target) in enumerate((("peak_max", "first-revolution maxima", "peak"),
                                                    ("stats_max", "RMS and mean, revolutions 2..N", "stats"))):  # fmt: skip
         ax = axes[panel]
-        for k, fam in enumerate(families):
-            rows = [r for r in data["runs"] if r["family"] == fam]
+        for fam in families:
+            rows = [r for r in data["runs"] if r["family"] == fam]  # tolerance or step from coarse to fine
             ok = [r for r in rows if r["status"] == "success" and (r["errors"] or {}).get(key) is not None]
-            ok.sort(key=lambda r: r["wall_s"])
-            style = {"color": colors(k % 10), "marker": "o", "ms": 4, "lw": 1}
+            style = {**styles[fam], "ms": 5, "lw": 1}
             ax.plot([r["wall_s"] for r in ok], [max(r["errors"][key], 1e-9) for r in ok], label=fam, **style)
             bad = [r for r in rows if r not in ok]
             if bad:
@@ -151,7 +159,7 @@ def figure(report: dict, case: str):
         ax.set_ylabel("largest relative error")
         ax.set_title(f"{case}: {title}")
         ax.grid(True, which="both", alpha=0.3)
-    axes[0].legend(fontsize=7, loc="lower left")
+    axes[1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     fig.suptitle("work-precision (x: failed run; dashed: target; dotted: spread of the converged solutions)",
                  fontsize=10)  # fmt: skip
     fig.tight_layout()
