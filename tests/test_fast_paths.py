@@ -4,7 +4,6 @@ Python equations and contact laws."""
 from __future__ import annotations
 
 import dataclasses
-import math
 
 import numpy as np
 import pytest
@@ -141,7 +140,7 @@ def test_compiled_channels_equal_the_numpy_channels(start_up_runs):
     contact = steps["impact_velocity_m_s"] > 0.0
     # Rebuild the integrated states from the channels' own inputs is not possible; run the
     # integrator once more and compare both channel functions on its rows.
-    from weftsim.reference.compiled import integrate_compiled
+    from weftsim.reference.compiled_run import integrate_compiled
 
     rows = integrate_compiled(scene, None, "numba_DOP853")[0]
     a, b = clearance_channels(scene, *rows), compiled_channels(scene, *rows)
@@ -351,3 +350,15 @@ def _machine():
     from weftsim.bench_report import machine_info
 
     return machine_info()
+
+
+def test_compiled_chunks_and_pauses_do_not_change_the_run(monkeypatch):
+    from weftsim.reference import compiled_run
+
+    scene = _scene(method="numba_DOP853", revolutions=0.05, rtol=1e-7, atol=1e-10)
+    whole = compiled_run.integrate_compiled(scene)
+    monkeypatch.setattr(compiled_run, "_STEP_BUFFER", 16)  # a chunk every few steps
+    pieces = compiled_run.integrate_compiled(scene, progress=lambda fraction: None)  # and pauses every 1 %
+    for a, b in zip(whole[0] + whole[1], pieces[0] + pieces[1]):
+        np.testing.assert_array_equal(a, b)  # bit for bit: the state carries over exactly
+    assert whole[2]["steps"] == pieces[2]["steps"] and whole[2]["function_evaluations"] == pieces[2]["function_evaluations"]

@@ -18,7 +18,6 @@ Speed is measured here only; no test asserts wall-clock limits.
 
 from __future__ import annotations
 
-import math
 import statistics as _stats
 import sys
 import time

@@ -89,7 +89,7 @@ def compiled_method(scene: Scene) -> str | None:
 def _solve_clearance(scene: Scene, progress) -> RunResult:
     method = compiled_method(scene)
     if method is not None:
-        from weftsim.reference.compiled import solve_compiled
+        from weftsim.reference.compiled_run import solve_compiled
 
         return solve_compiled(scene, progress, method)
     from weftsim.reference.channels import clearance_channels

@@ -13,7 +13,8 @@ tolerance (``tests/test_fast_paths.py``).
 
 Every function is module-level ``@njit(cache=True, error_model="numpy")`` and takes the scene as a parameter
 array: numba compiles once per machine (~10-20 s) and loads from its cache afterwards.
-The loop returns to Python every 1 % of the run (progress) or when its step buffer is full.
+The loop (:func:`advance`) returns to Python every 1 % of the run (progress) or when its step
+buffer is full; :mod:`.compiled_run` drives it and builds the result.
 
 Methods (``reference_solver.method``): ``"numba_DOP853"``, ``"numba_RK45"``.
 """
@@ -21,19 +22,14 @@ Methods (``reference_solver.method``): ``"numba_DOP853"``, ``"numba_RK45"``.
 from __future__ import annotations
 
 import math
-import time as _time
 
 import numpy as np
 from numba import njit
 from scipy.integrate import RK45 as _SCIPY_RK45
 from scipy.integrate._ivp import dop853_coefficients as _D853
 
-from weftsim.guards import RunGuard, failure_message, non_finite_breach
-from weftsim.params import Scene
-from weftsim.reference.compiled_kernel import V_MIN, chain, pack_parameters, penetration
-from weftsim.reference.dynamics import initial_state
-from weftsim.reference.integrate import _CONTACT_SUBSTEPS, _PROGRESS_EVERY, _ROOT_XTOL
-from weftsim.results import RunResult
+from weftsim.reference.compiled_kernel import V_MIN, chain, penetration
+from weftsim.reference.integrate import _CONTACT_SUBSTEPS, _ROOT_XTOL
 
 DOP853, RK45 = 0, 1
 METHODS = {"numba_DOP853": DOP853, "numba_RK45": RK45}
@@ -371,124 +367,3 @@ def advance(prm, method, rtol, atol, max_step, t_end, t_pause, limits, y, f, fst
             return PAUSED, n_rows
     fst[T] = t
     return DONE, n_rows
-
-
-def _empty_buffers(n: int):
-    return np.zeros(n), np.zeros((n, N)), np.zeros(n, dtype=np.uint8), np.zeros(n)
-
-
-def integrate_compiled(scene: Scene, progress=None, method: str = "numba_DOP853"):
-    """Run the compiled integrator; returns (steps, samples, stats, events, status, message).
-
-    ``steps`` and ``samples`` are tuples (t, y (n, 6), contact (bool), impact) as
-    :func:`weftsim.reference.channels.clearance_channels` takes them.
-    """
-    settings = scene.reference_solver
-    omega, t_end = scene.drive.speed, scene.drive.end_time
-    code_method = METHODS[method]
-    wall0 = _time.perf_counter()
-    prm = pack_parameters(scene)
-    sample_dt = scene.output.sample_angle / omega
-    n_samples = int(math.floor(t_end / sample_dt * (1.0 + 1e-12))) + 1
-    sample_times = np.arange(n_samples) * sample_dt
-    if t_end - sample_times[-1] > 1e-9 * sample_dt:
-        sample_times = np.append(sample_times, t_end)
-    y = initial_state(scene).astype(float)
-    f = np.zeros(N)
-    fst = np.array([0.0, 0.0, 0.0, 0.0, -1.0, -math.inf, math.inf])
-    ist = np.zeros(10, dtype=np.int64)
-    ist[START] = 1
-    guard = RunGuard(scene)
-    limits = np.array([math.inf if scene.joint.is_ideal else guard.max_penetration, guard.min_step,
-                       float(guard.max_steps or 0)])  # fmt: skip
-    smp = _empty_buffers(sample_times.size)
-    stp = _empty_buffers(_STEP_BUFFER)
-    chunks = [(np.zeros(1), y[None, :].copy(), np.zeros(1, dtype=np.uint8), np.zeros(1))]
-    if progress is not None:
-        progress(0.0)
-    # Pause every 1 % of the run for progress reports and the wall-time budget only if needed.
-    pausing = progress is not None or math.isfinite(guard.max_wall_time)
-    next_report = _PROGRESS_EVERY
-    status, message, failure = "success", "", None
-    # scipy raises rtol below 100 eps to it (a warning); the compiled path does the same, silently.
-    rtol = max(settings.rtol, 100.0 * np.finfo(float).eps)
-    steps_seen = 0
-    while True:
-        t_pause = next_report * t_end if pausing else 2.0 * t_end
-        code, rows = advance(prm, code_method, rtol, settings.atol, settings.max_step / omega, t_end,
-                             t_pause, limits, y, f, fst, ist, sample_times, *smp, *stp)  # fmt: skip
-        chunks.append(tuple(b[:rows].copy() for b in stp))
-        t = fst[T]
-        breach = None
-        if code == GUARD:
-            breach = guard.check(penetration=None if scene.joint.is_ideal else fst[LAST_PENETRATION],
-                                 step_size=fst[LAST_STEP], steps=int(ist[STEPS]) - steps_seen)  # fmt: skip
-        elif code == STEP_TOO_SMALL:
-            breach = guard.check(step_size=10.0 * np.spacing(t), steps=0)
-        elif code == NON_FINITE:
-            breach = non_finite_breach("the right-hand side or the state turned non-finite (NaN or inf)")
-        elif code != DONE:
-            breach = guard.check(steps=int(ist[STEPS]) - steps_seen)  # the wall-time budget
-        steps_seen = int(ist[STEPS])
-        if breach is not None:
-            status, failure = "failed", breach.kind
-            message = failure_message(f"reference solver ({method})", t, omega, breach.what, breach.hint)
-            break
-        if code == DONE:
-            break
-        if code == PAUSED and progress is not None:
-            progress(min(t / t_end, 1.0))
-        if code == PAUSED:
-            next_report = math.floor(t / t_end / _PROGRESS_EVERY + 1.0) * _PROGRESS_EVERY
-    wall = _time.perf_counter() - wall0
-    steps = tuple(np.concatenate([c[i] for c in chunks]) for i in range(4))
-    n_done = int(ist[NEXT_SAMPLE])
-    samples = tuple(b[:n_done] for b in smp)
-    steps = (steps[0], steps[1], steps[2].astype(bool), steps[3])
-    samples = (samples[0], samples[1], samples[2].astype(bool), samples[3])
-    stats = {
-        "method": method,
-        "rtol": settings.rtol,
-        "atol": settings.atol,
-        "max_step_rad": settings.max_step,
-        "steps": int(ist[STEPS]),
-        "rejected_steps": int(ist[REJECTED]),
-        "function_evaluations": int(ist[NFEV]),
-        "jacobian_evaluations": 0,
-        "lu_decompositions": 0,
-        "dense_output_calls": int(ist[DENSE]),
-        "segments": int(ist[SEGMENTS]),
-        "contact_events": int(ist[EVENTS]),
-        "impacts": int(ist[IMPACTS]),
-        "wall_time_s": wall,
-    }
-    events = {
-        "first_contact_time_s": None if fst[FIRST_CONTACT] < 0.0 else float(fst[FIRST_CONTACT]),
-        "max_impact_velocity_m_s": float(fst[MAX_RATE]),
-    }
-    if failure is not None:
-        stats["failure"] = failure
-    if progress is not None and status == "success":
-        progress(1.0)
-    return steps, samples, stats, events, status, message
-
-
-def solve_compiled(scene: Scene, progress=None, method: str | None = None) -> RunResult:
-    """The reference engine's clearance mode through the compiled integrator.
-
-    ``method``: one of :data:`METHODS`; default ``scene.reference_solver.method``.
-    """
-    from weftsim.reference.compiled_channels import compiled_channels
-    from weftsim.results import empty_channels
-
-    steps, samples, stats, events, status, message = integrate_compiled(
-        scene, progress, method or scene.reference_solver.method)
-    wall0 = _time.perf_counter()
-
-    def channels(arrays):
-        return compiled_channels(scene, *arrays) if arrays[0].size else empty_channels()
-
-    step_channels, sample_channels = channels(steps), channels(samples)
-    stats["postprocess_time_s"] = _time.perf_counter() - wall0
-    stats["wall_time_s"] += stats["postprocess_time_s"]
-    return RunResult(scene, "reference", status, message, sample_channels, step_channels, stats, events)
