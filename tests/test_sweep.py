@@ -39,11 +39,22 @@ def fake_solve(scene, progress=None):
     Driving torque T = m8 a v / omega (the power the crank gives to the rapier mass
     alone) and a synthetic contact force F = 1e3 c[mm] omega^2 (1 + sin theta) / 2,
     so every peak is known.  ``WEFTSIM_FAKE_DELAY_S`` in the environment makes each
-    call sleep that long (for the kill-and-resume test).
+    call sleep that long; ``WEFTSIM_FAKE_GATE_DIR`` lets only ``WEFTSIM_FAKE_FAST_CELLS`` calls
+    finish (for the kill-and-resume test).
     """
     from weftsim.kinematics import rapier_motion
 
     time.sleep(float(os.environ.get("WEFTSIM_FAKE_DELAY_S", "0")))
+    gate = os.environ.get("WEFTSIM_FAKE_GATE_DIR")
+    if gate:  # only the first WEFTSIM_FAKE_FAST_CELLS calls finish; later ones hang until killed
+        for slot in range(int(os.environ["WEFTSIM_FAKE_FAST_CELLS"])):
+            try:
+                os.close(os.open(os.path.join(gate, f"slot-{slot}"), os.O_CREAT | os.O_EXCL))
+                break
+            except FileExistsError:
+                continue
+        else:
+            time.sleep(600)
     restitution = scene.joint.restitution
     if restitution == CRASH_RESTITUTION:
         os._exit(17)  # a hard crash of the worker (like a segfault in compiled code)
@@ -254,10 +265,14 @@ def test_interrupted_sweep_resumes_without_losing_or_redoing_finished_cells(tmp_
     command = [sys.executable, "-m", "weftsim.cli", "sweep", str(REFERENCE), "--vary", "clearance_mm=0.1,0.2,0.3",
                "--vary", "speed_rpm=300:600:4", "--set", "revolutions=0.5", "--engine", FAKE, "--jobs", "2",
                "-o", str(outdir)]
-    env = {**os.environ, "PYTHONPATH": str(ROOT / "tests"), "WEFTSIM_FAKE_DELAY_S": "0.4"}
+    gate = tmp_path / "gate"
+    gate.mkdir()
+    # Exactly 4 cells can finish before the interrupt, however loaded the machine: the others hang.
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "tests"), "WEFTSIM_FAKE_DELAY_S": "0.2",
+           "WEFTSIM_FAKE_GATE_DIR": str(gate), "WEFTSIM_FAKE_FAST_CELLS": "4"}
     process = subprocess.Popen(command, env=env, start_new_session=True, stdout=subprocess.DEVNULL,
                                stderr=subprocess.PIPE, text=True)
-    deadline = time.monotonic() + 60  # generous: a loaded 2-core machine; the loop normally takes ~2 s
+    deadline = time.monotonic() + 120  # generous: a loaded 2-core machine; the loop normally takes ~2 s
     try:
         while len(list(outdir.glob(f"*/{CELL_FILE}"))) < 4:
             assert process.poll() is None, "the sweep ended before it could be interrupted"
@@ -271,9 +286,10 @@ def test_interrupted_sweep_resumes_without_losing_or_redoing_finished_cells(tmp_
         statuses = [r["status"] for r in read_table(outdir / TABLE_FILE)]  # rewritten on the way out
         assert len(statuses) == 12 and "pending" in statuses
     finished = sorted(p.parent for p in outdir.glob(f"*/{CELL_FILE}"))
-    assert 4 <= len(finished) < 12
+    assert len(finished) == 4
     before = {p: p.stat().st_mtime_ns for d in finished for p in d.iterdir()}
     env["WEFTSIM_FAKE_DELAY_S"] = "0"
+    del env["WEFTSIM_FAKE_GATE_DIR"]
     done = subprocess.run(command, env=env, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     assert f"{len(finished)} already finished" in done.stdout
