@@ -221,13 +221,17 @@ def _exudyn_scene(model="kinematic_tree", revolutions=0.1, **solver):
 
 @pytest.fixture(scope="module")
 def start_up_exudyn():
-    """The start-up impact (0..36 deg) with both Exudyn models and the reference engine."""
+    """The first revolution with both Exudyn models and the reference engine (~6 s, mostly rigid body).
+
+    It holds the start-up impact (maxima of contact force and acceleration near 9 deg) and the
+    impact sequence near 48 deg that makes the first revolution's torque maximum.
+    """
     pytest.importorskip("exudyn")
     from weftsim.exudyn_engine import solve as exudyn_solve
 
-    tree = exudyn_solve(_exudyn_scene(relative_tolerance=1e-8, absolute_tolerance=1e-11))
-    rigid = exudyn_solve(_exudyn_scene(model="rigid_body"))
-    reference = solve(_scene(method="numba_DOP853", rtol=1e-11, atol=1e-14))
+    tree = exudyn_solve(_exudyn_scene(revolutions=1.0, relative_tolerance=1e-8, absolute_tolerance=1e-11))
+    rigid = exudyn_solve(_exudyn_scene(model="rigid_body", revolutions=1.0))
+    reference = solve(_scene(method="numba_DOP853", rtol=1e-11, atol=1e-14, revolutions=1.0))
     return {"tree": tree, "rigid": rigid, "reference": reference}
 
 
@@ -239,13 +243,14 @@ def test_tree_model_matches_the_rigid_body_model(start_up_exudyn):
     assert tree.first_contact_angle_deg == pytest.approx(rigid.first_contact_angle_deg, abs=1e-4)
     pt, pr = peaks(tree, 0), peaks(rigid, 0)
     for name in PEAK_CHANNELS:
-        # The start-up peaks agree to ~1e-4 (rigid body at h = 2e-6 s, docs/clearance-joint.md);
-        # CompareTolerance.first_revolution_peaks is 1 %.
-        assert pt[name]["max"] == pytest.approx(pr[name]["max"], rel=1e-3), name
-    # Same rapier motion through the impacts (generalized-alpha's damping aside): 1e-4 of the stroke.
+        # First-revolution maxima: the rigid body at h = 2e-6 s is within 6.4e-4 of the converged
+        # ones (docs/performance.md), the tree at rtol 1e-8 within 4e-5; CompareTolerance says 1 %.
+        assert pt[name]["max"] == pytest.approx(pr[name]["max"], rel=2e-3), name
+    # Same rapier motion through the start-up impacts (0..36 deg): 1e-4 of the 1.05 m stroke.
     t = rigid.samples["time_s"]
-    s_tree = np.interp(t, tree.steps["time_s"], tree.steps["rapier_displacement_m"])
-    assert np.abs(s_tree - rigid.samples["rapier_displacement_m"]).max() < 1e-4 * 1.05
+    early = t < 0.1 * rigid.scene.drive.period
+    s_tree = np.interp(t[early], tree.steps["time_s"], tree.steps["rapier_displacement_m"])
+    assert np.abs(s_tree - rigid.samples["rapier_displacement_m"][early]).max() < 1e-4 * 1.05
 
 
 def test_tree_model_matches_the_reference_engine(start_up_exudyn):
@@ -254,14 +259,15 @@ def test_tree_model_matches_the_reference_engine(start_up_exudyn):
     assert tree.first_contact_angle_deg == pytest.approx(ref.first_contact_angle_deg, abs=1e-5)
     pt, pr = peaks(tree, 0), peaks(ref, 0)
     for name in PEAK_CHANNELS:
-        # Peaks read at the tree's step ends only (no dense output): 1e-4 at rtol 1e-8.
+        # Peaks read at the tree's step ends only (no dense output): measured 4e-5 at rtol 1e-8.
         assert pt[name]["max"] == pytest.approx(pr[name]["max"], rel=3e-4), name
     r = tree.steps
     residual = r["driving_work_J"] - (r["kinetic_energy_J"] - r["kinetic_energy_J"][0]) \
         - (r["potential_energy_J"] - r["potential_energy_J"][0]) - r["contact_energy_J"] - r["dissipated_energy_J"]
-    # Trapezoid sums of the contact powers over the steps (O(h^2)): measured 5e-3 J of the ~5 J that
-    # the start-up impacts dissipate, 2e-5 of the largest kinetic energy (2e-2 J at rtol 1e-6).
-    assert np.abs(residual).max() < 5e-5 * r["kinetic_energy_J"].max()
+    # Trapezoid sums of the contact powers over the steps (O(h^2)): 5e-3 J of the ~5 J that the
+    # start-up impacts dissipate; over the whole first revolution measured 9.6e-5 of the largest
+    # kinetic energy (~500 J) at rtol 1e-8; a lost contact force would leave ~1e-2.
+    assert np.abs(residual).max() < 3e-4 * r["kinetic_energy_J"].max()
 
 
 def test_tree_callback_routes_agree():
