@@ -146,7 +146,8 @@ class SweepProgress:
 def _executor(jobs: int | None, scheduler: str | None, n_cells: int):
     """(executor, in-flight window, stop): a local process pool, or a Dask client's executor.
 
-    ``stop()`` cancels what has not started and returns without waiting for running cells.
+    ``stop(interrupted)`` cancels what has not started and returns without waiting for running
+    cells; after an interrupt it also ends the local workers.
     """
     if scheduler:
         try:
@@ -160,14 +161,24 @@ def _executor(jobs: int | None, scheduler: str | None, n_cells: int):
         threads = sum(client.nthreads().values()) or 1
         executor = client.get_executor(pure=False)
 
-        def stop_dask() -> None:
+        def stop_dask(interrupted: bool = False) -> None:
             executor.shutdown(wait=False)  # cancels the cells still on the cluster
             client.close()
 
         return executor, threads * 2, stop_dask  # a short queue per worker keeps them busy
     workers = max(1, min(jobs or os.cpu_count() or 1, n_cells))
     pool = cf.ProcessPoolExecutor(max_workers=workers)
-    return pool, workers, lambda: pool.shutdown(wait=False, cancel_futures=True)
+
+    def stop_pool(interrupted: bool = False) -> None:
+        # On an interrupt the workers may already hold the next queued cells (the pool hands each
+        # worker one ahead), and Python's exit would wait for them: end them, their cells are
+        # unfinished and will rerun, and every finished cell is already on disk.
+        workers_alive = list((getattr(pool, "_processes", None) or {}).values()) if interrupted else []
+        pool.shutdown(wait=False, cancel_futures=True)
+        for process in workers_alive:
+            process.kill()
+
+    return pool, workers, stop_pool
 
 
 def _record_lost(outdir: Path, planned: PlannedCell, engine: str, error: str) -> dict:
@@ -277,6 +288,7 @@ def _run_cells(plan, outdir, todo, remaining, report, jobs, scheduler, cell_figu
             report.failures[planned.cell.name] = record["error"]
             log.warning("sweep cell %s failed: %s", planned.cell.name, record["error"])
 
+    interrupted = True
     try:
         while queue or retry or in_flight:
             broken = False
@@ -319,8 +331,9 @@ def _run_cells(plan, outdir, todo, remaining, report, jobs, scheduler, cell_figu
             if time.perf_counter() - last_table > TABLE_INTERVAL_S:
                 write_table(plan, outdir, remaining)
                 last_table = time.perf_counter()
+        interrupted = False
     finally:
-        stop()
+        stop(interrupted)
 
 
 def format_report(report: SweepReport) -> str:
