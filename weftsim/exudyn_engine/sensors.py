@@ -161,3 +161,12 @@ def first_nonfinite_row(steps: dict[str, np.ndarray]) -> int | None:
     idx = np.flatnonzero(bad)
     return int(idx[0]) if idx.size else None
 
+
+def silence(settings) -> None:
+    """No console output and no files: results come from sensors stored in memory (EXUDYN.md)."""
+    settings.timeIntegration.verboseMode = 0
+    settings.solution.file.write = False
+    settings.solution.sensors.writePeriod = 0.0
+    settings.solution.solverInformationFileName = ""
+    settings.show.statistics = False
+    settings.show.computationTime = False

@@ -21,7 +21,7 @@ import exudyn as exu
 
 from weftsim.exudyn_engine.clearance_joint import ROUTES, register_post_step
 from weftsim.exudyn_engine.mechanism import build_mechanism
-from weftsim.exudyn_engine.sensors import add_sensors, first_nonfinite_row, sample_channels, step_channels
+from weftsim.exudyn_engine.sensors import add_sensors, first_nonfinite_row, sample_channels, silence, step_channels
 from weftsim.guards import RunGuard, failure_message, non_finite_breach, vet_result
 from weftsim.params import Scene
 from weftsim.reference.ideal import angle_grid
@@ -93,12 +93,7 @@ def simulation_settings(scene: Scene, n_steps: int) -> exu.SimulationSettings:
     ti.discontinuous.ignoreMaxIterations = False
     # Newton failures halve the step down to this floor; then the run fails (step-size collapse).
     ti.minimumStepSize = scene.limits.min_step
-    ti.verboseMode = 0
-    ss.solution.file.write = False
-    ss.solution.sensors.writePeriod = 0.0
-    ss.solution.solverInformationFileName = ""
-    ss.show.statistics = False
-    ss.show.computationTime = False
+    silence(ss)
     return ss
 
 

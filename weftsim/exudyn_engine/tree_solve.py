@@ -31,7 +31,7 @@ import numpy as np
 from exudyn.itemInterface import SensorNode, SensorObject
 
 from weftsim.contact import make_law
-from weftsim.exudyn_engine.sensors import first_nonfinite_row, sample_channels
+from weftsim.exudyn_engine.sensors import first_nonfinite_row, sample_channels, silence
 from weftsim.exudyn_engine.tree import TreeModel, build_tree
 from weftsim.guards import RunGuard, failure_message, non_finite_breach, vet_result
 from weftsim.params import Scene
@@ -80,12 +80,7 @@ def tree_settings(scene: Scene) -> exu.SimulationSettings:
     ti.absoluteTolerance = s.absolute_tolerance
     ti.minimumStepSize = scene.limits.min_step
     ti.explicit.computeEndOfStepAccelerations = True
-    ti.verboseMode = 0
-    ss.solution.file.write = False
-    ss.solution.sensors.writePeriod = 0.0
-    ss.solution.solverInformationFileName = ""
-    ss.show.statistics = False
-    ss.show.computationTime = False
+    silence(ss)
     return ss
 
 
