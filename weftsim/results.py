@@ -137,3 +137,16 @@ class RunResult:
 def empty_channels() -> dict[str, np.ndarray]:
     """All channels with no rows, for a run that failed before its first step."""
     return {name: np.zeros(0) for name in CHANNELS}
+
+
+def angle_grid(end_time: float, omega: float, step_angle: float) -> np.ndarray:
+    """Times of a uniform crank-angle grid from t = 0 to end_time inclusive, s.
+
+    The last point is end_time itself if the grid does not land on it.
+    """
+    dt = step_angle / omega
+    n = int(math.floor(end_time / dt * (1.0 + 1e-12)))
+    t = np.arange(n + 1) * dt
+    if end_time - t[-1] > 1e-9 * dt:
+        t = np.append(t, end_time)
+    return t

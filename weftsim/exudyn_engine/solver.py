@@ -24,8 +24,7 @@ from weftsim.exudyn_engine.mechanism import build_mechanism
 from weftsim.exudyn_engine.sensors import add_sensors, first_nonfinite_row, sample_channels, silence, step_channels
 from weftsim.guards import RunGuard, failure_message, non_finite_breach, vet_result
 from weftsim.params import Scene
-from weftsim.reference.ideal import angle_grid
-from weftsim.results import RunResult, empty_channels
+from weftsim.results import RunResult, angle_grid, empty_channels
 
 MODELS = ("rigid_body", "kinematic_tree")  # kinematic_tree: tree.py, tree_solve.py
 # Modified Newton: iterations with one Jacobian before it is updated.  3 instead of

@@ -36,8 +36,8 @@ from weftsim.exudyn_engine.tree import TreeModel, build_tree
 from weftsim.guards import RunGuard, failure_message, non_finite_breach, vet_result
 from weftsim.params import Scene
 from weftsim.reference.dynamics import NUMPY, ChainConstants, chain_energy, eccentricity, initial_state
-from weftsim.reference.ideal import angle_grid, crank_side_inertia, crank_side_potential
-from weftsim.results import RunResult, empty_channels
+from weftsim.reference.ideal import crank_side_inertia, crank_side_potential
+from weftsim.results import RunResult, angle_grid, empty_channels
 
 OVT = exu.OutputVariableType
 EXPLICIT_METHODS = {"DOPRI5": exu.DynamicSolverType.DOPRI5, "ODE23": exu.DynamicSolverType.ODE23}

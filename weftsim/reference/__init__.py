@@ -56,7 +56,8 @@ def _check(scene: Scene) -> str | None:
 
 
 def _solve_ideal(scene: Scene, progress) -> RunResult:
-    from weftsim.reference.ideal import angle_grid, ideal_channels
+    from weftsim.reference.ideal import ideal_channels
+    from weftsim.results import angle_grid
 
     wall0 = _time.perf_counter()
     omega, t_end = scene.drive.speed, scene.drive.end_time

@@ -31,9 +31,9 @@ separate: :func:`crank_side_inertia` and :func:`crank_side_potential`.
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
+
 
 from weftsim import kinematics as kin
 from weftsim.params import Scene
@@ -184,14 +184,3 @@ def ideal_channels(time, scene: Scene) -> dict[str, np.ndarray]:
     }
 
 
-def angle_grid(end_time: float, omega: float, step_angle: float) -> np.ndarray:
-    """Times of a uniform crank-angle grid from t = 0 to end_time inclusive, s.
-
-    The last point is end_time itself if the grid does not land on it.
-    """
-    dt = step_angle / omega
-    n = int(math.floor(end_time / dt * (1.0 + 1e-12)))
-    t = np.arange(n + 1) * dt
-    if end_time - t[-1] > 1e-9 * dt:
-        t = np.append(t, end_time)
-    return t
