@@ -258,6 +258,16 @@ def test_a_directory_holding_another_sweep_is_refused(tmp_path):
         sweep(other, ["clearance_mm=0.1"])
 
 
+def _terminal_sigint() -> None:
+    """In the child before exec: SIGINT delivered and handled as in a terminal.
+
+    A signal mask and ignored signals are inherited through fork and exec; in the whole suite the
+    sweep child once never saw the Ctrl-C (it ran to the 60 s timeout), while the test alone passed.
+    """
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 @pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGINT], ids=["SIGKILL", "Ctrl-C"])
 def test_interrupted_sweep_resumes_without_losing_or_redoing_finished_cells(tmp_path, sig):
     """Kill (or Ctrl-C) the whole `weftsim sweep` process group mid-sweep, then run the same command again."""
@@ -271,7 +281,7 @@ def test_interrupted_sweep_resumes_without_losing_or_redoing_finished_cells(tmp_
     env = {**os.environ, "PYTHONPATH": str(ROOT / "tests"), "WEFTSIM_FAKE_DELAY_S": "0.2",
            "WEFTSIM_FAKE_GATE_DIR": str(gate), "WEFTSIM_FAKE_FAST_CELLS": "4"}
     process = subprocess.Popen(command, env=env, start_new_session=True, stdout=subprocess.DEVNULL,
-                               stderr=subprocess.PIPE, text=True)
+                               stderr=subprocess.PIPE, text=True, preexec_fn=_terminal_sigint)
     deadline = time.monotonic() + 120  # generous: a loaded 2-core machine; the loop normally takes ~2 s
     try:
         while len(list(outdir.glob(f"*/{CELL_FILE}"))) < 4:
