@@ -139,6 +139,36 @@ def symbolic_elastic_force(law, penetration, esym):
     )
 
 
+def symbolic_clearance_force(law, clearance: float, v_min: float, ex, ey, vx, vy, stiffness):
+    """Force on the journal ``[fx, fy, 0]`` as an Exudyn symbolic expression.
+
+    ``(ex, ey)`` is the eccentricity P_j - P_b and ``(vx, vy)`` its rate; ``stiffness`` holds the
+    held impact velocity and the last accepted (penetration, rate), from which the onset within the
+    step is interpolated.  Both branches of every ``IfThenElse`` may be evaluated, so divisors and
+    square roots are guarded.  Shared by the rigid-body and kinematic-tree models.
+    """
+    esym = exu.symbolic
+    real = esym.Real
+    xi = law.hysteresis
+    length = esym.sqrt(ex * ex + ey * ey)
+    delta = length - real(clearance)
+    safe = esym.max(length, real(_TINY_LENGTH))
+    nx = ex / safe
+    ny = ey / safe
+    rate = vx * nx + vy * ny
+    held = stiffness[0]
+    delta0 = stiffness[1]
+    rate0 = stiffness[2]
+    span = esym.min(delta0 - delta, real(-_TINY_LENGTH))
+    s = esym.min(esym.max(delta0 / span, real(0.0)), real(1.0))
+    onset = rate0 + s * (rate - rate0)
+    v_imp = esym.max(esym.IfThenElse(delta0 > real(0.0), held, onset), real(v_min))
+    f_el = symbolic_elastic_force(law, esym.max(delta, real(0.0)), esym)
+    f = esym.max(f_el * (real(1.0) + real(xi) * rate / v_imp), real(0.0))
+    f = esym.IfThenElse(delta > real(0.0), f, real(0.0))
+    return [f * nx, f * ny, real(0.0)]
+
+
 def make_symbolic_force(mbs, law, clearance: float, min_impact_velocity: float):
     """Exudyn symbolic user function of the clearance force (expression tree, C++ evaluation).
 
@@ -146,33 +176,13 @@ def make_symbolic_force(mbs, law, clearance: float, min_impact_velocity: float):
     are guarded (clamped penetration, |e| >= tiny, onset fraction clamped to [0, 1]).
     Keep the returned object alive as long as the system (Exudyn's requirement).
     """
-    esym = exu.symbolic
     from exudyn.advancedUtilities import CreateSymbolicUserFunction
 
-    c, v_min, xi = clearance, min_impact_velocity, law.hysteresis
-    real = esym.Real
+    c, v_min = clearance, min_impact_velocity
 
     def springForceUserFunction(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
-        ex = displacement[0]
-        ey = displacement[1]
-        length = esym.sqrt(ex * ex + ey * ey)
-        delta = length - real(c)
-        safe = esym.max(length, real(_TINY_LENGTH))
-        nx = ex / safe
-        ny = ey / safe
-        rate = velocity[0] * nx + velocity[1] * ny
-        held = stiffness[0]
-        delta0 = stiffness[1]
-        rate0 = stiffness[2]
-        span = esym.min(delta0 - delta, real(-_TINY_LENGTH))
-        s = esym.min(esym.max(delta0 / span, real(0.0)), real(1.0))
-        onset = rate0 + s * (rate - rate0)
-        v_imp = esym.max(esym.IfThenElse(delta0 > real(0.0), held, onset), real(v_min))
-        d = esym.max(delta, real(0.0))
-        f_el = symbolic_elastic_force(law, d, esym)
-        f = esym.max(f_el * (real(1.0) + real(xi) * rate / v_imp), real(0.0))
-        f = esym.IfThenElse(delta > real(0.0), f, real(0.0))
-        return [f * nx, f * ny, real(0.0)]
+        return symbolic_clearance_force(law, c, v_min, displacement[0], displacement[1], velocity[0],
+                                        velocity[1], stiffness)
 
     return CreateSymbolicUserFunction(
         mbs, springForceUserFunction, "springForceUserFunction",

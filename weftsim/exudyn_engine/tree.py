@@ -52,7 +52,7 @@ from exudyn.itemInterface import (
 )
 
 from weftsim.contact import make_law
-from weftsim.exudyn_engine.callbacks import _TINY_LENGTH, symbolic_elastic_force
+from weftsim.exudyn_engine.callbacks import symbolic_clearance_force
 from weftsim.exudyn_engine.onset import OnsetTracker, penetration_state
 from weftsim.params import Scene
 from weftsim.reference.dynamics import initial_state
@@ -212,30 +212,14 @@ def make_symbolic_force(mbs, law, clearance: float, min_impact_velocity: float, 
     esym = exu.symbolic
     from exudyn.advancedUtilities import CreateSymbolicUserFunction
 
-    c, v_min, xi, omega = clearance, min_impact_velocity, law.hysteresis, bearing.omega
+    c, v_min, omega = clearance, min_impact_velocity, bearing.omega
     real = esym.Real
 
     def springForceUserFunction(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
         by, bz, dby, dbz = bearing.terms(t, esym)
-        ex = displacement[0] - by
-        ey = displacement[1] - bz
-        length = esym.sqrt(ex * ex + ey * ey)
-        delta = length - real(c)
-        safe = esym.max(length, real(_TINY_LENGTH))
-        nx = ex / safe
-        ny = ey / safe
-        rate = (velocity[0] - real(omega) * dby) * nx + (velocity[1] - real(omega) * dbz) * ny
-        held = stiffness[0]
-        delta0 = stiffness[1]
-        rate0 = stiffness[2]
-        span = esym.min(delta0 - delta, real(-_TINY_LENGTH))
-        s = esym.min(esym.max(delta0 / span, real(0.0)), real(1.0))
-        onset = rate0 + s * (rate - rate0)
-        v_imp = esym.max(esym.IfThenElse(delta0 > real(0.0), held, onset), real(v_min))
-        f_el = symbolic_elastic_force(law, esym.max(delta, real(0.0)), esym)
-        f = esym.max(f_el * (real(1.0) + real(xi) * rate / v_imp), real(0.0))
-        f = esym.IfThenElse(delta > real(0.0), f, real(0.0))
-        return [f * nx, f * ny, real(0.0)]
+        return symbolic_clearance_force(law, c, v_min, displacement[0] - by, displacement[1] - bz,
+                                        velocity[0] - real(omega) * dby, velocity[1] - real(omega) * dbz,
+                                        stiffness)
 
     return CreateSymbolicUserFunction(
         mbs, springForceUserFunction, "springForceUserFunction",
