@@ -131,6 +131,12 @@ class ClearanceJoint:
         (v0, v1), m/s: the friction factor ramps from 0 to 1 between them.
     min_impact_velocity : float
         Floor v_min on the held impact velocity, m/s.
+    impact_velocity_rule : str
+        How the impact velocity delta_dot^- of the damping term is held through a contact:
+        ``"max_approach"`` (default), the largest approach rate since the onset, floored at
+        v_min (identical to the onset value in an isolated impact, bounded in a driven lasting
+        contact: xi delta_dot / delta_dot^- <= xi); ``"onset"``, the approach rate at the onset
+        alone (Lankarani-Nikravesh, Flores), for comparison with published results.
     """
 
     clearance: float = 0.25e-3
@@ -143,6 +149,7 @@ class ClearanceJoint:
     friction_coefficient: float = 0.0
     friction_velocities: tuple[float, float] = (1e-4, 2e-4)
     min_impact_velocity: float = 1e-4
+    impact_velocity_rule: str = "max_approach"
 
     @property
     def is_ideal(self) -> bool:

@@ -25,6 +25,7 @@ EXUDYN_MODELS = ("rigid_body", "kinematic_tree")
 EXPLICIT_METHODS = ("DOPRI5", "ODE23")
 CALLBACK_ROUTES = ("auto", "python", "symbolic", "numba")
 BRANCHES = {"+": 1, "-": -1}
+IMPACT_VELOCITY_RULES = ("max_approach", "onset")
 
 
 class SceneError(ValueError):
@@ -97,6 +98,8 @@ SCHEMA: tuple[Key, ...] = (
         doc="[v0, v1] of the friction ramp, v0 < v1"),
     Key("joint_e.min_impact_velocity_m_s", "joint.min_impact_velocity", "float", 1, 0,
         doc="floor on the held impact velocity"),
+    Key("joint_e.impact_velocity_rule", "joint.impact_velocity_rule", "str", choices=IMPACT_VELOCITY_RULES,
+        doc="held impact velocity: largest approach rate since onset, or the onset value alone"),
     Key("joint_e.journal_material.youngs_modulus_gpa", "joint.journal_material.youngs_modulus", "float", GPA, 0),
     Key("joint_e.journal_material.poisson_ratio", "joint.journal_material.poisson_ratio", "float", 1, 0, 0.5,
         False, True),
@@ -155,7 +158,10 @@ TOP_LEVEL = ("name", "description", "extends")
 # `extends` (a missing one is an error, never a silent default).  Solver settings, output,
 # compare tolerances and limits fall back to the defaults of weftsim.params.
 REQUIRED_SECTIONS = ("mechanism", "inertia", "joint_e", "drive")
-REQUIRED = tuple(key.path for key in SCHEMA if key.path.partition(".")[0] in REQUIRED_SECTIONS)
+# Model options inside those sections that are not part of the machine: they default.
+OPTIONAL = ("joint_e.impact_velocity_rule",)
+REQUIRED = tuple(key.path for key in SCHEMA
+                 if key.path.partition(".")[0] in REQUIRED_SECTIONS and key.path not in OPTIONAL)
 
 
 def _flatten(table: dict, prefix: str = "") -> dict[str, Any]:
