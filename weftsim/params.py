@@ -227,8 +227,12 @@ class CompareTolerance:
 
     first_contact_angle: float = math.radians(0.1)
     first_revolution_peaks: float = 0.01
-    rms: float = 0.03
-    percentile_99: float = 0.10
+    # Statistics over revolutions 2..N (N >= 10) are random draws of a chaotic impact sequence: one
+    # engine's 10-revolution RMS/mean scatter by s <= 1.08 %, its 99th percentiles by s <= 2.62 %
+    # (16-member ensemble, scripts/statistics_scatter.py).  Two engines differ by two draws: allow
+    # 4 s sqrt(2), a 4-sigma event for correct engines (more revolutions allow less: the test uses 40).
+    rms: float = 0.06
+    percentile_99: float = 0.15
     ideal_curves: float = 1e-4
 
 
