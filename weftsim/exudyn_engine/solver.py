@@ -227,7 +227,7 @@ def solve(scene: Scene, progress=None, callback: str | None = None) -> RunResult
         "newton_iterations": int(it.newtonStepsCount),
         "jacobian_evaluations": int(it.newtonJacobiCount),
         "function_evaluations": int(it.newtonStepsCount),
-        "contact_events": model.clearance.tracker.contact_events if model.clearance else 0,
+        **(model.clearance.tracker.counters() if model.clearance else {"contact_events": 0}),
         "callback": model.clearance.route if model.clearance else None,
         "solve_time_s": wall_solve,
         "wall_time_s": _time.perf_counter() - wall0,
@@ -236,8 +236,9 @@ def solve(scene: Scene, progress=None, callback: str | None = None) -> RunResult
         stats["failure"] = kind
     stats["time_per_step_us"] = 1e6 * wall_solve / max(n_done, 1)
     first = model.clearance.tracker.first_contact_time if model.clearance else None
+    counts = model.clearance.tracker.counters() if model.clearance else {}
     if progress is not None:
         progress(1.0)
     # Post-run criteria (energy balance, ...) that no single step shows; see weftsim.guards.
     return vet_result(RunResult(scene, "exudyn", status, message, samples, steps, stats,
-                                {"first_contact_time_s": first}))  # fmt: skip
+                                {"first_contact_time_s": first, **counts}))  # fmt: skip

@@ -20,8 +20,8 @@ velocity (closed form) from the connector's displacement and velocity,
 
     e = (P_j - O) - P_b(t),   e_dot = v_j - V_b(t),
 
-then applies the same law, onset interpolation and held impact velocity as
-:mod:`.callbacks` / :mod:`.onset`.  No constraints remain, so an error-controlled explicit
+then applies the same law, onset interpolation and held impact velocity rule
+(``joint.impact_velocity_rule``) as :mod:`.callbacks` / :mod:`.onset`.  No constraints remain, so an error-controlled explicit
 solver (DOPRI5 with automatic step size) integrates it; there is no Jacobian and no
 Newton iteration.
 
@@ -53,7 +53,7 @@ from exudyn.itemInterface import (
 
 from weftsim.contact import make_law
 from weftsim.exudyn_engine.callbacks import symbolic_clearance_force
-from weftsim.exudyn_engine.onset import OnsetTracker, penetration_state
+from weftsim.exudyn_engine.onset import OnsetTracker, callback_impact_velocity, penetration_state
 from weftsim.params import Scene
 from weftsim.reference.dynamics import initial_state
 from weftsim.reference.ideal import sector_chain_inertia
@@ -104,7 +104,7 @@ class BearingMotion:
 
 
 def make_python_force(law, clearance: float, min_impact_velocity: float, bearing: BearingMotion,
-                      memory: list, stash: list, counter: list | None = None):
+                      memory: list, stash: list, counter: list | None = None, max_approach: bool = True):
     """Plain-Python force callback with the moving bearing (see :mod:`.callbacks`).
 
     ``memory`` = [v_held, delta0, rate0] of the last accepted step (written by the post-step
@@ -116,6 +116,7 @@ def make_python_force(law, clearance: float, min_impact_velocity: float, bearing
     c, v_min, sqrt, cos, sin = clearance, min_impact_velocity, math.sqrt, math.cos, math.sin
     omega, tb, c0, s0, l_oe = bearing.omega, bearing.tan_beta, bearing.cos_oe0, bearing.sin_oe0, bearing.l_oe
     counter = [0] if counter is None else counter
+    impact_velocity = callback_impact_velocity
 
     def spring_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
         counter[0] += 1
@@ -140,14 +141,7 @@ def make_python_force(law, clearance: float, min_impact_velocity: float, bearing
         stash[0], stash[1], stash[2] = t, delta, rate
         if delta <= 0.0:
             return [0.0, 0.0, 0.0]
-        delta0 = memory[1]
-        if delta0 > 0.0:
-            v_imp = memory[0]
-        else:
-            rate0 = memory[2]
-            v_imp = rate0 + delta0 / (delta0 - delta) * (rate - rate0)
-        if v_imp < v_min:
-            v_imp = v_min
+        v_imp = impact_velocity(memory[0], memory[1], memory[2], delta, rate, v_min, max_approach)
         f = normal_force(delta, rate, v_imp)
         return [f * nx, f * ny, 0.0]
 
@@ -155,7 +149,7 @@ def make_python_force(law, clearance: float, min_impact_velocity: float, bearing
 
 
 def make_numba_force(law, clearance: float, min_impact_velocity: float, bearing: BearingMotion,
-                     memory: list, stash: list):
+                     memory: list, stash: list, max_approach: bool = True):
     """Python wrapper around an ``@njit`` core of the whole force, bearing motion included.
 
     ``memory`` and ``stash`` as in :func:`make_python_force`.
@@ -163,6 +157,7 @@ def make_numba_force(law, clearance: float, min_impact_velocity: float, bearing:
     import numba
 
     normal_force = law.numba()
+    impact_velocity = numba.njit(callback_impact_velocity)
     c, v_min = clearance, min_impact_velocity
     omega, tb, c0, s0, l_oe = bearing.omega, bearing.tan_beta, bearing.cos_oe0, bearing.sin_oe0, bearing.l_oe
 
@@ -186,9 +181,7 @@ def make_numba_force(law, clearance: float, min_impact_velocity: float, bearing:
         rate = (vx + omega * l_oe * sq * dphi) * nx + (vy - omega * l_oe * cq * dphi) * ny
         if delta <= 0.0:
             return 0.0, 0.0, delta, rate
-        v_imp = held if delta0 > 0.0 else rate0 + delta0 / (delta0 - delta) * (rate - rate0)
-        if v_imp < v_min:
-            v_imp = v_min
+        v_imp = impact_velocity(held, delta0, rate0, delta, rate, v_min, max_approach)
         f = normal_force(delta, rate, v_imp)
         return f * nx, f * ny, delta, rate
 
@@ -203,7 +196,8 @@ def make_numba_force(law, clearance: float, min_impact_velocity: float, bearing:
     return spring_force
 
 
-def make_symbolic_force(mbs, law, clearance: float, min_impact_velocity: float, bearing: BearingMotion):
+def make_symbolic_force(mbs, law, clearance: float, min_impact_velocity: float, bearing: BearingMotion,
+                        max_approach: bool = True):
     """Exudyn symbolic user function (C++ expression tree) of the force with the moving bearing.
 
     Same guards as :func:`weftsim.exudyn_engine.callbacks.make_symbolic_force` (both branches of
@@ -219,7 +213,7 @@ def make_symbolic_force(mbs, law, clearance: float, min_impact_velocity: float, 
         by, bz, dby, dbz = bearing.terms(t, esym)
         return symbolic_clearance_force(law, c, v_min, displacement[0] - by, displacement[1] - bz,
                                         velocity[0] - real(omega) * dby, velocity[1] - real(omega) * dbz,
-                                        stiffness)
+                                        stiffness, max_approach)
 
     return CreateSymbolicUserFunction(
         mbs, springForceUserFunction, "springForceUserFunction",
@@ -289,15 +283,16 @@ def build_tree(mbs, scene: Scene, callback: str = "auto") -> TreeModel:
     calls = [0]
     keep = None
     c, v_min = joint.clearance, joint.min_impact_velocity
-    tracker = OnsetTracker(c, v_min)
+    max_approach = joint.impact_velocity_rule == "max_approach"
+    tracker = OnsetTracker(c, v_min, rule=joint.impact_velocity_rule)
     memory = list(tracker.callback_state)
     stash = [math.nan, 0.0, 0.0]
     if route == "python":
-        force = make_python_force(law, c, v_min, bearing, memory, stash, calls)
+        force = make_python_force(law, c, v_min, bearing, memory, stash, calls, max_approach)
     elif route == "numba":
-        force = make_numba_force(law, c, v_min, bearing, memory, stash)
+        force = make_numba_force(law, c, v_min, bearing, memory, stash, max_approach)
     elif route == "symbolic":
-        keep = force = make_symbolic_force(mbs, law, c, v_min, bearing)
+        keep = force = make_symbolic_force(mbs, law, c, v_min, bearing, max_approach)
     else:
         raise ValueError(f"`callback` must be one of 'auto', 'python', 'symbolic', 'numba', got {callback!r}")
     connector = mbs.AddObject(ObjectConnectorCartesianSpringDamper(
