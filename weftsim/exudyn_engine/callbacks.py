@@ -18,7 +18,9 @@ f = F_N n with n = e/|e| pulls the journal back to the bearing centre::
         '---------'                               otherwise (onset inside this step; the trial
                                                   delta_dot if that is <= 0)
                                       "max_approach" rule: v_imp = max(v_imp, delta_dot)
-                                      F_N = law(delta, delta_dot, max(v_imp, v_min))
+                                      F_N = law(delta, delta_dot', max(v_imp, v_min))
+                                      delta_dot' = delta_dot less a dead zone of +-1e-6 v_min
+                                      (onset.damping_rate: resting contact)
 
 (:func:`weftsim.exudyn_engine.onset.callback_impact_velocity` is the one scalar definition.)
 
@@ -39,7 +41,7 @@ import math
 import exudyn as exu
 
 from weftsim.contact import ElasticFoundation, VariableKD
-from weftsim.exudyn_engine.onset import callback_impact_velocity
+from weftsim.exudyn_engine.onset import RESTING_RATE_FRACTION, callback_impact_velocity, damping_rate
 
 # Smallest |e| used as a divisor in the symbolic route (which evaluates both branches of
 # IfThenElse): any positive value below round-off of a clearance works, m.
@@ -55,7 +57,7 @@ def make_python_force(law, clearance: float, min_impact_velocity: float, counter
     """
     normal_force = law.scalar()
     c, v_min, sqrt = clearance, min_impact_velocity, math.sqrt
-    impact_velocity = callback_impact_velocity
+    impact_velocity, damped, v_dead = callback_impact_velocity, damping_rate, RESTING_RATE_FRACTION * min_impact_velocity
 
     def spring_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
         ex = displacement[0]
@@ -68,7 +70,7 @@ def make_python_force(law, clearance: float, min_impact_velocity: float, counter
         ny = ey / length
         rate = velocity[0] * nx + velocity[1] * ny
         v_imp = impact_velocity(stiffness[0], stiffness[1], stiffness[2], delta, rate, v_min, max_approach)
-        f = normal_force(delta, rate, v_imp)
+        f = normal_force(delta, damped(rate, v_dead), v_imp)
         return [f * nx, f * ny, 0.0]
 
     if counter is None:
@@ -86,8 +88,8 @@ def make_numba_force(law, clearance: float, min_impact_velocity: float, max_appr
     import numba  # optional dependency: only this route needs it
 
     normal_force = law.numba()
-    impact_velocity = numba.njit(callback_impact_velocity)
-    c, v_min = clearance, min_impact_velocity
+    impact_velocity, damped = numba.njit(callback_impact_velocity), numba.njit(damping_rate)
+    c, v_min, v_dead = clearance, min_impact_velocity, RESTING_RATE_FRACTION * min_impact_velocity
 
     @numba.njit(cache=False)
     def core(ex, ey, vx, vy, held, delta0, rate0):
@@ -99,7 +101,7 @@ def make_numba_force(law, clearance: float, min_impact_velocity: float, max_appr
         ny = ey / length
         rate = vx * nx + vy * ny
         v_imp = impact_velocity(held, delta0, rate0, delta, rate, v_min, max_approach)
-        f = normal_force(delta, rate, v_imp)
+        f = normal_force(delta, damped(rate, v_dead), v_imp)
         return f * nx, f * ny
 
     core(1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0)  # compile now, not inside the first step
@@ -167,8 +169,10 @@ def symbolic_clearance_force(law, clearance: float, v_min: float, ex, ey, vx, vy
     else:
         v = esym.IfThenElse(delta0 > real(0.0), held, esym.IfThenElse(onset > real(0.0), onset, rate))
     v_imp = esym.max(v, real(v_min))
+    v_dead = RESTING_RATE_FRACTION * v_min
+    damped = rate - esym.min(esym.max(rate, real(-v_dead)), real(v_dead))  # onset.damping_rate
     f_el = symbolic_elastic_force(law, esym.max(delta, real(0.0)), esym)
-    f = esym.max(f_el * (real(1.0) + real(xi) * rate / v_imp), real(0.0))
+    f = esym.max(f_el * (real(1.0) + real(xi) * damped / v_imp), real(0.0))
     f = esym.IfThenElse(delta > real(0.0), f, real(0.0))
     return [f * nx, f * ny, real(0.0)]
 

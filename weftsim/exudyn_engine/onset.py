@@ -103,6 +103,28 @@ def callback_impact_velocity(held: float, delta0: float, rate0: float, delta: fl
     return v if v > v_min else v_min
 
 
+# Half-width of the dead zone of the damping rate, as a fraction of v_min (1e-10 m/s by default).
+# A journal resting under load is otherwise locked by its own damper onto a round-off limit cycle
+# that generalized-alpha's Newton cannot leave (docs/clearance-joint.md, "Resting contact"): the
+# elastic force jumps by K'(delta) x one ulp of the marker positions between neighbouring floats, and
+# the damper holds the journal exactly there.  Removing rates below 1e-6 v_min from the damping term
+# changes the normal force by at most xi 1e-6 F_el.
+RESTING_RATE_FRACTION = 1e-6
+
+
+def damping_rate(rate: float, dead_rate: float) -> float:
+    """Penetration rate that drives the damping term: delta_dot less a dead zone +-dead_rate, m/s.
+
+    Continuous and piecewise linear: 0 for |rate| <= dead_rate, rate -+ dead_rate outside
+    (``dead_rate`` = :data:`RESTING_RATE_FRACTION` x v_min in every callback route).
+    """
+    if rate > dead_rate:
+        return rate - dead_rate
+    if rate < -dead_rate:
+        return rate + dead_rate
+    return 0.0
+
+
 def positive_onset_velocity(t0: float, delta0: float, rate0: float, t1: float, delta1: float,
                             rate1: float) -> tuple[float, bool]:
     """Approach rate at an onset inside the accepted step [t0, t1], never <= 0, m/s.

@@ -53,7 +53,13 @@ from exudyn.itemInterface import (
 
 from weftsim.contact import make_law
 from weftsim.exudyn_engine.callbacks import symbolic_clearance_force
-from weftsim.exudyn_engine.onset import OnsetTracker, callback_impact_velocity, penetration_state
+from weftsim.exudyn_engine.onset import (
+    RESTING_RATE_FRACTION,
+    OnsetTracker,
+    callback_impact_velocity,
+    damping_rate,
+    penetration_state,
+)
 from weftsim.params import Scene
 from weftsim.reference.dynamics import initial_state
 from weftsim.reference.ideal import sector_chain_inertia
@@ -116,7 +122,7 @@ def make_python_force(law, clearance: float, min_impact_velocity: float, bearing
     c, v_min, sqrt, cos, sin = clearance, min_impact_velocity, math.sqrt, math.cos, math.sin
     omega, tb, c0, s0, l_oe = bearing.omega, bearing.tan_beta, bearing.cos_oe0, bearing.sin_oe0, bearing.l_oe
     counter = [0] if counter is None else counter
-    impact_velocity = callback_impact_velocity
+    impact_velocity, damped, v_dead = callback_impact_velocity, damping_rate, RESTING_RATE_FRACTION * min_impact_velocity
 
     def spring_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
         counter[0] += 1
@@ -142,7 +148,7 @@ def make_python_force(law, clearance: float, min_impact_velocity: float, bearing
         if delta <= 0.0:
             return [0.0, 0.0, 0.0]
         v_imp = impact_velocity(memory[0], memory[1], memory[2], delta, rate, v_min, max_approach)
-        f = normal_force(delta, rate, v_imp)
+        f = normal_force(delta, damped(rate, v_dead), v_imp)
         return [f * nx, f * ny, 0.0]
 
     return spring_force
@@ -157,8 +163,8 @@ def make_numba_force(law, clearance: float, min_impact_velocity: float, bearing:
     import numba
 
     normal_force = law.numba()
-    impact_velocity = numba.njit(callback_impact_velocity)
-    c, v_min = clearance, min_impact_velocity
+    impact_velocity, damped = numba.njit(callback_impact_velocity), numba.njit(damping_rate)
+    c, v_min, v_dead = clearance, min_impact_velocity, RESTING_RATE_FRACTION * min_impact_velocity
     omega, tb, c0, s0, l_oe = bearing.omega, bearing.tan_beta, bearing.cos_oe0, bearing.sin_oe0, bearing.l_oe
 
     @numba.njit(cache=False)
@@ -182,7 +188,7 @@ def make_numba_force(law, clearance: float, min_impact_velocity: float, bearing:
         if delta <= 0.0:
             return 0.0, 0.0, delta, rate
         v_imp = impact_velocity(held, delta0, rate0, delta, rate, v_min, max_approach)
-        f = normal_force(delta, rate, v_imp)
+        f = normal_force(delta, damped(rate, v_dead), v_imp)
         return f * nx, f * ny, delta, rate
 
     core(0.0, 1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0)  # compile now, not inside the first step
