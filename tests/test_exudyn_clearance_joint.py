@@ -118,7 +118,7 @@ STATES = [  # (e, e_dot, [v_held, delta0, rate0]): free, onset inside the step, 
 
 
 def _reference_force(law, e, e_dot, mem, max_approach=True):
-    """The callback's contract written with the numpy law and the onset module (SPEC rule)."""
+    """The callback's contract written with the numpy law and the onset module."""
     delta, rate = penetration_state(e[0], e[1], e_dot[0], e_dot[1], C)
     if delta <= 0.0:
         return np.zeros(2)

@@ -124,6 +124,22 @@ def test_startup_first_contact_and_peaks_match_reference(startup):
         assert ex.steps[name].max() == pytest.approx(ref.steps[name].max(), rel=0.01)
 
 
+COUNTS = ("contact_events", "nonpositive_onsets", "separations", "missed_separations", "missed_contacts")
+
+
+@pytest.mark.parametrize("model", ["rigid_body", "kinematic_tree"])
+def test_contact_history_counts_are_reported(startup, model):
+    r = startup[0] if model == "rigid_body" else solve(scene(0.25e-3, 400.0, START, model=model))
+    assert r.ok, r.message
+    for key in COUNTS:
+        assert r.solver_stats[key] == r.events[key], key
+    flag = r.steps["in_contact"]
+    # The counts agree with the per-step contact flag: onsets are its 0 -> 1 steps, separations 1 -> 0.
+    assert r.solver_stats["contact_events"] == np.sum((flag[1:] > 0) & (flag[:-1] == 0)) > 0
+    assert r.solver_stats["separations"] == np.sum((flag[1:] == 0) & (flag[:-1] > 0))
+    assert r.solver_stats["nonpositive_onsets"] == 0  # every start-up onset has a clear approach rate
+
+
 def test_energy_balance_with_clearance(startup):
     st = startup[0].steps
     residual = (st["driving_work_J"] - (st["kinetic_energy_J"] - st["kinetic_energy_J"][0])
