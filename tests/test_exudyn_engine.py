@@ -205,6 +205,9 @@ def test_invalid_settings_and_friction_fail_naming_the_setting():
     assert r.status == "failed" and "spectral_radius" in r.message
     r = solve(dataclasses.replace(scene(), joint=ClearanceJoint(friction_coefficient=0.1)))
     assert r.status == "failed" and "friction" in r.message
+    for model in ("rigid_body", "kinematic_tree"):
+        r = solve(scene(rule="largest", model=model))
+        assert r.status == "failed" and "impact_velocity_rule" in r.message and "max_approach" in r.message
 
 
 def test_newton_failure_is_reported_not_passed_over():
