@@ -18,6 +18,7 @@ from weftsim.exudyn_engine.clearance_joint import add_clearance_joint, register_
 from weftsim.exudyn_engine.onset import (
     RESTING_RATE_FRACTION,
     OnsetTracker,
+    hermite_extremum,
     onset_fraction,
     onset_velocity,
     penetration_state,
@@ -89,6 +90,7 @@ def test_tracker_never_holds_a_nonpositive_onset_and_counts_it():
 def test_tracker_detects_a_separation_inside_one_step():
     # In contact at both ends, leaving at 0.1 m/s and returning at 0.1 m/s over 10 us: the cubic
     # through the ends dips to 1e-7 - 10e-6 * 0.1 / 4 = -1.5e-7 m, a whole free flight in the step.
+    assert hermite_extremum(1e-7, -0.1, 1e-7, 0.1, 1e-5) == pytest.approx(-1.5e-7, rel=1e-12)  # at s = 1/2
     tr = OnsetTracker(C, 1e-4, t0=0.0, delta0=1e-7, rate0=-0.1)
     tr.accept(1e-5, 1e-7, 0.1)
     assert tr.missed_separations == 1

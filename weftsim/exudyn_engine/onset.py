@@ -144,9 +144,10 @@ def hermite_extremum(delta0: float, rate0: float, delta1: float, rate1: float, h
     """Interior extremum of the cubic Hermite interpolant of delta over a step of length h, m.
 
     The cubic through (delta0, rate0) at s = 0 and (delta1, rate1) at s = 1 (s = time / h);
-    returns its value at the interior stationary point (the one where the rate changes sign
-    between the ends), or ``min``/``max`` of the ends if there is none.  Used to detect a
-    separation and a re-contact (or a contact and a separation) inside one accepted step.
+    returns its smallest interior stationary value if ``rate0 < 0`` (a dip between the ends),
+    its largest otherwise (a bump), or the smaller / larger end value if the cubic has no
+    interior stationary point.  Used to detect a separation and a re-contact (or a contact and
+    a separation) inside one accepted step.
     """
     m0, m1 = h * rate0, h * rate1
     # p(s) = a s^3 + b s^2 + m0 s + delta0; p'(s) = 3 a s^2 + 2 b s + m0
