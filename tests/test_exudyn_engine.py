@@ -172,9 +172,9 @@ def test_startup_impact_converges_at_second_order():
 def test_startup_impact_is_step_converged_under_max_approach():
     # Under "max_approach" the start-up contacts hold the largest approach rate, which the
     # steps sample at O(h^2) near its maximum and which no longer hangs on the onset estimate:
-    # measured changes 3.4e-6 J and 1.9e-6 J (about 1e-6 of the ~3 J dissipated, at the level
-    # of the trapezoid sums' round-off), so no order is observable; the bound is the same
-    # 1e-4 of the dissipated energy as for the onset rule.
+    # measured changes 1.9e-6 J (h 4e-6 -> 2e-6 s) and 3.4e-6 J (2e-6 -> 1e-6 s), about 1e-6 of
+    # the 2.73 J dissipated, so no order is observable at that level (the onset rule: 2.7e-4 and
+    # 5.7e-5 J of 2.95 J); the bound is the same 1e-4 of the dissipated energy.
     dissipated, d1, d2 = _startup_dissipation("max_approach")
     assert max(d1, d2) < 1e-4 * dissipated[2]
 
