@@ -21,7 +21,8 @@ RPM = math.pi / 30.0
 
 def scene(clearance=0.25e-3, rpm=400.0, revolutions=2.0, rule="max_approach", **solver) -> Scene:
     return Scene(joint=ClearanceJoint(clearance=clearance, impact_velocity_rule=rule),
-                 drive=Drive(speed=rpm * RPM, revolutions=revolutions), exudyn_solver=ExudynSolver(**solver))  # fmt: skip
+                 drive=Drive(speed=rpm * RPM, revolutions=revolutions),
+                 exudyn_solver=ExudynSolver(**solver))  # fmt: skip
 
 
 # Ideal joints: constraint reactions carry round-off noise ~ eps |q| / (beta h^2) (index-3

@@ -57,7 +57,8 @@ def make_python_force(law, clearance: float, min_impact_velocity: float, counter
     """
     normal_force = law.scalar()
     c, v_min, sqrt = clearance, min_impact_velocity, math.sqrt
-    impact_velocity, damped, v_dead = callback_impact_velocity, damping_rate, RESTING_RATE_FRACTION * min_impact_velocity
+    impact_velocity, damped = callback_impact_velocity, damping_rate
+    v_dead = RESTING_RATE_FRACTION * min_impact_velocity
 
     def spring_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
         ex = displacement[0]

@@ -21,9 +21,9 @@ velocity (closed form) from the connector's displacement and velocity,
     e = (P_j - O) - P_b(t),   e_dot = v_j - V_b(t),
 
 then applies the same law, onset interpolation and held impact velocity rule
-(``joint.impact_velocity_rule``) as :mod:`.callbacks` / :mod:`.onset`.  No constraints remain, so an error-controlled explicit
-solver (DOPRI5 with automatic step size) integrates it; there is no Jacobian and no
-Newton iteration.
+(``joint.impact_velocity_rule``) as :mod:`.callbacks` / :mod:`.onset`.  No constraints
+remain, so an error-controlled explicit solver (DOPRI5 with automatic step size) integrates
+it; there is no Jacobian and no Newton iteration.
 
 The driving torque comes from the contact force in closed form, with the crank-side
 terms of :mod:`weftsim.reference.ideal` (SPEC.md 4, docs/reference-solver.md):
@@ -122,7 +122,8 @@ def make_python_force(law, clearance: float, min_impact_velocity: float, bearing
     c, v_min, sqrt, cos, sin = clearance, min_impact_velocity, math.sqrt, math.cos, math.sin
     omega, tb, c0, s0, l_oe = bearing.omega, bearing.tan_beta, bearing.cos_oe0, bearing.sin_oe0, bearing.l_oe
     counter = [0] if counter is None else counter
-    impact_velocity, damped, v_dead = callback_impact_velocity, damping_rate, RESTING_RATE_FRACTION * min_impact_velocity
+    impact_velocity, damped = callback_impact_velocity, damping_rate
+    v_dead = RESTING_RATE_FRACTION * min_impact_velocity
 
     def spring_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
         counter[0] += 1
