@@ -171,8 +171,12 @@ def test_absurd_stiffness_overflows_at_the_first_contact(engine):
     r = SOLVERS[engine](scene(youngs_modulus=1e305))
     if engine == "reference":
         assert_failed(r, "non_finite", "right-hand side turned non-finite", "[joint_e]")
-    else:
+    elif r.solver_stats.get("failure") == "solver":
         assert_failed(r, "solver", "not factorized", "exudyn_solver.step_size")
+    else:
+        # Which of the infinite values reaches Exudyn first (the numerical Jacobian, inf - inf, or the
+        # residual, inf / inf in the damping term) depends on the callback's arithmetic: both are named.
+        assert_failed(r, "non_finite", "Newton residual is nan", "exudyn_solver.step_size")
     assert failure_angle(r) == pytest.approx(FIRST_CONTACT_DEG, abs=0.01)
     assert r.steps["penetration_m"][:-1].max() <= 0.0  # all kept steps but the last are free flight
 
@@ -220,8 +224,8 @@ def test_exudyn_nan_contact_force(monkeypatch):
 
     make = callbacks.make_python_force
 
-    def poisoned(law, clearance, v_min, counter=None):
-        force = make(law, clearance, v_min, counter)
+    def poisoned(law, clearance, v_min, *args):
+        force = make(law, clearance, v_min, *args)
 
         def nan_in_contact(mbs, t, *args):
             out = force(mbs, t, *args)

@@ -4,8 +4,9 @@
 (``MarkerBodyPosition`` at the two joint centres, bodies moving in Exudyn's XY plane,
 joint axis = Exudyn Z) as an ``ObjectConnectorCartesianSpringDamper`` whose force callback
 applies a contact law of :mod:`weftsim.contact`.  The impact velocity is located at the
-true onset within the step and held until separation (:mod:`.onset`); the bookkeeping
-runs in a post-step user function, i.e. on accepted steps only.  Usage::
+true onset within the step and held until separation, raised to any larger approach rate
+under the default ``joint.impact_velocity_rule = "max_approach"`` (:mod:`.onset`); the
+bookkeeping runs in a post-step user function, i.e. on accepted steps only.  Usage::
 
     model = add_clearance_joint(mbs, marker_bearing, marker_journal, joint)
     mbs.Assemble()
@@ -96,7 +97,8 @@ class ClearanceJointModel:
     def reset(self, mbs, t0: float = 0.0) -> None:
         """Start the bookkeeping from the current (assembled, initial) state of ``mbs``."""
         delta, rate = self.state(mbs)
-        self.tracker = OnsetTracker(self.joint.clearance, self.joint.min_impact_velocity, t0, delta, rate)
+        self.tracker = OnsetTracker(self.joint.clearance, self.joint.min_impact_velocity, t0, delta, rate,
+                                    self.joint.impact_velocity_rule)
         mbs.SetObjectParameter(self.connector, "stiffness", self.tracker.callback_state)
 
 
@@ -154,14 +156,15 @@ def add_clearance_joint(mbs, marker_bearing, marker_journal, joint: ClearanceJoi
     if call_counter is not None and route != "python":
         raise ValueError("`call_counter` works with callback='python' only")
     c, v_min = joint.clearance, joint.min_impact_velocity
+    max_approach = joint.impact_velocity_rule == "max_approach"
+    tracker = OnsetTracker(c, v_min, rule=joint.impact_velocity_rule)  # checks the rule's name
     keep = None
     if route == "python":
-        force = callbacks.make_python_force(law, c, v_min, call_counter)
+        force = callbacks.make_python_force(law, c, v_min, call_counter, max_approach)
     elif route == "numba":
-        force = callbacks.make_numba_force(law, c, v_min)
+        force = callbacks.make_numba_force(law, c, v_min, max_approach)
     else:
-        keep = force = callbacks.make_symbolic_force(mbs, law, c, v_min)
-    tracker = OnsetTracker(c, v_min)
+        keep = force = callbacks.make_symbolic_force(mbs, law, c, v_min, max_approach)
     connector = mbs.AddObject(ObjectConnectorCartesianSpringDamper(
         markerNumbers=[marker_bearing, marker_journal],
         stiffness=tracker.callback_state, damping=[0.0, 0.0, 0.0], offset=[0.0, 0.0, 0.0],

@@ -16,6 +16,22 @@ The same formula runs inside the force callback (trial states of the onset step,
 the force is a smooth function of the unknowns and Newton sees it) and in the
 accepted-step bookkeeping (:class:`OnsetTracker`, which then holds the value until
 separation).
+
+Held impact velocity rules (``ClearanceJoint.impact_velocity_rule``):
+
+- ``"max_approach"`` (default): v_imp = the largest approach rate since the onset,
+  floored at v_min.  In an isolated impact delta_dot only falls after the onset, so this
+  is the onset value and every law keeps its restitution; in a driven lasting contact
+  delta_dot can grow far beyond the onset value, and this rule keeps the damping term
+  xi delta_dot / v_imp <= xi (damping force <= xi x elastic force).
+- ``"onset"``: v_imp = the approach rate at the onset alone (Lankarani and Nikravesh
+  1990; Flores and Ambrosio 2004), for comparison with published results.
+
+An onset is a crossing of delta from <= 0 to > 0 with delta_dot > 0.  Within one step
+the linear interpolation can give a non-positive rate at the crossing (a graze or a
+turnaround inside the step: delta and delta_dot are then not both linear); such an
+estimate is never held, the best positive one is (:func:`positive_onset_velocity`), and
+the tracker counts it.
 """
 
 from __future__ import annotations
@@ -23,6 +39,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
+from weftsim.scene import IMPACT_VELOCITY_RULES
 
 
 def onset_fraction(delta0: float, delta1: float) -> float:
@@ -46,6 +64,109 @@ def onset_velocity(delta0: float, rate0: float, delta1: float, rate1: float) -> 
     return rate0 + s * (rate1 - rate0)
 
 
+def callback_impact_velocity(held: float, delta0: float, rate0: float, delta: float, rate: float,
+                             v_min: float, max_approach: bool) -> float:
+    """Impact velocity the force law uses at a trial state in contact (delta > 0), m/s.
+
+    The one scalar definition of the rule inside a step; the python and numba callbacks
+    call (or compile) it, the symbolic route writes the same branches as an expression.
+
+    Parameters
+    ----------
+    held : float
+        Held impact velocity of the last accepted state, m/s.
+    delta0, rate0 : float
+        Penetration (m) and rate (m/s) of the last accepted state; ``delta0 > 0`` means the
+        contact was already on, otherwise the onset lies inside this step.
+    delta, rate : float
+        Trial penetration (> 0) and rate.
+    v_min : float
+        Floor, m/s.
+    max_approach : bool
+        True for the ``"max_approach"`` rule: v_imp = max(held or onset value, rate).
+
+    Returns
+    -------
+    float
+        ``max(v, v_min)`` with ``v`` the held value (``delta0 > 0``) or the interpolated
+        onset rate (never a non-positive one: then the trial rate), maxed with ``rate``
+        under ``"max_approach"``.
+    """
+    if delta0 > 0.0:
+        v = held
+    else:
+        v = rate0 + delta0 / (delta0 - delta) * (rate - rate0)
+        if v <= 0.0:  # graze within the step: no positive onset estimate, use the trial rate
+            v = rate
+    if max_approach and rate > v:
+        v = rate
+    return v if v > v_min else v_min
+
+
+# Half-width of the dead zone of the damping rate, as a fraction of v_min (1e-10 m/s by default).
+# A journal resting under load is otherwise locked by its own damper onto a round-off limit cycle
+# that generalized-alpha's Newton cannot leave (docs/clearance-joint.md, "Resting contact"): the
+# elastic force jumps by K'(delta) x one ulp of the marker positions between neighbouring floats, and
+# the damper holds the journal exactly there.  Removing rates below 1e-6 v_min from the damping term
+# changes the normal force by at most xi 1e-6 F_el.
+RESTING_RATE_FRACTION = 1e-6
+
+
+def damping_rate(rate: float, dead_rate: float) -> float:
+    """Penetration rate that drives the damping term: delta_dot less a dead zone +-dead_rate, m/s.
+
+    Continuous and piecewise linear: 0 for |rate| <= dead_rate, rate -+ dead_rate outside
+    (``dead_rate`` = :data:`RESTING_RATE_FRACTION` x v_min in every callback route).
+    """
+    if rate > dead_rate:
+        return rate - dead_rate
+    if rate < -dead_rate:
+        return rate + dead_rate
+    return 0.0
+
+
+def positive_onset_velocity(t0: float, delta0: float, rate0: float, t1: float, delta1: float,
+                            rate1: float) -> tuple[float, bool]:
+    """Approach rate at an onset inside the accepted step [t0, t1], never <= 0, m/s.
+
+    Returns ``(v, interpolated)``: the linear in-step estimate when it is positive
+    (``interpolated`` True), otherwise the larger of the end-of-step rate and the secant rate
+    (delta1 - delta0) / (t1 - t0), which is > 0 whenever delta crossed from <= 0 to > 0.
+    """
+    v = onset_velocity(delta0, rate0, delta1, rate1)
+    if v > 0.0:
+        return v, True
+    secant = (delta1 - delta0) / (t1 - t0) if t1 > t0 else 0.0
+    return max(rate1, secant), False
+
+
+def hermite_extremum(delta0: float, rate0: float, delta1: float, rate1: float, h: float) -> float:
+    """Interior extremum of the cubic Hermite interpolant of delta over a step of length h, m.
+
+    The cubic through (delta0, rate0) at s = 0 and (delta1, rate1) at s = 1 (s = time / h);
+    returns its smallest interior stationary value if ``rate0 < 0`` (a dip between the ends),
+    its largest otherwise (a bump), or the smaller / larger end value if the cubic has no
+    interior stationary point.  Used to detect a separation and a re-contact (or a contact and
+    a separation) inside one accepted step.
+    """
+    m0, m1 = h * rate0, h * rate1
+    # p(s) = a s^3 + b s^2 + m0 s + delta0; p'(s) = 3 a s^2 + 2 b s + m0
+    a = 2.0 * delta0 - 2.0 * delta1 + m0 + m1
+    b = -3.0 * delta0 + 3.0 * delta1 - 2.0 * m0 - m1
+    roots = []
+    if abs(a) > 1e-300:
+        disc = b * b - 3.0 * a * m0
+        if disc >= 0.0:
+            r = math.sqrt(disc)
+            roots = [(-b - r) / (3.0 * a), (-b + r) / (3.0 * a)]
+    elif abs(b) > 1e-300:
+        roots = [-m0 / (2.0 * b)]
+    values = [((a * s + b) * s + m0) * s + delta0 for s in roots if 0.0 < s < 1.0]
+    if not values:
+        return min(delta0, delta1) if rate0 < 0.0 else max(delta0, delta1)
+    return min(values) if rate0 < 0.0 else max(values)
+
+
 def penetration_state(ex: float, ey: float, vx: float, vy: float, clearance: float):
     """delta = |e| - c and delta_dot = e_dot . e/|e| of an in-plane eccentricity (m, m/s).
 
@@ -60,10 +181,20 @@ def penetration_state(ex: float, ey: float, vx: float, vy: float, clearance: flo
 class OnsetTracker:
     """Accepted-step bookkeeping of one clearance joint: contact state and held v_imp.
 
-    Call :meth:`accept` once per accepted step with the eccentricity and its rate.
+    Call :meth:`accept` once per accepted step with the penetration and its rate.
     The state the force callback needs, ``(v_held, delta0, rate0)``, is in
     :attr:`callback_state`; the callback holds ``v_held`` when ``delta0 > 0`` (last
-    accepted state in contact) and interpolates the onset otherwise.
+    accepted state in contact) and interpolates the onset otherwise
+    (:func:`callback_impact_velocity`).
+
+    Parameters
+    ----------
+    clearance, min_impact_velocity : float
+        c (m) and v_min (m/s).
+    t0, delta0, rate0 : float
+        Initial time (s), penetration (m, default -c: centred) and rate (m/s).
+    rule : {"max_approach", "onset"}
+        Held impact velocity rule (module docstring).
 
     Attributes
     ----------
@@ -72,19 +203,37 @@ class OnsetTracker:
         velocity (m/s, 0 out of contact), contact flag (1.0 / 0.0).
     contact_events : int
         Number of contact onsets.
+    nonpositive_onsets : int
+        Onsets whose in-step interpolated approach rate was <= 0 (a graze or turnaround
+        within the step); the held value is then :func:`positive_onset_velocity`.
+    separations : int
+        Accepted contact -> free transitions.
+    missed_separations, missed_contacts : int
+        Steps in contact at both ends whose Hermite interpolant of delta dips below 0
+        (a separation and re-contact inside one step), and steps free at both ends whose
+        interpolant rises above 0 (a whole contact inside one step).
     first_contact_time : float or None
         Onset time of the first contact, s, located within its step.
     """
 
     def __init__(self, clearance: float, min_impact_velocity: float, t0: float = 0.0,
-                 delta0: float | None = None, rate0: float = 0.0):
+                 delta0: float | None = None, rate0: float = 0.0, rule: str = "max_approach"):
+        if rule not in IMPACT_VELOCITY_RULES:
+            raise ValueError(f"`impact_velocity_rule` must be one of {IMPACT_VELOCITY_RULES}, got {rule!r}")
         self.clearance = clearance
         self.min_impact_velocity = min_impact_velocity
+        self.max_approach = rule == "max_approach"
         self.t = t0
         self.delta = -clearance if delta0 is None else delta0
         self.rate = rate0
         self.held = min_impact_velocity
+        if self.delta > 0.0 and self.max_approach:
+            self.held = max(self.held, rate0)
         self.contact_events = 0
+        self.nonpositive_onsets = 0
+        self.separations = 0
+        self.missed_separations = 0
+        self.missed_contacts = 0
         self.first_contact_time: float | None = None
         self.time = [t0]
         self.in_contact = [1.0 if self.delta > 0.0 else 0.0]
@@ -97,17 +246,41 @@ class OnsetTracker:
 
     def accept(self, t: float, delta: float, rate: float) -> None:
         """Record an accepted state (time t, penetration delta, rate delta_dot)."""
-        if delta > 0.0 and self.delta <= 0.0:
-            s = onset_fraction(self.delta, delta)
-            self.held = max(self.rate + s * (rate - self.rate), self.min_impact_velocity)
+        was_in = self.delta > 0.0
+        inside = delta > 0.0
+        if inside and not was_in:
+            v, interpolated = positive_onset_velocity(self.t, self.delta, self.rate, t, delta, rate)
+            if not interpolated:
+                self.nonpositive_onsets += 1
+            if self.max_approach and rate > v:
+                v = rate
+            self.held = max(v, self.min_impact_velocity)
             self.contact_events += 1
             if self.first_contact_time is None:
-                self.first_contact_time = self.t + s * (t - self.t)
+                self.first_contact_time = self.t + onset_fraction(self.delta, delta) * (t - self.t)
+        elif inside:
+            if self.max_approach and rate > self.held:
+                self.held = rate
+            if self.rate < 0.0 < rate and hermite_extremum(self.delta, self.rate, delta, rate, t - self.t) <= 0.0:
+                self.missed_separations += 1
+        elif was_in:
+            self.separations += 1
+        elif self.rate > 0.0 > rate and hermite_extremum(self.delta, self.rate, delta, rate, t - self.t) > 0.0:
+            self.missed_contacts += 1
         self.t, self.delta, self.rate = t, delta, rate
-        inside = delta > 0.0
         self.time.append(t)
         self.in_contact.append(1.0 if inside else 0.0)
         self.impact_velocity.append(self.held if inside else 0.0)
+
+    def counters(self) -> dict[str, int]:
+        """Contact-history counts for ``solver_stats`` (read by the run's plausibility checks)."""
+        return {
+            "contact_events": self.contact_events,
+            "nonpositive_onsets": self.nonpositive_onsets,
+            "separations": self.separations,
+            "missed_separations": self.missed_separations,
+            "missed_contacts": self.missed_contacts,
+        }
 
     def history(self) -> dict[str, np.ndarray]:
         """Per-accepted-state arrays: ``time``, ``impact_velocity``, ``in_contact``."""

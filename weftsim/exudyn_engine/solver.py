@@ -24,6 +24,7 @@ from weftsim.exudyn_engine.mechanism import build_mechanism
 from weftsim.exudyn_engine.sensors import add_sensors, first_nonfinite_row, sample_channels, silence, step_channels
 from weftsim.guards import RunGuard, failure_message, non_finite_breach, vet_result
 from weftsim.params import Scene
+from weftsim.scene import IMPACT_VELOCITY_RULES
 from weftsim.results import RunResult, angle_grid, empty_channels
 
 MODELS = ("rigid_body", "kinematic_tree")  # kinematic_tree: tree.py, tree_solve.py
@@ -62,6 +63,9 @@ def check_settings(scene: Scene) -> str | None:
             return "`exudyn_solver.callback` = 'numba' needs numba installed; use 'auto' or 'python'"
     if not scene.output.sample_angle > 0.0:
         return f"`output.sample_angle` must be > 0, got {scene.output.sample_angle}"
+    if scene.joint.impact_velocity_rule not in IMPACT_VELOCITY_RULES:
+        return (f"`joint.impact_velocity_rule` must be one of {IMPACT_VELOCITY_RULES}, "
+                f"got {scene.joint.impact_velocity_rule!r}")  # fmt: skip
     if scene.joint.friction_coefficient > 0.0 and not scene.joint.is_ideal:
         return ("the Exudyn engine has no friction in the clearance joint (docs/clearance-joint.md); "
                 "set `friction_coefficient` = 0 or use the reference engine")  # fmt: skip
@@ -227,7 +231,7 @@ def solve(scene: Scene, progress=None, callback: str | None = None) -> RunResult
         "newton_iterations": int(it.newtonStepsCount),
         "jacobian_evaluations": int(it.newtonJacobiCount),
         "function_evaluations": int(it.newtonStepsCount),
-        "contact_events": model.clearance.tracker.contact_events if model.clearance else 0,
+        **(model.clearance.tracker.counters() if model.clearance else {"contact_events": 0}),
         "callback": model.clearance.route if model.clearance else None,
         "solve_time_s": wall_solve,
         "wall_time_s": _time.perf_counter() - wall0,
@@ -236,8 +240,9 @@ def solve(scene: Scene, progress=None, callback: str | None = None) -> RunResult
         stats["failure"] = kind
     stats["time_per_step_us"] = 1e6 * wall_solve / max(n_done, 1)
     first = model.clearance.tracker.first_contact_time if model.clearance else None
+    counts = model.clearance.tracker.counters() if model.clearance else {}
     if progress is not None:
         progress(1.0)
     # Post-run criteria (energy balance, ...) that no single step shows; see weftsim.guards.
     return vet_result(RunResult(scene, "exudyn", status, message, samples, steps, stats,
-                                {"first_contact_time_s": first}))  # fmt: skip
+                                {"first_contact_time_s": first, **counts}))  # fmt: skip

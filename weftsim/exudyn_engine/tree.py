@@ -20,10 +20,10 @@ velocity (closed form) from the connector's displacement and velocity,
 
     e = (P_j - O) - P_b(t),   e_dot = v_j - V_b(t),
 
-then applies the same law, onset interpolation and held impact velocity as
-:mod:`.callbacks` / :mod:`.onset`.  No constraints remain, so an error-controlled explicit
-solver (DOPRI5 with automatic step size) integrates it; there is no Jacobian and no
-Newton iteration.
+then applies the same law, onset interpolation and held impact velocity rule
+(``joint.impact_velocity_rule``) as :mod:`.callbacks` / :mod:`.onset`.  No constraints
+remain, so an error-controlled explicit solver (DOPRI5 with automatic step size) integrates
+it; there is no Jacobian and no Newton iteration.
 
 The driving torque comes from the contact force in closed form, with the crank-side
 terms of :mod:`weftsim.reference.ideal` (SPEC.md 4, docs/reference-solver.md):
@@ -53,7 +53,13 @@ from exudyn.itemInterface import (
 
 from weftsim.contact import make_law
 from weftsim.exudyn_engine.callbacks import symbolic_clearance_force
-from weftsim.exudyn_engine.onset import OnsetTracker, penetration_state
+from weftsim.exudyn_engine.onset import (
+    RESTING_RATE_FRACTION,
+    OnsetTracker,
+    callback_impact_velocity,
+    damping_rate,
+    penetration_state,
+)
 from weftsim.params import Scene
 from weftsim.reference.dynamics import initial_state
 from weftsim.reference.ideal import sector_chain_inertia
@@ -104,7 +110,7 @@ class BearingMotion:
 
 
 def make_python_force(law, clearance: float, min_impact_velocity: float, bearing: BearingMotion,
-                      memory: list, stash: list, counter: list | None = None):
+                      memory: list, stash: list, counter: list | None = None, max_approach: bool = True):
     """Plain-Python force callback with the moving bearing (see :mod:`.callbacks`).
 
     ``memory`` = [v_held, delta0, rate0] of the last accepted step (written by the post-step
@@ -116,6 +122,8 @@ def make_python_force(law, clearance: float, min_impact_velocity: float, bearing
     c, v_min, sqrt, cos, sin = clearance, min_impact_velocity, math.sqrt, math.cos, math.sin
     omega, tb, c0, s0, l_oe = bearing.omega, bearing.tan_beta, bearing.cos_oe0, bearing.sin_oe0, bearing.l_oe
     counter = [0] if counter is None else counter
+    impact_velocity, damped = callback_impact_velocity, damping_rate
+    v_dead = RESTING_RATE_FRACTION * min_impact_velocity
 
     def spring_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
         counter[0] += 1
@@ -140,22 +148,15 @@ def make_python_force(law, clearance: float, min_impact_velocity: float, bearing
         stash[0], stash[1], stash[2] = t, delta, rate
         if delta <= 0.0:
             return [0.0, 0.0, 0.0]
-        delta0 = memory[1]
-        if delta0 > 0.0:
-            v_imp = memory[0]
-        else:
-            rate0 = memory[2]
-            v_imp = rate0 + delta0 / (delta0 - delta) * (rate - rate0)
-        if v_imp < v_min:
-            v_imp = v_min
-        f = normal_force(delta, rate, v_imp)
+        v_imp = impact_velocity(memory[0], memory[1], memory[2], delta, rate, v_min, max_approach)
+        f = normal_force(delta, damped(rate, v_dead), v_imp)
         return [f * nx, f * ny, 0.0]
 
     return spring_force
 
 
 def make_numba_force(law, clearance: float, min_impact_velocity: float, bearing: BearingMotion,
-                     memory: list, stash: list):
+                     memory: list, stash: list, max_approach: bool = True):
     """Python wrapper around an ``@njit`` core of the whole force, bearing motion included.
 
     ``memory`` and ``stash`` as in :func:`make_python_force`.
@@ -163,7 +164,8 @@ def make_numba_force(law, clearance: float, min_impact_velocity: float, bearing:
     import numba
 
     normal_force = law.numba()
-    c, v_min = clearance, min_impact_velocity
+    impact_velocity, damped = numba.njit(callback_impact_velocity), numba.njit(damping_rate)
+    c, v_min, v_dead = clearance, min_impact_velocity, RESTING_RATE_FRACTION * min_impact_velocity
     omega, tb, c0, s0, l_oe = bearing.omega, bearing.tan_beta, bearing.cos_oe0, bearing.sin_oe0, bearing.l_oe
 
     @numba.njit(cache=False)
@@ -186,10 +188,8 @@ def make_numba_force(law, clearance: float, min_impact_velocity: float, bearing:
         rate = (vx + omega * l_oe * sq * dphi) * nx + (vy - omega * l_oe * cq * dphi) * ny
         if delta <= 0.0:
             return 0.0, 0.0, delta, rate
-        v_imp = held if delta0 > 0.0 else rate0 + delta0 / (delta0 - delta) * (rate - rate0)
-        if v_imp < v_min:
-            v_imp = v_min
-        f = normal_force(delta, rate, v_imp)
+        v_imp = impact_velocity(held, delta0, rate0, delta, rate, v_min, max_approach)
+        f = normal_force(delta, damped(rate, v_dead), v_imp)
         return f * nx, f * ny, delta, rate
 
     core(0.0, 1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0)  # compile now, not inside the first step
@@ -203,7 +203,8 @@ def make_numba_force(law, clearance: float, min_impact_velocity: float, bearing:
     return spring_force
 
 
-def make_symbolic_force(mbs, law, clearance: float, min_impact_velocity: float, bearing: BearingMotion):
+def make_symbolic_force(mbs, law, clearance: float, min_impact_velocity: float, bearing: BearingMotion,
+                        max_approach: bool = True):
     """Exudyn symbolic user function (C++ expression tree) of the force with the moving bearing.
 
     Same guards as :func:`weftsim.exudyn_engine.callbacks.make_symbolic_force` (both branches of
@@ -219,7 +220,7 @@ def make_symbolic_force(mbs, law, clearance: float, min_impact_velocity: float, 
         by, bz, dby, dbz = bearing.terms(t, esym)
         return symbolic_clearance_force(law, c, v_min, displacement[0] - by, displacement[1] - bz,
                                         velocity[0] - real(omega) * dby, velocity[1] - real(omega) * dbz,
-                                        stiffness)
+                                        stiffness, max_approach)
 
     return CreateSymbolicUserFunction(
         mbs, springForceUserFunction, "springForceUserFunction",
@@ -289,15 +290,16 @@ def build_tree(mbs, scene: Scene, callback: str = "auto") -> TreeModel:
     calls = [0]
     keep = None
     c, v_min = joint.clearance, joint.min_impact_velocity
-    tracker = OnsetTracker(c, v_min)
+    max_approach = joint.impact_velocity_rule == "max_approach"
+    tracker = OnsetTracker(c, v_min, rule=joint.impact_velocity_rule)
     memory = list(tracker.callback_state)
     stash = [math.nan, 0.0, 0.0]
     if route == "python":
-        force = make_python_force(law, c, v_min, bearing, memory, stash, calls)
+        force = make_python_force(law, c, v_min, bearing, memory, stash, calls, max_approach)
     elif route == "numba":
-        force = make_numba_force(law, c, v_min, bearing, memory, stash)
+        force = make_numba_force(law, c, v_min, bearing, memory, stash, max_approach)
     elif route == "symbolic":
-        keep = force = make_symbolic_force(mbs, law, c, v_min, bearing)
+        keep = force = make_symbolic_force(mbs, law, c, v_min, bearing, max_approach)
     else:
         raise ValueError(f"`callback` must be one of 'auto', 'python', 'symbolic', 'numba', got {callback!r}")
     connector = mbs.AddObject(ObjectConnectorCartesianSpringDamper(

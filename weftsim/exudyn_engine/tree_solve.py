@@ -219,7 +219,7 @@ def solve_tree(scene: Scene, progress=None, callback: str | None = None) -> RunR
         "min_step_s": state["min_step"],
         "callback": model.route,
         "callback_calls": model.callback_calls[0] if model.route == "python" else None,
-        "contact_events": model.tracker.contact_events,
+        **model.tracker.counters(),  # contact_events, nonpositive_onsets, separations, missed_*
         "solve_time_s": wall_solve,
         "wall_time_s": _time.perf_counter() - wall0,
     }
@@ -229,4 +229,5 @@ def solve_tree(scene: Scene, progress=None, callback: str | None = None) -> RunR
     if progress is not None:
         progress(1.0)
     return vet_result(RunResult(scene, "exudyn", status, message, samples, steps, stats,
-                                {"first_contact_time_s": model.tracker.first_contact_time}))  # fmt: skip
+                                {"first_contact_time_s": model.tracker.first_contact_time,
+                                 **model.tracker.counters()}))  # fmt: skip
