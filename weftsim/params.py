@@ -101,6 +101,7 @@ class Material:
 
     youngs_modulus: float = 207e9  # Pa
     poisson_ratio: float = 0.3
+    yield_strength: float | None = None  # Pa; None = not given (no contact-pressure warning)
 
     @property
     def compliance(self) -> float:
@@ -258,6 +259,13 @@ class Limits:
         Largest residual of the energy balance W = dKE + dPE + E_contact + E_dissipated
         at any step, as a fraction of the largest kinetic energy of the run.  Sound runs
         stay below 1e-5; a step that does not resolve the impacts creates energy.
+    max_damping_ratio : float
+        Largest damping force allowed, as a multiple of the law's xi times the elastic
+        force: (F_N - F_el) / (xi F_el) = delta_dot / v_imp.  An isolated impact, the case the
+        laws were derived for, stays <= 1, and so does every step under the default impact
+        velocity rule ``max_approach``; a driven lasting contact under the ``onset`` rule
+        exceeds it (14 in the reference scene), an onset held at v_min against a real
+        re-impact reaches 50-160 (:mod:`weftsim.plausibility`).
     """
 
     max_wall_time: float = 0.0
@@ -265,6 +273,7 @@ class Limits:
     max_penetration: float = 0.1
     min_step: float = 1e-12
     max_energy_error: float = 0.01
+    max_damping_ratio: float = 20.0
 
 
 @dataclass(frozen=True)
