@@ -204,7 +204,7 @@ class ExudynSolver:
     """
 
     model: str = "rigid_body"
-    step_size: float = 2e-6  # s
+    step_size: float = 2e-6  # s; with the ideal joint at least 0.05 deg of crank (exudyn_engine.solver)
     spectral_radius: float = 0.8
     modified_newton: bool = True
     newton_relative_tolerance: float = 1e-8

@@ -122,7 +122,7 @@ SCHEMA: tuple[Key, ...] = (
     Key("solver.exudyn.model", "exudyn_solver.model", "str", choices=EXUDYN_MODELS,
         doc="Exudyn model: rigid_body (members 1-8, general) or kinematic_tree (members 1-3 prescribed)"),
     Key("solver.exudyn.step_size_s", "exudyn_solver.step_size", "float", 1, 0, 1e-2,
-        doc="generalized-alpha step size"),
+        doc="generalized-alpha step size (ideal joint: at least 0.05 deg of crank, nothing to resolve)"),
     Key("solver.exudyn.spectral_radius", "exudyn_solver.spectral_radius", "float", 1, 0, 1, False, False,
         doc="generalized-alpha spectral radius (<= 0.9 for smooth constraint torques)"),
     Key("solver.exudyn.modified_newton", "exudyn_solver.modified_newton", "bool", doc="modified Newton"),
