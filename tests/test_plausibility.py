@@ -184,16 +184,22 @@ def test_each_warning_fires_only_outside_the_laws_range():
     assert validity_warnings(scene, law, 0.0, 3e8, None) == []  # no yield strength given: no pressure check
 
 
-def test_run_reports_the_counts_and_each_warning_once_on_stderr(tmp_path):
-    """The reference scene's start-up impact: 1.02 GPa of Hertz pressure against a 250 MPa steel
-    (first yield 417 MPa), and 0.69 of the clearance of penetration."""
-    scene = tmp_path / "soft.toml"
-    scene.write_text(f'extends = "{REFERENCE.as_posix()}"\nname = "soft"\n[drive]\nrevolutions = 0.1\n'
-                     "[joint_e.journal_material]\nyield_strength_mpa = 250.0\n"
-                     "[joint_e.bearing_material]\nyield_strength_mpa = 600.0\n")
+def run_reference(tmp_path, body: str):
+    """``weftsim run`` on the reference scene with ``body`` added (TOML); (process, summary.json)."""
+    scene = tmp_path / "scene.toml"
+    scene.write_text(f'extends = "{REFERENCE.as_posix()}"\nname = "changed"\n{body}')
     out = tmp_path / "out"
     done = subprocess.run([sys.executable, "-m", "weftsim.cli", "run", scene, "--engine", "reference", "-o", out,
                            "--no-plot"], capture_output=True, text=True, timeout=300)  # fmt: skip
+    return done, json.loads((out / "summary.json").read_text())
+
+
+def test_run_reports_the_counts_and_each_warning_once_on_stderr(tmp_path):
+    """The reference scene's start-up impact: 1.02 GPa of Hertz pressure against a 250 MPa steel
+    (first yield 417 MPa), and 0.69 of the clearance of penetration."""
+    done, written = run_reference(tmp_path, "[drive]\nrevolutions = 0.1\n"
+                                            "[joint_e.journal_material]\nyield_strength_mpa = 250.0\n"
+                                            "[joint_e.bearing_material]\nyield_strength_mpa = 600.0\n")
     assert done.returncode == 0, done.stderr
     lines = [line for line in done.stderr.splitlines() if line.startswith("weftsim run: ")]
     assert len([line for line in lines if "plausibility:" in line]) == 1
@@ -201,22 +207,16 @@ def test_run_reports_the_counts_and_each_warning_once_on_stderr(tmp_path):
     assert len(warnings) == 2, done.stderr
     assert sum("exceeds first yield 417.5 MPa" in line for line in warnings) == 1
     assert sum("of the clearance" in line for line in warnings) == 1
-    block = json.loads((out / "summary.json").read_text())["plausibility"]
+    block = written["plausibility"]
     assert block["yield_pressure_pa"] == pytest.approx(TRESCA_LINE_CONTACT_YIELD * 250e6)
     assert [w[:40] for w in block["warnings"]] == [line.split("warning: ", 1)[1][:40] for line in warnings]
 
 
 def test_run_fails_with_exit_3_on_a_plausibility_defect_and_keeps_its_results(tmp_path):
     """limits.max_damping_ratio = 0.5 < 1: every impact's onset (delta_dot = v_imp) crosses it."""
-    scene = tmp_path / "strict.toml"
-    scene.write_text(f'extends = "{REFERENCE.as_posix()}"\nname = "strict"\n[drive]\nrevolutions = 0.05\n'
-                     "[limits]\nmax_damping_ratio = 0.5\n")
-    out = tmp_path / "out"
-    done = subprocess.run([sys.executable, "-m", "weftsim.cli", "run", scene, "--engine", "reference", "-o", out,
-                           "--no-plot"], capture_output=True, text=True, timeout=300)  # fmt: skip
+    done, written = run_reference(tmp_path, "[drive]\nrevolutions = 0.05\n[limits]\nmax_damping_ratio = 0.5\n")
     assert done.returncode == 3, done.stderr
     errors = [line for line in done.stderr.splitlines() if line.startswith("weftsim run:")]
     assert len(errors) == 1 and "limits.max_damping_ratio = 0.5" in errors[0] and "crank angle" in errors[0]
-    written = json.loads((out / "summary.json").read_text())
     assert written["status"] == "failed" and written["plausibility"]["damping_steps"] > 0
     assert written["simulated_time_s"] == pytest.approx(0.05 * 60.0 / 400.0)

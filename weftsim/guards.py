@@ -7,17 +7,17 @@ comes back as a :class:`Breach`; the engine then stops, keeps what it computed a
 returns ``status = "failed"`` with :func:`failure_message`: what failed, at which time
 and crank angle, and what to try.  The criteria, in the order they are checked:
 
-==============  ==========================================  ==============================
-kind            fails when                                  limit (scene ``[limits]``)
-==============  ==========================================  ==============================
-``non_finite``  a state or channel is NaN or inf            always on
-``penetration`` delta > max_penetration_ratio * R_j         ``max_penetration_ratio`` (0.1)
-``step_size``   an accepted step h < min_step               ``min_step_s`` (1e-12 s)
-``steps``       more than max_steps accepted steps          ``max_steps`` (0 = none)
-``wall_time``   wall-clock time since the start > budget    ``max_wall_time_s`` (0 = none)
-``energy``      W - dKE - dPE - E_contact - E_diss > limit  ``max_energy_error`` (0.01)
-``plausibility`` a broken contact history (see below)       ``max_damping_ratio`` (20)
-==============  ==========================================  ==============================
+================  ==========================================  ==============================
+kind              fails when                                  limit (scene ``[limits]``)
+================  ==========================================  ==============================
+``non_finite``    a state or channel is NaN or inf            always on
+``penetration``   delta > max_penetration_ratio * R_j         ``max_penetration_ratio`` (0.1)
+``step_size``     an accepted step h < min_step               ``min_step_s`` (1e-12 s)
+``steps``         more than max_steps accepted steps          ``max_steps`` (0 = none)
+``wall_time``     wall-clock time since the start > budget    ``max_wall_time_s`` (0 = none)
+``energy``        W - dKE - dPE - E_contact - E_diss > limit  ``max_energy_error`` (0.01)
+``plausibility``  a broken contact history (see below)        ``max_damping_ratio`` (20)
+================  ==========================================  ==============================
 
 The last two need the whole run's channels: :func:`vet_result` checks them (and again the
 first two) on every run an engine considers a success.  ``plausibility`` counts onsets with a

@@ -19,8 +19,11 @@ integration of the model produces.
   construction (v_imp is the largest approach rate since the onset); the literature's ``onset``
   rule lets it grow in a driven lasting contact.  Steps above ``limits.max_damping_ratio``
   (default 20) count: the held impact velocity is then no longer the velocity of the impact that
-  carries the contact.  Measured on the reference scene (1 revolution, onset rule): 14.3 at most;
-  an onset held at v_min = 1e-4 m/s against the 5-16 mm/s re-impacts of issue 11: 50-160.
+  carries the contact.  Measured (reference engine, per-step data): max_approach 1 + 5e-15 on every
+  scene tried; onset rule 14.3 on the reference scene (2 revolutions) and 33.8 on the 500 rpm,
+  c = 0.25 mm paper scene (10 revolutions, numba_DOP853 at rtol 1e-5), whose peak forces the
+  lasting contacts inflate; an onset held at v_min = 1e-4 m/s against a 5-16 mm/s re-impact
+  (the event-location defect of the reference engine before it was fixed) gives 50-160.
 - *Negative penetration inside a contact.*  A step of a contact segment whose delta is below
   -:func:`roundoff_penetration`: the journal left the bearing and came back between two step
   ends (a missed separation), and the contact force was applied across a free flight.
@@ -70,8 +73,10 @@ class Plausibility:
     nonpositive_onsets : int
         Of those, onsets whose approach rate at the first contact state is <= 0 (defect).
     engine_nonpositive_onsets : int or None
-        The engine's own count of onset candidates with a non-positive rate (it replaced or
-        rejected them), if it reports one.
+        The engine's own ``nonpositive_onsets`` (``events`` or ``solver_stats``), if it reports
+        one: for information, since engines differ in what they count (the reference engine
+        counts the onsets it accepted without a rising root, which the per-step count sees too;
+        an engine may also count estimates it replaced by a positive one, which are no defect).
     damping_steps : int
         Contact steps with (F_N - F_el) / (xi F_el) above ``damping_limit`` (defect).
     max_damping_ratio : float
@@ -131,8 +136,9 @@ class Plausibility:
 
     def summary_line(self) -> str:
         """The counts in one line (for stderr)."""
+        engine = "" if self.engine_nonpositive_onsets is None else f" (engine's count {self.engine_nonpositive_onsets})"
         return (f"plausibility: {self.onsets} contact onsets, {self.nonpositive_onsets} with a non-positive approach "
-                f"rate; {self.damping_steps} steps with damping above {self.damping_limit:g} xi x elastic "
+                f"rate{engine}; {self.damping_steps} steps with damping above {self.damping_limit:g} xi x elastic "
                 f"(largest {self.max_damping_ratio:.3g}); {self.negative_penetration_steps} contact steps with "
                 "negative penetration")
 
@@ -262,19 +268,19 @@ HINT = ("the contact history is broken, so its forces are not to be trusted: for
 def first_defect_row(result, report: Plausibility) -> int:
     """Index of the first step showing one of the defects (for the failure message's time)."""
     steps = result.steps
-    law_rows = []
+    rows = []
     mode = contact_mode(steps)
     starts = onset_rows(mode)
     bad_onsets = starts[np.asarray(steps["penetration_rate_m_s"])[starts] <= 0.0]
-    law_rows.extend(bad_onsets[:1].tolist())
+    rows.extend(bad_onsets[:1].tolist())
     if report.damping_steps:
         from weftsim.contact import make_law
 
         ratio = damping_ratio(steps, make_law(result.scene.joint))
-        law_rows.append(int(np.flatnonzero(ratio > report.damping_limit)[0]))
+        rows.append(int(np.flatnonzero(ratio > report.damping_limit)[0]))
     negative = np.flatnonzero(mode & (np.asarray(steps["penetration_m"]) < -report.roundoff_m))
-    law_rows.extend(negative[:1].tolist())
-    return min(law_rows) if law_rows else 0
+    rows.extend(negative[:1].tolist())
+    return min(rows) if rows else 0
 
 
 def format_lines(result) -> list[str]:
