@@ -220,3 +220,24 @@ def test_run_fails_with_exit_3_on_a_plausibility_defect_and_keeps_its_results(tm
     assert len(errors) == 1 and "limits.max_damping_ratio = 0.5" in errors[0] and "crank angle" in errors[0]
     assert written["status"] == "failed" and written["plausibility"]["damping_steps"] > 0
     assert written["simulated_time_s"] == pytest.approx(0.05 * 60.0 / 400.0)
+
+
+@pytest.mark.parametrize("model", ["rigid_body", "kinematic_tree"])
+def test_exudyn_penetration_rate_channel_is_the_time_derivative_of_the_penetration(model):
+    """The Exudyn engine's delta_dot (sensors of the rigid-body model, minimal coordinates of the tree)
+    against central differences of its delta, over the free flight before the first contact (6.6 deg).
+
+    Measured: rigid body (1133 steps of 2e-6 s) 3e-9 of the rate's range, kinematic tree (10 steps of
+    ~2e-4 s under its error control) 7e-6; the bound is the reference test's, 1e-3 of the range, far
+    below what a wrong channel gives (a sign or a missing term is O(1))."""
+    exudyn_engine = pytest.importorskip("weftsim.exudyn_engine")
+    scene = load_scene(REFERENCE, {"drive.revolutions": 0.015, "solver.exudyn.model": model})
+    result = exudyn_engine.solve(scene)
+    st = result.steps
+    t, delta, rate = st["time_s"], st["penetration_m"], st["penetration_rate_m_s"]
+    free = ~contact_mode(st) & (delta < 0.0)
+    i = np.flatnonzero(free[1:-1] & free[:-2] & free[2:]) + 1
+    assert i.size >= 5  # 10 for the tree, whose steps are long in free flight
+    quotient = (delta[i + 1] - delta[i - 1]) / (t[i + 1] - t[i - 1])
+    assert np.max(np.abs(quotient - rate[i])) < 1e-3 * np.ptp(rate[i]), model
+    assert result.plausibility["onsets"] == 0 or result.plausibility["defects"] == []
