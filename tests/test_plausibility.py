@@ -2,8 +2,8 @@
 
 Sound runs pass with every defect count at zero; each defect, put into a sound run's per-step data
 by hand, fails the run through weftsim.guards.vet_result (the path every engine's result takes);
-an "onset"-rule run whose damping outgrows the elastic force fails for real; the warnings fire
-where the law is used outside its range, once each on stderr.
+an "onset"-rule run whose damping outgrows the isolated-impact bound gets a warning (a property of
+that rule, not a defect); the warnings fire where the law is used outside its range, once each on stderr.
 """
 
 from __future__ import annotations
@@ -95,7 +95,7 @@ def test_an_onset_with_a_non_positive_approach_rate_fails_the_run(sound):
     assert bad.steps["time_s"].size == sound.steps["time_s"].size  # what was computed is kept
 
 
-def test_damping_above_the_limit_fails_the_run_unless_the_limit_is_raised(sound):
+def test_damping_above_the_isolated_impact_bound_fails_a_max_approach_run(sound):
     law = make_law(sound.scene.joint)
     st = sound.steps
     inside = np.flatnonzero(contact_mode(st) & (st["penetration_m"] > 0.0))
@@ -109,8 +109,8 @@ def test_damping_above_the_limit_fails_the_run_unless_the_limit_is_raised(sound)
     assert damping_ratio(result.steps, law)[row] == pytest.approx(25.0, rel=1e-12)
     bad = vet_result(result)
     assert bad.status == "failed" and bad.solver_stats["failure"] == "plausibility"
-    assert "1 contact steps have a damping force above limits.max_damping_ratio = 20" in bad.message
-    assert "impact_velocity_rule" in bad.message
+    assert "1 contact steps have a damping force above limits.max_damping_ratio = 1 " in bad.message
+    assert "did not hold the impact velocity" in bad.message
     raised = dataclasses.replace(sound.scene, limits=Limits(max_damping_ratio=30.0))
     assert vet_result(dataclasses.replace(result, scene=raised)).ok
 
@@ -133,20 +133,22 @@ def test_negative_penetration_inside_a_contact_fails_beyond_round_off_only(sound
     assert bad.status == "failed" and "1 contact steps have a negative penetration" in bad.message
 
 
-def test_the_onset_rule_in_a_lasting_contact_is_flagged_and_max_approach_is_not():
+def test_the_onset_rule_in_a_lasting_contact_is_warned_about_and_max_approach_stays_within_the_bound():
     """Issue 11's reproduction scene (500 rpm, c = 0.25 mm, numba_DOP853 at rtol 1e-5): under the onset rule
-    the approach rate of the lasting contacts grows to 34 x the held impact velocity (measured), the run
-    fails on the damping; the same run under max_approach stays at 1 and passes."""
+    the approach rate of the lasting contacts grows to 34 x the held impact velocity (measured), a warning;
+    the same run under max_approach stays at 1 (to round-off, measured 1 + 5e-15)."""
     overrides = {"solver.reference.method": "numba_DOP853", "solver.reference.rtol": 1e-5,
                  "solver.reference.atol": 1e-8, "drive.revolutions": 10}
     path = MODELS / "paper" / "speed_500rpm_c0p25mm.toml"
     onset = reference.solve(load_scene(path, {**overrides, "joint_e.impact_velocity_rule": "onset"}))
-    assert onset.status == "failed" and onset.solver_stats["failure"] == "plausibility", onset.message
-    assert onset.plausibility["damping_steps"] > 0 and onset.plausibility["max_damping_ratio"] > 20.0
-    assert onset.plausibility["nonpositive_onsets"] == 0
+    assert onset.ok, onset.message
+    p = onset.plausibility
+    assert p["damping_steps"] > 0 and p["max_damping_ratio"] > 20.0 and p["defects"] == []
+    assert sum("the \"onset\" rule in a lasting contact" in text for text in p["warnings"]) == 1
     new = reference.solve(load_scene(path, {**overrides, "joint_e.impact_velocity_rule": "max_approach"}))
     assert new.ok, new.message
-    assert new.plausibility["max_damping_ratio"] < 1.0 + 1e-12  # as in the sound run above
+    assert new.plausibility["damping_steps"] == 0
+    assert abs(new.plausibility["max_damping_ratio"] - 1.0) < 1e-12  # as in the sound run above
 
 
 def test_the_ideal_joint_has_no_plausibility_block():

@@ -16,13 +16,14 @@ kind              fails when                                  limit (scene ``[li
 ``steps``         more than max_steps accepted steps          ``max_steps`` (0 = none)
 ``wall_time``     wall-clock time since the start > budget    ``max_wall_time_s`` (0 = none)
 ``energy``        W - dKE - dPE - E_contact - E_diss > limit  ``max_energy_error`` (0.01)
-``plausibility``  a broken contact history (see below)        ``max_damping_ratio`` (20)
+``plausibility``  a broken contact history (see below)        ``max_damping_ratio`` (1)
 ================  ==========================================  ==============================
 
 The last two need the whole run's channels: :func:`vet_result` checks them (and again the
 first two) on every run an engine considers a success.  ``plausibility`` counts onsets with a
 non-positive approach rate, steps whose damping force exceeds ``max_damping_ratio`` x xi x the
-elastic force, and contact steps with a negative penetration (:mod:`weftsim.plausibility`);
+elastic force (under the ``max_approach`` rule, which bounds it), and contact steps with a negative
+penetration (:mod:`weftsim.plausibility`);
 :func:`vet_result` also attaches those counts and the law-range warnings to every result.
 
 Newton non-convergence is the engines' own (Exudyn's convergence flags; scipy's implicit

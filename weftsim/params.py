@@ -260,12 +260,12 @@ class Limits:
         at any step, as a fraction of the largest kinetic energy of the run.  Sound runs
         stay below 1e-5; a step that does not resolve the impacts creates energy.
     max_damping_ratio : float
-        Largest damping force allowed, as a multiple of the law's xi times the elastic
-        force: (F_N - F_el) / (xi F_el) = delta_dot / v_imp.  An isolated impact, the case the
-        laws were derived for, stays <= 1, and so does every step under the default impact
-        velocity rule ``max_approach``; a driven lasting contact under the ``onset`` rule
-        exceeds it (14 in the reference scene), an onset held at v_min against a real
-        re-impact reaches 50-160 (:mod:`weftsim.plausibility`).
+        Largest damping force, as a multiple of the law's xi times the elastic force:
+        (F_N - F_el) / (xi F_el) = delta_dot / v_imp.  An isolated impact, the case the laws
+        were derived for, stays within 1, and the default impact velocity rule
+        ``max_approach`` keeps every step within 1: a step beyond it fails the run.  Under the
+        ``onset`` rule a driven lasting contact exceeds it as a property of that model: a
+        warning (:mod:`weftsim.plausibility`).
     """
 
     max_wall_time: float = 0.0
@@ -273,7 +273,7 @@ class Limits:
     max_penetration: float = 0.1
     min_step: float = 1e-12
     max_energy_error: float = 0.01
-    max_damping_ratio: float = 20.0
+    max_damping_ratio: float = 1.0
 
 
 @dataclass(frozen=True)

@@ -3,8 +3,8 @@
 Engine-independent: everything is read from a result's per-step channels (and the engines' own
 counters where they report them), with numpy only.  Two kinds of finding:
 
-**Defects** (the run fails, :func:`plausibility_breach`): a contact history no correct
-integration of the model produces.
+**Defects** (the run fails, :func:`weftsim.guards.plausibility_breach`): a contact history no
+correct integration of the model produces.
 
 - *Onset with a non-positive approach rate.*  An onset is a crossing of delta from negative to
   positive while the journal approaches (delta_dot > 0).  Read at the first state of each
@@ -12,18 +12,18 @@ integration of the model produces.
   engine): delta_dot <= 0 there is a root of the previous separation found again by round-off,
   or an impact shorter than one step.  Its held impact velocity is then v_min, and the damping
   term xi delta_dot / v_imp of the rest of the contact is hundreds of times too large.
-- *Damping far above the elastic force.*  Every law has F_N = F_el (1 + xi delta_dot / v_imp),
-  so ``(F_N - F_el) / (xi F_el) = delta_dot / v_imp`` at each step in contact.  The laws were
-  derived for an isolated impact, in which delta_dot only falls after the onset: the ratio is
-  <= 1 (Lankarani & Nikravesh 1990).  The default rule ``max_approach`` keeps it <= 1 by
-  construction (v_imp is the largest approach rate since the onset); the literature's ``onset``
-  rule lets it grow in a driven lasting contact.  Steps above ``limits.max_damping_ratio``
-  (default 20) count: the held impact velocity is then no longer the velocity of the impact that
-  carries the contact.  Measured (reference engine, per-step data): max_approach 1 + 5e-15 on every
-  scene tried; onset rule 14.3 on the reference scene (2 revolutions) and 33.8 on the 500 rpm,
-  c = 0.25 mm paper scene (10 revolutions, numba_DOP853 at rtol 1e-5), whose peak forces the
-  lasting contacts inflate; an onset held at v_min = 1e-4 m/s against a 5-16 mm/s re-impact
-  (the event-location defect of the reference engine before it was fixed) gives 50-160.
+- *Damping above the isolated-impact bound, under the ``max_approach`` rule.*  Every law has
+  F_N = F_el (1 + xi delta_dot / v_imp), so ``(F_N - F_el) / (xi F_el) = delta_dot / v_imp`` at
+  each step in contact.  The laws were derived for an isolated impact, in which delta_dot only
+  falls after the onset: the damping force stays within xi x the elastic force, the ratio within 1
+  (Lankarani & Nikravesh 1990).  The default rule ``max_approach`` (v_imp = the largest approach
+  rate since the onset) keeps every step of every contact within that bound by construction, so a
+  step above ``limits.max_damping_ratio`` (default 1, beyond a relative round-off of
+  :data:`DAMPING_ROUNDOFF`) is an engine that did not hold v_imp as the rule says.  Measured with
+  the reference engine: 1 + 5e-15 at most, on the reference scene (2 revolutions) and the 500 rpm,
+  c = 0.25 mm paper scene (10 revolutions).  Under the literature's ``onset`` rule a driven lasting
+  contact exceeds the bound as a property of the model (14.3 and 33.8 on those two runs, while their
+  peak forces per revolution stay within 1.1 x the median): counted, and a warning, not a failure.
 - *Negative penetration inside a contact.*  A step of a contact segment whose delta is below
   -:func:`roundoff_penetration`: the journal left the bearing and came back between two step
   ends (a missed separation), and the contact force was applied across a free flight.
@@ -60,6 +60,10 @@ TRESCA_LINE_CONTACT_YIELD = 1.67  # p0 / Y at first yield under a Hertz line con
 # lengths (9e-15 m for the reference mechanism) sits above the 1.4e-15 m measured at the located
 # onsets of the reference scene (the root's own round-off) and nine orders below a micrometre.
 ROUNDOFF_ULPS = 64
+# (F_N - F_el) / (xi F_el) under max_approach exceeds 1 by at most 5e-15 in the reference engine (two
+# evaluations of the law at the same delta); 1e-9 also covers an engine whose force comes from another
+# expression of the law (Exudyn's symbolic callback agrees with the numpy law to ~1e-12).
+DAMPING_ROUNDOFF = 1e-9
 
 
 @dataclass(frozen=True)
@@ -78,11 +82,14 @@ class Plausibility:
         counts the onsets it accepted without a rising root, which the per-step count sees too;
         an engine may also count estimates it replaced by a positive one, which are no defect).
     damping_steps : int
-        Contact steps with (F_N - F_el) / (xi F_el) above ``damping_limit`` (defect).
+        Contact steps with (F_N - F_el) / (xi F_el) above ``damping_limit`` (a defect under the
+        ``max_approach`` rule, a warning under ``onset``).
     max_damping_ratio : float
         Largest (F_N - F_el) / (xi F_el) = delta_dot / v_imp of the run (0 without contact).
     damping_limit : float
         ``limits.max_damping_ratio``.
+    damping_is_defect : bool
+        True under ``joint_e.impact_velocity_rule = "max_approach"``, which bounds the ratio.
     negative_penetration_steps : int
         Steps of a contact segment with delta < -``roundoff_m`` (defect).
     min_penetration_in_contact_m : float or None
@@ -105,6 +112,7 @@ class Plausibility:
     damping_steps: int
     max_damping_ratio: float
     damping_limit: float
+    damping_is_defect: bool
     negative_penetration_steps: int
     min_penetration_in_contact_m: float | None
     roundoff_m: float
@@ -118,7 +126,7 @@ class Plausibility:
         out = []
         if self.nonpositive_onsets:
             out.append(f"{self.nonpositive_onsets} of {self.onsets} contact onsets have a non-positive approach rate")
-        if self.damping_steps:
+        if self.damping_steps and self.damping_is_defect:
             out.append(f"{self.damping_steps} contact steps have a damping force above limits.max_damping_ratio = "
                        f"{self.damping_limit:g} times the law's xi x the elastic force (largest "
                        f"{self.max_damping_ratio:.3g})")
@@ -138,7 +146,7 @@ class Plausibility:
         """The counts in one line (for stderr)."""
         engine = "" if self.engine_nonpositive_onsets is None else f" (engine's count {self.engine_nonpositive_onsets})"
         return (f"plausibility: {self.onsets} contact onsets, {self.nonpositive_onsets} with a non-positive approach "
-                f"rate{engine}; {self.damping_steps} steps with damping above {self.damping_limit:g} xi x elastic "
+                f"rate{engine}; {self.damping_steps} steps with damping above {self.damping_limit:g} x xi x elastic "
                 f"(largest {self.max_damping_ratio:.3g}); {self.negative_penetration_steps} contact steps with "
                 "negative penetration")
 
@@ -157,6 +165,11 @@ def contact_mode(steps: dict) -> np.ndarray:
 def onset_rows(mode: np.ndarray) -> np.ndarray:
     """Rows that start a contact segment (contact mode after a free-flight row)."""
     return np.flatnonzero(mode[1:] & ~mode[:-1]) + 1
+
+
+def damping_excess(ratio: np.ndarray, limit: float) -> np.ndarray:
+    """Steps whose damping ratio exceeds ``limit`` beyond round-off (:data:`DAMPING_ROUNDOFF`)."""
+    return ratio > limit * (1.0 + DAMPING_ROUNDOFF)
 
 
 def damping_ratio(steps: dict, law) -> np.ndarray:
@@ -200,10 +213,15 @@ def _engine_count(result) -> int | None:
 
 
 def validity_warnings(scene, law, max_penetration_ratio: float, peak_pressure: float,
-                      yield_pressure: float | None) -> list[str]:
-    """The law-range warnings of a clearance run (module docstring)."""
+                      yield_pressure: float | None, damping_steps: int = 0, max_damping: float = 0.0) -> list[str]:
+    """The law-range warnings of a clearance run (module docstring); ``damping_steps`` count under "onset"."""
     joint = scene.joint
     out = []
+    if damping_steps and joint.impact_velocity_rule != "max_approach":
+        out.append(f"{damping_steps} contact steps have a damping force above {scene.limits.max_damping_ratio:g} x xi "
+                   f"x the elastic force (largest {max_damping:.3g}), beyond any isolated impact the law was derived "
+                   "for: the \"onset\" rule in a lasting contact; joint_e.impact_velocity_rule = \"max_approach\" "
+                   "bounds it")
     lo, hi = law.valid_restitution
     if not lo <= joint.restitution <= hi:
         out.append(f"joint_e.restitution = {joint.restitution:g} is outside {lo:g}..{hi:g}, the range the "
@@ -241,28 +259,30 @@ def assess(result) -> Plausibility | None:
     strength = _yield_strength(joint)
     yield_pressure = None if strength is None else TRESCA_LINE_CONTACT_YIELD * strength
     max_penetration_ratio = max(float(np.max(delta)), 0.0) / joint.clearance
+    damping_steps = int(np.count_nonzero(damping_excess(ratio, limit)))
     return Plausibility(
         onsets=int(starts.size),
         nonpositive_onsets=int(np.count_nonzero(rate[starts] <= 0.0)),
         engine_nonpositive_onsets=_engine_count(result),
-        damping_steps=int(np.count_nonzero(ratio > limit)),
+        damping_steps=damping_steps,
         max_damping_ratio=float(ratio.max()),
         damping_limit=limit,
+        damping_is_defect=joint.impact_velocity_rule == "max_approach",
         negative_penetration_steps=int(np.count_nonzero(mode & (delta < -roundoff))),
         min_penetration_in_contact_m=float(delta[mode].min()) if mode.any() else None,
         roundoff_m=roundoff,
         max_penetration_ratio=max_penetration_ratio,
         peak_pressure_pa=peak_pressure,
         yield_pressure_pa=yield_pressure,
-        warnings=tuple(validity_warnings(scene, law, max_penetration_ratio, peak_pressure, yield_pressure)),
+        warnings=tuple(validity_warnings(scene, law, max_penetration_ratio, peak_pressure, yield_pressure,
+                                         damping_steps, float(ratio.max()))),
     )
 
 
 HINT = ("the contact history is broken, so its forces are not to be trusted: for a non-positive onset or a negative "
         "penetration in contact try a tighter solver tolerance or a smaller step (an impact or a free flight shorter "
-        "than one step); for damping above the limit use joint_e.impact_velocity_rule = \"max_approach\" (the "
-        "\"onset\" rule holds an impact velocity far below the approach rate of a lasting contact), or raise "
-        "limits.max_damping_ratio only if that is meant")
+        "than one step); damping above the limit under the max_approach rule means the engine did not hold the "
+        "impact velocity as the rule says (report it; limits.max_damping_ratio only sets the round-off margin)")
 
 
 def first_defect_row(result, report: Plausibility) -> int:
@@ -273,11 +293,11 @@ def first_defect_row(result, report: Plausibility) -> int:
     starts = onset_rows(mode)
     bad_onsets = starts[np.asarray(steps["penetration_rate_m_s"])[starts] <= 0.0]
     rows.extend(bad_onsets[:1].tolist())
-    if report.damping_steps:
+    if report.damping_steps and report.damping_is_defect:
         from weftsim.contact import make_law
 
         ratio = damping_ratio(steps, make_law(result.scene.joint))
-        rows.append(int(np.flatnonzero(ratio > report.damping_limit)[0]))
+        rows.append(int(np.flatnonzero(damping_excess(ratio, report.damping_limit))[0]))
     negative = np.flatnonzero(mode & (np.asarray(steps["penetration_m"]) < -report.roundoff_m))
     rows.extend(negative[:1].tolist())
     return min(rows) if rows else 0

@@ -156,8 +156,8 @@ SCHEMA: tuple[Key, ...] = (
     Key("limits.max_energy_error", "limits.max_energy_error", "float", 1, 0, 1, True, False,
         doc="the run fails when the energy balance misses by more than this fraction of the largest kinetic energy"),
     Key("limits.max_damping_ratio", "limits.max_damping_ratio", "float", 1, 0, None, True,
-        doc="the run fails at steps whose damping force exceeds this multiple of xi x the elastic force "
-            "(delta_dot / v_imp; <= 1 in an isolated impact)"),
+        doc="damping force bound, multiple of xi x the elastic force (delta_dot / v_imp): <= 1 in an isolated "
+            "impact and under max_approach (beyond it the run fails); the onset rule exceeds it (a warning)"),
 )
 _BY_PATH = {key.path: key for key in SCHEMA}
 TOP_LEVEL = ("name", "description", "extends")
