@@ -10,7 +10,9 @@ def main() -> None:
     print("|---|---|---|---|")
     for key in SCHEMA:
         value = defaults[key.path]
-        if isinstance(value, float):
+        if value is None:  # an optional key without a default
+            value = "not set"
+        elif isinstance(value, float):
             value = f"{value:.6g}"
         elif isinstance(value, list):
             value = "[" + ", ".join(f"{v:.6g}" for v in value) + "]"

@@ -65,7 +65,7 @@ def test_round_trip_through_file_keys(tmp_path):
     assert set(keys) == {"name"} | {k.path for k in SCHEMA}
     lines = []
     for dotted, value in keys.items():
-        if dotted == "name":
+        if dotted == "name" or value is None:  # TOML has no null: an unset optional key is left out
             continue
         lines.append(f"{dotted} = {_toml(value)}")
     (tmp_path / "s.toml").write_text(f'name = "{scene.name}"\n' + "\n".join(lines))

@@ -228,6 +228,18 @@ def _report_run(result, written) -> None:
         print(f"  wrote {path}")
 
 
+def report_plausibility(result, label: str) -> None:
+    """The plausibility counts and each validity warning of a finished run, one line each on stderr
+    (``weftsim <label>: ...``; once per run, where its results are written).  A failed run says
+    only why it failed (its summary.json still holds the block)."""
+    from weftsim.plausibility import format_lines
+
+    if not result.ok:
+        return
+    for line in format_lines(result):
+        print(f"weftsim {label}: {line}", file=sys.stderr)
+
+
 def cmd_run(args) -> int:
     from weftsim.output import prepare_directory, write_run
 
@@ -236,6 +248,7 @@ def cmd_run(args) -> int:
     result = _solve(scene, args.engine)
     written = write_run(result, outdir, figure=not args.no_plot, force=args.force)
     _report_run(result, written)
+    report_plausibility(result, "run")
     if not result.ok:
         raise CliError(f"simulation failed: {result.message} (results up to the failure written to {outdir}, "
                        "marked incomplete in summary.json)", EXIT_FAILED)

@@ -7,19 +7,24 @@ comes back as a :class:`Breach`; the engine then stops, keeps what it computed a
 returns ``status = "failed"`` with :func:`failure_message`: what failed, at which time
 and crank angle, and what to try.  The criteria, in the order they are checked:
 
-==============  ==========================================  ==============================
-kind            fails when                                  limit (scene ``[limits]``)
-==============  ==========================================  ==============================
-``non_finite``  a state or channel is NaN or inf            always on
-``penetration`` delta > max_penetration_ratio * R_j         ``max_penetration_ratio`` (0.1)
-``step_size``   an accepted step h < min_step               ``min_step_s`` (1e-12 s)
-``steps``       more than max_steps accepted steps          ``max_steps`` (0 = none)
-``wall_time``   wall-clock time since the start > budget    ``max_wall_time_s`` (0 = none)
-``energy``      W - dKE - dPE - E_contact - E_diss > limit  ``max_energy_error`` (0.01)
-==============  ==========================================  ==============================
+================  ==========================================  ==============================
+kind              fails when                                  limit (scene ``[limits]``)
+================  ==========================================  ==============================
+``non_finite``    a state or channel is NaN or inf            always on
+``penetration``   delta > max_penetration_ratio * R_j         ``max_penetration_ratio`` (0.1)
+``step_size``     an accepted step h < min_step               ``min_step_s`` (1e-12 s)
+``steps``         more than max_steps accepted steps          ``max_steps`` (0 = none)
+``wall_time``     wall-clock time since the start > budget    ``max_wall_time_s`` (0 = none)
+``energy``        W - dKE - dPE - E_contact - E_diss > limit  ``max_energy_error`` (0.01)
+``plausibility``  a broken contact history (see below)        ``max_damping_ratio`` (1)
+================  ==========================================  ==============================
 
-The last one needs the whole run's channels: :func:`vet_result` checks it (and again the
-first two) on every run an engine considers a success.
+The last two need the whole run's channels: :func:`vet_result` checks them (and again the
+first two) on every run an engine considers a success.  ``plausibility`` counts onsets with a
+non-positive approach rate, steps whose damping force exceeds ``max_damping_ratio`` x xi x the
+elastic force (under the ``max_approach`` rule, which bounds it), and contact steps with a negative
+penetration (:mod:`weftsim.plausibility`);
+:func:`vet_result` also attaches those counts and the law-range warnings to every result.
 
 Newton non-convergence is the engines' own (Exudyn's convergence flags; scipy's implicit
 methods shrink the step until it collapses).  Why the defaults are what they are, and the
@@ -37,7 +42,7 @@ import numpy as np
 
 from weftsim.params import Scene
 
-KINDS = ("non_finite", "penetration", "step_size", "steps", "wall_time", "energy")
+KINDS = ("non_finite", "penetration", "step_size", "steps", "wall_time", "energy", "plausibility")
 
 
 @dataclass(frozen=True)
@@ -225,16 +230,35 @@ def result_breach(result) -> tuple[int, Breach] | None:
     return None
 
 
-def vet_result(result):
-    """``result`` itself, or a copy with ``status = "failed"`` if :func:`result_breach` finds one.
+def plausibility_breach(result, report) -> tuple[int, Breach] | None:
+    """The first step showing a defect of :func:`weftsim.plausibility.assess`'s report, and the breach."""
+    from weftsim.plausibility import HINT, first_defect_row
 
-    Applied by both engines to every run that they consider a success, so a criterion
-    crossed without the step-by-step checks seeing it still fails the run.  The channels
-    are kept whole (the run did finish); the message names the first step concerned.
+    defects = report.defects()
+    if not defects:
+        return None
+    return first_defect_row(result, report), Breach("plausibility", "; ".join(defects), HINT)
+
+
+def vet_result(result):
+    """``result`` with its plausibility report attached, failed if a criterion is crossed.
+
+    Applied by both engines to every run, so a criterion crossed without the step-by-step
+    checks seeing it still fails the run: :func:`result_breach`, then the defects of
+    :func:`weftsim.plausibility.assess`.  Runs that already failed keep their message and
+    get the report only.  The channels are kept whole (the run did finish); the message
+    names the first step concerned.
     """
+    from weftsim.plausibility import assess
+
+    report = assess(result)
+    if report is not None:
+        result = replace(result, plausibility=report.as_dict())
     if not result.ok:
         return result
     found = result_breach(result)
+    if found is None and report is not None:
+        found = plausibility_breach(result, report)
     if found is None:
         return result
     i, breach = found

@@ -101,6 +101,7 @@ class Material:
 
     youngs_modulus: float = 207e9  # Pa
     poisson_ratio: float = 0.3
+    yield_strength: float | None = None  # Pa; None = not given (no contact-pressure warning)
 
     @property
     def compliance(self) -> float:
@@ -203,7 +204,7 @@ class ExudynSolver:
     """
 
     model: str = "rigid_body"
-    step_size: float = 2e-6  # s
+    step_size: float = 2e-6  # s; with the ideal joint at least 0.05 deg of crank (exudyn_engine.solver)
     spectral_radius: float = 0.8
     modified_newton: bool = True
     newton_relative_tolerance: float = 1e-8
@@ -262,6 +263,13 @@ class Limits:
         Largest residual of the energy balance W = dKE + dPE + E_contact + E_dissipated
         at any step, as a fraction of the largest kinetic energy of the run.  Sound runs
         stay below 1e-5; a step that does not resolve the impacts creates energy.
+    max_damping_ratio : float
+        Largest damping force, as a multiple of the law's xi times the elastic force:
+        (F_N - F_el) / (xi F_el) = delta_dot / v_imp.  An isolated impact, the case the laws
+        were derived for, stays within 1, and the default impact velocity rule
+        ``max_approach`` keeps every step within 1: a step beyond it fails the run.  Under the
+        ``onset`` rule a driven lasting contact exceeds it as a property of that model: a
+        warning (:mod:`weftsim.plausibility`).
     """
 
     max_wall_time: float = 0.0
@@ -269,6 +277,7 @@ class Limits:
     max_penetration: float = 0.1
     min_step: float = 1e-12
     max_energy_error: float = 0.01
+    max_damping_ratio: float = 1.0
 
 
 @dataclass(frozen=True)

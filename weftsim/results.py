@@ -33,6 +33,7 @@ CHANNELS: tuple[str, ...] = (
     "contact_energy_J",
     "driving_work_J",
     "dissipated_energy_J",
+    "penetration_rate_m_s",
 )
 
 # Channels that describe the contact at E; identically zero for the ideal joint.
@@ -45,6 +46,7 @@ CONTACT_CHANNELS: tuple[str, ...] = (
     "in_contact",
     "contact_energy_J",
     "dissipated_energy_J",
+    "penetration_rate_m_s",
 )
 
 # Channels summarised by peaks and statistics (SPEC.md section 4; paper Fig. 12).
@@ -98,6 +100,10 @@ class RunResult:
         Steps, rejected steps, function evaluations, contact events, ``wall_time_s``, ...
     events : dict
         E.g. ``first_contact_time_s`` (true onset, located within the step) or None.
+    plausibility : dict
+        Counts of a broken contact history and the law-range warnings
+        (:meth:`weftsim.plausibility.Plausibility.as_dict`), filled by
+        :func:`weftsim.guards.vet_result`; empty for the ideal joint.
     """
 
     scene: Scene
@@ -108,6 +114,7 @@ class RunResult:
     steps: dict[str, np.ndarray]
     solver_stats: dict = field(default_factory=dict)
     events: dict = field(default_factory=dict)
+    plausibility: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if self.engine not in ENGINES:

@@ -58,7 +58,7 @@ class Key:
         return " and ".join(parts) or "any finite value"
 
 
-MM, DEG, GPA, RPM = 1e-3, math.pi / 180.0, 1e9, 2.0 * math.pi / 60.0
+MM, DEG, GPA, MPA, RPM = 1e-3, math.pi / 180.0, 1e9, 1e6, 2.0 * math.pi / 60.0
 
 SCHEMA: tuple[Key, ...] = (
     Key("mechanism.crank_inclination_deg", "geometry.crank_inclination", "float", DEG, 0, 90, True, True,
@@ -106,6 +106,10 @@ SCHEMA: tuple[Key, ...] = (
     Key("joint_e.bearing_material.youngs_modulus_gpa", "joint.bearing_material.youngs_modulus", "float", GPA, 0),
     Key("joint_e.bearing_material.poisson_ratio", "joint.bearing_material.poisson_ratio", "float", 1, 0, 0.5,
         False, True),
+    Key("joint_e.journal_material.yield_strength_mpa", "joint.journal_material.yield_strength", "float", MPA, 0,
+        doc="optional; peak contact pressure above 1.67 x this (first yield) is warned about"),
+    Key("joint_e.bearing_material.yield_strength_mpa", "joint.bearing_material.yield_strength", "float", MPA, 0,
+        doc="optional; as for the journal (the smaller of the two counts)"),
     Key("drive.speed_rpm", "drive.speed", "float", RPM, 0, 5000, doc="constant crank speed"),
     Key("drive.revolutions", "drive.revolutions", "float", 1, 0, 1000, doc="crank revolutions to simulate"),
     Key("solver.reference.method", "reference_solver.method", "str", choices=INTEGRATORS,
@@ -118,7 +122,7 @@ SCHEMA: tuple[Key, ...] = (
     Key("solver.exudyn.model", "exudyn_solver.model", "str", choices=EXUDYN_MODELS,
         doc="Exudyn model: rigid_body (members 1-8, general) or kinematic_tree (members 1-3 prescribed)"),
     Key("solver.exudyn.step_size_s", "exudyn_solver.step_size", "float", 1, 0, 1e-2,
-        doc="generalized-alpha step size"),
+        doc="generalized-alpha step size (ideal joint: at least 0.05 deg of crank, nothing to resolve)"),
     Key("solver.exudyn.spectral_radius", "exudyn_solver.spectral_radius", "float", 1, 0, 1, False, False,
         doc="generalized-alpha spectral radius (<= 0.9 for smooth constraint torques)"),
     Key("solver.exudyn.modified_newton", "exudyn_solver.modified_newton", "bool", doc="modified Newton"),
@@ -151,6 +155,9 @@ SCHEMA: tuple[Key, ...] = (
         doc="step-size collapse: the smallest step either engine may take"),
     Key("limits.max_energy_error", "limits.max_energy_error", "float", 1, 0, 1, True, False,
         doc="the run fails when the energy balance misses by more than this fraction of the largest kinetic energy"),
+    Key("limits.max_damping_ratio", "limits.max_damping_ratio", "float", 1, 0, None, True,
+        doc="damping force bound, multiple of xi x the elastic force (delta_dot / v_imp): <= 1 in an isolated "
+            "impact and under max_approach (beyond it the run fails); the onset rule exceeds it (a warning)"),
 )
 _BY_PATH = {key.path: key for key in SCHEMA}
 TOP_LEVEL = ("name", "description", "extends")
@@ -159,7 +166,8 @@ TOP_LEVEL = ("name", "description", "extends")
 # compare tolerances and limits fall back to the defaults of weftsim.params.
 REQUIRED_SECTIONS = ("mechanism", "inertia", "joint_e", "drive")
 # Model options inside those sections that are not part of the machine: they default.
-OPTIONAL = ("joint_e.impact_velocity_rule",)
+OPTIONAL = ("joint_e.impact_velocity_rule", "joint_e.journal_material.yield_strength_mpa",
+            "joint_e.bearing_material.yield_strength_mpa")
 REQUIRED = tuple(key.path for key in SCHEMA
                  if key.path.partition(".")[0] in REQUIRED_SECTIONS and key.path not in OPTIONAL)
 
@@ -370,7 +378,9 @@ def to_file_keys(scene: params.Scene) -> dict[str, Any]:
         obj: Any = scene
         for part in key.target.split("."):
             obj = getattr(obj, part)
-        if key.path == "mechanism.fourbar_branch":
+        if obj is None:  # an optional key the scene does not give
+            pass
+        elif key.path == "mechanism.fourbar_branch":
             obj = "+" if obj > 0 else "-"
         elif key.kind in ("float", "floats2", "floats3"):
             obj = obj / key.scale if key.kind == "float" else [v / key.scale for v in obj]

@@ -7,7 +7,8 @@ Every sensor stores internally at every accepted step (``storeInternal=True``,
     rapier s, v, a    (d5 d7/d6) x (angle, rate, acceleration of the sector node)
     driving torque    T = -lambda_drive (the motor's torque on the crank about +z)
     contact           e = connector Displacement (X, Y) = SPEC (y, z); F_N = |connector Force|;
-                      delta = |e| - c; held impact velocity and contact flag from the tracker
+                      delta = |e| - c, delta_dot = e_dot . e/|e|; held impact velocity and
+                      contact flag from the tracker
     kinetic energy    sum of the bodies' KineticEnergy outputs
     potential energy  sum of m g Y_com (gravity along -Y)
     contact energy    law.elastic_energy(delta)
@@ -27,7 +28,7 @@ import numpy as np
 from exudyn.itemInterface import SensorBody, SensorNode, SensorObject
 
 from weftsim.exudyn_engine.mechanism import CRANK_COORDINATE, ROTATION_2D, MechanismModel
-from weftsim.results import CHANNELS
+from weftsim.results import CHANNELS, CONTACT_CHANNELS
 
 OVT = exu.OutputVariableType
 
@@ -99,8 +100,7 @@ def step_channels(mbs, model: MechanismModel, sensors: dict) -> dict[str, np.nda
     }
     zeros = np.zeros(n)
     if model.clearance is None:
-        for name in ("contact_force_N", "penetration_m", "eccentricity_y_m", "eccentricity_z_m",
-                     "impact_velocity_m_s", "in_contact", "contact_energy_J", "dissipated_energy_J"):  # fmt: skip
+        for name in CONTACT_CHANNELS:
             ch[name] = zeros
         return ch
     cl = model.clearance
@@ -127,6 +127,7 @@ def step_channels(mbs, model: MechanismModel, sensors: dict) -> dict[str, np.nda
         "in_contact": contact,
         "contact_energy_J": np.where(delta > 0.0, cl.law.elastic_energy(np.maximum(delta, 0.0)), 0.0),
         "dissipated_energy_J": _cumtrapz((f_n - f_el) * rate, t),
+        "penetration_rate_m_s": rate,
     })  # fmt: skip
     return ch
 

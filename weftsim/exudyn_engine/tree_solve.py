@@ -135,6 +135,7 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
         "contact_energy_J": energy,
         "driving_work_J": kin13 + u13 - (0.5 * float(j13_0) * omega**2 + float(u13_0)) + _cumtrapz(-q3 * omega, t),
         "dissipated_energy_J": _cumtrapz((f_n - f_el) * rate, t),
+        "penetration_rate_m_s": rate,
     }
 
 

@@ -28,6 +28,7 @@ from weftsim.reference.dynamics import (
     ChainConstants,
     chain_dynamics,
     chain_energy,
+    eccentricity,
     initial_state,
     numpy_backend,
 )
@@ -50,7 +51,9 @@ def clearance_channels(scene: Scene, time, states, contact, impact) -> dict[str,
     dict of str to (N,) ndarray
         ``penetration_m`` is delta = |e| - c, negative in free flight (SPEC.md 4);
         ``in_contact`` is 1 where delta > 0 in a contact segment, else 0;
-        ``impact_velocity_m_s`` is the held value in contact segments, 0 in free flight.
+        ``impact_velocity_m_s`` is the held value in contact segments, 0 in free flight;
+        ``penetration_rate_m_s`` is delta_dot = e_dot . n in both modes (the plausibility
+        checks read the approach rate at each onset from it).
     """
     time = np.asarray(time, dtype=float)
     states = np.asarray(states, dtype=float).reshape(len(time), 6)
@@ -72,6 +75,10 @@ def clearance_channels(scene: Scene, time, states, contact, impact) -> dict[str,
         for k in range(n_out):
             out[k][idx] = values[k]
     dd_a, _, _, _, f_n, _, delta, _, ecc_y, ecc_z, _, _, _, q3 = out
+    # chain_dynamics gives delta_dot only in contact: the geometric rate holds in both modes.
+    _, _, v_y, v_z, *_ = eccentricity(backend, p, time, a, psi, da, dpsi)
+    length = np.hypot(ecc_y, ecc_z)
+    rate = np.where(length > 0.0, (ecc_y * v_y + ecc_z * v_z) / np.where(length > 0.0, length, 1.0), 0.0)
 
     theta = omega * time
     j13, dj13 = crank_side_inertia(theta, scene)
@@ -101,5 +108,6 @@ def clearance_channels(scene: Scene, time, states, contact, impact) -> dict[str,
         "contact_energy_J": np.where(delta > 0.0, law.elastic_energy(delta), 0.0),
         "driving_work_J": kin13 + u13 - (0.5 * float(j13_0) * omega**2 + float(u13_0)) + w3,
         "dissipated_energy_J": dissipated,
+        "penetration_rate_m_s": rate,
     }
 

@@ -25,7 +25,7 @@ from numba import njit
 from weftsim.params import Geometry, Inertia, Scene
 from weftsim.reference.compiled_kernel import (
     CLEARANCE, COUPLING, GRAVITY, L_EF, L_FG, LAW_COEF, LAW_CONSTANT, LAW_ID, LAW_VARIABLE_KD, M11, M22, OMEGA,
-    ROD_MASS, chain, pack_parameters,
+    ROD_MASS, chain, pack_parameters, penetration,
 )  # fmt: skip
 from weftsim.reference.dynamics import initial_state
 from weftsim.results import CHANNELS
@@ -124,7 +124,7 @@ def elastic_energy(prm, delta):
 
 @njit(cache=True, error_model="numpy")
 def _fill(prm, table, a0, ratio, time, states, contact, impact, out):
-    """Rows of :data:`CHANNELS` (in that order) into out (n, 17)."""
+    """Rows of :data:`CHANNELS` (in that order) into out (n, 18)."""
     omega = prm[OMEGA]
     d = np.empty(6)
     start = np.empty(4)
@@ -158,6 +158,7 @@ def _fill(prm, table, a0, ratio, time, states, contact, impact, out):
         out[i, 14] = elastic_energy(prm, delta)
         out[i, 15] = kin13 + crank[2] - work0 + y[4]
         out[i, 16] = y[5]
+        out[i, 17] = penetration(prm, t, y)[1]
 
 
 def compiled_channels(scene: Scene, time, states, contact, impact) -> dict[str, np.ndarray]:

@@ -181,6 +181,7 @@ def ideal_channels(time, scene: Scene) -> dict[str, np.ndarray]:
         "contact_energy_J": zeros,
         "driving_work_J": kinetic + u - (0.5 * float(j0) * omega**2 + float(u0)),
         "dissipated_energy_J": zeros,
+        "penetration_rate_m_s": zeros,
     }
 
 
