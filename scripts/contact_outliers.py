@@ -1,0 +1,67 @@
+"""Frequency study of contact-force outliers on the reference engine (issue 11).
+
+    python scripts/contact_outliers.py [--jobs 1] [--only speed_500] [--methods numba_DOP853]
+        [--set joint_e.impact_velocity_rule=onset] [--csv docs/data/contact-outliers.csv]
+        [--section contact-outliers] [--force] [--report-only]
+
+Runs every scene of models/paper/ for 10 revolutions with scipy DOP853 at rtol 1e-6..1e-10 and
+numba_DOP853 at rtol 1e-4..1e-10 (atol = rtol * 1e-3): 72 runs.  Each finished run is added to
+the CSV at once; a rerun skips the runs already there (``--force`` redoes them), so an
+interrupted study continues where it stopped.  The table goes to docs/hard-cases.md between
+the markers of ``--section``.  ``--flores`` runs the flores ce = 0.3 case instead
+(weftsim.studies.outliers.flores_cells).  Measures: weftsim/studies/outliers.py.
+"""
+
+from __future__ import annotations
+
+import argparse
+import shlex
+import sys
+from pathlib import Path
+
+from weftsim.scene import SceneError
+from weftsim.studies.common import StudyError
+from weftsim.studies import outliers
+from weftsim.sweep_grid import SweepError, parse_set
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--models", default=str(ROOT / "models"), help="models directory (holds paper/)")
+    parser.add_argument("--only", nargs="+", help="scenes whose name contains one of these")
+    parser.add_argument("--methods", help=f"comma-separated subset of {','.join(outliers.STUDY_RTOLS)}")
+    parser.add_argument("--revolutions", type=float, default=outliers.STUDY_REVOLUTIONS)
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="scene override, every run")
+    parser.add_argument("--jobs", type=int, default=1, help="worker processes, 1 or 2")
+    parser.add_argument("--csv", default=str(ROOT / "docs" / "data" / "contact-outliers.csv"))
+    parser.add_argument("--doc", default=str(ROOT / "docs" / "hard-cases.md"))
+    parser.add_argument("--section", default="contact-outliers", help="marker name in --doc; '' = no table")
+    parser.add_argument("--force", action="store_true", help="rerun the selected runs already in the CSV")
+    parser.add_argument("--report-only", action="store_true", help="only rewrite the table from the CSV")
+    args = parser.parse_args(argv)
+    try:
+        if not args.revolutions > 1:
+            raise StudyError(f"--revolutions must be > 1 (revolution 1 is left out of the median), got {args.revolutions}")
+        overrides = tuple(parse_set(text) for text in args.set)
+        methods = args.methods.split(",") if args.methods else None
+        cells = outliers.study_cells(args.models, methods, args.only, args.revolutions, overrides)
+        for cell in cells[:1]:
+            cell.scene()  # a bad --set fails here, in one line, before any run
+        if not args.report_only:
+            outliers.run_study(cells, args.csv, args.jobs, args.force)
+        if args.section:
+            rows = outliers.read_rows(args.csv)
+            command = "python scripts/contact_outliers.py " + shlex.join(
+                [a for a in argv if a not in ("--force", "--report-only")])
+            outliers.replace_section(args.doc, args.section, outliers.markdown_report(rows, command.strip()))
+    except (StudyError, SceneError, SweepError) as exc:
+        print(f"contact_outliers: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
