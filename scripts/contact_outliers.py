@@ -8,8 +8,12 @@ Runs every scene of models/paper/ for 10 revolutions with scipy DOP853 at rtol 1
 numba_DOP853 at rtol 1e-4..1e-10 (atol = rtol * 1e-3): 72 runs.  Each finished run is added to
 the CSV at once; a rerun skips the runs already there (``--force`` redoes them), so an
 interrupted study continues where it stopped.  The table goes to docs/hard-cases.md between
-the markers of ``--section``.  ``--flores`` runs the flores ce = 0.3 case instead
-(weftsim.studies.outliers.flores_cells).  Measures: weftsim/studies/outliers.py.
+the markers of ``--section``.
+
+``--flores`` runs the flores ce = 0.3 case instead (models/reference.toml with law flores,
+restitution 0.3, each impact-velocity rule, numba_DOP853 and DOP853 at rtol 1e-9, 10 revolutions;
+weftsim.studies.outliers.flores_cells) into docs/data/contact-outliers-flores.csv and the
+section ``contact-outliers-flores``.  Measures: weftsim/studies/outliers.py.
 """
 
 from __future__ import annotations
@@ -36,27 +40,37 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--revolutions", type=float, default=outliers.STUDY_REVOLUTIONS)
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="scene override, every run")
     parser.add_argument("--jobs", type=int, default=1, help="worker processes, 1 or 2")
-    parser.add_argument("--csv", default=str(ROOT / "docs" / "data" / "contact-outliers.csv"))
+    parser.add_argument("--flores", action="store_true", help="the flores ce = 0.3 case instead of the study")
+    parser.add_argument("--csv", help="default docs/data/contact-outliers.csv (--flores: contact-outliers-flores.csv)")
     parser.add_argument("--doc", default=str(ROOT / "docs" / "hard-cases.md"))
-    parser.add_argument("--section", default="contact-outliers", help="marker name in --doc; '' = no table")
+    parser.add_argument("--section", help="marker name in --doc (default contact-outliers, --flores: "
+                        "contact-outliers-flores); '' = no table")  # fmt: skip
     parser.add_argument("--force", action="store_true", help="rerun the selected runs already in the CSV")
     parser.add_argument("--report-only", action="store_true", help="only rewrite the table from the CSV")
     args = parser.parse_args(argv)
+    name = "contact-outliers-flores" if args.flores else "contact-outliers"
+    csv_path = args.csv or str(ROOT / "docs" / "data" / f"{name}.csv")
+    section = name if args.section is None else args.section
     try:
         if not args.revolutions > 1:
             raise StudyError(f"--revolutions must be > 1 (revolution 1 is left out of the median), got {args.revolutions}")
         overrides = tuple(parse_set(text) for text in args.set)
         methods = args.methods.split(",") if args.methods else None
-        cells = outliers.study_cells(args.models, methods, args.only, args.revolutions, overrides)
+        if args.flores:
+            cells = outliers.flores_cells(args.models, methods or ("numba_DOP853", "DOP853"),
+                                          revolutions=args.revolutions, overrides=overrides)  # fmt: skip
+        else:
+            cells = outliers.study_cells(args.models, methods, args.only, args.revolutions, overrides)
         for cell in cells[:1]:
             cell.scene()  # a bad --set fails here, in one line, before any run
         if not args.report_only:
-            outliers.run_study(cells, args.csv, args.jobs, args.force)
-        if args.section:
-            rows = outliers.read_rows(args.csv)
+            outliers.run_study(cells, csv_path, args.jobs, args.force)
+        if section:
+            rows = outliers.read_rows(csv_path)
             command = "python scripts/contact_outliers.py " + shlex.join(
                 [a for a in argv if a not in ("--force", "--report-only")])
-            outliers.replace_section(args.doc, args.section, outliers.markdown_report(rows, command.strip()))
+            report = outliers.flores_report if args.flores else outliers.markdown_report
+            outliers.replace_section(args.doc, section, report(rows, command.strip()))
     except (StudyError, SceneError, SweepError) as exc:
         print(f"contact_outliers: {exc}", file=sys.stderr)
         return 2

@@ -18,6 +18,9 @@ from weftsim.scene import load_scene
 from weftsim.studies.common import StudyError
 from weftsim.studies.outliers import (
     Cell,
+    ensemble_ratios,
+    flores_cells,
+    markdown_report,
     negative_penetration_in_contact,
     onset_rows,
     onsets,
@@ -40,6 +43,35 @@ def test_peak_ratios_leave_out_the_first_revolution():
     assert peak_ratios([5.0, 3.0, 3.0, 3.0]) == (3.0, 1.0, 2)
     median, worst, revolution = peak_ratios([5.0])
     assert math.isnan(median) and math.isnan(worst) and revolution == 0
+
+
+def _row(scene, rtol, peaks, status="success"):
+    row = {"scene": scene, "method": "numba_DOP853", "rtol": rtol, "overrides": "", "status": status,
+           "revolutions": str(len(peaks)), "steps": "1", "wall_time_s": "0.1", "onsets": "3",
+           "nonpositive_onsets": "0", "contact_segments_with_negative_penetration": "0", "message": ""}  # fmt: skip
+    row.update({f"peak_rev{k + 1}_N": str(p) for k, p in enumerate(peaks)})
+    median, worst, rev = peak_ratios(peaks)
+    row.update(median_peak_N=str(median), worst_ratio=str(worst), worst_revolution=str(rev))
+    return row
+
+
+def test_the_scene_ensemble_median_catches_a_run_broken_for_most_revolutions():
+    # Run "b" breaks in revolution 3 and peaks at 40 from then on: against its own median (40) it looks
+    # steady (1.0x), against the median of the scene's runs (revolutions 2..5 of a, b, c: 2) it is 20x.
+    rows = [_row("s", "1e-05", [9, 2, 2, 2, 2]), _row("s", "1e-06", [9, 2, 40, 40, 40]),
+            _row("s", "1e-07", [9, 2, 2, 3, 2]), _row("t", "1e-05", [9, 5, 5, 5, 5]),
+            _row("t", "1e-06", [0, 0, 0, 0, 0], status="failed")]  # fmt: skip
+    ratios = ensemble_ratios(rows)
+    assert ratios[("s", "numba_DOP853", "1e-06", "")] == 20.0
+    assert float(rows[1]["worst_ratio"]) == 1.0
+    assert ratios[("s", "numba_DOP853", "1e-07", "")] == 1.5
+    assert ratios[("t", "numba_DOP853", "1e-05", "")] == 1.0
+    assert len(ratios) == 4  # the failed run has no ratio
+    # c's worst is exactly 1.5x: "above" is strict, so only b counts
+    text = markdown_report(rows, "cmd")
+    assert "**0** above 1.5x, **0** above 3x; against the scene's ensemble median (all its runs): " \
+           "**1** above 1.5x, **1** above 3x" in text  # fmt: skip
+    assert "- failed: t `numba_DOP853` rtol 1e-06" in text
 
 
 def test_segment_bookkeeping_on_synthetic_rows():
@@ -124,6 +156,16 @@ def test_study_cells_and_bad_selections():
         study_cells(MODELS, only=["no_such_scene"])
 
 
+def test_flores_cells():
+    cells = flores_cells(MODELS)
+    assert {(dict(c.overrides)["joint_e.impact_velocity_rule"], c.method) for c in cells} == {
+        (rule, m) for rule in ("onset", "max_approach") for m in ("numba_DOP853", "DOP853")}
+    scene = cells[0].scene()
+    assert (scene.joint.law, scene.joint.restitution, scene.reference_solver.atol) == ("flores", 0.3, pytest.approx(1e-12))
+    only = flores_cells(MODELS, overrides=(("joint_e.impact_velocity_rule", "onset"),))
+    assert {dict(c.overrides)["joint_e.impact_velocity_rule"] for c in only} == {"onset"} and len(only) == 2
+
+
 def test_replace_section(tmp_path):
     doc = tmp_path / "doc.md"
     doc.write_text("head\n<!-- x:begin -->\nold\n<!-- x:end -->\ntail\n")
@@ -134,7 +176,7 @@ def test_replace_section(tmp_path):
 
 
 @pytest.mark.parametrize("flags", [["--set", "joint_e.bogus=1"], ["--methods", "RK45"], ["--jobs", "3"],
-                                   ["--revolutions", "1"]])  # fmt: skip
+                                   ["--revolutions", "1"], ["--flores", "--methods", "RK45"]])  # fmt: skip
 def test_script_bad_input_is_one_line(tmp_path, flags):
     run = subprocess.run([sys.executable, str(ROOT / "scripts" / "contact_outliers.py"), "--csv",
                           str(tmp_path / "x.csv"), "--section", "", "--only", "speed_500", *flags],
