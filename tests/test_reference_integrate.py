@@ -101,16 +101,21 @@ def _errors_after_startup(result, start_deg=30.0):
 def test_small_clearance_tends_to_the_ideal_joint():
     """c = 0.1, 0.01, 0.001 mm: the acceleration and torque errors w.r.t. the ideal joint shrink.
 
-    The first ~20 deg are left out: the journal starts centred and force-free (SPEC.md 2), so the
-    chain first falls behind and is then caught by an impact, whatever c is.  The limit is not the
-    ideal joint exactly but the compliant one: under ~70 kN the variable_kd law still penetrates
-    ~50 um as c -> 0, which leaves ~1-2 % of the ideal amplitudes (measured 11 m/s^2, 11 N m).
+    The first revolution is left out: the journal starts centred and force-free (SPEC.md 2), so the
+    chain first falls behind and is then caught by an impact, whatever c is.  That start-up impact is
+    driven (the approach rate keeps growing after the onset: 0.011 -> 0.06 m/s at c = 1 um), so under
+    the "max_approach" rule its damping is the law's (xi = 0.14 at ce = 0.9) and the contact rings down
+    over ~150 deg of crank (measured), not ~20 deg as under the onset-only rule, whose 0.011 m/s
+    overdamps it.  The limit is not the ideal joint exactly but the compliant one: under ~30-70 kN the
+    variable_kd law still penetrates ~50 um as c -> 0, which leaves ~1-3 % of the ideal amplitudes
+    (measured over revolution 2 at c = 1 um: 15.7 m/s^2, 15.3 N m; onset rule 10.9, 10.8).
     """
-    errors = [_errors_after_startup(solve(_scene(clearance=c))) for c in (1e-4, 1e-5, 1e-6)]
+    errors = [_errors_after_startup(solve(_scene(clearance=c, revolutions=2.0)), start_deg=360.0)
+              for c in (1e-4, 1e-5, 1e-6)]  # fmt: skip
     acc, torque = zip(*errors)
     assert acc[0] > acc[1] > acc[2] and torque[0] > torque[1] > torque[2]
     ideal_acc, ideal_torque_amplitude = 1142.05, 505.43  # SPEC check value; ideal run of the reference scene
-    # The compliance floor above (~1 % acceleration, ~2 % torque) with a 2.5x margin.
+    # The compliance floor above (1.4 % acceleration, 3.0 % torque at c = 1 um) with a margin of ~1.7x.
     assert acc[2] < 0.025 * ideal_acc and torque[2] < 0.05 * ideal_torque_amplitude
 
 

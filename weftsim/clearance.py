@@ -12,8 +12,16 @@ Pure functions used by both engines (Flores-Ambrosio formulation)::
 
 - Penetration rate delta_dot = e_dot . n (m/s, positive while approaching).
 - Normal force F_N = law.normal_force(delta, delta_dot, v_imp) >= 0 (:mod:`weftsim.contact`).
-  The impact velocity v_imp is *held* by the engine: delta_dot at the contact onset, kept
-  until separation and floored at ``joint.min_impact_velocity``; this module only uses it.
+  The engine holds the impact velocity: delta_dot at the contact onset, floored at
+  ``joint.min_impact_velocity``, kept until separation and, under the default rule
+  ``joint.impact_velocity_rule = "max_approach"``, raised to every larger approach rate since
+  the onset.  This module applies that last part itself (:func:`effective_impact_velocity`):
+  v_imp = max(held, delta_dot), so the damping term xi delta_dot / v_imp never exceeds xi even
+  between the engine's updates of the held value.  In an isolated impact delta_dot only falls
+  after the onset, so the rule gives the onset value of Lankarani & Nikravesh (1990) and every
+  law keeps its restitution; in a driven lasting contact the approach rate can grow far beyond
+  the onset value, and the onset-only rule (``"onset"``, kept for comparison with published
+  results) then inflates the damping force without bound.
 - Friction (modified Coulomb, Ambrosio 2003): on the journal, F_T = -mu c_d(|v_T|) F_N sign(v_T) t,
   with v_T = (velocity of the journal's material point at Q - that of the bearing's) . t.
 - Force on the journal f_j = -F_N n + F_T (pulls it back towards the bearing centre); on the
@@ -112,6 +120,18 @@ def tangential_velocity(ecc, bearing_velocity, bearing_angular_velocity,
     return np.where(length > 0.0, v_t, 0.0)
 
 
+def effective_impact_velocity(held, penetration_rate, joint: ClearanceJoint):
+    """The impact velocity delta_dot^- of the damping term, m/s (numpy, broadcasts).
+
+    ``held``: the engine's held value (onset rate floored at v_min, raised at its updates);
+    under ``"max_approach"`` the current approach rate raises it further, under ``"onset"`` not.
+    """
+    held = np.asarray(held, dtype=float)
+    if joint.impact_velocity_rule == "max_approach":
+        return np.maximum(held, penetration_rate)
+    return held
+
+
 def clearance_contact(ecc, ecc_rate, rel_tangential_velocity, impact_velocity, law,
                       joint: ClearanceJoint) -> ClearanceContact:
     """Normal and friction force of the clearance joint, with moments (numpy, broadcasts).
@@ -124,13 +144,14 @@ def clearance_contact(ecc, ecc_rate, rel_tangential_velocity, impact_velocity, l
         v_T, m/s: tangential component (along t) of the journal contact point's velocity
         relative to the bearing's (:func:`tangential_velocity`).  Ignored when mu = 0.
     impact_velocity : array_like (...,)
-        Held, floored impact velocity, m/s (> 0 wherever delta > 0).
+        Held, floored impact velocity, m/s (> 0 wherever delta > 0); :func:`effective_impact_velocity`
+        applies the joint's rule to it.
     law : contact law of :mod:`weftsim.contact` (from ``make_law(joint)``).
     joint : ClearanceJoint
-        Supplies c, R_b, mu and the friction ramp (v0, v1).
+        Supplies c, R_b, mu, the friction ramp (v0, v1) and the impact-velocity rule.
     """
     delta, delta_dot, n = contact_geometry(ecc, ecc_rate, joint.clearance)
-    f_n = law.normal_force(delta, delta_dot, impact_velocity)
+    f_n = law.normal_force(delta, delta_dot, effective_impact_velocity(impact_velocity, delta_dot, joint))
     t = np.stack([-n[..., 1], n[..., 0]], axis=-1)
     if joint.friction_coefficient > 0.0:
         v_t = np.asarray(rel_tangential_velocity, dtype=float)
@@ -173,7 +194,8 @@ def make_clearance_kernel(law, joint: ClearanceJoint, jit: bool = False) -> Clea
     Returns ``kernel(ex, ey, ex_dot, ey_dot, v_t, v_imp) -> (fx, fy, F_N, delta, delta_dot,
     M_j, M_b)``: force on the journal (N), normal force, penetration (m) and its rate (m/s),
     friction moments about P_j and P_b (N m); same values as :func:`clearance_contact`
-    (force on the bearing is (-fx, -fy)).  No argument checks: v_imp must be > 0 in contact.
+    (force on the bearing is (-fx, -fy)), with the joint's impact-velocity rule applied to the
+    held v_imp.  No argument checks: v_imp must be > 0 in contact.
     ``jit=True`` compiles it with ``numba.njit`` (law compiled too; ImportError without numba).
     """
     normal_force = law.numba() if jit else law.scalar()
@@ -181,6 +203,7 @@ def make_clearance_kernel(law, joint: ClearanceJoint, jit: bool = False) -> Clea
     r_b = joint.bearing_radius
     mu = joint.friction_coefficient
     v0, v1 = joint.friction_velocities
+    track = joint.impact_velocity_rule == "max_approach"  # effective_impact_velocity, scalar
     if not 0.0 <= v0 < v1:
         raise ValueError(f"friction velocities must satisfy 0 <= v0 < v1, got {joint.friction_velocities}")
 
@@ -192,6 +215,8 @@ def make_clearance_kernel(law, joint: ClearanceJoint, jit: bool = False) -> Clea
         nx = ex / length
         ny = ey / length
         delta_dot = ex_dot * nx + ey_dot * ny
+        if track and delta_dot > v_imp:
+            v_imp = delta_dot
         f_n = normal_force(delta, delta_dot, v_imp)
         f_t = 0.0
         if mu > 0.0 and f_n > 0.0:

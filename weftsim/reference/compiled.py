@@ -28,7 +28,8 @@ from numba import njit
 from scipy.integrate import RK45 as _SCIPY_RK45
 from scipy.integrate._ivp import dop853_coefficients as _D853
 
-from weftsim.reference.compiled_kernel import V_MIN, chain, penetration
+from weftsim.reference.compiled_kernel import CLEARANCE, TRACK_MAX, V_MIN, chain, penetration
+from weftsim.reference.events import _GOLDEN_ITERATIONS, _INV_PHI, END_FRACTION, SAMPLES
 from weftsim.reference.integrate import _CONTACT_SUBSTEPS, _ROOT_XTOL
 
 DOP853, RK45 = 0, 1
@@ -50,6 +51,7 @@ DONE, PAUSED, BUFFER_FULL, STEP_TOO_SMALL, NON_FINITE, GUARD = 0, 1, 2, -1, -2, 
 _ROWS_PER_STEP = _CONTACT_SUBSTEPS + 2  # substeps + step or event + new segment's first row
 _STEP_BUFFER = 1 << 15
 _SUBSTEPS = np.arange(1, _CONTACT_SUBSTEPS + 1) / (_CONTACT_SUBSTEPS + 1.0)
+_GRID = np.linspace(0.0, 1.0, SAMPLES + 1)  # the event search grid of a step (integrate._GRID)
 
 # Float state: t, h_abs, held impact velocity, max penetration rate, first contact time (-1: none),
 # last accepted step, its penetration and length (for the guards of weftsim.guards).
@@ -57,7 +59,12 @@ T, H_ABS, IMPACT, MAX_RATE, FIRST_CONTACT, LAST_PENETRATION, LAST_STEP = range(7
 # Guard limits: penetration bound (m), shortest accepted step (s), step budget (0: none).
 PENETRATION_LIMIT, MIN_STEP_LIMIT, STEP_BUDGET = range(3)
 # Int state: mode, segment to start, counters, next output sample.
-CONTACT, START, STEPS, REJECTED, NFEV, DENSE, SEGMENTS, EVENTS, IMPACTS, NEXT_SAMPLE = range(10)
+CONTACT, START, STEPS, REJECTED, NFEV, DENSE, SEGMENTS, EVENTS, IMPACTS, NEXT_SAMPLE, PEAKS, NONPOSITIVE = range(12)
+N_INT_STATE = 12
+# Kinds of event (weftsim.reference.events).
+NO_EVENT, ONSET, SEPARATION, PEAK = 0, 1, 2, 3
+# What _maximum maximizes on the dense output: sign * delta, -sign * delta, delta_dot.
+_G, _MINUS_G, _RATE = 0, 1, 2
 
 
 @njit(cache=True, error_model="numpy")
@@ -201,8 +208,25 @@ def _dense(method, F, t_old, h, y_old, t, out):
 
 
 @njit(cache=True, error_model="numpy")
-def _locate(prm, method, F, t_old, h, y_old, lo, hi, g_lo, g_hi, to_contact, tmp):
-    """Illinois regula falsi on the dense output (integrate._locate); root on the new side."""
+def _state(prm, method, F, t_old, h, y_old, t, tmp):
+    """(delta, delta_dot) on the dense output of the last step at time t."""
+    _dense(method, F, t_old, h, y_old, t, tmp)
+    return penetration(prm, t, tmp)
+
+
+@njit(cache=True, error_model="numpy")
+def _value(prm, method, F, t_old, h, y_old, t, tmp, what, sign):
+    d, r = _state(prm, method, F, t_old, h, y_old, t, tmp)
+    if what == _G:
+        return sign * d
+    if what == _MINUS_G:
+        return -sign * d
+    return r
+
+
+@njit(cache=True, error_model="numpy")
+def _locate(prm, method, F, t_old, h, y_old, sign, lo, hi, g_lo, g_hi, tmp):
+    """Root of g = sign * delta in [lo, hi] on its positive side (events.locate_root)."""
     last = 0
     for _ in range(200):
         if hi - lo <= _ROOT_XTOL:
@@ -210,9 +234,8 @@ def _locate(prm, method, F, t_old, h, y_old, lo, hi, g_lo, g_hi, to_contact, tmp
         m = hi - g_hi * (hi - lo) / (g_hi - g_lo)
         if not lo < m < hi:
             m = 0.5 * (lo + hi)
-        _dense(method, F, t_old, h, y_old, m, tmp)
-        g_m = penetration(prm, m, tmp)[0]
-        if (g_m > 0.0) if to_contact else (g_m < 0.0):
+        g_m = _value(prm, method, F, t_old, h, y_old, m, tmp, _G, sign)
+        if g_m > 0.0:
             hi, g_hi = m, g_m
             if last == -1:
                 g_lo *= 0.5
@@ -223,6 +246,78 @@ def _locate(prm, method, F, t_old, h, y_old, lo, hi, g_lo, g_hi, to_contact, tmp
                 g_hi *= 0.5
             last = 1
     return hi
+
+
+@njit(cache=True, error_model="numpy")
+def _maximum(prm, method, F, t_old, h, y_old, what, sign, lo, hi, tmp):
+    """(t, value) of the largest value on [lo, hi], golden section (events.maximum)."""
+    a, b = lo, hi
+    x1 = b - _INV_PHI * (b - a)
+    x2 = a + _INV_PHI * (b - a)
+    f1 = _value(prm, method, F, t_old, h, y_old, x1, tmp, what, sign)
+    f2 = _value(prm, method, F, t_old, h, y_old, x2, tmp, what, sign)
+    for _ in range(_GOLDEN_ITERATIONS):
+        if f1 < f2:
+            a, x1, f1 = x1, x2, f2
+            x2 = a + _INV_PHI * (b - a)
+            f2 = _value(prm, method, F, t_old, h, y_old, x2, tmp, what, sign)
+        else:
+            b, x2, f2 = x2, x1, f1
+            x1 = b - _INV_PHI * (b - a)
+            f1 = _value(prm, method, F, t_old, h, y_old, x1, tmp, what, sign)
+    best_t, best = lo, _value(prm, method, F, t_old, h, y_old, lo, tmp, what, sign)
+    if f1 > best:
+        best_t, best = x1, f1
+    if f2 > best:
+        best_t, best = x2, f2
+    f_hi = _value(prm, method, F, t_old, h, y_old, hi, tmp, what, sign)
+    if f_hi > best:
+        best_t, best = hi, f_hi
+    return best_t, best
+
+
+@njit(cache=True, error_model="numpy")
+def _first_crossing(prm, method, F, t_old, h, y_old, times, deltas, rates, sign, tmp):
+    """(found, t, sign * delta_dot) of the first rising crossing of sign * delta (events.first_crossing)."""
+    if sign * deltas[0] > 0.0:
+        return True, times[0], sign * rates[0]
+    for k in range(times.size - 1):
+        lo, hi = times[k], times[k + 1]
+        g_lo, g_hi = sign * deltas[k], sign * deltas[k + 1]
+        if g_hi <= 0.0:
+            if not (sign * rates[k] > 0.0 > sign * rates[k + 1]):
+                continue
+            t_top, g_top = _maximum(prm, method, F, t_old, h, y_old, _G, sign, lo, hi, tmp)
+            if g_top <= 0.0:
+                continue
+            hi, g_hi = t_top, g_top
+        root = _locate(prm, method, F, t_old, h, y_old, sign, lo, hi, g_lo, g_hi, tmp)
+        rate = sign * _state(prm, method, F, t_old, h, y_old, root, tmp)[1]
+        if rate <= 0.0:
+            t_low, minus_g_low = _maximum(prm, method, F, t_old, h, y_old, _MINUS_G, sign, root, hi, tmp)
+            if -minus_g_low < 0.0:
+                root = _locate(prm, method, F, t_old, h, y_old, sign, t_low, hi, -minus_g_low, g_hi, tmp)
+                rate = sign * _state(prm, method, F, t_old, h, y_old, root, tmp)[1]
+        return True, root, rate
+    return False, 0.0, 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def _rate_peak(prm, method, F, t_old, h, y_old, times, rates, n, held, tmp):
+    """(found, t, delta_dot) of a maximum of delta_dot above ``held`` before times[n - 1] (events.rate_peak)."""
+    k = 0
+    for i in range(1, n):
+        if rates[i] > rates[k]:
+            k = i
+    if rates[k] <= held:
+        return False, 0.0, 0.0
+    lo = times[max(k - 1, 0)]
+    hi = times[min(k + 1, n - 1)]
+    t_peak, r_peak = _maximum(prm, method, F, t_old, h, y_old, _RATE, 1.0, lo, hi, tmp)
+    end = times[n - 1]
+    if end - t_peak <= END_FRACTION * (end - times[0]) or r_peak <= held:
+        return False, 0.0, 0.0
+    return True, t_peak, r_peak
 
 
 @njit(cache=True, error_model="numpy")
@@ -257,6 +352,13 @@ def advance(prm, method, rtol, atol, max_step, t_end, t_pause, limits, y, f, fst
     capacity = stp_t.size
     n_samples = sample_times.size
     v_min = prm[V_MIN]
+    track = prm[TRACK_MAX] != 0.0
+    ideal = 1 if prm[CLEARANCE] <= 0.0 else 0
+    grid_t = np.empty(SAMPLES + 1)
+    grid_d = np.empty(SAMPLES + 1)
+    grid_r = np.empty(SAMPLES + 1)
+    peak_t = np.empty(SAMPLES + 2)
+    peak_r = np.empty(SAMPLES + 2)
     t = fst[T]
     while t < t_end:
         contact = ist[CONTACT] == 1
@@ -306,22 +408,58 @@ def advance(prm, method, rtol, atol, max_step, t_end, t_pause, limits, y, f, fst
                 return NON_FINITE, n_rows
         ist[STEPS] += 1
         f_new = K[f_row]
-        fst[LAST_PENETRATION] = g_new
+        g_new, r_new = penetration(prm, t_new, y_new)
+        fst[LAST_PENETRATION] = g_new if contact else -math.inf  # only contact steps are model states
         fst[LAST_STEP] = h if t_new < t_end else math.inf
-        if (g_new > limits[PENETRATION_LIMIT] or fst[LAST_STEP] < limits[MIN_STEP_LIMIT]
+        if (fst[LAST_PENETRATION] > limits[PENETRATION_LIMIT] or fst[LAST_STEP] < limits[MIN_STEP_LIMIT]
                 or (limits[STEP_BUDGET] > 0.0 and ist[STEPS] > limits[STEP_BUDGET])):
             fst[T] = t_new
             y[:] = y_new
             n_rows = _record(stp_t, stp_y, stp_c, stp_i, n_rows, t_new, y_new, contact, impact)
             return GUARD, n_rows
-        crossed = (g_new < 0.0) if contact else (g_new > 0.0)
+        # Events inside the step (weftsim.reference.events): first rising crossing, rate peak.
+        g_old, r_old = penetration(prm, t, y)
+        sign = -1.0 if contact else 1.0
+        possible = (sign * g_new > 0.0 or sign * r_old > 0.0 > sign * r_new) and ideal == 0
         t_stop = t_new
+        kind = NO_EVENT
+        value = 0.0
         dense = False
-        if crossed:
+        if contact or possible:
             _dense_coefficients(prm, method, t, y, y_new, f_new, h, K, contact, impact, ist, F, tmp)
             dense = True
-            g_old = penetration(prm, t, y)[0]
-            t_stop = _locate(prm, method, F, t, h, y, t, t_new, g_old, g_new, not contact, tmp)
+            grid_d[0], grid_r[0] = g_old, r_old
+            grid_d[SAMPLES], grid_r[SAMPLES] = g_new, r_new
+            for i in range(SAMPLES + 1):
+                grid_t[i] = t + h * _GRID[i]
+            grid_t[SAMPLES] = t_new
+            for i in range(1, SAMPLES):
+                d, r = _state(prm, method, F, t, h, y, grid_t[i], tmp)
+                grid_d[i], grid_r[i] = d, r
+            if possible:
+                found, t_root, rate = _first_crossing(prm, method, F, t, h, y, grid_t, grid_d, grid_r, sign, tmp)
+                if found:
+                    t_stop = t_root
+                    kind = SEPARATION if contact else ONSET
+                    value = sign * rate
+            if contact and track:
+                n = SAMPLES + 1
+                if kind != NO_EVENT:  # the approach rate counts up to the separation only
+                    n = 0
+                    for i in range(SAMPLES + 1):
+                        if grid_t[i] < t_stop:
+                            peak_t[n], peak_r[n] = grid_t[i], grid_r[i]
+                            n += 1
+                    peak_t[n], peak_r[n] = t_stop, value
+                    n += 1
+                else:
+                    peak_t[:n] = grid_t
+                    peak_r[:n] = grid_r
+                found, t_peak, r_peak = _rate_peak(prm, method, F, t, h, y, peak_t, peak_r, n, impact, tmp)
+                if found:
+                    t_stop = t_peak
+                    kind = PEAK
+                    value = r_peak
         k = ist[NEXT_SAMPLE]
         while k < n_samples and sample_times[k] <= t_stop:
             if not dense:
@@ -332,26 +470,27 @@ def advance(prm, method, rtol, atol, max_step, t_end, t_pause, limits, y, f, fst
             k += 1
         ist[NEXT_SAMPLE] = k
         if contact and _CONTACT_SUBSTEPS > 0:
-            if not dense:
-                _dense_coefficients(prm, method, t, y, y_new, f_new, h, K, contact, impact, ist, F, tmp)
-                dense = True
             for i in range(_CONTACT_SUBSTEPS):
                 t_sub = t + (t_stop - t) * _SUBSTEPS[i]
                 _dense(method, F, t, h, y, t_sub, tmp)
                 n_rows = _record(stp_t, stp_y, stp_c, stp_i, n_rows, t_sub, tmp, contact, impact)
-        if crossed:
+        if kind != NO_EVENT:
             _dense(method, F, t, h, y, t_stop, tmp)
             t = t_stop
             y[:] = tmp
             ist[EVENTS] += 1
-            if contact:
+            if kind == SEPARATION:
                 ist[CONTACT] = 0
                 fst[IMPACT] = 0.0
+            elif kind == PEAK:
+                fst[IMPACT] = value
+                ist[PEAKS] += 1
             else:
-                rate = penetration(prm, t, y)[1]
-                fst[MAX_RATE] = max(fst[MAX_RATE], rate)
+                if not value > 0.0:
+                    ist[NONPOSITIVE] += 1  # no rising root found: counted, judged by weftsim.guards
+                fst[MAX_RATE] = max(fst[MAX_RATE], value)
                 ist[CONTACT] = 1
-                fst[IMPACT] = max(rate, v_min)
+                fst[IMPACT] = max(value, v_min)
                 ist[IMPACTS] += 1
                 if fst[FIRST_CONTACT] < 0.0:
                     fst[FIRST_CONTACT] = t

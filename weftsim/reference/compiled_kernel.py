@@ -33,8 +33,8 @@ LAW_CONSTANT, LAW_VARIABLE_KD, LAW_ELASTIC_FOUNDATION = 0, 1, 2
 
 # Indices into the parameter array.
 (OMEGA, TAN_BETA, COS_OE0, SIN_OE0, L_OE, L_EF, L_FG, L_OG, ROD_MASS, GRAVITY, M11, M22, COUPLING,
- CLEARANCE, BEARING_RADIUS, MU, V0, V1, LAW_ID, LAW_COEF, XI, V_MIN) = range(22)  # fmt: skip
-N_PARAMETERS = 22
+ CLEARANCE, BEARING_RADIUS, MU, V0, V1, LAW_ID, LAW_COEF, XI, V_MIN, TRACK_MAX) = range(23)  # fmt: skip
+N_PARAMETERS = 23
 
 
 def law_parameters(law) -> tuple[int, float]:
@@ -63,6 +63,7 @@ def pack_parameters(scene: Scene) -> np.ndarray:
     out[MU], out[V0], out[V1] = p.friction_coefficient, p.friction_v0, p.friction_v1
     out[LAW_ID], out[LAW_COEF], out[XI] = law_id, coef, law.hysteresis
     out[V_MIN] = scene.joint.min_impact_velocity
+    out[TRACK_MAX] = 1.0 if scene.joint.impact_velocity_rule == "max_approach" else 0.0
     return out
 
 
@@ -153,7 +154,10 @@ def chain(prm, t, y, contact, impact_velocity, out):
         if length > 0.0:
             nx, ny = ecc_y / length, ecc_z / length
             delta_dot = v_y * nx + v_z * ny
-            f_n = normal_force(prm, delta, delta_dot, impact_velocity)
+            v_imp = impact_velocity
+            if prm[TRACK_MAX] != 0.0 and delta_dot > v_imp:  # weftsim.clearance.effective_impact_velocity
+                v_imp = delta_dot
+            f_n = normal_force(prm, delta, delta_dot, v_imp)
             f_t = 0.0
             mu = prm[MU]
             if mu > 0.0 and f_n > 0.0:

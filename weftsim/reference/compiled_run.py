@@ -16,7 +16,8 @@ from weftsim.guards import RunGuard, failure_message, non_finite_breach
 from weftsim.params import Scene
 from weftsim.reference.compiled import (
     DENSE, DONE, EVENTS, FIRST_CONTACT, GUARD, IMPACTS, LAST_PENETRATION, LAST_STEP, MAX_RATE, METHODS,
-    N, NEXT_SAMPLE, NFEV, NON_FINITE, PAUSED, REJECTED, SEGMENTS, START, STEP_TOO_SMALL, STEPS, T, _STEP_BUFFER,
+    N, N_INT_STATE, NEXT_SAMPLE, NFEV, NON_FINITE, NONPOSITIVE, PAUSED, PEAKS, REJECTED, SEGMENTS, START,
+    STEP_TOO_SMALL, STEPS, T, _STEP_BUFFER,
     advance,
 )  # fmt: skip
 from weftsim.reference.compiled_kernel import pack_parameters
@@ -50,7 +51,7 @@ def integrate_compiled(scene: Scene, progress=None, method: str = "numba_DOP853"
     y = initial_state(scene).astype(float)
     f = np.zeros(N)
     fst = np.array([0.0, 0.0, 0.0, 0.0, -1.0, -math.inf, math.inf])
-    ist = np.zeros(10, dtype=np.int64)
+    ist = np.zeros(N_INT_STATE, dtype=np.int64)
     ist[START] = 1
     guard = RunGuard(scene)
     limits = np.array([math.inf if scene.joint.is_ideal else guard.max_penetration, guard.min_step,
@@ -114,6 +115,8 @@ def integrate_compiled(scene: Scene, progress=None, method: str = "numba_DOP853"
         "segments": int(ist[SEGMENTS]),
         "contact_events": int(ist[EVENTS]),
         "impacts": int(ist[IMPACTS]),
+        "rate_peaks": int(ist[PEAKS]),
+        "nonpositive_onsets": int(ist[NONPOSITIVE]),
         "wall_time_s": wall,
     }
     events = {

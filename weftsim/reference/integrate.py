@@ -6,16 +6,23 @@ The run is cut into segments at contact onset (delta crosses 0 upwards) and sepa
 so that the loop sees every accepted step (recorded for peaks), evaluates the uniform
 output grid through the step's dense output, detects the events and reports progress.
 
-Events are located on the dense output of the step that crossed (Illinois regula
-falsi to ~1e-13 s), and the located state is taken from the side of the root that the
-new segment needs: a contact segment starts with delta >= 0, a free one with delta <= 0,
-so the next event is always a genuine crossing.  At onset the penetration rate of the
-located state is the impact velocity delta_dot^-, floored at ``joint.min_impact_velocity``
-and held until separation (SPEC.md section 2).  Restarting the solver at each event also
-keeps the method's order: the force law is only C^0 at delta = 0.
+Events are located on the dense output of the step (:mod:`.events`: onset, separation and,
+under the ``"max_approach"`` rule, the peak of the approach rate above the held impact
+velocity), and the located state is taken from the side of the root that the new segment
+needs: a contact segment starts with delta >= 0, a free one with delta <= 0.  A crossing counts
+only where delta rises (onset) or falls (separation), and the first one inside the step is
+taken, not only a change of sign between the step's ends.  At onset the penetration rate of
+the located state is the held impact velocity delta_dot^-, floored at
+``joint.min_impact_velocity``; under ``"max_approach"`` the contact force uses
+max(held, delta_dot) (:func:`weftsim.clearance.effective_impact_velocity`) and every maximum
+of delta_dot above the held value ends the segment with that maximum as the new held value,
+so delta_dot^- is exactly the largest approach rate since the onset.  Restarting the solver at
+each event also keeps the method's order: the force law is only C^0 at delta = 0 and at
+delta_dot = delta_dot^-.
 
-An impact that starts and ends within one step is not seen (as in every event-driven
-scheme); with max_step = 0.5 deg of crank it would need a graze shorter than 0.2 ms.
+The penetration guard looks at contact steps only: the end of a free-flight step that
+crossed into the bearing is not a state of the model (no contact force acted on it); the
+onset located inside the step is.
 """
 
 from __future__ import annotations
@@ -32,6 +39,7 @@ from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, Radau
 from weftsim.contact import make_law
 from weftsim.guards import RunGuard, failure_message, non_finite_breach
 from weftsim.params import Scene
+from weftsim.reference import events
 from weftsim.reference.dynamics import (
     ChainConstants,
     chain_dynamics,
@@ -65,13 +73,16 @@ _START_EVALS = 2
 # |state| beyond which an exception of the right-hand side is taken as the overflow of a
 # trial stage (angles in rad, rates in rad/s, energies in J: a real state is < ~1e4).
 _OVERFLOW_GUARD = 1e8
-_ROOT_XTOL = 1e-13  # s: event time accuracy (delta_dot ~ 1 m/s -> 1e-13 m in delta)
+_ROOT_XTOL = events.ROOT_XTOL
 _PROGRESS_EVERY = 0.01  # report progress every 1 % of the run
 # Dense-output points recorded inside every step of a contact segment (besides the step ends):
 # an impact pulse spans a few tens of steps, and its peak read at the step ends alone is low by
 # up to ~1e-4 relative (DOP853, rtol 1e-9); 3 interior points cut that ~16-fold.
 _CONTACT_SUBSTEPS = 3
 _SUBSTEP_FRACTIONS = np.arange(1, _CONTACT_SUBSTEPS + 1) / (_CONTACT_SUBSTEPS + 1.0)
+# The event search grid of a step: its ends and the contact substeps (events.SAMPLES intervals).
+_GRID = np.linspace(0.0, 1.0, events.SAMPLES + 1)
+assert events.SAMPLES == _CONTACT_SUBSTEPS + 1
 
 
 @dataclass
@@ -151,32 +162,6 @@ def make_rhs(p: ChainConstants, backend, counter: list):
     return free, contact_factory
 
 
-def _locate(gfun, lo, hi, g_lo, g_hi, new_side):
-    """Root of g between lo (old side) and hi (new side), returned on the new side.
-
-    Illinois regula falsi with the bracket kept; ``new_side(g)`` is True on the new side.
-    """
-    last = 0
-    for _ in range(200):
-        if hi - lo <= _ROOT_XTOL:
-            break
-        m = hi - g_hi * (hi - lo) / (g_hi - g_lo)
-        if not lo < m < hi:
-            m = 0.5 * (lo + hi)
-        g_m = gfun(m)
-        if new_side(g_m):
-            hi, g_hi = m, g_m
-            if last == -1:
-                g_lo *= 0.5
-            last = -1
-        else:
-            lo, g_lo = m, g_m
-            if last == 1:
-                g_hi *= 0.5
-            last = 1
-    return hi
-
-
 def integrate(scene: Scene, progress=None) -> Trajectory:
     """Integrate the clearance-mode equations from t = 0 to the scene's end time.
 
@@ -215,7 +200,8 @@ def _integrate(scene: Scene, progress) -> Trajectory:
     t, y = 0.0, initial_state(scene)
     contact, impact = False, 0.0
     next_sample = 0
-    n_steps = n_segments = n_events = n_dense = n_impacts = 0
+    n_steps = n_segments = n_events = n_dense = n_impacts = n_peaks = n_nonpositive = 0
+    track_max = joint.impact_velocity_rule == "max_approach"
     solver_evals = njev = nlu = 0
     first_contact = None
     max_penetration_rate = 0.0
@@ -241,9 +227,11 @@ def _integrate(scene: Scene, progress) -> Trajectory:
             fail(f"cannot start a segment ({type(exc).__name__}: {exc})")
             break
         n_segments += 1
-        event = None
+        event = None  # (kind, time, value): "onset" / "separation" (value: rate), "peak" (value: new held)
+        g_old, r_old = penetration(p, t, y)
+        sign = -1.0 if contact else 1.0  # the crossing looked for: delta falls (contact) / rises (free)
         while solver.status == "running":
-            t_old, y_old = solver.t, np.array(solver.y)
+            t_old = solver.t
             non_finite_before = counter[1]
             try:
                 message = solver.step()
@@ -270,12 +258,15 @@ def _integrate(scene: Scene, progress) -> Trajectory:
             n_steps += 1
             t_new, y_new = solver.t, solver.y
             finite = bool(np.all(np.isfinite(y_new)))
-            g_new = penetration(p, t_new, y_new)[0] if finite else math.nan
+            g_new, r_new = penetration(p, t_new, y_new) if finite else (math.nan, math.nan)
             # The step that lands on the end time is cut to fit and may be arbitrarily short.
             h = t_new - t_old if t_new < t_end else None
             if h is not None:
                 min_step = min(min_step, h)
-            breach = guard.check(penetration=None if joint.is_ideal else g_new, step_size=h, finite=finite)
+            # Only a contact step's end is a state of the model; a free step that ran into the
+            # bearing is cut at the onset below.
+            watched = None if (joint.is_ideal or not contact) else g_new
+            breach = guard.check(penetration=watched, step_size=h, finite=finite)
             if breach is not None and breach.kind == "step_size" and counter[1] > non_finite_before:
                 breach = non_finite_breach(
                     f"the right-hand side turned non-finite (NaN or inf) in the trials of this step, which "
@@ -287,16 +278,35 @@ def _integrate(scene: Scene, progress) -> Trajectory:
                     traj.add_step(t, y_new, contact, impact)
                 fail(breach.what, breach.hint, breach.kind)
                 break
-            crossed = (g_new < 0.0) if contact else (g_new > 0.0)
             t_stop = t_new
             dense = None
-            if crossed:
+            grid = None
+            possible = (sign * g_new > 0.0 or sign * r_old > 0.0 > sign * r_new) and not joint.is_ideal
+            if contact or possible:
                 dense = solver.dense_output()
                 n_dense += 1
-                g_old, _ = penetration(p, t_old, y_old)
-                side = (lambda g: g < 0.0) if contact else (lambda g: g > 0.0)
-                t_stop = _locate(lambda s: penetration(p, s, dense(s))[0], t_old, t_new, g_old, g_new, side)
-                event = t_stop
+                grid = t_old + (t_new - t_old) * _GRID
+                inner = [penetration(p, s, ys) for s, ys in zip(grid[1:-1], dense(grid[1:-1]).T)]
+                deltas = [g_old] + [d for d, _ in inner] + [g_new]
+                rates = [r_old] + [r for _, r in inner] + [r_new]
+
+                def state(s, dense=dense):
+                    return penetration(p, s, dense(s))
+
+                found = events.first_crossing(state, grid, deltas, rates, sign) if possible else None
+                if found is not None:
+                    t_stop = found[0]
+                    event = ("separation" if contact else "onset", t_stop, sign * found[1])
+                if contact and track_max:
+                    times, rs = list(grid), list(rates)
+                    if event is not None:  # the approach rate counts up to the separation only
+                        keep = [i for i, s in enumerate(times) if s < t_stop]
+                        times = [times[i] for i in keep] + [t_stop]
+                        rs = [rs[i] for i in keep] + [event[2]]
+                    peak = events.rate_peak(lambda s: state(s)[1], times, rs, impact)
+                    if peak is not None:
+                        t_stop = peak[0]
+                        event = ("peak", t_stop, peak[1])
             if next_sample < len(sample_times) and sample_times[next_sample] <= t_stop:
                 if dense is None:
                     dense = solver.dense_output()
@@ -307,16 +317,14 @@ def _integrate(scene: Scene, progress) -> Trajectory:
                 next_sample = stop
             if contact and _CONTACT_SUBSTEPS:
                 # Impacts last tens of steps: read the pulse between steps too, for its peaks.
-                if dense is None:
-                    dense = solver.dense_output()
-                    n_dense += 1
                 ts = t_old + (t_stop - t_old) * _SUBSTEP_FRACTIONS
                 for t_sub, y_sub in zip(ts, dense(ts).T):
                     traj.add_step(t_sub, y_sub, contact, impact)
             if event is not None:
-                t, y = event, dense(event)
+                t, y = t_stop, dense(t_stop)
                 break
             t, y = t_new, y_new
+            g_old, r_old = g_new, r_new
             traj.add_step(t, y, contact, impact)
             if progress is not None and t >= next_report * t_end:
                 progress(t / t_end)
@@ -327,10 +335,16 @@ def _integrate(scene: Scene, progress) -> Trajectory:
         if event is None:
             continue
         n_events += 1
-        if contact:
+        kind, _, value = event
+        if kind == "separation":
             contact, impact = False, 0.0
+        elif kind == "peak":
+            impact = value
+            n_peaks += 1
         else:
-            rate = penetration(p, t, y)[1]
+            rate = value
+            if not rate > 0.0:
+                n_nonpositive += 1  # no rising root found: counted, and judged by weftsim.guards
             max_penetration_rate = max(max_penetration_rate, rate)
             contact, impact = True, max(rate, joint.min_impact_velocity)
             n_impacts += 1
@@ -357,6 +371,8 @@ def _integrate(scene: Scene, progress) -> Trajectory:
         "segments": n_segments,
         "contact_events": n_events,
         "impacts": n_impacts,
+        "rate_peaks": n_peaks,
+        "nonpositive_onsets": n_nonpositive,
         "min_step_s": min_step if math.isfinite(min_step) else None,
         "wall_time_s": wall,
         **({"failure": traj.stats["failure"]} if "failure" in traj.stats else {}),
