@@ -53,7 +53,8 @@ def main(argv: list[str] | None = None) -> int:
     section = name if args.section is None else args.section
     try:
         if not args.revolutions > 1:
-            raise StudyError(f"--revolutions must be > 1 (revolution 1 is left out of the median), got {args.revolutions}")
+            raise StudyError(f"--revolutions must be > 1 (revolution 1 is left out of the median), "
+                             f"got {args.revolutions}")
         overrides = tuple(parse_set(text) for text in args.set)
         methods = args.methods.split(",") if args.methods else None
         if args.flores:

@@ -161,7 +161,8 @@ def test_flores_cells():
     assert {(dict(c.overrides)["joint_e.impact_velocity_rule"], c.method) for c in cells} == {
         (rule, m) for rule in ("onset", "max_approach") for m in ("numba_DOP853", "DOP853")}
     scene = cells[0].scene()
-    assert (scene.joint.law, scene.joint.restitution, scene.reference_solver.atol) == ("flores", 0.3, pytest.approx(1e-12))
+    assert (scene.joint.law, scene.joint.restitution) == ("flores", 0.3)
+    assert scene.reference_solver.atol == pytest.approx(1e-12)
     only = flores_cells(MODELS, overrides=(("joint_e.impact_velocity_rule", "onset"),))
     assert {dict(c.overrides)["joint_e.impact_velocity_rule"] for c in only} == {"onset"} and len(only) == 2
 

@@ -100,6 +100,12 @@ class Cell:
         return load_scene(self.scene_file, overrides)
 
 
+def _check_methods(methods) -> None:
+    unknown = [m for m in methods if m not in STUDY_RTOLS]
+    if unknown:
+        raise StudyError(f"--methods: unknown method(s) {unknown}; allowed: {sorted(STUDY_RTOLS)}")
+
+
 def study_cells(models: str | Path, methods=None, only=None, revolutions=STUDY_REVOLUTIONS,
                 overrides=()) -> list[Cell]:  # fmt: skip
     """Cells of the study: ``models/paper/*.toml`` x :data:`STUDY_RTOLS`, compiled method first (fastest).
@@ -107,9 +113,7 @@ def study_cells(models: str | Path, methods=None, only=None, revolutions=STUDY_R
     ``methods``: subset of :data:`STUDY_RTOLS`; ``only``: keep scenes whose name contains one of these.
     """
     methods = list(methods or STUDY_RTOLS)
-    unknown = [m for m in methods if m not in STUDY_RTOLS]
-    if unknown:
-        raise StudyError(f"--methods: unknown method(s) {unknown}; allowed: {sorted(STUDY_RTOLS)}")
+    _check_methods(methods)
     files = sorted((Path(models) / "paper").glob("*.toml"))
     if not files:
         raise StudyError(f"no scene files in {Path(models) / 'paper'}; run from the repository root or pass --models")
@@ -118,7 +122,8 @@ def study_cells(models: str | Path, methods=None, only=None, revolutions=STUDY_R
         if not files:
             raise StudyError(f"--only {' '.join(only)}: matches none of the paper scenes")
     order = sorted(methods, key=lambda m: not m.startswith("numba"))
-    return [Cell(str(f), m, rtol, revolutions, tuple(overrides)) for m in order for f in files for rtol in STUDY_RTOLS[m]]
+    return [Cell(str(f), m, rtol, revolutions, tuple(overrides))
+            for m in order for f in files for rtol in STUDY_RTOLS[m]]  # fmt: skip
 
 
 def flores_cells(models: str | Path, methods=("numba_DOP853", "DOP853"), rtol: float = 1e-9,
@@ -128,9 +133,7 @@ def flores_cells(models: str | Path, methods=("numba_DOP853", "DOP853"), rtol: f
     since the onset), unless ``overrides`` sets the rule.  rtol 1e-9 (atol 1e-12) is the reference
     scene's own tolerance, at which docs/hard-cases.md found the 1.13 MN lasting-contact peak.
     """
-    unknown = [m for m in methods if m not in STUDY_RTOLS]
-    if unknown:
-        raise StudyError(f"--methods: unknown method(s) {unknown}; allowed: {sorted(STUDY_RTOLS)}")
+    _check_methods(methods)
     path = Path(models) / "reference.toml"
     if not path.is_file():
         raise StudyError(f"scene file {path} not found; run from the repository root or pass --models")
@@ -138,7 +141,7 @@ def flores_cells(models: str | Path, methods=("numba_DOP853", "DOP853"), rtol: f
     rules = [given.pop("joint_e.impact_velocity_rule")] if "joint_e.impact_velocity_rule" in given else [
         "onset", "max_approach"]  # fmt: skip
     base = (("joint_e.law", "flores"), ("joint_e.restitution", 0.3))
-    return [Cell(str(path), m, rtol, revolutions, base + (("joint_e.impact_velocity_rule", rule),) + tuple(given.items()))
+    return [Cell(str(path), m, rtol, revolutions, (*base, ("joint_e.impact_velocity_rule", rule), *given.items()))
             for rule in rules for m in methods]  # fmt: skip
 
 
