@@ -12,6 +12,7 @@ the markers of ``--section``.
 
 ``--flores`` runs the flores ce = 0.3 case instead (models/reference.toml with law flores,
 restitution 0.3, each impact-velocity rule, numba_DOP853 and DOP853 at rtol 1e-9, 10 revolutions;
+``--methods numba_DOP853,DOP853,exudyn`` adds the Exudyn engine at the scene's settings, for the agreement of the peaks;
 weftsim.studies.outliers.flores_cells) into docs/data/contact-outliers-flores.csv and the
 section ``contact-outliers-flores``.  Measures: weftsim/studies/outliers.py.
 """

@@ -165,6 +165,8 @@ def test_flores_cells():
     assert scene.reference_solver.atol == pytest.approx(1e-12)
     only = flores_cells(MODELS, overrides=(("joint_e.impact_velocity_rule", "onset"),))
     assert {dict(c.overrides)["joint_e.impact_velocity_rule"] for c in only} == {"onset"} and len(only) == 2
+    exudyn = flores_cells(MODELS, methods=("exudyn",))[0].scene()  # the Exudyn row keeps the scene's solver
+    assert (exudyn.joint.law, exudyn.reference_solver.method) == ("flores", "auto")
 
 
 def test_replace_section(tmp_path):

@@ -41,6 +41,9 @@ STUDY_RTOLS = {
 # atol = rtol * 1e-3: the states (angles ~1 rad, rates ~10-100 rad/s) are resolved to rtol
 # relative; this is the pair of the issue's reproduction (rtol 1e-5, atol 1e-8).
 ATOL_PER_RTOL = 1e-3
+# The "method" of a flores-case row run on the Exudyn engine with the scene's own solver settings (its
+# first-revolution peak against the reference engine's); it has no onset rates (they need the state).
+EXUDYN = "exudyn"
 STUDY_REVOLUTIONS = 10
 OUTLIER_RATIOS = (1.5, 3.0)  # the thresholds the issue counts (peak / median of revolutions 2..N)
 
@@ -90,6 +93,8 @@ class Cell:
     def scene(self):
         from weftsim.scene import load_scene
 
+        if self.method == EXUDYN:
+            return load_scene(self.scene_file, {"drive.revolutions": self.revolutions, **dict(self.overrides)})
         overrides = {
             "solver.reference.method": self.method,
             "solver.reference.rtol": self.rtol,
@@ -100,10 +105,10 @@ class Cell:
         return load_scene(self.scene_file, overrides)
 
 
-def _check_methods(methods) -> None:
-    unknown = [m for m in methods if m not in STUDY_RTOLS]
+def _check_methods(methods, allowed=tuple(STUDY_RTOLS)) -> None:
+    unknown = [m for m in methods if m not in allowed]
     if unknown:
-        raise StudyError(f"--methods: unknown method(s) {unknown}; allowed: {sorted(STUDY_RTOLS)}")
+        raise StudyError(f"--methods: unknown method(s) {unknown}; allowed: {sorted(allowed)}")
 
 
 def study_cells(models: str | Path, methods=None, only=None, revolutions=STUDY_REVOLUTIONS,
@@ -132,8 +137,9 @@ def flores_cells(models: str | Path, methods=("numba_DOP853", "DOP853"), rtol: f
     impact-velocity rule (``onset``, the literature's; ``max_approach``, the largest approach rate
     since the onset), unless ``overrides`` sets the rule.  rtol 1e-9 (atol 1e-12) is the reference
     scene's own tolerance, at which docs/hard-cases.md found the 1.13 MN lasting-contact peak.
+    ``methods`` may include :data:`EXUDYN` (the Exudyn engine at the scene's own settings).
     """
-    _check_methods(methods)
+    _check_methods(methods, (*STUDY_RTOLS, EXUDYN))
     path = Path(models) / "reference.toml"
     if not path.is_file():
         raise StudyError(f"scene file {path} not found; run from the repository root or pass --models")
@@ -221,11 +227,15 @@ def revolution_peaks(result, channel: str = "contact_force_N") -> list[float]:
 
 
 def measure(cell: Cell) -> dict:
-    """Run one cell on the reference engine and return its CSV row (see :func:`csv_fields`)."""
-    from weftsim.analysis import complete_revolutions
+    """Run one cell and return its CSV row (see :func:`csv_fields`); an :data:`EXUDYN` cell has
+    the peak and cost columns only."""
     from weftsim.reference import solve
 
     scene = cell.scene()
+    if cell.method == EXUDYN:
+        from weftsim.exudyn_engine import solve as exudyn_solve
+
+        return _peak_columns(cell, scene, exudyn_solve(scene))
     raw = {}
 
     def keep(t, y, contact, impact):
@@ -234,10 +244,7 @@ def measure(cell: Cell) -> dict:
     result = solve(scene, step_states=keep)
     if not raw:
         raise StudyError(f"{cell.scene_name}: the reference engine gave no step states (ideal joint?)")
-    peaks = revolution_peaks(result)
-    median, worst, worst_rev = peak_ratios(peaks)
-    acc = np.abs(result.steps["rapier_acceleration_m_s2"])
-    later = result.steps["time_s"] >= scene.drive.period
+    row = _peak_columns(cell, scene, result)
     found = onsets(scene, raw["t"], raw["y"], raw["contact"], raw["impact"])
     # result.steps holds one row per raw row (both reference paths build its channels from them)
     if result.steps["time_s"].size != raw["t"].size:
@@ -246,14 +253,7 @@ def measure(cell: Cell) -> dict:
     nonpositive = found.approach_rate_m_s <= 0.0
     engine_count = result.solver_stats.get("nonpositive_onsets", result.events.get("nonpositive_onsets"))
     omega = scene.drive.speed
-    row = {
-        "scene": cell.scene_name, "method": cell.method, "rtol": f"{cell.rtol:.0e}", "atol": f"{cell.atol:.0e}",
-        "overrides": cell.overrides_text, "impact_velocity_rule": scene.joint.impact_velocity_rule,
-        "status": result.status, "message": result.message, "revolutions": complete_revolutions(result),
-        "median_peak_N": median, "worst_ratio": worst, "worst_revolution": worst_rev,
-        "max_abs_acceleration_m_s2": float(acc.max()) if acc.size else math.nan,
-        "max_abs_acceleration_after_rev1_m_s2": float(acc[later].max()) if later.any() else math.nan,
-        "steps": result.solver_stats.get("steps"), "wall_time_s": round(result.wall_time_s, 2),
+    row.update({
         "onsets": int(found.time_s.size), "nonpositive_onsets": int(nonpositive.sum()),
         "engine_nonpositive_onsets": "" if engine_count is None else int(engine_count),
         "onsets_below_floor": int((found.approach_rate_m_s < scene.joint.min_impact_velocity).sum()),
@@ -262,6 +262,26 @@ def measure(cell: Cell) -> dict:
         "nonpositive_onset_angles_deg": " ".join(f"{math.degrees(omega * t):.2f}" for t in found.time_s[nonpositive]),
         "negative_penetration_rows_in_contact": neg_rows,
         "contact_segments_with_negative_penetration": neg_segments,
+    })  # fmt: skip
+    return row
+
+
+def _peak_columns(cell: Cell, scene, result) -> dict:
+    """The columns of a row that need only the channels: identity, status, peaks, cost."""
+    from weftsim.analysis import complete_revolutions
+
+    peaks = revolution_peaks(result)
+    median, worst, worst_rev = peak_ratios(peaks)
+    acc = np.abs(result.steps["rapier_acceleration_m_s2"])
+    later = result.steps["time_s"] >= scene.drive.period
+    row = {
+        "scene": cell.scene_name, "method": cell.method, "rtol": f"{cell.rtol:.0e}", "atol": f"{cell.atol:.0e}",
+        "overrides": cell.overrides_text, "impact_velocity_rule": scene.joint.impact_velocity_rule,
+        "status": result.status, "message": result.message, "revolutions": complete_revolutions(result),
+        "median_peak_N": median, "worst_ratio": worst, "worst_revolution": worst_rev,
+        "max_abs_acceleration_m_s2": float(acc.max()) if acc.size else math.nan,
+        "max_abs_acceleration_after_rev1_m_s2": float(acc[later].max()) if later.any() else math.nan,
+        "steps": result.solver_stats.get("steps"), "wall_time_s": round(result.wall_time_s, 2),
     }  # fmt: skip
     for k in range(int(math.ceil(cell.revolutions))):
         row[f"peak_rev{k + 1}_N"] = peaks[k] if k < len(peaks) else math.nan
