@@ -69,8 +69,8 @@ def test_the_scene_ensemble_median_catches_a_run_broken_for_most_revolutions():
     assert len(ratios) == 4  # the failed run has no ratio
     # c's worst is exactly 1.5x: "above" is strict, so only b counts
     text = markdown_report(rows, "cmd")
-    assert "**0** above 1.5x, **0** above 3x; against the scene's ensemble median (all its runs): " \
-           "**1** above 1.5x, **1** above 3x" in text  # fmt: skip
+    assert "own revolutions 2..N: **0** above 1.5x, **0** above 3x (largest 1.50x)" in text
+    assert "ensemble median (all its runs): **1** above 1.5x, **1** above 3x (largest 20.00x)" in text
     assert "- failed: t `numba_DOP853` rtol 1e-06" in text
 
 

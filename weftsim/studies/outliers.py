@@ -404,8 +404,10 @@ def _onset_lines(rows: list[dict]) -> list[str]:
         def total(name):
             return sum(int(_float(r, name)) for r in mine)
 
+        counted = [r for r in mine if r.get("engine_nonpositive_onsets", "") != ""]
+        engine = f"; the engine counts {total('engine_nonpositive_onsets')}" if len(counted) == len(mine) else ""
         lines.append(f"- `{method}`, {len(mine)} runs: **{total('nonpositive_onsets')}** onsets with a non-positive "
-                     f"approach rate (in {sum(_float(r, 'nonpositive_onsets') > 0 for r in mine)} runs) of "
+                     f"approach rate (in {sum(_float(r, 'nonpositive_onsets') > 0 for r in mine)} runs{engine}) of "
                      f"{total('onsets')} onsets; {total('contact_segments_with_negative_penetration')} contact "
                      "segments with a negative penetration at a recorded row inside (missed separations)")  # fmt: skip
     for r in rows:
@@ -418,10 +420,12 @@ def markdown_report(rows: list[dict], command: str) -> str:
     """The frequency study as Markdown: outlier counts by both medians, onset defects, one line per run."""
     ok = [r for r in rows if r.get("status") == "success"]
     pooled = ensemble_ratios(rows)
+    own = [_float(r, "worst_ratio") for r in ok]
     lines = [f"Regenerate: `{command}`", "",
              f"{len(rows)} runs, {len(ok)} successful.  Worst revolution after the first against the median of "
-             f"the run's own revolutions 2..N: {_counts(_float(r, 'worst_ratio') for r in ok)}; against the "
-             f"scene's ensemble median (all its runs): {_counts(pooled.values())}.", ""]  # fmt: skip
+             f"the run's own revolutions 2..N: {_counts(own)} (largest {np.nanmax(own, initial=0.0):.2f}x); "
+             f"against the scene's ensemble median (all its runs): {_counts(pooled.values())} (largest "
+             f"{max(pooled.values(), default=0.0):.2f}x).", ""]  # fmt: skip
     lines += _onset_lines(rows)
     lines += ["", "| scene | method | rtol | worst / run median (rev) | worst / scene median | worst peak (N) | "
               "run median 2..N (N) | rev 1 peak (N) | max abs(a) (m/s²) | steps | wall (s) | onsets | "
