@@ -87,16 +87,19 @@ def compiled_method(scene: Scene) -> str | None:
     return method if method in COMPILED_METHODS else None
 
 
-def _solve_clearance(scene: Scene, progress) -> RunResult:
+def _solve_clearance(scene: Scene, progress, step_states) -> RunResult:
     method = compiled_method(scene)
     if method is not None:
         from weftsim.reference.compiled_run import solve_compiled
 
-        return solve_compiled(scene, progress, method)
+        return solve_compiled(scene, progress, method, step_states)
     from weftsim.reference.channels import clearance_channels
     from weftsim.reference.integrate import integrate
 
     traj = integrate(scene, progress)
+    if step_states is not None:
+        states = np.array(traj.step_y).reshape(-1, 6)
+        step_states(np.array(traj.step_t), states, np.array(traj.step_contact, dtype=bool), np.array(traj.step_impact))
     wall0 = _time.perf_counter()
 
     def channels(t, y, contact, impact):
@@ -112,7 +115,7 @@ def _solve_clearance(scene: Scene, progress) -> RunResult:
     return RunResult(scene, "reference", traj.status, traj.message, samples, steps, stats, traj.events)
 
 
-def solve(scene: Scene, progress=None) -> RunResult:
+def solve(scene: Scene, progress=None, step_states=None) -> RunResult:
     """Run the reference solver on a scene.
 
     Parameters
@@ -124,6 +127,12 @@ def solve(scene: Scene, progress=None) -> RunResult:
         LSODA with friction; rtol, atol, max_step as crank angle).
     progress : callable, optional
         Called with the completed fraction in [0, 1].
+    step_states : callable, optional
+        Clearance mode only: called once, after the integration, as
+        ``step_states(t, y, contact, impact)`` with the raw rows behind ``result.steps``
+        (times (N,) s; states (N, 6) [a, psi, a', psi', W3, D]; the segment's mode (N,) bool;
+        the held impact velocity (N,) m/s), for analyses that need the state itself, e.g.
+        the approach rate at each contact onset (:mod:`weftsim.studies.outliers`).
 
     Returns
     -------
@@ -136,6 +145,9 @@ def solve(scene: Scene, progress=None) -> RunResult:
     if problem is not None:
         return RunResult(scene, "reference", "failed", problem, empty_channels(), empty_channels(),
                          {"wall_time_s": 0.0}, {"first_contact_time_s": None})  # fmt: skip
-    result = _solve_ideal(scene, progress) if scene.joint.is_ideal else _solve_clearance(scene, progress)
+    if scene.joint.is_ideal:
+        result = _solve_ideal(scene, progress)
+    else:
+        result = _solve_clearance(scene, progress, step_states)
     # Post-run criteria (energy balance, ...) that no single step shows; see weftsim.guards.
     return vet_result(result)

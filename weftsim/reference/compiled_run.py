@@ -130,16 +130,20 @@ def integrate_compiled(scene: Scene, progress=None, method: str = "numba_DOP853"
     return steps, samples, stats, events, status, message
 
 
-def solve_compiled(scene: Scene, progress=None, method: str | None = None) -> RunResult:
+def solve_compiled(scene: Scene, progress=None, method: str | None = None, step_states=None) -> RunResult:
     """The reference engine's clearance mode through the compiled integrator.
 
     ``method``: one of :data:`METHODS`; default ``scene.reference_solver.method``.
+    ``step_states``: optional callable given the raw step rows (t, y, contact, impact), as
+    in :func:`weftsim.reference.solve`.
     """
     from weftsim.reference.compiled_channels import compiled_channels
     from weftsim.results import empty_channels
 
     steps, samples, stats, events, status, message = integrate_compiled(
         scene, progress, method or scene.reference_solver.method)
+    if step_states is not None:
+        step_states(*steps)
     wall0 = _time.perf_counter()
 
     def channels(arrays):
