@@ -152,55 +152,99 @@ def figures(result) -> dict[str, float]:
     return out
 
 
+def contact_depths(result) -> np.ndarray:
+    """Largest penetration of each contact (from an onset to the next separation), m."""
+    st = result.steps
+    contact = st["in_contact"] > 0
+    separations = np.flatnonzero(contact[:-1] & ~contact[1:]) + 1
+    depths = []
+    for start in onsets(result):
+        later = separations[separations > start]
+        end = int(later[0]) if later.size else contact.size
+        depths.append(st["penetration_m"][start:end].max())
+    return np.array(depths)
+
+
+# A contact whose penetration never exceeds this is a tangency of delta(t) with 0, not an impact: its
+# elastic force, and the damping force proportional to it, are ~0 whatever the held velocity.  In the
+# creep window 1e-15 m is 30x the deepest tangency measured (3.0e-17 m, round-off of the 0.25 mm
+# clearance) and 1e-9 of the shallowest real re-contact (0.92 um).
+TANGENCY_DEPTH = 1e-15
+
+
 @pytest.mark.slow
 def test_impact_velocity_floor_keeps_damping_finite_and_results_do_not_hinge_on_it():
+    """Every floor keeps the held velocity, so the damping, finite; a floor changes the results only
+    where real onsets are slower than it.  Which onsets are slow depends on the event location and the
+    held-velocity rule (the engine of issue 7 found two real onsets at 5.7e-4 and 6.0e-4 m/s and 9
+    tangencies below 1e-6 m/s; with the largest-approach rule and the corrected event location of issue
+    11 every onset is above 1.5e-3 m/s), so the test reads them from the run instead of naming them."""
     runs = {v: reference.solve(revolutions(CREEP, 0.1, min_impact_velocity=v)) for v in FLOORS}
     for v, r in runs.items():
         assert_finite_and_bounded(r)
-        st, starts = r.steps, onsets(r)
+        st = r.steps
         inside = st["in_contact"] > 0
         # The held impact velocity never goes below the floor, so D = xi F_el / v_imp stays finite.
         assert np.all(st["impact_velocity_m_s"][inside] >= v)
         assert np.all(np.isfinite(damping(r)))
-        # Grazing onsets exist: some were slower than even the lowest floor and were held at it.
-        assert np.sum(st["impact_velocity_m_s"][starts] == v) >= 1, v
-        assert len(starts) > 40  # the gentle re-contacts of a journal resting on the wall
-    # Floors of 1e-6 .. 1e-4 m/s: every result is the same to round-off.  The grazing onsets they
-    # touch are tangencies (penetration ~1e-17 m for no measurable time), where F_el ~ 0 whatever
-    # the damping; every real onset here is faster than 1e-4 m/s.
-    base = figures(runs[1e-4])
-    for v in (1e-6, 1e-5):
-        for key, value in figures(runs[v]).items():
-            assert value == pytest.approx(base[key], rel=1e-9), (v, key)
-    # 1e-3 m/s is above two real onsets: it lowers their damping, and the dissipated energy changes
-    # (measured -6 %, the RMS torque +2 %) while the peaks do not.  Results hinge on v_min once it
-    # exceeds real onset velocities: keep it below the slowest one (docs/hard-cases.md).
-    high = figures(runs[1e-3])
-    for key in ("contact_force_N", "rapier_acceleration_m_s2", "driving_torque_Nm", "penetration_m"):
-        assert high[key] == pytest.approx(base[key], rel=1e-3), key
-    assert high["dissipated_energy_J"] != pytest.approx(base["dissipated_energy_J"], rel=1e-3)
+        assert len(onsets(r)) > 40  # the gentle re-contacts of a journal resting on the wall (measured 49-63)
+    lowest = runs[FLOORS[0]]
+    rates = lowest.steps["impact_velocity_m_s"][onsets(lowest)]  # approach rates, held at 1e-6 if slower
+    real = contact_depths(lowest) > TANGENCY_DEPTH
+    base = figures(lowest)
+    for v in FLOORS[1:]:
+        if not np.any(real & (rates < v)):
+            # Below every real onset: only tangencies are held at the floor, and the results are the same
+            # to round-off (measured identical).
+            for key, value in figures(runs[v]).items():
+                assert value == pytest.approx(base[key], rel=1e-9), (v, key)
+        else:
+            # Above some real onsets: their damping is lower (measured at 1e-3 m/s with the engine of issue
+            # 7: dissipated energy -5.8 %), but the peaks, set by faster impacts, stay within 0.1 %
+            # (measured unchanged).
+            # Results hinge on v_min once it exceeds real onset velocities: keep it below the slowest one.
+            for key in ("contact_force_N", "rapier_acceleration_m_s2", "driving_torque_Nm", "penetration_m"):
+                assert figures(runs[v])[key] == pytest.approx(base[key], rel=1e-3), (v, key)
+            assert figures(runs[v])["dissipated_energy_J"] != base["dissipated_energy_J"]
+    # The default floor, 1e-4 m/s, must be below every real onset of this gentle case.
+    assert not np.any(real & (rates < 1e-4))
 
 
 @pytest.mark.slow
 def test_floor_acts_only_from_the_first_onset_slower_than_it():
-    """E = 1000 GPa, one revolution at 400 rpm: a re-contact at ~300 deg comes at 6.5e-4 m/s.  Floors
-    up to 1e-4 leave the run bit for bit unchanged; 1e-3 holds that onset at 1e-3 and changes the run
-    from there on only (its first-revolution peak acceleration by -12 %, docs/hard-cases.md)."""
+    """E = 1000 GPa, one revolution at 400 rpm: the re-contacts after the start-up impact come at
+    mm/s.  A floor below the slowest onset leaves the run bit for bit unchanged; a floor above it holds
+    that onset at the floor and changes the run from there on only.
+
+    Which onset is the slowest, and how slow, depends on the event location and the held-velocity
+    rule (measured 6.5e-4 m/s at ~300 deg in issue 7, 2.0e-3 m/s at 285 deg and 5.0e-3 m/s at 282 deg
+    with later versions of the reference engine), so the test finds it in the run instead of naming it.
+    """
     stiff = revolutions(STEEL, 1.0, journal_material=Material(1000e9, 0.3), bearing_material=Material(1000e9, 0.3))
-    runs = {v: reference.solve(revolutions(stiff, 1.0, min_impact_velocity=v)) for v in (1e-5, 1e-4, 1e-3)}
-    for r in runs.values():
-        assert_finite_and_bounded(r)
-    assert figures(runs[1e-5]) == figures(runs[1e-4])
-    low, high = runs[1e-4], runs[1e-3]
-    floored = [i for i in onsets(high) if high.steps["impact_velocity_m_s"][i] == 1e-3]
-    assert floored, "expected an onset slower than 1e-3 m/s"
+    low = reference.solve(revolutions(stiff, 1.0, min_impact_velocity=1e-5))
+    assert_finite_and_bounded(low)
+    slowest = float(low.steps["impact_velocity_m_s"][onsets(low)].min())
+    # Floors a decade apart: one below the slowest onset and the first one above it.  The start-up impact
+    # comes at 0.18 m/s, so 0.1 m/s is the highest floor that can only touch the re-contacts.
+    floors = (1e-5, 1e-4, 1e-3, 1e-2, 1e-1)
+    assert 1e-5 < slowest < floors[-1], slowest
+    below = max(v for v in floors if v < slowest)
+    above = min(v for v in floors if v > slowest)
+    unchanged = reference.solve(revolutions(stiff, 1.0, min_impact_velocity=below))
+    assert figures(unchanged) == figures(low)
+    high = reference.solve(revolutions(stiff, 1.0, min_impact_velocity=above))
+    assert_finite_and_bounded(high)
+    floored = [i for i in onsets(high) if high.steps["impact_velocity_m_s"][i] == above]
+    assert floored, f"expected the onset at {slowest:.3g} m/s to be held at the floor {above:g} m/s"
     t_floor = high.steps["time_s"][floored[0]]
     n = int(np.searchsorted(low.steps["time_s"], t_floor))
     # Identical up to that onset (same steps, same states) ...
     for name in CHANNELS:
         np.testing.assert_array_equal(high.steps[name][:n], low.steps[name][:n], err_msg=name)
-    # ... and the raw onset velocity there was indeed below 1e-3 (with the low floor it is held unfloored).
-    assert 1e-4 < low.steps["impact_velocity_m_s"][n] < 1e-3
+    # ... where the raw onset velocity (held unfloored with the low floor) was below the floor ...
+    assert low.steps["impact_velocity_m_s"][n] < above
+    # ... and from where the run differs (a lower contact damping D = xi F_el / v_imp).
+    assert high.steps["dissipated_energy_J"][-1] != low.steps["dissipated_energy_J"][-1]
 
 
 @pytest.mark.slow

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.integrate import trapezoid
 
 from weftsim.params import Drive, Scene
 from weftsim.results import CHANNELS, RunResult
@@ -77,7 +78,7 @@ def test_bin_means_are_exact_for_a_piecewise_linear_signal():
     for k in range(3):
         keep = (fine >= edges[k]) & (fine <= edges[k + 1])
         # The fine trapezoid of a piecewise-linear function errs only at its kinks: ~(h/len)^2.
-        assert means[k] == pytest.approx(np.trapezoid(interpolant[keep], fine[keep]) / 0.5, abs=1e-8)
+        assert means[k] == pytest.approx(trapezoid(interpolant[keep], fine[keep]) / 0.5, abs=1e-8)
 
 
 def test_bin_means_reject_a_window_outside_the_data():
