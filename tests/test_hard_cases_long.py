@@ -80,13 +80,23 @@ def test_fifty_revolutions_without_drift(long_reference):
         # by ~1.5 % (1 SE) by chance; 5 % is ~3.4 SE.  Measured 2.2-2.4 %.  A drift of the steady cycle
         # (energy pumped in, a creeping journal) would show as a trend here.
         assert late == pytest.approx(early, rel=0.05), name
-    # The mechanism's energy at the start of every revolution (theta = 0 mod 360) stays put: measured
-    # 8.978-9.037 J, i.e. within 0.7 % of each other (no energy accumulates).
+    # The mechanism's energy at the start of every revolution (theta = 0 mod 360) does not accumulate.
+    # It scatters from revolution to revolution with the vibration the last impacts left in the chain:
+    # measured s = 0.46 J (4.8 %) about 9.63 J under the max_approach rule (0.7 % under the onset rule,
+    # whose slow onsets overdamped every lasting contact).  A drift shows as a difference of the two
+    # halves' means beyond chance: their chance difference has standard error s sqrt(2 / n) (1.4 % here;
+    # measured 2.6 %); 4 of it.
     ke = rev["kinetic_energy_at_start_J"]
-    assert ke.max() - ke.min() < 0.01 * ke.mean()
-    # The rapier stroke, 1.0578 m with the journal offset (ideal 1.052348 m): the same in every
-    # revolution to 0.25 mm (measured), far below the 5 mm that the clearance's lever could shift it.
-    assert rev["stroke_m"].max() - rev["stroke_m"].min() < 1e-3
+    chance = ke.std(ddof=1) * np.sqrt(2.0 / half)
+    assert abs(ke[half:].mean() - ke[:half].mean()) < 4.0 * chance
+    # The rapier stroke (1.0578 m with the journal offset; ideal 1.052348 m) varies between revolutions
+    # only by where the journal sits in its clearance at the stroke's ends: each end moves by at most
+    # (d5 d7 / d6) (c + delta_max) / L_FG (the journal displaced along the sector arm's tangent), 5.5 mm
+    # for the reference scene (0.675 m x 0.42 mm / 50 mm = 5.7 mm).  Measured 2.3 mm (0.25 mm under the
+    # onset rule).
+    geo, joint = r.scene.geometry, r.scene.joint
+    lever = geo.rapier_ratio * (joint.clearance + r.steps["penetration_m"].max()) / geo.l_fg
+    assert rev["stroke_m"].max() - rev["stroke_m"].min() < lever
     print(f"\nreference {LONG_REVOLUTIONS} revolutions: {r.solver_stats['steps']} steps, "
           f"{r.solver_stats['impacts']} impacts, wall {r.wall_time_s:.1f} s, energy residual "
           f"{balance['residual_J']:.3g} J of {balance['dissipated_energy_J']:.4g} J dissipated, max penetration "
@@ -107,8 +117,10 @@ def test_exudyn_steady_running_matches_the_long_reference_run(long_reference):
         # Mean of 3 steady revolutions against the 49 of the reference: per-revolution scatter 5 %, so
         # the 3-revolution mean has ~3 % standard error; 10 % is ~3 of it.
         assert ex[name].mean() == pytest.approx(ref[name].mean(), rel=0.10), name
-    # Same energy at every revolution start as the reference engine's steady cycle (within 1 %).
-    assert np.abs(ex["kinetic_energy_at_start_J"] / ref["kinetic_energy_at_start_J"].mean() - 1).max() < 0.01
+    # Energy at every revolution start within the reference engine's steady band: 4 of its measured
+    # revolution-to-revolution standard deviation (0.46 J about 9.63 J) from its mean.
+    band = 4.0 * ref["kinetic_energy_at_start_J"].std(ddof=1)
+    assert np.abs(ex["kinetic_energy_at_start_J"] - ref["kinetic_energy_at_start_J"].mean()).max() < band
     print(f"\nexudyn {EXUDYN_REVOLUTIONS} revolutions: {r.solver_stats['steps']} steps, wall {r.wall_time_s:.1f} s, "
           f"energy residual {balance['residual_J']:.3g} J of {balance['dissipated_energy_J']:.4g} J; RMS "
           + ", ".join(f"{n} {ex[n].mean():.4g} (reference {ref[n].mean():.4g})" for n in RMS_CHANNELS))
