@@ -1,15 +1,15 @@
 """Compiled path of the reference engine: the event-driven integration of
 :mod:`weftsim.reference.integrate` with the whole integrator in numba.
 
-scipy's ``DOP853`` and ``RK45`` are re-implemented step for step (same tableaux, taken from
-scipy; same initial step, error norm, step-size control and dense output), with the
+scipy's ``DOP853`` and ``RK45`` are re-implemented step for step in :mod:`.compiled_rk` (same
+tableaux, taken from scipy; same initial step, error norm, step-size control and dense output), with the
 right-hand side and the contact law of :mod:`weftsim.reference.compiled_kernel`.  What
 the scipy path pays per step in Python (stage combinations, error norm, dense-output
 objects, event location; ~50 us per step attempt, docs/reference-solver.md section 4)
 becomes a few microseconds.  Events, impact velocity, recorded steps (accepted steps,
 events, ``_CONTACT_SUBSTEPS`` dense points inside contact steps) and output samples
-follow :mod:`weftsim.reference.integrate` exactly, so both paths agree to the integration
-tolerance (``tests/test_fast_paths.py``).
+follow :mod:`weftsim.reference.integrate` and :mod:`weftsim.reference.events` exactly, so both
+paths agree to the integration tolerance (``tests/test_fast_paths.py``).
 
 Every function is module-level ``@njit(cache=True, error_model="numpy")`` and takes the scene as a parameter
 array: numba compiles once per machine (~9 s) and loads from its cache afterwards (~0.3 s).
@@ -25,26 +25,19 @@ import math
 
 import numpy as np
 from numba import njit
-from scipy.integrate import RK45 as _SCIPY_RK45
-from scipy.integrate._ivp import dop853_coefficients as _D853
 
-from weftsim.reference.compiled_kernel import CLEARANCE, TRACK_MAX, V_MIN, chain, penetration
+from weftsim.reference.compiled_kernel import CLEARANCE, TRACK_MAX, V_MIN, penetration
+from weftsim.reference.compiled_rk import (
+    _MAX_FACTOR, _MIN_FACTOR, _SAFETY, DOP853, RK45, N, _dense, _dense_coefficients, _error_norm, _f,
+    _initial_step, _stages,
+)  # fmt: skip
+from weftsim.reference.compiled_rk import DENSE as _RK_DENSE
+from weftsim.reference.compiled_rk import NFEV as _RK_NFEV
 from weftsim.reference.events import _GOLDEN_ITERATIONS, _INV_PHI, END_FRACTION, SAMPLES
 from weftsim.reference.integrate import _CONTACT_SUBSTEPS, _ROOT_XTOL
 
-DOP853, RK45 = 0, 1
 METHODS = {"numba_DOP853": DOP853, "numba_RK45": RK45}
 
-# Tableaux (scipy's own coefficients; DOP853 stages 12, f_new at row 12, 3 extra dense stages).
-_A853 = np.ascontiguousarray(_D853.A[: _D853.N_STAGES, : _D853.N_STAGES])
-_B853, _C853 = _D853.B.copy(), _D853.C[: _D853.N_STAGES].copy()
-_E3, _E5, _D = _D853.E3.copy(), _D853.E5.copy(), np.ascontiguousarray(_D853.D)
-_A853X = np.ascontiguousarray(_D853.A[_D853.N_STAGES + 1:])
-_C853X = _D853.C[_D853.N_STAGES + 1:].copy()
-_A45, _B45, _C45 = _SCIPY_RK45.A.copy(), _SCIPY_RK45.B.copy(), _SCIPY_RK45.C.copy()
-_E45, _P45 = _SCIPY_RK45.E.copy(), np.ascontiguousarray(_SCIPY_RK45.P)
-_SAFETY, _MIN_FACTOR, _MAX_FACTOR = 0.9, 0.2, 10.0  # scipy's step-size control
-N = 6  # state size
 
 # Return codes of the core.
 DONE, PAUSED, BUFFER_FULL, STEP_TOO_SMALL, NON_FINITE, GUARD = 0, 1, 2, -1, -2, -3
@@ -61,150 +54,11 @@ PENETRATION_LIMIT, MIN_STEP_LIMIT, STEP_BUDGET = range(3)
 # Int state: mode, segment to start, counters, next output sample.
 CONTACT, START, STEPS, REJECTED, NFEV, DENSE, SEGMENTS, EVENTS, IMPACTS, NEXT_SAMPLE, PEAKS, NONPOSITIVE = range(12)
 N_INT_STATE = 12
+assert (NFEV, DENSE) == (_RK_NFEV, _RK_DENSE)  # compiled_rk counts evaluations into the same int state
 # Kinds of event (weftsim.reference.events).
 NO_EVENT, ONSET, SEPARATION, PEAK = 0, 1, 2, 3
 # What _maximum maximizes on the dense output: sign * delta, -sign * delta, delta_dot.
 _G, _MINUS_G, _RATE = 0, 1, 2
-
-
-@njit(cache=True, error_model="numpy")
-def _rms(v):
-    s = 0.0
-    for i in range(v.size):
-        s += v[i] * v[i]
-    return math.sqrt(s / v.size)
-
-
-@njit(cache=True, error_model="numpy")
-def _f(prm, t, y, contact, impact, out, ist):
-    """y' into out; returns delta at (t, y) (the kernel computes it anyway)."""
-    ist[NFEV] += 1
-    return chain(prm, t, y, contact, impact, out)[2]
-
-
-@njit(cache=True, error_model="numpy")
-def _initial_step(prm, t0, y0, f0, t_end, max_step, order, rtol, atol, contact, impact, ist, tmp):
-    """scipy.integrate._ivp.common.select_initial_step (one extra evaluation)."""
-    scale = atol + np.abs(y0) * rtol
-    d0 = _rms(y0 / scale)
-    d1 = _rms(f0 / scale)
-    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
-    h0 = min(h0, t_end - t0)
-    _f(prm, t0 + h0, y0 + h0 * f0, contact, impact, tmp, ist)
-    d2 = _rms((tmp - f0) / scale) / h0
-    if d1 <= 1e-15 and d2 <= 1e-15:
-        h1 = max(1e-6, h0 * 1e-3)
-    else:
-        h1 = (0.01 / max(d1, d2)) ** (1.0 / (order + 1))
-    return min(100.0 * h0, h1, t_end - t0, max_step)
-
-
-@njit(cache=True, error_model="numpy")
-def _stages(prm, method, t, y, h, K, contact, impact, ist, y_new, tmp):
-    """One explicit RK step from K[0] = f(t, y): fills K (stages, f_new last), y_new.
-
-    Returns delta at the end of the step (from the last evaluation, f_new).
-    """
-    if method == DOP853:
-        A, B, C, n_st = _A853, _B853, _C853, 12
-    else:
-        A, B, C, n_st = _A45, _B45, _C45, 6
-    for s in range(1, n_st):  # as scipy's rk_step: y + (K^T a) h, y + h (K^T b)
-        tmp[:] = 0.0
-        for r in range(s):
-            a = A[s, r]
-            for j in range(N):
-                tmp[j] += K[r, j] * a
-        for j in range(N):
-            tmp[j] = y[j] + tmp[j] * h
-        _f(prm, t + C[s] * h, tmp, contact, impact, K[s], ist)
-    y_new[:] = 0.0
-    for r in range(n_st):
-        b = B[r]
-        for j in range(N):
-            y_new[j] += K[r, j] * b
-    for j in range(N):
-        y_new[j] = y[j] + h * y_new[j]
-    return _f(prm, t + h, y_new, contact, impact, K[n_st], ist)
-
-
-@njit(cache=True, error_model="numpy")
-def _error_norm(method, K, h, scale):
-    if method == DOP853:
-        e5 = 0.0
-        e3 = 0.0
-        for j in range(N):
-            a5 = 0.0
-            a3 = 0.0
-            for r in range(13):
-                a5 += K[r, j] * _E5[r]
-                a3 += K[r, j] * _E3[r]
-            a5 /= scale[j]
-            a3 /= scale[j]
-            e5 += a5 * a5
-            e3 += a3 * a3
-        if e5 == 0.0 and e3 == 0.0:
-            return 0.0
-        return abs(h) * e5 / math.sqrt((e5 + 0.01 * e3) * N)
-    s = 0.0
-    for j in range(N):
-        a = 0.0
-        for r in range(7):
-            a += K[r, j] * _E45[r]
-        a *= h / scale[j]
-        s += a * a
-    return math.sqrt(s / N)
-
-
-@njit(cache=True, error_model="numpy")
-def _dense_coefficients(prm, method, t_old, y_old, y_new, f_new, h, K, contact, impact, ist, F, tmp):
-    """Interpolant of the last step into F (DOP853: 7 rows of scipy's F; RK45: Q^T, 4 rows)."""
-    ist[DENSE] += 1
-    if method == DOP853:
-        for s in range(13, 16):
-            for j in range(N):
-                acc = 0.0
-                for r in range(s):
-                    acc += K[r, j] * _A853X[s - 13, r]
-                tmp[j] = y_old[j] + acc * h
-            _f(prm, t_old + _C853X[s - 13] * h, tmp, contact, impact, K[s], ist)
-        for j in range(N):
-            dy = y_new[j] - y_old[j]
-            F[0, j] = dy
-            F[1, j] = h * K[0, j] - dy
-            F[2, j] = 2.0 * dy - h * (f_new[j] + K[0, j])
-            for i in range(4):
-                acc = 0.0
-                for r in range(16):
-                    acc += _D[i, r] * K[r, j]
-                F[3 + i, j] = h * acc
-    else:
-        for i in range(4):
-            for j in range(N):
-                acc = 0.0
-                for r in range(7):
-                    acc += K[r, j] * _P45[r, i]
-                F[i, j] = acc
-
-
-@njit(cache=True, error_model="numpy")
-def _dense(method, F, t_old, h, y_old, t, out):
-    x = (t - t_old) / h
-    if method == DOP853:
-        for j in range(N):
-            acc = 0.0
-            for i in range(7):
-                acc += F[6 - i, j]
-                acc *= x if i % 2 == 0 else 1.0 - x
-            out[j] = acc + y_old[j]
-    else:
-        for j in range(N):
-            acc = 0.0
-            p = x
-            for i in range(4):
-                acc += F[i, j] * p
-                p *= x
-            out[j] = y_old[j] + h * acc
 
 
 @njit(cache=True, error_model="numpy")
