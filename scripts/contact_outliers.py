@@ -26,7 +26,7 @@ from pathlib import Path
 
 from weftsim.scene import SceneError
 from weftsim.studies.common import StudyError
-from weftsim.studies import outliers
+from weftsim.studies import outliers, outliers_report
 from weftsim.sweep_grid import SweepError, parse_set
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -71,8 +71,8 @@ def main(argv: list[str] | None = None) -> int:
             rows = outliers.read_rows(csv_path)
             command = "python scripts/contact_outliers.py " + shlex.join(
                 [a for a in argv if a not in ("--force", "--report-only")])
-            report = outliers.flores_report if args.flores else outliers.markdown_report
-            outliers.replace_section(args.doc, section, report(rows, command.strip()))
+            report = outliers_report.flores_report if args.flores else outliers_report.markdown_report
+            outliers_report.replace_section(args.doc, section, report(rows, command.strip()))
     except (StudyError, SceneError, SweepError) as exc:
         print(f"contact_outliers: {exc}", file=sys.stderr)
         return 2

@@ -18,16 +18,14 @@ from weftsim.scene import load_scene
 from weftsim.studies.common import StudyError
 from weftsim.studies.outliers import (
     Cell,
-    ensemble_ratios,
     flores_cells,
-    markdown_report,
     negative_penetration_in_contact,
     onset_rows,
     onsets,
     peak_ratios,
-    replace_section,
     study_cells,
 )
+from weftsim.studies.outliers_report import ensemble_ratios, markdown_report, replace_section
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = ROOT / "models"
