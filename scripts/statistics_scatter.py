@@ -1,6 +1,6 @@
 """How much the statistics that `weftsim compare` checks scatter within ONE engine (issue 11).
 
-After the first impacts the impact sequence is chaotic (SPEC.md section 6): any change far
+After the first impacts the impact sequence is chaotic (docs/hard-cases.md): any change far
 below the model's accuracy (here the crank speed times 1 + k 1e-9, k = 0..M-1) gives another,
 equally valid impact sequence.  The statistics over revolutions 2..N (RMS of rapier acceleration
 and driving torque, mean contact force, 99th percentiles of the magnitudes) then scatter; two

@@ -1,4 +1,4 @@
-"""Contact events and the held impact velocity of the reference engine (issue 11, SPEC.md section 2).
+"""Contact events and the held impact velocity of the reference engine (issue 11; docs/reference-solver.md section 3).
 
 - Event location (weftsim.reference.events): an onset is a rising crossing of delta, a separation a
   falling one; the root a segment starts from, seen through round-off, is never taken for a new event;

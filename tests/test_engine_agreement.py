@@ -1,4 +1,4 @@
-"""Exudyn against the closed-form reference engine over many revolutions (issue 4, issue 11, SPEC.md 6).
+"""Exudyn against the closed-form reference engine over many revolutions (issues 4 and 11).
 
 After the first impacts the impact sequence is chaotic: single revolutions differ between the engines
 (and within one engine under any change of step or tolerance) by 5-30 %.  What is reproducible, and
