@@ -9,7 +9,6 @@
 - The scenes that reported absurd forces as a success (issue 11) run clean on both reference paths.
 """
 
-import dataclasses
 import math
 from pathlib import Path
 
