@@ -9,6 +9,7 @@
 - The scenes that reported absurd forces as a success (issue 11) run clean on both reference paths.
 """
 
+import dataclasses
 import math
 from pathlib import Path
 
@@ -20,9 +21,7 @@ from weftsim.clearance import make_clearance_kernel
 from weftsim.contact import LAWS, make_law, restored_restitution
 from weftsim.params import ClearanceJoint
 from weftsim.reference import events, solve
-from weftsim.reference.compiled_run import integrate_compiled
 from weftsim.reference.dynamics import ChainConstants, penetration
-from weftsim.reference.integrate import integrate
 from weftsim.scene import load_scene
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
@@ -146,12 +145,13 @@ def test_driven_contact_damping_is_bounded_by_the_new_rule_only():
 
 
 def _raw_steps(scene, compiled):
+    """The raw rows (t, y, contact mode, held impact velocity) behind ``solve(scene).steps``."""
     if compiled:
-        (t, y, contact, impact), *_ = integrate_compiled(scene, method="numba_DOP853")
-        return t, y, contact, impact
-    traj = integrate(scene)
-    return (np.array(traj.step_t), np.array(traj.step_y), np.array(traj.step_contact, dtype=bool),
-            np.array(traj.step_impact))  # fmt: skip
+        scene = dataclasses.replace(scene, reference_solver=dataclasses.replace(scene.reference_solver,
+                                                                                 method="numba_DOP853"))
+    rows = []
+    assert solve(scene, step_states=lambda *arrays: rows.extend(arrays)).ok
+    return rows
 
 
 @pytest.mark.parametrize("compiled", [False, True], ids=["scipy", "compiled"])
