@@ -27,7 +27,7 @@ from pathlib import Path
 from weftsim.scene import SceneError
 from weftsim.studies.common import StudyError
 from weftsim.studies import outliers, outliers_report
-from weftsim.sweep_grid import SweepError, parse_set
+from weftsim.sweep.grid import SweepError, parse_set
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -337,7 +337,7 @@ def test_tree_model_settings_and_guards():
 
 
 def test_bench_errors_are_relative_and_means_relative_to_the_rms():
-    from weftsim.bench import QUANTITY_CHANNELS, errors
+    from weftsim.bench.measure import QUANTITY_CHANNELS, errors
 
     ref = {"revolutions": 10, "first_contact_deg": 6.6,
            "peak": {ch: 100.0 for ch in QUANTITY_CHANNELS},
@@ -356,8 +356,8 @@ def test_bench_errors_are_relative_and_means_relative_to_the_rms():
 
 
 def test_bench_measures_a_setting_and_reports_failures(tmp_path):
-    from weftsim import bench
-    from weftsim.bench_report import markdown
+    from weftsim.bench import measure as bench
+    from weftsim.bench.report import markdown
 
     ref = bench.converged_solution("c0.25mm-400rpm", "models", 1.0, log=lambda text: None)
     ok = bench.measure("c0.25mm-400rpm", bench._ref("numba_DOP853", 1e-6), ref, "models", 1.0, 2, 10.0, 0.5)
@@ -381,7 +381,7 @@ def test_bench_measures_a_setting_and_reports_failures(tmp_path):
 
 
 def _machine():
-    from weftsim.bench_report import machine_info
+    from weftsim.bench.report import machine_info
 
     return machine_info()
 

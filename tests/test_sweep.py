@@ -20,9 +20,9 @@ import pytest
 from weftsim.cli import EXIT_FAILED, EXIT_USAGE, main
 from weftsim.results import CHANNELS, RunResult
 from weftsim.sweep import plan_sweep, run_sweep
-from weftsim.sweep_cell import CELL_FILE, ERROR_FILE
-from weftsim.sweep_grid import SweepError, cell_name, grid_cells, parse_set, parse_vary
-from weftsim.sweep_store import TABLE_FILE, read_table
+from weftsim.sweep.cell import CELL_FILE, ERROR_FILE
+from weftsim.sweep.grid import SweepError, cell_name, grid_cells, parse_set, parse_vary
+from weftsim.sweep.store import TABLE_FILE, read_table
 
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE = ROOT / "models" / "reference.toml"

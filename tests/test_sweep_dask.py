@@ -10,7 +10,7 @@ import pytest
 
 from weftsim.cli import main
 from weftsim.sweep import plan_sweep, run_sweep
-from weftsim.sweep_store import TABLE_FILE, read_table
+from weftsim.sweep.store import TABLE_FILE, read_table
 
 distributed = pytest.importorskip("dask.distributed")
 

@@ -12,9 +12,7 @@ import math
 import sys
 from pathlib import Path
 
-EXIT_USAGE = 2  # bad scene, flag or output directory
-EXIT_FAILED = 3  # the simulation itself failed (partial results written)
-EXIT_DISAGREE = 4  # compare: engines disagree beyond the scene's tolerance
+from weftsim.exitcodes import EXIT_DISAGREE, EXIT_FAILED, EXIT_USAGE  # noqa: F401 (re-exported)
 
 
 class CliError(Exception):
@@ -228,27 +226,16 @@ def _report_run(result, written) -> None:
         print(f"  wrote {path}")
 
 
-def report_plausibility(result, label: str) -> None:
-    """The plausibility counts and each validity warning of a finished run, one line each on stderr
-    (``weftsim <label>: ...``; once per run, where its results are written).  A failed run says
-    only why it failed (its summary.json still holds the block)."""
-    from weftsim.plausibility import format_lines
-
-    if not result.ok:
-        return
-    for line in format_lines(result):
-        print(f"weftsim {label}: {line}", file=sys.stderr)
-
-
 def cmd_run(args) -> int:
     from weftsim.output import prepare_directory, write_run
+    from weftsim.plausibility import report_lines
 
     scene = _load(args)
     outdir = prepare_directory(_outdir(args, scene), args.force)
     result = _solve(scene, args.engine)
     written = write_run(result, outdir, figure=not args.no_plot, force=args.force)
     _report_run(result, written)
-    report_plausibility(result, "run")
+    report_lines(result, "run")
     if not result.ok:
         raise CliError(f"simulation failed: {result.message} (results up to the failure written to {outdir}, "
                        "marked incomplete in summary.json)", EXIT_FAILED)

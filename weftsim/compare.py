@@ -153,7 +153,8 @@ def format_report(report: dict) -> str:
 
 def run_compare(scene, outdir, as_json: bool, solve, force: bool = False) -> int:
     """Run both engines, write the overlay figure and both runs' files, print the report; exit status."""
-    from weftsim.cli import EXIT_DISAGREE, EXIT_FAILED, report_plausibility
+    from weftsim.exitcodes import EXIT_DISAGREE, EXIT_FAILED
+    from weftsim.plausibility import report_lines
     from weftsim.output import finish_directory, prepare_directory, to_json, write_figure, write_json, write_run
     from weftsim.plots import plot_channels
 
@@ -161,7 +162,7 @@ def run_compare(scene, outdir, as_json: bool, solve, force: bool = False) -> int
     results = {engine: solve(scene, engine) for engine in ("reference", "exudyn")}
     for engine, result in results.items():
         write_run(result, outdir / engine, figure=False, force=force)
-        report_plausibility(result, f"compare: {engine}")
+        report_lines(result, f"compare: {engine}")
     report = compare_results(results["exudyn"], results["reference"])
     written = {"json": write_json(outdir / "compare.json", report)}
     written["figure"] = write_figure(outdir / "compare.png", plot_channels(

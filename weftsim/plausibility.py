@@ -49,6 +49,7 @@ correct integration of the model produces.
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -320,3 +321,13 @@ def format_lines(result) -> list[str]:
         return []
     report = Plausibility(**{k: v if k != "warnings" else tuple(v) for k, v in block.items() if k != "defects"})
     return [report.summary_line()] + [f"warning: {text}" for text in report.warnings]
+
+
+def report_lines(result, label: str) -> None:
+    """The plausibility counts and each validity warning of a finished run, one line each on stderr
+    (``weftsim <label>: ...``; once per run, where its results are written).  A failed run says
+    only why it failed (its summary.json still holds the block)."""
+    if not result.ok:
+        return
+    for line in format_lines(result):
+        print(f"weftsim {label}: {line}", file=sys.stderr)

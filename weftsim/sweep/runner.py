@@ -2,12 +2,12 @@
 
 ``weftsim sweep SCENE --vary KEY=VALUES ...`` is :func:`plan_sweep` then :func:`run_sweep`:
 
-1. plan: parse the grid (:mod:`weftsim.sweep_grid`), build and validate the scene of
+1. plan: parse the grid (:mod:`weftsim.sweep.grid`), build and validate the scene of
    EVERY cell with :func:`weftsim.scene.load_scene` before anything runs, and check the
-   output directory holds no other sweep (:mod:`weftsim.sweep_store`);
+   output directory holds no other sweep (:mod:`weftsim.sweep.store`);
 2. run: skip the cells already finished, send the others to a local process pool
    (default, ``--jobs`` workers) or to an existing Dask cluster (``--scheduler``), each
-   as :func:`weftsim.sweep_cell.run_cell` in its own process; a failed cell is recorded
+   as :func:`weftsim.sweep.cell.run_cell` in its own process; a failed cell is recorded
    and the others go on; a worker that dies is retried once, alone;
 3. tabulate: ``sweep.csv`` is rebuilt from the cell directories (periodically, at the
    end and on interrupt) and ``sweep.png`` drawn for 1-D and 2-D grids.
@@ -26,9 +26,9 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from weftsim.sweep_cell import cell_record, is_finished, normalise, resolve_engine, run_cell, write_cell_record
-from weftsim.sweep_grid import Axis, Cell, SweepError, grid_cells, parse_set, parse_vary
-from weftsim.sweep_store import (SWEEP_FILE, TABLE_FILE, collect_rows, manifest, merge_manifest, table_text)
+from weftsim.sweep.cell import cell_record, is_finished, normalise, resolve_engine, run_cell, write_cell_record
+from weftsim.sweep.grid import Axis, Cell, SweepError, grid_cells, parse_set, parse_vary
+from weftsim.sweep.store import (SWEEP_FILE, TABLE_FILE, collect_rows, manifest, merge_manifest, table_text)
 
 log = logging.getLogger(__name__)
 
@@ -202,7 +202,7 @@ def write_table(plan: SweepPlan, outdir: Path, pending: list[PlannedCell] = ()) 
 def write_figure(plan: SweepPlan, outdir: Path, rows: list[dict]) -> Path | None:
     """``sweep.png`` for 1-D and 2-D sweeps (None for more axes or no successful cell)."""
     from weftsim.output import write_figure as save
-    from weftsim.sweep_plots import plot_sweep
+    from weftsim.sweep.plots import plot_sweep
 
     base = plan.base_keys
     title = (f"{Path(plan.scene_path).name}, {plan.engine} engine, {base['joint_e.law']}, "

@@ -12,7 +12,7 @@ hard scenes, each engine setting of :func:`settings` and measures
   mean rapier acceleration over whole revolutions is ~0);
 - steps, rejected steps, the first contact angle; failed runs with their reason.
 
-The report (tables, figures, machine, versions) is written by :mod:`weftsim.bench_report`.
+The report (tables, figures, machine, versions) is written by :mod:`weftsim.bench.report`.
 Speed is measured here only; no test asserts wall-clock limits.
 """
 
@@ -245,7 +245,7 @@ def startup_costs(models, log=print) -> dict:
 def run_benchmark(outdir, models="models", quick: bool = False, cases=None, revolutions: float | None = None,
                   repeats: int = 5, repeat_limit: float | None = None, force: bool = False, log=None) -> dict:
     """Run the whole benchmark and write its report into ``outdir``; returns the report dict."""
-    from weftsim.bench_report import machine_info, write_report
+    from weftsim.bench.report import machine_info, write_report
 
     log = log or (lambda text: print(text, file=sys.stderr, flush=True))
     revolutions = revolutions or (2.0 if quick else 10.0)
@@ -300,6 +300,3 @@ def main(argv=None) -> int:
     print(f"benchmark done in {report['total_time_s']:.0f} s; wrote " + ", ".join(map(str, report["files"])))
     return 0
 
-
-if __name__ == "__main__":
-    raise SystemExit(main())

@@ -1,6 +1,6 @@
 """Sweep figures (no physics here): peaks across a 1-D grid (lines) or a 2-D grid (heat maps).
 
-Rows are those of :func:`weftsim.sweep_store.collect_rows`.  Failed or missing
+Rows are those of :func:`weftsim.sweep.store.collect_rows`.  Failed or missing
 cells are left blank (grey in a heat map, a gap in a line).
 """
 
@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from weftsim.sweep_cell import METRIC_CHANNELS
+from weftsim.sweep.cell import METRIC_CHANNELS
 
 PANEL_LABELS = {
     "driving_torque_Nm": "peak |driving torque| [N·m]",

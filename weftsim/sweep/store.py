@@ -3,7 +3,7 @@
 Layout::
 
     OUT/sweep.json                        base scene, engine, varied keys and values
-    OUT/<cell name>/cell.json             one per cell, written last (see weftsim.sweep_cell)
+    OUT/<cell name>/cell.json             one per cell, written last (see weftsim.sweep.cell)
     OUT/<cell name>/summary.json, channels.csv[, channels.png, error.txt]
     OUT/sweep.csv                         one row per cell, rebuilt from the cell.json files
     OUT/sweep.png                         peaks across the grid (1-D lines or 2-D heat maps)
@@ -24,8 +24,8 @@ from pathlib import Path
 from typing import Any
 
 from weftsim import __version__
-from weftsim.sweep_cell import METRIC_CHANNELS, finite_or_none, read_record
-from weftsim.sweep_grid import Axis, SweepError, format_value
+from weftsim.sweep.cell import METRIC_CHANNELS, finite_or_none, read_record
+from weftsim.sweep.grid import Axis, SweepError, format_value
 
 SWEEP_FILE = "sweep.json"
 TABLE_FILE = "sweep.csv"

@@ -1,0 +1,5 @@
+"""``python -m weftsim.bench``."""
+
+from weftsim.bench.measure import main
+
+raise SystemExit(main())
