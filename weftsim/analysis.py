@@ -129,6 +129,8 @@ def summary(result: RunResult) -> dict:
     return {
         "scene": to_file_keys(result.scene),
         "engine": result.engine,
+        # The model and method that ran, and why (the engine's automatic selection or the scene's keys).
+        "path": dict(result.path) or None,
         "status": result.status,
         # False for a failed run: what it holds ends where the run stopped (simulated_time_s).
         "complete": result.ok,

@@ -202,6 +202,12 @@ def _solve(scene, engine: str, label: str | None = None):
         from weftsim.exudyn_engine import solve
     else:
         raise CliError(f"--engine must be 'reference' or 'exudyn', got {engine!r}")
+    if label is None:  # a run's first line: the model and method it takes, and why
+        from importlib import import_module
+
+        select = import_module("weftsim.reference" if engine == "reference" else "weftsim.exudyn_engine").select_path
+        path = select(scene)
+        print(f"scene {scene.name}, engine {engine}: {path['model']}, {path['method']} ({path['reason']})", flush=True)
     progress = Progress(label or f"{engine} {scene.name}")
     try:
         return solve(scene, progress=progress)

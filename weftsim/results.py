@@ -104,6 +104,9 @@ class RunResult:
         Counts of a broken contact history and the law-range warnings
         (:meth:`weftsim.plausibility.Plausibility.as_dict`), filled by
         :func:`weftsim.guards.vet_result`; empty for the ideal joint.
+    path : dict
+        The model and method that ran and why (``{"model": ..., "method": ..., "reason": ...}``):
+        what the engine's automatic selection chose for this scene, or what the scene forced.
     """
 
     scene: Scene
@@ -115,6 +118,7 @@ class RunResult:
     solver_stats: dict = field(default_factory=dict)
     events: dict = field(default_factory=dict)
     plausibility: dict = field(default_factory=dict)
+    path: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if self.engine not in ENGINES:
@@ -135,6 +139,15 @@ class RunResult:
         if t is None:
             return None
         return math.degrees(self.scene.drive.speed * t)
+
+    @property
+    def path_text(self) -> str:
+        """One line: ``model, method (reason)``, or empty when the engine did not say."""
+        if not self.path:
+            return ""
+        what = ", ".join(str(self.path[k]) for k in ("model", "method") if self.path.get(k))
+        reason = self.path.get("reason")
+        return f"{what} ({reason})" if reason else what
 
     @property
     def wall_time_s(self) -> float:

@@ -3,6 +3,7 @@
 Public API::
 
     solve(scene, progress=None) -> weftsim.results.RunResult
+    select_path(scene) -> dict                                 the model and method solve will use, and why
     build_mechanism(mbs, scene, ...) -> MechanismModel          members 1-8 in an Exudyn system
     add_clearance_joint(mbs, marker_bearing, marker_journal, joint, law=None, callback="auto")
         -> ClearanceJointModel                                   reusable planar clearance joint
@@ -18,10 +19,12 @@ from weftsim.exudyn_engine.clearance_joint import (
     register_post_step,
 )
 from weftsim.exudyn_engine.mechanism import MechanismModel, build_mechanism
+from weftsim.exudyn_engine.selection import select_path
 from weftsim.exudyn_engine.solver import solve
 
 __all__ = [
     "solve",
+    "select_path",
     "build_mechanism",
     "MechanismModel",
     "add_clearance_joint",

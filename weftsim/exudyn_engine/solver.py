@@ -21,6 +21,7 @@ import exudyn as exu
 
 from weftsim.exudyn_engine.clearance_joint import ROUTES, register_post_step
 from weftsim.exudyn_engine.mechanism import build_mechanism
+from weftsim.exudyn_engine.selection import select_path
 from weftsim.exudyn_engine.sensors import add_sensors, first_nonfinite_row, sample_channels, silence, step_channels
 from weftsim.guards import RunGuard, failure_message, non_finite_breach, vet_result
 from weftsim.params import Scene
@@ -169,6 +170,12 @@ def solve(scene: Scene, progress=None, callback: str | None = None) -> RunResult
     problem = check_settings(scene)
     if problem is not None:
         return _failed(scene, problem, 0.0)
+    result = _solve_model(scene, progress, callback, wall0)
+    object.__setattr__(result, "path", select_path(scene))
+    return result
+
+
+def _solve_model(scene: Scene, progress, callback: str | None, wall0: float) -> RunResult:
     if scene.exudyn_solver.model == "kinematic_tree":
         from weftsim.exudyn_engine.tree_solve import solve_tree
 

@@ -26,7 +26,7 @@ from weftsim.params import Scene
 from weftsim.reference.integrate import AUTO, METHODS
 from weftsim.results import RunResult, empty_channels
 
-__all__ = ["solve", "METHODS", "AUTO", "COMPILED_METHODS"]
+__all__ = ["solve", "select_path", "METHODS", "AUTO", "COMPILED_METHODS"]
 
 # Steps of the ideal-joint run: the closed form evaluated on a grid this many times finer
 # than the output grid (peaks of smooth curves then err by ~(step/2)^2 |f''|/2, < 1e-6 relative).
@@ -85,6 +85,15 @@ def compiled_method(scene: Scene) -> str | None:
     """
     method = scene.reference_solver.method
     return method if method in COMPILED_METHODS else None
+
+
+def select_path(scene: Scene) -> dict:
+    """``{"model", "method", "reason"}`` of the run :func:`solve` makes of ``scene``."""
+    if scene.joint.is_ideal:
+        return {"model": "ideal joint", "method": "closed form", "reason": "clearance 0: no free coordinate"}
+    s = scene.reference_solver
+    method = compiled_method(scene) or s.method
+    return {"model": "clearance chain", "method": f"{method} rtol {s.rtol:g}", "reason": "scene key solver.reference.method"}
 
 
 def _solve_clearance(scene: Scene, progress, step_states) -> RunResult:
@@ -149,5 +158,6 @@ def solve(scene: Scene, progress=None, step_states=None) -> RunResult:
         result = _solve_ideal(scene, progress)
     else:
         result = _solve_clearance(scene, progress, step_states)
+    object.__setattr__(result, "path", select_path(scene))
     # Post-run criteria (energy balance, ...) that no single step shows; see weftsim.guards.
     return vet_result(result)
