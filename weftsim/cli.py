@@ -253,7 +253,8 @@ def cmd_kinematics(args) -> int:
     rows = int(round(2.0 * math.pi / step)) + 1
     outdir = _outdir(args, scene, "-kinematics")
     check_output_fits(rows, len(KINEMATICS_COLUMNS), outdir,
-                      f"output.sample_deg = {math.degrees(step):g} over one revolution")
+                      f"output.sample_deg = {math.degrees(step):g} over one revolution",
+                      fix="a coarser output.sample_deg (any value up to 0.5 deg)")
     outdir = prepare_directory(outdir, args.force)
     theta = np.linspace(0.0, 2.0 * math.pi, rows)
     state = linkage_state(theta, scene.geometry, scene.inertia.rocker_com)

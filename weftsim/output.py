@@ -316,13 +316,14 @@ def _size(n: float) -> str:
     raise AssertionError("unreachable")
 
 
-def check_output_fits(rows: float, columns: int, outdir: Path, what: str, runs: int = 1) -> None:
+def check_output_fits(rows: float, columns: int, outdir: Path, what: str, runs: int = 1,
+                      fix: str = "a coarser output.sample_deg (any value up to 0.5 deg) or fewer drive.revolutions") -> None:
     """Refuse, before anything is created, an output grid that cannot be held or written.
 
     ``runs`` results of ``rows`` x ``columns`` values are held in memory
     (:data:`MEMORY_BYTES_PER_VALUE` each) and written as CSV (:data:`CSV_BYTES_PER_VALUE`).
-    Raises :class:`OutputError` naming the scene keys that set the size when the memory
-    available or the free disk space under ``outdir`` is smaller.
+    Raises :class:`OutputError` when the memory available or the free disk space under
+    ``outdir`` is smaller: ``what`` names the scene keys that set the size, ``fix`` what to change.
     """
     values = float(rows) * columns * runs
     memory, disk = values * MEMORY_BYTES_PER_VALUE, values * CSV_BYTES_PER_VALUE
@@ -333,8 +334,7 @@ def check_output_fits(rows: float, columns: int, outdir: Path, what: str, runs: 
     if free is not None and disk > free:
         short.append(f"~{_size(disk)} of CSV (free under {outdir}: {_size(free)})")
     if short:
-        raise OutputError(f"{what} gives {rows:.3g} output samples, {' and '.join(short)}: use a coarser "
-                          "output.sample_deg (0.5 deg or finer is allowed) or fewer drive.revolutions")
+        raise OutputError(f"{what} gives {rows:.3g} output samples, {' and '.join(short)}: use {fix}")
 
 
 def output_rows(scene) -> float:
