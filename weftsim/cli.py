@@ -362,11 +362,12 @@ def cmd_run(args) -> int:
 
 def cmd_compare(args) -> int:
     from weftsim.compare import format_report, run_compare
-    from weftsim.output import to_json
+    from weftsim.output import prepare_directory, to_json
 
     scene = _load(args)
     outdir = _outdir(args, scene, "-compare")
     _check_fits(scene, outdir, runs=2)
+    prepare_directory(outdir, args.force)  # refused before the estimate is shown
     _announce_run_time(scene, ("reference", "exudyn"), "compare")
     with _stdout_to_stderr() if args.json else contextlib.nullcontext():
         report, status, problem = run_compare(scene, outdir, solve=_solve, force=args.force)

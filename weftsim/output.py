@@ -297,14 +297,16 @@ def _available_memory() -> int | None:
 
 
 def _free_disk(path: Path) -> int | None:
-    """Free bytes on the file system that would hold ``path`` (its nearest existing ancestor)."""
+    """Free bytes on the file system that would hold ``path`` (its nearest existing ancestor), or
+    None where that says nothing (a pseudo file system such as /proc reports a size of 0)."""
     path = Path(os.path.abspath(path))
     for candidate in (path, *path.parents):
         if candidate.exists():
             try:
-                return shutil.disk_usage(candidate).free
+                usage = shutil.disk_usage(candidate)
             except OSError:
                 return None
+            return usage.free if usage.total > 0 else None
     return None
 
 

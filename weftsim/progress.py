@@ -75,7 +75,9 @@ def estimate_run_time(scene, engine: str) -> float:
         return revolutions * SECONDS_PER_REVOLUTION["reference numba" if "numba" in method else "reference scipy"]
     if scene.exudyn_solver.model == "kinematic_tree":
         return revolutions * SECONDS_PER_REVOLUTION["exudyn kinematic_tree"]
-    return scene.drive.end_time / scene.exudyn_solver.step_size * EXUDYN_SECONDS_PER_STEP
+    from weftsim.exudyn_engine.solver import step_plan  # the steps the engine will take (longer for an ideal joint)
+
+    return step_plan(scene)[1] * EXUDYN_SECONDS_PER_STEP
 
 
 def format_duration(seconds: float) -> str:
