@@ -368,8 +368,8 @@ def cmd_compare(args) -> int:
     outdir = _outdir(args, scene, "-compare")
     _check_fits(scene, outdir, runs=2)
     prepare_directory(outdir, args.force)  # refused before the estimate is shown
-    _announce_run_time(scene, ("reference", "exudyn"), "compare")
-    with _stdout_to_stderr() if args.json else contextlib.nullcontext():
+    with _stdout_to_stderr() if args.json else contextlib.nullcontext():  # the estimate imports Exudyn
+        _announce_run_time(scene, ("reference", "exudyn"), "compare")
         report, status, problem = run_compare(scene, outdir, solve=_solve, force=args.force)
     print(to_json(report) if args.json else format_report(report), end="" if args.json else "\n")
     if status:
