@@ -423,7 +423,7 @@ def test_a_stop_request_ends_the_run_as_interrupted_and_keeps_what_was_computed(
 
     def progress(fraction):
         if fraction >= 0.3:
-            request_stop("interrupted by the user (SIGINT, Ctrl-C)")
+            request_stop("stopped by the user (Ctrl-C, SIGINT)")
 
     clear_stop()
     try:
@@ -431,7 +431,7 @@ def test_a_stop_request_ends_the_run_as_interrupted_and_keeps_what_was_computed(
     finally:
         clear_stop()
     assert r.status == "failed" and r.solver_stats["failure"] == "interrupted"
-    assert "interrupted by the user" in r.message and "crank angle" in r.message
+    assert "stopped by the user" in r.message and "crank angle" in r.message
     reached = r.steps["time_s"][-1] / r.scene.drive.end_time
     # Progress is reported every 0.1 % of the run and the guard checks every step: the run stops
     # within a step or two of the request; 0.35 leaves room for one long free-flight step (the

@@ -188,31 +188,41 @@ def _announce_run_time(scene, engines: tuple[str, ...], command: str) -> None:
           "computed", file=sys.stderr, flush=True)
 
 
+# Signals that stop a run gracefully: the engine ends at its next step and what it computed is
+# written.  SIGINT is Ctrl-C; SIGTERM is what `kill`, a batch scheduler at its time limit or a
+# container stop sends first.
+STOP_SIGNALS = {signal.SIGINT: "Ctrl-C, SIGINT", signal.SIGTERM: "SIGTERM"}
+
+
 @contextlib.contextmanager
 def _stop_on_interrupt(command: str):
-    """While the block runs, SIGINT (Ctrl-C) asks the running engine to stop at its next step and
-    keep what it computed (weftsim.guards.request_stop); a second Ctrl-C abandons at once.
+    """While the block runs, SIGINT (Ctrl-C) or SIGTERM asks the running engine to stop at its next
+    step and keep what it computed (weftsim.guards.request_stop); a second signal abandons at once.
 
-    Yields a dict whose ``"interrupted"`` is True once the signal came.
+    Yields a dict whose ``"signal"`` is the signal number once one came (else None).
     """
     from weftsim.guards import clear_stop, request_stop
 
-    state = {"interrupted": False}
+    state = {"signal": None}
+    previous = {signum: signal.getsignal(signum) for signum in STOP_SIGNALS}
 
     def handler(signum, frame):
-        state["interrupted"] = True
-        request_stop("interrupted by the user (SIGINT, Ctrl-C)")
-        signal.signal(signal.SIGINT, signal.default_int_handler)
+        state["signal"] = signum
+        request_stop(f"stopped by the user ({STOP_SIGNALS[signum]})")
+        for other in STOP_SIGNALS:  # the next one ends the process at once
+            signal.signal(other, signal.default_int_handler if other == signal.SIGINT else signal.SIG_DFL)
         if sys.stderr.isatty():  # at a terminal, say at once that the key was seen
             sys.stderr.write(f"\nweftsim {command}: stopping at the next step, keeping what was computed "
                              "(Ctrl-C again to abandon it)\n")
 
     clear_stop()
-    previous = signal.signal(signal.SIGINT, handler)
+    for signum in STOP_SIGNALS:
+        signal.signal(signum, handler)
     try:
         yield state
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for signum, old in previous.items():
+            signal.signal(signum, old)
         clear_stop()
 
 
@@ -330,12 +340,12 @@ def _report_run(result, written) -> None:
         print(f"  wrote {path}")
 
 
-def _interrupted_line(result, outdir: Path) -> str:
+def _interrupted_line(result, outdir: Path, signum: int) -> str:
     from weftsim.guards import where
 
     t = float(result.steps["time_s"][-1]) if result.steps["time_s"].size else 0.0
-    return (f"interrupted (Ctrl-C) at {where(t, result.scene.drive.speed)}: the results up to there are in "
-            f"{outdir} (summary.json says complete: false); rerun to compute the whole run")
+    return (f"stopped by {STOP_SIGNALS[signum]} at {where(t, result.scene.drive.speed)}: the results up to "
+            f"there are in {outdir} (summary.json says complete: false); rerun to compute the whole run")
 
 
 def cmd_run(args) -> int:
@@ -352,8 +362,8 @@ def cmd_run(args) -> int:
     written = write_run(result, outdir, figure=not args.no_plot, force=args.force)
     _report_run(result, written)
     report_lines(result, "run")
-    if stop["interrupted"] and not result.ok:
-        raise CliError(_interrupted_line(result, outdir), EXIT_INTERRUPTED)
+    if stop["signal"] is not None and not result.ok:
+        raise CliError(_interrupted_line(result, outdir, stop["signal"]), 128 + stop["signal"])
     if not result.ok:
         raise CliError(f"simulation failed: {result.message} (results up to the failure written to {outdir}, "
                        "marked incomplete in summary.json)", EXIT_FAILED)

@@ -17,7 +17,7 @@ kind              fails when                                  limit (scene ``[li
 ``wall_time``     wall-clock time since the start > budget    ``max_wall_time_s`` (0 = none)
 ``energy``        W - dKE - dPE - E_contact - E_diss > limit  ``max_energy_error`` (0.01)
 ``plausibility``  a broken contact history (see below)        ``max_damping_ratio`` (1)
-``interrupted``   the user asked the run to stop (Ctrl-C)     :func:`request_stop`
+``interrupted``   the user stopped the run (Ctrl-C, SIGTERM)  :func:`request_stop`
 ================  ==========================================  ==============================
 
 The last two need the whole run's channels: :func:`vet_result` checks them (and again the
