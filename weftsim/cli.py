@@ -13,6 +13,7 @@ import math
 import os
 import signal
 import sys
+import threading
 from pathlib import Path
 
 from weftsim.exitcodes import EXIT_DISAGREE, EXIT_FAILED, EXIT_USAGE  # noqa: F401 (re-exported)
@@ -216,7 +217,9 @@ def _stop_on_interrupt(command: str):
                              "(Ctrl-C again to abandon it)\n")
 
     clear_stop()
-    for signum in STOP_SIGNALS:
+    if threading.current_thread() is not threading.main_thread():  # only the main thread may set handlers
+        previous = {}
+    for signum in previous:
         signal.signal(signum, handler)
     try:
         yield state
@@ -246,6 +249,7 @@ def _stdout_to_stderr():
         os.close(saved)
 
 
+# The columns of kinematics.csv, in order (their number sizes the output before it is computed).
 KINEMATICS_COLUMNS = ("crank_angle_deg", "rapier_displacement_m", "rapier_velocity_m_s", "rapier_acceleration_m_s2",
                       "rocker_angle_deg", "rocker_arm_angle_deg", "sector_angle_deg", "rod_angle_deg",
                       "transmission_angle_deg")
@@ -280,7 +284,6 @@ def cmd_kinematics(args) -> int:
         "rod_angle_deg": np.degrees(state.theta_ef),
         "transmission_angle_deg": np.degrees(state.transmission_angle),
     }
-    assert tuple(columns) == KINEMATICS_COLUMNS
     rpm = scene.drive.speed * 30 / math.pi
     title = f"{scene.name}: ideal rapier motion at {rpm:g} rpm"
     written = write_files(outdir, {"kind": "kinematics", "scene": scene.name}, {
