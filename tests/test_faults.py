@@ -307,3 +307,17 @@ def test_compare_with_a_failed_engine_says_which_and_why(tmp_path):
     assert last.startswith("weftsim compare: error: engine exudyn failed: Exudyn engine failed at t = "), last
     assert "limits.max_steps" in last and f"{tmp_path / 'cmp'}/exudyn" in last, last
     assert "engines DISAGREE" in done.stdout  # the table is still printed
+
+
+def test_progress_on_a_closed_stream_does_not_end_the_run():
+    """stderr piped into a reader that exited (``2>&1 | head -1``): progress stops, the run goes on."""
+    from weftsim.progress import Progress
+
+    read, write = os.pipe()
+    os.close(read)
+    stream = os.fdopen(write, "w")
+    progress = Progress("run", stream=stream, delay=0.0, interval=0.0)
+    progress(0.5)  # raises BrokenPipeError inside; swallowed
+    progress(0.9)
+    progress.close()
+    assert progress.stream is None

@@ -34,14 +34,23 @@ class Progress:
         fraction = min(max(fraction, 0.0), 1.0)
         left = elapsed * (1.0 - fraction) / fraction if fraction > 0 else float("nan")
         text = f"{self.label}: {100 * fraction:5.1f}%  elapsed {elapsed:6.1f} s  left ~{left:6.1f} s"
-        self.stream.write(("\r" + text) if self.tty else (text + "\n"))
-        self.stream.flush()
+        self._write(("\r" + text) if self.tty else (text + "\n"))
         self.shown = True
+
+    def _write(self, text: str) -> None:
+        """Write, or stop reporting when the stream is gone (stderr piped into ``head`` that exited):
+        a progress line must never end the run it reports on."""
+        if self.stream is None:
+            return
+        try:
+            self.stream.write(text)
+            self.stream.flush()
+        except (OSError, ValueError):  # BrokenPipeError, a closed file
+            self.stream = None
 
     def close(self) -> None:
         if self.shown and self.tty:
-            self.stream.write("\n")
-            self.stream.flush()
+            self._write("\n")
 
 
 # Run-time estimate shown before a long run starts.  Wall-clock seconds per crank revolution of
