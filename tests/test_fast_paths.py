@@ -394,7 +394,7 @@ def test_compiled_chunks_and_pauses_do_not_change_the_run(monkeypatch):
     scene = _scene(method="numba_DOP853", revolutions=0.05, rtol=1e-7, atol=1e-10)
     whole = compiled_run.integrate_compiled(scene)
     monkeypatch.setattr(compiled_run, "_STEP_BUFFER", 16)  # a chunk every few steps
-    pieces = compiled_run.integrate_compiled(scene, progress=lambda fraction: None)  # and pauses every 1 %
+    pieces = compiled_run.integrate_compiled(scene, progress=lambda fraction: None)  # and pauses every 0.1 %
     for a, b in zip(whole[0] + whole[1], pieces[0] + pieces[1]):
         np.testing.assert_array_equal(a, b)  # bit for bit: the state carries over exactly
     assert whole[2]["steps"] == pieces[2]["steps"] and whole[2]["function_evaluations"] == pieces[2]["function_evaluations"]
