@@ -22,10 +22,11 @@ import exudyn as exu
 from weftsim.exudyn_engine.clearance_joint import ROUTES, register_post_step
 from weftsim.exudyn_engine.mechanism import build_mechanism
 from weftsim.exudyn_engine.selection import select_path
+from weftsim.exudyn_engine.step_control import StepController
 from weftsim.exudyn_engine.sensors import add_sensors, first_nonfinite_row, sample_channels, silence, step_channels
 from weftsim.guards import RunGuard, failure_message, non_finite_breach, vet_result
 from weftsim.params import Scene
-from weftsim.scene import IMPACT_VELOCITY_RULES
+from weftsim.scene import IMPACT_VELOCITY_RULES, STEP_CONTROLS
 from weftsim.results import RunResult, angle_grid, empty_channels
 
 MODELS = ("rigid_body", "kinematic_tree")  # kinematic_tree: tree.py, tree_solve.py
@@ -60,6 +61,10 @@ def check_settings(scene: Scene) -> str | None:
         return f"`exudyn_solver.newton_relative_tolerance` must be > 0, got {s.newton_relative_tolerance}"
     if not s.newton_max_iterations >= 1:
         return f"`exudyn_solver.newton_max_iterations` must be >= 1, got {s.newton_max_iterations}"
+    if s.step_control not in STEP_CONTROLS:
+        return f"`exudyn_solver.step_control` must be one of {STEP_CONTROLS}, got {s.step_control!r}"
+    if not (s.local_error > 0.0 and math.isfinite(s.local_error)):
+        return f"`exudyn_solver.local_error` must be > 0 (m), got {s.local_error}"
     if s.callback not in ROUTES + ("auto",):
         return f"`exudyn_solver.callback` must be one of {('auto',) + ROUTES}, got {s.callback!r}"
     if s.callback == "numba" and not scene.joint.is_ideal:
@@ -115,8 +120,21 @@ def simulation_settings(scene: Scene, n_steps: int) -> exu.SimulationSettings:
     ti.discontinuous.ignoreMaxIterations = False
     # Newton failures halve the step down to this floor; then the run fails (step-size collapse).
     ti.minimumStepSize = scene.limits.min_step
+    if adaptive(scene):
+        # The first step is ``step_size`` (Exudyn starts at end time / numberOfSteps); afterwards the
+        # controller sets each step, and Exudyn's own lengthening after easy Newton steps is off.
+        ti.numberOfSteps = max(1, round(scene.drive.end_time / s.step_size))
+        ti.adaptiveStep = True
+        ti.adaptiveStepRecoverySteps = 2**30
     silence(ss)
     return ss
+
+
+def adaptive(scene: Scene) -> bool:
+    """True when the step is error-controlled (:mod:`.step_control`): a clearance joint under
+    ``step_control = "adaptive"``.  The ideal joint always takes the fixed step of :func:`step_plan`
+    (nothing but the prescribed kinematics to follow; :data:`IDEAL_JOINT_STEP_ANGLE`)."""
+    return scene.exudyn_solver.step_control == "adaptive" and not scene.joint.is_ideal
 
 
 def _failed(scene: Scene, message: str, wall: float) -> RunResult:
@@ -205,13 +223,17 @@ def _solve_model(scene: Scene, progress, callback: str | None, wall0: float) -> 
         return True
 
     register_post_step(mbs, count)
+    solver = exu.MainSolverImplicitSecondOrder()
+    control = None
+    if adaptive(scene):
+        control = StepController.for_mechanism(mbs, solver, model, scene)
+        control.install()
     mbs.Assemble()
     if model.clearance is not None:
         model.clearance.reset(mbs)
     if progress is not None:
         progress(0.0)
     status, message, kind = "success", "", None
-    solver = exu.MainSolverImplicitSecondOrder()
     wall_solve = _time.perf_counter()
     try:
         if not solver.SolveSystem(mbs, simulation_settings(scene, n_steps)):
@@ -250,7 +272,9 @@ def _solve_model(scene: Scene, progress, callback: str | None, wall0: float) -> 
     n_done = max(len(steps["time_s"]) - 1, 0)
     stats = {
         "method": "generalized_alpha",
-        "step_size_s": h,
+        "step_control": "adaptive" if control else "fixed",
+        # adaptive: the smallest accepted step (the resolution through impacts); fixed: the step.
+        "step_size_s": control.counters()["smallest_step_s"] or h if control else h,
         "steps": n_done,
         "rejected_steps": int(it.rejectedModifiedNewtonSteps),
         "newton_iterations": int(it.newtonStepsCount),
@@ -258,6 +282,7 @@ def _solve_model(scene: Scene, progress, callback: str | None, wall0: float) -> 
         "function_evaluations": int(it.newtonStepsCount),
         **(model.clearance.tracker.counters() if model.clearance else {"contact_events": 0}),
         "callback": model.clearance.route if model.clearance else None,
+        **({k: v for k, v in control.counters().items() if k != "smallest_step_s"} if control else {}),
         "solve_time_s": wall_solve,
         "wall_time_s": _time.perf_counter() - wall0,
     }
