@@ -20,6 +20,8 @@ RPM = math.pi / 30.0
 
 
 def scene(clearance=0.25e-3, rpm=400.0, revolutions=2.0, rule="max_approach", **solver) -> Scene:
+    if "step_size" in solver:  # these tests mean that step: the fixed-step generalized-alpha
+        solver.setdefault("step_control", "fixed")
     return Scene(joint=ClearanceJoint(clearance=clearance, impact_velocity_rule=rule),
                  drive=Drive(speed=rpm * RPM, revolutions=revolutions),
                  exudyn_solver=ExudynSolver(**solver))  # fmt: skip

@@ -16,18 +16,19 @@ same start state by
     e = |beta - 1/6| h^2 |a(t + h) - a(t)|
 
 with beta the Newmark parameter of the method (0.309 at spectral radius 0.8).  It is applied to the
-quantity the impacts act on: the eccentricity e of joint E (journal centre relative to bearing
-centre), so a(t) is the relative acceleration of the two marker points.  In free flight a(t) varies
-with the mechanism's kinematics (the estimate allows steps of a fraction of a degree); through an
-impact it jumps by F_N / m within microseconds (it asks for microsecond steps); in a lasting,
-smoothly loaded contact it lets the step grow again.  The new step follows the usual controller for
+point the impacts act on: the journal centre at E, whose acceleration is bounded from its body's
+node (centre of mass of the rod, member 4: translation plus arm x angular acceleration; one cheap
+call per step).  The bearing on the rocker follows the prescribed kinematics of members 1-3, which
+change far more slowly.  In free flight a(t) varies with the mechanism's kinematics (the estimate
+allows steps of up to one output sample, 0.5 deg); through an impact it jumps by F_N / m within
+microseconds (it asks for microsecond steps); in a lasting, smoothly loaded contact it lets the
+step grow again.  The new step follows the usual controller for
 an error of order h^3 (Hairer, Norsett and Wanner, Solving ODEs I, section II.4)::
 
     h_new = h * min(GROWTH_MAX, max(SHRINK_MIN, SAFETY * (tol / e)^(1/3)))
 
 clamped to [min_step, max_step]; a step whose estimate exceeds ``REJECT_FACTOR * tol`` is repeated
-with that step.  The same control serves the ideal joint (E a revolute joint): its marker points
-then coincide and the estimate uses the journal point alone.
+with that step.  The ideal joint does not use it (solver.py: a fixed crank-angle step).
 """
 
 from __future__ import annotations
