@@ -81,7 +81,7 @@ class StepController:
     def __init__(self, mbs, solver, node, arm: float, tolerance: float, min_step: float, max_step: float,
                  sample_period: float, newmark_beta: float):
         self.mbs = mbs
-        self.solver = solver
+        self.it = solver.it  # the solver's step data (a live reference: writes reach the solver)
         self.node = node
         self.arm = arm
         self.tolerance = tolerance
@@ -133,7 +133,7 @@ class StepController:
 
     def post_newton(self, mbs, t):
         """Exudyn post-Newton function: [error flag, recommended step] of the converged trial step."""
-        h = self.solver.it.currentStepSize
+        h = self.it.currentStepSize
         a1 = self.acceleration()
         err = self.error(h, a1)
         if err > REJECT_FACTOR * self.tolerance and h > self.min_step * (1.0 + 1e-9):
@@ -149,14 +149,14 @@ class StepController:
             self.accel_start = self.acceleration()
             h_next = self.next_step
         else:
-            h = self.solver.it.currentStepSize
+            h = self.it.currentStepSize
             self.smallest = min(self.smallest, h)
             self.largest = max(self.largest, h)
             self.accel_start = self.accel_trial
             h_next = self.proposal(h, self.error_trial)
         self.accel_trial = None
         self.next_step = h_next
-        self.solver.it.currentStepSize = to_sample_grid(t, h_next, self.sample_period)
+        self.it.currentStepSize = to_sample_grid(t, h_next, self.sample_period)
         return True
 
     def install(self) -> None:
