@@ -207,7 +207,7 @@ class ExudynSolver:
     model: str = "rigid_body"
     step_control: str = "adaptive"  # rigid_body: "adaptive" (local error control, step_control.py) or "fixed"
     local_error: float = 3e-9  # m; rigid_body, adaptive: local error tolerance on the eccentricity at E
-    step_size: float = 2e-6  # s; fixed: the step (ideal joint: see exudyn_engine.solver); adaptive: the first step
+    step_size: float = 2e-6  # s; fixed: the step (ideal joint: see exudyn_engine.solver); adaptive: unused
     spectral_radius: float = 0.8
     modified_newton: bool = True
     newton_relative_tolerance: float = 1e-8

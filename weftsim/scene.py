@@ -128,8 +128,8 @@ SCHEMA: tuple[Key, ...] = (
     Key("solver.exudyn.local_error_m", "exudyn_solver.local_error", "float", 1, 0, 1e-3,
         doc="rigid_body model, adaptive: tolerance of the local error estimate of the journal centre at E per step"),
     Key("solver.exudyn.step_size_s", "exudyn_solver.step_size", "float", 1, 0, 1e-2,
-        doc="generalized-alpha step: the step when fixed; the first step when adaptive (an ideal joint then "
-            "steps 0.25 deg of crank: nothing to resolve)"),
+        doc="generalized-alpha step when fixed (adaptive: unused; an ideal joint then steps 0.25 deg of "
+            "crank, nothing to resolve)"),
     Key("solver.exudyn.spectral_radius", "exudyn_solver.spectral_radius", "float", 1, 0, 1, False, False,
         doc="generalized-alpha spectral radius (<= 0.9 for smooth constraint torques)"),
     Key("solver.exudyn.modified_newton", "exudyn_solver.modified_newton", "bool", doc="modified Newton"),

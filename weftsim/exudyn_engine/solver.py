@@ -89,7 +89,7 @@ def check_settings(scene: Scene) -> str | None:
 
 
 def requested_step(scene: Scene) -> float:
-    """The (first) step to aim for, s: the scene's, or with the ideal joint :data:`IDEAL_JOINT_STEP_ANGLE`.
+    """The fixed step to aim for, s: the scene's, or with the ideal joint :data:`IDEAL_JOINT_STEP_ANGLE`.
 
     A scene's step is chosen to resolve impacts (about 2e-6 s).  With an ideal joint there is none,
     and such a step only adds round-off: the constraint reactions of generalized-alpha carry an error
@@ -127,9 +127,10 @@ def simulation_settings(scene: Scene, n_steps: int) -> exu.SimulationSettings:
     # Newton failures halve the step down to this floor; then the run fails (step-size collapse).
     ti.minimumStepSize = scene.limits.min_step
     if adaptive(scene):
-        # The first step is ``step_size`` (Exudyn starts at end time / numberOfSteps); afterwards the
-        # controller sets each step, and Exudyn's own lengthening after easy Newton steps is off.
-        ti.numberOfSteps = max(1, round(scene.drive.end_time / s.step_size))
+        # The controller sets every step from its post-step hook (the first one at t = 0: one output
+        # sample, free flight from the centred journal); Exudyn's own lengthening after easy Newton
+        # steps is off.  numberOfSteps only sets Exudyn's initial and largest step.
+        ti.numberOfSteps = max(1, math.ceil(scene.drive.end_time * scene.drive.speed / scene.output.sample_angle))
         ti.adaptiveStep = True
         ti.adaptiveStepRecoverySteps = 2**30
     silence(ss)
