@@ -206,7 +206,7 @@ class ExudynSolver:
 
     model: str = "rigid_body"
     step_control: str = "adaptive"  # rigid_body: "adaptive" (local error control, step_control.py) or "fixed"
-    local_error: float = 3e-9  # m; rigid_body, adaptive: local error tolerance on the eccentricity at E
+    local_error: float = 3e-10  # m; rigid_body, adaptive: local error tolerance on the eccentricity at E
     step_size: float = 2e-6  # s; fixed: the step (ideal joint: see exudyn_engine.solver); adaptive: unused
     spectral_radius: float = 0.8
     modified_newton: bool = True

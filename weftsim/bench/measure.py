@@ -83,7 +83,7 @@ def settings(case: str, quick: bool = False) -> list[Setting]:
         out = [_ref("numba_DOP853", r) for r in (1e-5, 1e-7)] + [_ref("DOP853", 1e-7)]
         out += [_tree(r) for r in (1e-5, 1e-6)]
         if case == "c0.25mm-400rpm":
-            out += [_rigid(2e-6), _rigid_adaptive(3e-9)]
+            out += [_rigid(2e-6), _rigid_adaptive(3e-10)]
         return out
     out = [_ref("numba_DOP853", r) for r in (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9)]
     out += [_ref("numba_RK45", r) for r in (1e-4, 1e-5, 1e-6, 1e-7, 1e-8)]
