@@ -28,11 +28,11 @@ import time as _time
 
 import exudyn as exu
 import numpy as np
-from exudyn.itemInterface import SensorNode, SensorObject
+from exudyn.itemInterface import SensorNode
 
 from weftsim.contact import make_law
 from weftsim.exudyn_engine.sensors import first_nonfinite_row, sample_channels, silence
-from weftsim.exudyn_engine.tree import TreeModel, build_tree
+from weftsim.exudyn_engine.tree import TREE_ROUTES, TreeModel, build_tree
 from weftsim.guards import RunGuard, failure_message, non_finite_breach, vet_result
 from weftsim.params import Scene
 from weftsim.reference.dynamics import NUMPY, ChainConstants, chain_energy, eccentricity, initial_state
@@ -42,6 +42,7 @@ from weftsim.results import RunResult, angle_grid, empty_channels
 OVT = exu.OutputVariableType
 EXPLICIT_METHODS = {"DOPRI5": exu.DynamicSolverType.DOPRI5, "ODE23": exu.DynamicSolverType.ODE23}
 _PROGRESS_EVERY = 0.01
+END_OF_STEP_ACCELERATIONS = False
 
 
 def check_tree_settings(scene: Scene) -> str | None:
@@ -50,6 +51,9 @@ def check_tree_settings(scene: Scene) -> str | None:
     if scene.joint.is_ideal:
         return ("the 'kinematic_tree' Exudyn model needs a clearance joint (with an ideal joint nothing moves "
                 "freely); use `exudyn_solver.model` = 'rigid_body' or the reference engine")  # fmt: skip
+    if s.callback not in TREE_ROUTES:
+        return (f"the 'kinematic_tree' Exudyn model has the callback routes {TREE_ROUTES}, got {s.callback!r}; "
+                "use `exudyn_solver.model` = 'rigid_body' for it")  # fmt: skip
     if s.explicit_method not in EXPLICIT_METHODS:
         return f"`exudyn_solver.explicit_method` must be one of {tuple(EXPLICIT_METHODS)}, got {s.explicit_method!r}"
     for name in ("relative_tolerance", "absolute_tolerance"):
@@ -79,7 +83,7 @@ def tree_settings(scene: Scene) -> exu.SimulationSettings:
     ti.relativeTolerance = s.relative_tolerance
     ti.absoluteTolerance = s.absolute_tolerance
     ti.minimumStepSize = scene.limits.min_step
-    ti.explicit.computeEndOfStepAccelerations = True
+    ti.explicit.computeEndOfStepAccelerations = END_OF_STEP_ACCELERATIONS
     silence(ss)
     return ss
 
@@ -89,6 +93,8 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
     scene = model.scene
     n = min(len(v) for v in data.values())
     q, q_t, q_tt, force = (data[k][:n] for k in ("q", "q_t", "q_tt", "force"))
+    if n and np.any(force[:, 0] != q[:, 0]):
+        raise RuntimeError("kinematic tree: the recorded contact forces are not at the sensors' times")
     t = q[:, 0]
     a, psi = q[:, 1], q[:, 1] + q[:, 2] - math.pi
     da, dpsi = q_t[:, 1], q_t[:, 1] + q_t[:, 2]
@@ -151,7 +157,6 @@ def solve_tree(scene: Scene, progress=None, callback: str | None = None) -> RunR
         "q": mbs.AddSensor(SensorNode(nodeNumber=model.node, outputVariableType=OVT.Coordinates, **store)),
         "q_t": mbs.AddSensor(SensorNode(nodeNumber=model.node, outputVariableType=OVT.Coordinates_t, **store)),
         "q_tt": mbs.AddSensor(SensorNode(nodeNumber=model.node, outputVariableType=OVT.Coordinates_tt, **store)),
-        "force": mbs.AddSensor(SensorObject(objectNumber=model.connector, outputVariableType=OVT.Force, **store)),
     }
     guard = RunGuard(scene)
     breach = []
@@ -191,6 +196,7 @@ def solve_tree(scene: Scene, progress=None, callback: str | None = None) -> RunR
         kind = "non_finite" if isinstance(exc, exu.SolverError) else "model" if isinstance(exc, exu.ModelError) else "solver"
     wall_solve = _time.perf_counter() - wall_solve
     data = {k: mbs.GetSensorStoredData(v) for k, v in sensors.items()}
+    data["force"] = np.array(model.bearing_force).reshape(-1, 3)
     steps = tree_channels(model, data) if min(len(v) for v in data.values()) else empty_channels()
     bad = first_nonfinite_row(steps)
     if bad is not None:
@@ -219,7 +225,7 @@ def solve_tree(scene: Scene, progress=None, callback: str | None = None) -> RunR
         "rejected_steps": int(it.rejectedAutomaticStepSizeSteps),
         "min_step_s": state["min_step"],
         "callback": model.route,
-        "callback_calls": model.callback_calls[0] if model.route == "python" else None,
+        "callback_calls": int(model.callback_calls[0]),
         **model.tracker.counters(),  # contact_events, nonpositive_onsets, separations, missed_*
         "solve_time_s": wall_solve,
         "wall_time_s": _time.perf_counter() - wall0,
