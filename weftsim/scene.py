@@ -21,7 +21,7 @@ from typing import Any, Callable
 from weftsim import params
 
 INTEGRATORS = ("auto", "DOP853", "RK45", "RK23", "Radau", "LSODA", "BDF", "numba_DOP853", "numba_RK45")
-EXUDYN_MODELS = ("rigid_body", "kinematic_tree")
+EXUDYN_MODELS = ("auto", "rigid_body", "kinematic_tree")
 EXPLICIT_METHODS = ("DOPRI5", "ODE23")
 CALLBACK_ROUTES = ("auto", "python", "symbolic", "numba")
 BRANCHES = {"+": 1, "-": -1}
@@ -120,7 +120,8 @@ SCHEMA: tuple[Key, ...] = (
     Key("solver.reference.max_step_deg", "reference_solver.max_step", "float", DEG, 0, 90,
         doc="largest step, as crank angle"),
     Key("solver.exudyn.model", "exudyn_solver.model", "str", choices=EXUDYN_MODELS,
-        doc="Exudyn model: rigid_body (members 1-8, general) or kinematic_tree (members 1-3 prescribed)"),
+        doc="Exudyn model: auto = kinematic_tree unless the scene needs rigid_body (ideal joint, friction, "
+            "symbolic callback); rigid_body = members 1-8, general; kinematic_tree = members 1-3 prescribed"),
     Key("solver.exudyn.step_size_s", "exudyn_solver.step_size", "float", 1, 0, 1e-2,
         doc="generalized-alpha step size (ideal joint: at least 0.05 deg of crank, nothing to resolve)"),
     Key("solver.exudyn.spectral_radius", "exudyn_solver.spectral_radius", "float", 1, 0, 1, False, False,
