@@ -39,7 +39,6 @@ two against each other.
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass, field
 
@@ -204,66 +203,6 @@ def make_python_force(law, clearance: float, min_impact_velocity: float, bearing
     return tree_force
 
 
-# Slots after the scene parameters in the numba route's state array: the callback's memory
-# (v_held, delta0, rate0), its stash (t, delta, delta_dot, F_b,x, F_b,y) and its call count.
-HELD, STASH, CALLS, N_SLOTS = 0, 3, 8, 9
-
-
-@functools.cache
-def _compiled_tree_force():
-    """The ``@njit(cache=True)`` core of the numba route, built on first use (numba is imported lazily).
-
-    Every scene-dependent number comes in the parameter array of
-    :func:`weftsim.reference.compiled_kernel.pack_parameters` (bearing motion, chain lengths, law,
-    v_min, rule), so the core compiles once per machine and loads from numba's cache afterwards.
-    The memory and stash of :func:`make_python_force` live in the same array after the parameters
-    (:data:`HELD`, :data:`STASH`, :data:`CALLS`), so a call passes one array and four floats.
-    """
-    from numba import njit
-
-    from weftsim.reference import compiled_kernel as ck
-
-    impact_velocity = njit(cache=True)(callback_impact_velocity)
-    damped = njit(cache=True)(damping_rate)
-    crank_side, normal_force = ck.crank_side, ck.normal_force
-    L_OG, L_FG, L_EF, OMEGA, CLEARANCE, V_MIN, TRACK_MAX = (
-        ck.L_OG, ck.L_FG, ck.L_EF, ck.OMEGA, ck.CLEARANCE, ck.V_MIN, ck.TRACK_MAX)  # fmt: skip
-    held_at, stash_at, calls_at = ck.N_PARAMETERS + HELD, ck.N_PARAMETERS + STASH, ck.N_PARAMETERS + CALLS
-
-    @njit(cache=True)
-    def core(state, t, a, q1, da, dq1):
-        state[calls_at] += 1.0
-        b_y, b_z, db_y, db_z, _ = crank_side(state, t)
-        omega, l_fg, l_ef = state[OMEGA], state[L_FG], state[L_EF]
-        b = a + q1
-        db = da + dq1
-        sa, ca, sb, cb = math.sin(a), math.cos(a), math.sin(b), math.cos(b)
-        ex = state[L_OG] + l_fg * ca + l_ef * cb - b_y
-        ey = l_fg * sa + l_ef * sb - b_z
-        length = math.sqrt(ex * ex + ey * ey)
-        delta = length - state[CLEARANCE]
-        state[stash_at], state[stash_at + 1] = t, delta
-        state[stash_at + 2] = state[stash_at + 3] = state[stash_at + 4] = 0.0
-        if length <= 0.0:
-            return 0.0, 0.0
-        nx = ex / length
-        ny = ey / length
-        rate = ((-l_fg * sa * da - l_ef * sb * db - omega * db_y) * nx
-                + (l_fg * ca * da + l_ef * cb * db - omega * db_z) * ny)  # fmt: skip
-        state[stash_at + 2] = rate
-        if delta <= 0.0:
-            return 0.0, 0.0
-        v_min = state[V_MIN]
-        v_imp = impact_velocity(state[held_at], state[held_at + 1], state[held_at + 2], delta, rate, v_min,
-                                state[TRACK_MAX] > 0.5)  # fmt: skip
-        f = normal_force(state, delta, damped(rate, RESTING_RATE_FRACTION * v_min), v_imp)
-        state[stash_at + 3], state[stash_at + 4] = f * nx, f * ny
-        gq1 = f * l_ef * (nx * sb - ny * cb)
-        return f * l_fg * (nx * sa - ny * ca) + gq1, gq1
-
-    return core
-
-
 def make_numba_force(scene: Scene, memory: list):
     """Compiled generalized force (as :func:`make_python_force`): (callback, memory, stash, call count).
 
@@ -271,13 +210,14 @@ def make_numba_force(scene: Scene, memory: list):
     against ~2 us for the plain-Python body.  The memory, stash and count returned are views of
     the core's state array (indexable as the python route's lists).
     """
+    from weftsim.exudyn_engine.tree_kernel import CALLS, HELD, N_SLOTS, STASH, tree_force_core
     from weftsim.reference.compiled_kernel import N_PARAMETERS, pack_parameters
 
-    core = _compiled_tree_force()
     state = np.concatenate([pack_parameters(scene), np.zeros(N_SLOTS)])
-    state[N_PARAMETERS + STASH] = math.nan
     slots = state[N_PARAMETERS:]
     slots[HELD:HELD + 3] = memory
+    slots[STASH] = math.nan
+    core = tree_force_core
 
     def tree_force(mbs, t, itemNumber, q, q_t):
         return core(state, t, q[0], q[1], q_t[0], q_t[1])
