@@ -22,7 +22,10 @@ percentiles; a false failure needs a 4-sigma draw (6e-5 per check, normal tails)
 its default path, as ``weftsim compare`` runs it: the automatic selection takes the kinematic-tree
 model (members 1-3 prescribed, the same equations in Exudyn's minimal coordinates, DOPRI5 with error
 control at its default tolerance).  The rigid-body model (40 revolutions take ~7 minutes) is checked
-against the reference on the first revolution in tests/test_exudyn_engine.py.
+against the reference on the first revolution in tests/test_exudyn_engine.py.  Measured on that default
+path (rtol 1e-6, numba route): c = 0.25 mm: RMS a / T 0.12 % / 0.05 %, mean F_N 0.06 %, p99 <= 0.31 %,
+first-revolution maxima <= 7.7e-4; c = 0.5 mm: RMS 0.50 % / 0.57 %, mean 0.07 %, p99 <= 2.3 %, maxima
+<= 3.6e-4.
 """
 
 import math
