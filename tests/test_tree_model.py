@@ -14,7 +14,7 @@ pytest.importorskip("exudyn")
 from weftsim.contact import make_law  # noqa: E402
 from weftsim.exudyn_engine import solve  # noqa: E402
 from weftsim.exudyn_engine.onset import OnsetTracker  # noqa: E402
-from weftsim.exudyn_engine.tree import BearingMotion, ChainGeometry, make_numba_force, make_python_force  # noqa: E402
+from weftsim.exudyn_engine.tree import BearingMotion, make_numba_force, make_python_force  # noqa: E402
 from weftsim.exudyn_engine.tree_solve import contact_work  # noqa: E402
 from weftsim.reference.dynamics import ChainConstants, eccentricity, initial_state  # noqa: E402
 from weftsim.reference.dynamics import MATH  # noqa: E402
@@ -51,7 +51,7 @@ def test_the_generalized_force_is_the_virtual_work_of_the_contact_force(route):
     memory, stash, calls = [0.05, 1e-6, 0.05], [math.nan] * 5, [0]
     if route == "python":
         force = make_python_force(make_law(scene.joint), c, scene.joint.min_impact_velocity,
-                                  BearingMotion.from_scene(scene), ChainGeometry.from_scene(scene), memory, stash, calls)
+                                  BearingMotion.from_scene(scene), scene.geometry, memory, stash, calls)
     else:
         force, memory, stash, calls = make_numba_force(scene, tracker.callback_state)
         memory[:] = [0.05, 1e-6, 0.05]
@@ -60,7 +60,7 @@ def test_the_generalized_force_is_the_virtual_work_of_the_contact_force(route):
     t = 0.0123
     ey0, ez0 = eccentricity(MATH, p, t, a0, psi0, 0.0, 0.0)[:2]
     # Move the rod angle until the journal penetrates 20 um (e is nearly along the rod at theta ~ 0).
-    g = ChainGeometry.from_scene(scene)
+    g = scene.geometry
     q = [a0, psi0 + math.pi - a0]
     for _ in range(50):
         ey, ez = eccentricity(MATH, p, t, q[0], q[0] + q[1] - math.pi, 0.0, 0.0)[:2]

@@ -118,29 +118,14 @@ class BearingMotion:
         return by, bz, self.omega * dby, self.omega * dbz
 
 
-@dataclass(frozen=True)
-class ChainGeometry:
-    """Lengths of the free chain in Exudyn's plane: base G = (L_OG, 0), F = G + L_FG u(a), P_j = F + L_EF u(b).
-
-    b = q0 + q1 = psi + pi is the absolute angle of the rod's x axis (F to the journal).
-    """
-
-    l_og: float
-    l_fg: float
-    l_ef: float
-
-    @classmethod
-    def from_scene(cls, scene: Scene) -> "ChainGeometry":
-        g = scene.geometry
-        return cls(g.l_og, g.l_fg, g.l_ef)
-
-
 def make_python_force(law, clearance: float, min_impact_velocity: float, bearing: BearingMotion,
-                      chain: ChainGeometry, memory: list, stash: list, counter: list | None = None,
+                      geometry, memory: list, stash: list, counter: list | None = None,
                       max_approach: bool = True):
     """Plain-Python generalized contact force of the tree, ``forceUserFunction(mbs, t, i, q, q_t)``.
 
-    The journal centre and its velocity follow from the joint coordinates in closed form,
+    The journal centre and its velocity follow from the joint coordinates in closed form
+    (``geometry``: :class:`weftsim.params.Geometry`, lengths L_OG, L_FG, L_EF; b = q0 + q1 = psi + pi
+    is the absolute angle of the rod's x axis from F to the journal),
 
         P_j = G + L_FG u(a) + L_EF u(b),  v_j = L_FG a' u'(a) + L_EF b' u'(b),  b = q0 + q1,
 
@@ -160,29 +145,21 @@ def make_python_force(law, clearance: float, min_impact_velocity: float, bearing
     """
     normal_force = law.scalar()
     c, v_min, sqrt, cos, sin = clearance, min_impact_velocity, math.sqrt, math.cos, math.sin
-    omega, tb, c0, s0, l_oe = bearing.omega, bearing.tan_beta, bearing.cos_oe0, bearing.sin_oe0, bearing.l_oe
-    l_og, l_fg, l_ef = chain.l_og, chain.l_fg, chain.l_ef
+    l_og, l_fg, l_ef = geometry.l_og, geometry.l_fg, geometry.l_ef
     counter = [0] if counter is None else counter
     impact_velocity, damped = callback_impact_velocity, damping_rate
     v_dead = RESTING_RATE_FRACTION * min_impact_velocity
 
     def tree_force(mbs, t, itemNumber, q, q_t):
         counter[0] += 1
-        # BearingMotion.terms inlined (this runs ~7 times per step): P_b = L_OE (cos q, sin q).
-        theta = omega * t
-        u = tb * cos(theta)
-        w = 1.0 + u * u
-        r = 1.0 / sqrt(w)
-        sq = (s0 - c0 * u) * r
-        cq = (c0 + s0 * u) * r
-        k = omega * l_oe * tb * sin(theta) / w  # omega L_OE phi'
+        b_y, b_z, vb_y, vb_z = bearing(t)
         a = q[0]
         b = a + q[1]
         da = q_t[0]
         db = da + q_t[1]
         sa, ca, sb, cb = sin(a), cos(a), sin(b), cos(b)
-        ex = l_og + l_fg * ca + l_ef * cb - l_oe * cq
-        ey = l_fg * sa + l_ef * sb - l_oe * sq
+        ex = l_og + l_fg * ca + l_ef * cb - b_y
+        ey = l_fg * sa + l_ef * sb - b_z
         length = sqrt(ex * ex + ey * ey)
         delta = length - c
         if length <= 0.0:
@@ -190,7 +167,7 @@ def make_python_force(law, clearance: float, min_impact_velocity: float, bearing
             return [0.0, 0.0]
         nx = ex / length
         ny = ey / length
-        rate = (k * sq - l_fg * sa * da - l_ef * sb * db) * nx + (l_fg * ca * da + l_ef * cb * db - k * cq) * ny
+        rate = (-l_fg * sa * da - l_ef * sb * db - vb_y) * nx + (l_fg * ca * da + l_ef * cb * db - vb_z) * ny
         if delta <= 0.0:
             stash[0], stash[1], stash[2], stash[3], stash[4] = t, delta, rate, 0.0, 0.0
             return [0.0, 0.0]
@@ -267,7 +244,6 @@ def build_tree(mbs, scene: Scene, callback: str = "auto") -> TreeModel:
     a0, psi0, da0, dpsi0 = initial_state(scene)[:4]
     law = make_law(joint)
     bearing = BearingMotion.from_scene(scene)
-    chain = ChainGeometry.from_scene(scene)
     route = tree_route(callback)
     calls = [0]
     c, v_min = joint.clearance, joint.min_impact_velocity
@@ -276,7 +252,7 @@ def build_tree(mbs, scene: Scene, callback: str = "auto") -> TreeModel:
     memory = list(tracker.callback_state)
     stash = [math.nan, 0.0, 0.0, 0.0, 0.0]
     if route == "python":
-        force = make_python_force(law, c, v_min, bearing, chain, memory, stash, calls, max_approach)
+        force = make_python_force(law, c, v_min, bearing, g, memory, stash, calls, max_approach)
     elif route == "numba":
         force, memory, stash, calls = make_numba_force(scene, memory)
     else:
