@@ -34,6 +34,12 @@ SOLVERS = {"reference": reference.solve, "exudyn": exudyn_engine.solve}
 FIRST_CONTACT_DEG = 6.637  # reference scene: onset of the start-up impact (docs/clearance-joint.md)
 
 
+# These faults were written against scipy's DOP853 at rtol 1e-9 (the reference engine's default
+# until issue 12): named here, so they keep testing that path; the compiled path's guards are
+# tested in tests/test_fast_paths.py.
+SCIPY_DOP853 = ReferenceSolver(method="DOP853", rtol=1e-9, atol=1e-12)
+
+
 def scene(degrees=20.0, youngs_modulus=207e9, exudyn=None, reference_solver=None, **limits) -> Scene:
     """The reference scene over the first ``degrees`` of crank, both materials of the given modulus.
 
@@ -48,7 +54,7 @@ def scene(degrees=20.0, youngs_modulus=207e9, exudyn=None, reference_solver=None
         joint=dataclasses.replace(steel.joint, journal_material=material, bearing_material=material),
         drive=Drive(speed=400.0 * RPM, revolutions=degrees / 360.0),
         exudyn_solver=exudyn or steel.exudyn_solver,
-        reference_solver=reference_solver or steel.reference_solver,
+        reference_solver=reference_solver or SCIPY_DOP853,
         limits=Limits(**limits),
     )
 
@@ -358,9 +364,10 @@ def write_scene(path: Path, body: str) -> Path:
 
 @pytest.mark.parametrize("engine", SOLVERS)
 def test_cli_failed_run_exits_3_and_writes_what_it_computed_marked_incomplete(tmp_path, engine):
-    # 100 steps: about 4 deg of crank for the reference engine; 8.5 deg for Exudyn's default model, the
-    # kinematic tree (13 free-flight steps of 0.5 deg to the first contact at 6.6 deg, then short ones).
-    budget = 100
+    # Steps: the default reference path takes 93 in the 18 deg of the run (10 up to 4.5 deg, then the
+    # start-up impact at 6.6 deg); Exudyn's default model, the kinematic tree, 298 (13 free-flight steps
+    # of 0.5 deg up to 6.5 deg, then short ones in contact; 40 reach 7.5 deg): both stop well before the end.
+    budget = 40
     path = write_scene(tmp_path / "limited.toml", f"[drive]\nrevolutions = 0.05\n[limits]\nmax_steps = {budget}\n")
     out = tmp_path / "out"
     done = run_cli("run", path, "-o", out, "--engine", engine, "--no-plot")

@@ -122,7 +122,10 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Time every engine setting on an easy and two hard scenes against a converged "
                        "solution: tables, log-log figures and JSON.  The full mode takes ~30 min on 2 cores.")
     p.add_argument("--quick", action="store_true", help="a few settings, 2 revolutions (a few minutes)")
-    p.add_argument("-o", "--output", default=None, help="output directory (default: out/bench or out/bench-quick)")
+    p.add_argument("--targets", action="store_true",
+                   help="the speed targets of the default paths against the 0.1 defaults (about 10 min)")
+    p.add_argument("-o", "--output", default=None,
+                   help="output directory (default: out/bench, out/bench-quick or out/bench-targets)")
     p.add_argument("--case", action="append", help="only this case (repeatable): c0.25mm-400rpm, c0.01mm-800rpm, "
                    "c0.50mm-800rpm")
     p.add_argument("--models", default="models", help="directory of the scene files (default: models)")
@@ -193,7 +196,7 @@ def cmd_kinematics(args) -> int:
     return 0
 
 
-def _solve(scene, engine: str, label: str | None = None):
+def _solve(scene, engine: str, label: str | None = None, announce: bool = False):
     from weftsim.progress import Progress
 
     if engine == "reference":
@@ -202,17 +205,22 @@ def _solve(scene, engine: str, label: str | None = None):
         from weftsim.exudyn_engine import solve
     else:
         raise CliError(f"--engine must be 'reference' or 'exudyn', got {engine!r}")
-    if label is None:  # a run's first line: the model and method it takes, and why
-        from importlib import import_module
-
-        select = import_module("weftsim.reference" if engine == "reference" else "weftsim.exudyn_engine").select_path
-        path = select(scene)
+    if announce:  # `run`: its first line is the model and method it takes, and why
+        path = _select(engine)(scene)
         print(f"scene {scene.name}, engine {engine}: {path['model']}, {path['method']} ({path['reason']})", flush=True)
     progress = Progress(label or f"{engine} {scene.name}")
     try:
         return solve(scene, progress=progress)
     finally:
         progress.close()
+
+
+def _select(engine: str):
+    if engine == "reference":
+        from weftsim.reference import select_path
+    else:
+        from weftsim.exudyn_engine import select_path
+    return select_path
 
 
 def _report_run(result, written) -> None:
@@ -238,7 +246,7 @@ def cmd_run(args) -> int:
 
     scene = _load(args)
     outdir = prepare_directory(_outdir(args, scene), args.force)
-    result = _solve(scene, args.engine)
+    result = _solve(scene, args.engine, announce=True)
     written = write_run(result, outdir, figure=not args.no_plot, force=args.force)
     _report_run(result, written)
     report_lines(result, "run")
@@ -293,6 +301,13 @@ def cmd_bench(args) -> int:
     unknown = [c for c in args.case or [] if c not in CASES]
     if unknown:
         raise CliError(f"unknown --case {', '.join(unknown)}; choose from {', '.join(CASES)}")
+    if args.targets:
+        from weftsim.bench.targets import run_targets, write_targets
+
+        report = run_targets(args.models, repeats=args.repeats, log=lambda text: print(text, file=sys.stderr))
+        files = write_targets(report, args.output or "out/bench-targets", args.force)
+        print(f"targets measured in {report['total_time_s']:.0f} s; wrote " + ", ".join(map(str, files)))
+        return 0
     outdir = args.output or ("out/bench-quick" if args.quick else "out/bench")
     report = run_benchmark(outdir, args.models, args.quick, args.case, repeats=args.repeats, force=args.force)
     print(f"benchmark done in {report['total_time_s']:.0f} s; wrote " + ", ".join(map(str, report["files"])))

@@ -108,12 +108,13 @@ def write_csv(target: Path, columns: dict[str, np.ndarray]) -> Path:
 
 
 def write_figure(target: Path, figure) -> Path:
-    import matplotlib.pyplot as plt
+    import sys
 
     try:
         return write_atomic(target, lambda p: figure.savefig(p, format=target.suffix.lstrip("."), dpi=130))
     finally:
-        plt.close(figure)
+        if "matplotlib.pyplot" in sys.modules:  # a pyplot figure: free it (weftsim.plots.figure() are not held)
+            sys.modules["matplotlib.pyplot"].close(figure)
 
 
 def _manifest_files(outdir: Path) -> set[str]:
