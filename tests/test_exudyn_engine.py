@@ -20,11 +20,12 @@ RPM = math.pi / 30.0
 
 
 def scene(clearance=0.25e-3, rpm=400.0, revolutions=2.0, rule="max_approach", **solver) -> Scene:
+    """A scene of the rigid-body model unless ``model`` says otherwise (the tests here mean it)."""
     if "step_size" in solver:  # these tests mean that step: the fixed-step generalized-alpha
         solver.setdefault("step_control", "fixed")
     return Scene(joint=ClearanceJoint(clearance=clearance, impact_velocity_rule=rule),
                  drive=Drive(speed=rpm * RPM, revolutions=revolutions),
-                 exudyn_solver=ExudynSolver(**solver))  # fmt: skip
+                 exudyn_solver=ExudynSolver(**{"model": "rigid_body", **solver}))  # fmt: skip
 
 
 # Ideal joints: constraint reactions carry round-off noise ~ eps |q| / (beta h^2) (index-3
@@ -207,7 +208,7 @@ def test_output_grid_and_every_step(startup):
 
 
 def test_invalid_settings_and_friction_fail_naming_the_setting():
-    r = solve(dataclasses.replace(scene(), exudyn_solver=ExudynSolver(spectral_radius=1.5)))
+    r = solve(dataclasses.replace(scene(), exudyn_solver=ExudynSolver(model="rigid_body", spectral_radius=1.5)))
     assert r.status == "failed" and "spectral_radius" in r.message
     r = solve(dataclasses.replace(scene(), joint=ClearanceJoint(friction_coefficient=0.1)))
     assert r.status == "failed" and "friction" in r.message

@@ -202,14 +202,16 @@ class ReferenceSolver:
 class ExudynSolver:
     """Settings of the Exudyn engine.
 
-    ``model``: "rigid_body" (members 1-8 as bodies and joints, generalized-alpha with
-    ``spectral_radius`` and the Newton settings; its step is error-controlled to ``local_error``
-    under ``step_control = "adaptive"``, or ``step_size`` under ``"fixed"``) or "kinematic_tree" (members
-    1-3 prescribed, 4-8 in minimal coordinates, explicit ``explicit_method`` with automatic
-    step size to ``relative_tolerance`` / ``absolute_tolerance``; docs/performance.md).
+    ``model``: "auto" (the kinematic tree unless the scene needs the rigid-body model:
+    :mod:`weftsim.exudyn_engine.selection`), "rigid_body" (members 1-8 as bodies and joints,
+    generalized-alpha with ``spectral_radius`` and the Newton settings; its step is error-controlled
+    to ``local_error`` under ``step_control = "adaptive"``, or ``step_size`` under ``"fixed"``) or
+    "kinematic_tree" (members 1-3 prescribed, 4-8 in minimal coordinates, explicit
+    ``explicit_method`` with automatic step size to ``relative_tolerance`` /
+    ``absolute_tolerance``; docs/performance.md).
     """
 
-    model: str = "rigid_body"
+    model: str = "auto"
     step_control: str = "adaptive"  # rigid_body: "adaptive" (local error control, step_control.py) or "fixed"
     local_error: float = 3e-10  # m; rigid_body, adaptive: local error tolerance on the eccentricity at E
     step_size: float = 2e-6  # s; fixed: the step (ideal joint: see exudyn_engine.solver); adaptive: unused

@@ -14,6 +14,7 @@ No files are written (solution and sensor files off) and the solver prints nothi
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time as _time
 
@@ -21,7 +22,7 @@ import exudyn as exu
 
 from weftsim.exudyn_engine.clearance_joint import ROUTES, register_post_step
 from weftsim.exudyn_engine.mechanism import build_mechanism
-from weftsim.exudyn_engine.selection import select_path
+from weftsim.exudyn_engine.selection import select_model, select_path
 from weftsim.exudyn_engine.step_control import StepController
 from weftsim.exudyn_engine.sensors import add_sensors, first_nonfinite_row, sample_channels, silence, step_channels
 from weftsim.guards import RunGuard, failure_message, non_finite_breach, vet_result
@@ -29,7 +30,7 @@ from weftsim.params import Scene
 from weftsim.scene import IMPACT_VELOCITY_RULES, STEP_CONTROLS
 from weftsim.results import RunResult, angle_grid, empty_channels
 
-MODELS = ("rigid_body", "kinematic_tree")  # kinematic_tree: tree.py, tree_solve.py
+MODELS = ("auto", "rigid_body", "kinematic_tree")  # auto: selection.py; kinematic_tree: tree.py, tree_solve.py
 # Modified Newton: iterations with one Jacobian before it is updated.  3 instead of
 # Exudyn's 8: 3.75 instead of 5.9 iterations per step, ~30 % less time, identical results
 # at the same tolerance (2: 2.97 iterations but 4x the Jacobians, slower).
@@ -52,7 +53,7 @@ def check_settings(scene: Scene) -> str | None:
     s = scene.exudyn_solver
     if s.model not in MODELS:
         return f"`exudyn_solver.model` must be one of {MODELS}, got {s.model!r}"
-    if s.model == "kinematic_tree":
+    if select_model(scene)[0] == "kinematic_tree":
         from weftsim.exudyn_engine.tree_solve import check_tree_settings
 
         problem = check_tree_settings(scene)
@@ -196,16 +197,19 @@ def solve(scene: Scene, progress=None, callback: str | None = None) -> RunResult
         time; ``events["first_contact_time_s"]`` located within its step.
     """
     wall0 = _time.perf_counter()
+    if callback is not None:  # the route is part of the scene the selection sees (selection.py)
+        scene = dataclasses.replace(scene, exudyn_solver=dataclasses.replace(scene.exudyn_solver, callback=callback))
     problem = check_settings(scene)
     if problem is not None:
         return _failed(scene, problem, 0.0)
-    result = _solve_model(scene, progress, callback, wall0)
-    object.__setattr__(result, "path", select_path(scene))
+    path = select_path(scene)
+    result = _solve_model(scene, path["model"], progress, None, wall0)
+    object.__setattr__(result, "path", path)
     return result
 
 
-def _solve_model(scene: Scene, progress, callback: str | None, wall0: float) -> RunResult:
-    if scene.exudyn_solver.model == "kinematic_tree":
+def _solve_model(scene: Scene, model: str, progress, callback: str | None, wall0: float) -> RunResult:
+    if model == "kinematic_tree":
         from weftsim.exudyn_engine.tree_solve import solve_tree
 
         return solve_tree(scene, progress, callback)
