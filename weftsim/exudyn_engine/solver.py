@@ -19,7 +19,8 @@ import time as _time
 
 import exudyn as exu
 
-from weftsim.exudyn_engine.clearance_joint import ROUTES, register_post_step
+from weftsim.exudyn_engine.callbacks import route_error
+from weftsim.exudyn_engine.clearance_joint import register_post_step
 from weftsim.exudyn_engine.mechanism import build_mechanism
 from weftsim.exudyn_engine.selection import select_path
 from weftsim.exudyn_engine.sensors import add_sensors, first_nonfinite_row, sample_channels, silence, step_channels
@@ -60,8 +61,8 @@ def check_settings(scene: Scene) -> str | None:
         return f"`exudyn_solver.newton_relative_tolerance` must be > 0, got {s.newton_relative_tolerance}"
     if not s.newton_max_iterations >= 1:
         return f"`exudyn_solver.newton_max_iterations` must be >= 1, got {s.newton_max_iterations}"
-    if s.callback not in ROUTES + ("auto",):
-        return f"`exudyn_solver.callback` must be one of {('auto',) + ROUTES}, got {s.callback!r}"
+    if route_error(s.callback):
+        return f"`exudyn_solver.{route_error(s.callback)[1:]}"
     if s.callback == "numba" and not scene.joint.is_ideal:
         try:
             import numba  # noqa: F401 - optional dependency of this route only

@@ -51,24 +51,15 @@ from exudyn.itemInterface import (
     ObjectKinematicTree,
 )
 
-from weftsim.contact import make_law
-from weftsim.exudyn_engine.callbacks import symbolic_clearance_force
-from weftsim.exudyn_engine.onset import (
-    RESTING_RATE_FRACTION,
-    OnsetTracker,
-    callback_impact_velocity,
-    damping_rate,
-    penetration_state,
-)
+from weftsim.exudyn_engine import callbacks
+from weftsim.exudyn_engine.onset import OnsetTracker, penetration_state
 from weftsim.params import Scene
-from weftsim.reference.dynamics import initial_state
+from weftsim.reference.dynamics import initial_state, pack_parameters
 from weftsim.reference.ideal import sector_chain_inertia
 
 UNSPECIFIED_MASS = 1.0  # sector mass (balanced, on its fixed axis: no effect), kg
-# "auto" route of this model: the symbolic route's expression tree repeats the bearing motion in
-# every use of e (Exudyn evaluates it as a tree, not a graph): 51 us per call against 3.4 us for
-# the fixed-bearing expression of callbacks.py; the plain-Python callback is ~1.5 us.
-AUTO_ROUTE = "python"
+# "auto" route of this model: the fastest measured (scripts/bench_callbacks.py).
+AUTO_ROUTE = "numba"
 
 
 @dataclass(frozen=True)
@@ -109,125 +100,6 @@ class BearingMotion:
         return by, bz, self.omega * dby, self.omega * dbz
 
 
-def make_python_force(law, clearance: float, min_impact_velocity: float, bearing: BearingMotion,
-                      memory: list, stash: list, counter: list | None = None, max_approach: bool = True):
-    """Plain-Python force callback with the moving bearing (see :mod:`.callbacks`).
-
-    ``memory`` = [v_held, delta0, rate0] of the last accepted step (written by the post-step
-    bookkeeping; the connector's ``stiffness`` parameter is not needed); every call leaves
-    [t, delta, delta_dot] in ``stash``: the last call of a step is at the accepted state
-    (end-of-step accelerations), so the bookkeeping needs no ``GetObjectOutput``.
-    """
-    normal_force = law.scalar()
-    c, v_min, sqrt, cos, sin = clearance, min_impact_velocity, math.sqrt, math.cos, math.sin
-    omega, tb, c0, s0, l_oe = bearing.omega, bearing.tan_beta, bearing.cos_oe0, bearing.sin_oe0, bearing.l_oe
-    counter = [0] if counter is None else counter
-    impact_velocity, damped = callback_impact_velocity, damping_rate
-    v_dead = RESTING_RATE_FRACTION * min_impact_velocity
-
-    def spring_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
-        counter[0] += 1
-        # BearingMotion.terms inlined (this runs ~13 times per step): P_b = L_OE (cos q, sin q).
-        theta = omega * t
-        u = tb * cos(theta)
-        w = 1.0 + u * u
-        r = 1.0 / sqrt(w)
-        sq = (s0 - c0 * u) * r
-        cq = (c0 + s0 * u) * r
-        k = omega * l_oe * tb * sin(theta) / w  # omega L_OE phi'
-        ex = displacement[0] - l_oe * cq
-        ey = displacement[1] - l_oe * sq
-        length = sqrt(ex * ex + ey * ey)
-        delta = length - c
-        if length <= 0.0:
-            stash[0], stash[1], stash[2] = t, delta, 0.0
-            return [0.0, 0.0, 0.0]
-        nx = ex / length
-        ny = ey / length
-        rate = (velocity[0] + k * sq) * nx + (velocity[1] - k * cq) * ny
-        stash[0], stash[1], stash[2] = t, delta, rate
-        if delta <= 0.0:
-            return [0.0, 0.0, 0.0]
-        v_imp = impact_velocity(memory[0], memory[1], memory[2], delta, rate, v_min, max_approach)
-        f = normal_force(delta, damped(rate, v_dead), v_imp)
-        return [f * nx, f * ny, 0.0]
-
-    return spring_force
-
-
-def make_numba_force(law, clearance: float, min_impact_velocity: float, bearing: BearingMotion,
-                     memory: list, stash: list, max_approach: bool = True):
-    """Python wrapper around an ``@njit`` core of the whole force, bearing motion included.
-
-    ``memory`` and ``stash`` as in :func:`make_python_force`.
-    """
-    import numba
-
-    normal_force = law.numba()
-    impact_velocity, damped = numba.njit(callback_impact_velocity), numba.njit(damping_rate)
-    c, v_min, v_dead = clearance, min_impact_velocity, RESTING_RATE_FRACTION * min_impact_velocity
-    omega, tb, c0, s0, l_oe = bearing.omega, bearing.tan_beta, bearing.cos_oe0, bearing.sin_oe0, bearing.l_oe
-
-    @numba.njit(cache=False)
-    def core(t, px, py, vx, vy, held, delta0, rate0):
-        theta = omega * t
-        u = tb * math.cos(theta)
-        w = 1.0 + u * u
-        r = 1.0 / math.sqrt(w)
-        sq = s0 * r - c0 * u * r
-        cq = c0 * r + s0 * u * r
-        dphi = tb * math.sin(theta) / w
-        ex = px - l_oe * cq
-        ey = py - l_oe * sq
-        length = math.sqrt(ex * ex + ey * ey)
-        delta = length - c
-        if length <= 0.0:
-            return 0.0, 0.0, delta, 0.0
-        nx = ex / length
-        ny = ey / length
-        rate = (vx + omega * l_oe * sq * dphi) * nx + (vy - omega * l_oe * cq * dphi) * ny
-        if delta <= 0.0:
-            return 0.0, 0.0, delta, rate
-        v_imp = impact_velocity(held, delta0, rate0, delta, rate, v_min, max_approach)
-        f = normal_force(delta, damped(rate, v_dead), v_imp)
-        return f * nx, f * ny, delta, rate
-
-    core(0.0, 1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0)  # compile now, not inside the first step
-
-    def spring_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
-        fx, fy, delta, rate = core(t, displacement[0], displacement[1], velocity[0], velocity[1],
-                                   memory[0], memory[1], memory[2])  # fmt: skip
-        stash[0], stash[1], stash[2] = t, delta, rate
-        return [fx, fy, 0.0]
-
-    return spring_force
-
-
-def make_symbolic_force(mbs, law, clearance: float, min_impact_velocity: float, bearing: BearingMotion,
-                        max_approach: bool = True):
-    """Exudyn symbolic user function (C++ expression tree) of the force with the moving bearing.
-
-    Same guards as :func:`weftsim.exudyn_engine.callbacks.make_symbolic_force` (both branches of
-    ``IfThenElse`` are evaluated).  Keep the returned object alive as long as the system.
-    """
-    esym = exu.symbolic
-    from exudyn.advancedUtilities import CreateSymbolicUserFunction
-
-    c, v_min, omega = clearance, min_impact_velocity, bearing.omega
-    real = esym.Real
-
-    def springForceUserFunction(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
-        by, bz, dby, dbz = bearing.terms(t, esym)
-        return symbolic_clearance_force(law, c, v_min, displacement[0] - by, displacement[1] - bz,
-                                        velocity[0] - real(omega) * dby, velocity[1] - real(omega) * dbz,
-                                        stiffness, max_approach)
-
-    return CreateSymbolicUserFunction(
-        mbs, springForceUserFunction, "springForceUserFunction",
-        itemTypeName="ObjectConnectorCartesianSpringDamper",
-    )  # fmt: skip
-
-
 @dataclass
 class TreeModel:
     """Items of the kinematic-tree model and the clearance bookkeeping."""
@@ -256,8 +128,6 @@ class TreeModel:
                                             self.scene.joint.clearance)  # fmt: skip
         self.tracker.accept(t, delta, rate)
         self.memory[:] = self.tracker.callback_state
-        if self.route == "symbolic":
-            mbs.SetObjectParameter(self.connector, "stiffness", self.memory)
 
 
 def build_tree(mbs, scene: Scene, callback: str = "auto") -> TreeModel:
@@ -265,7 +135,7 @@ def build_tree(mbs, scene: Scene, callback: str = "auto") -> TreeModel:
 
     Initial state: the ideal mechanism at theta = 0, journal centred
     (:func:`weftsim.reference.dynamics.initial_state`).  ``callback``: "auto" (= :data:`AUTO_ROUTE`),
-    "symbolic", "python" or "numba".  Needs ``scene.joint.clearance > 0`` and no friction.
+    "python" or "numba".  Needs ``scene.joint.clearance > 0`` and no friction.
     """
     g, m, joint = scene.geometry, scene.inertia, scene.joint
     a0, psi0, da0, dpsi0 = initial_state(scene)[:4]
@@ -284,24 +154,17 @@ def build_tree(mbs, scene: Scene, callback: str = "auto") -> TreeModel:
     ground = mbs.AddObject(ObjectGround())
     m_origin = mbs.AddMarker(MarkerBodyPosition(bodyNumber=ground, localPosition=[0.0, 0.0, 0.0]))
     m_journal = mbs.AddMarker(MarkerKinematicTreeRigid(objectNumber=tree, linkNumber=1, localPosition=[g.l_ef, 0, 0]))
-    law = make_law(joint)
+    if callbacks.route_error(callback):
+        raise ValueError(callbacks.route_error(callback))
     bearing = BearingMotion.from_scene(scene)
     route = AUTO_ROUTE if callback == "auto" else callback
     calls = [0]
     keep = None
     c, v_min = joint.clearance, joint.min_impact_velocity
-    max_approach = joint.impact_velocity_rule == "max_approach"
     tracker = OnsetTracker(c, v_min, rule=joint.impact_velocity_rule)
     memory = list(tracker.callback_state)
     stash = [math.nan, 0.0, 0.0]
-    if route == "python":
-        force = make_python_force(law, c, v_min, bearing, memory, stash, calls, max_approach)
-    elif route == "numba":
-        force = make_numba_force(law, c, v_min, bearing, memory, stash, max_approach)
-    elif route == "symbolic":
-        keep = force = make_symbolic_force(mbs, law, c, v_min, bearing, max_approach)
-    else:
-        raise ValueError(f"`callback` must be one of 'auto', 'python', 'symbolic', 'numba', got {callback!r}")
+    force = callbacks.make_tree_force(pack_parameters(scene), memory, stash, route, calls)
     connector = mbs.AddObject(ObjectConnectorCartesianSpringDamper(
         markerNumbers=[m_origin, m_journal], stiffness=tracker.callback_state, damping=[0.0, 0.0, 0.0],
         offset=[0.0, 0.0, 0.0], springForceUserFunction=force,

@@ -3,7 +3,7 @@
 
 scipy's ``DOP853`` and ``RK45`` are re-implemented step for step in :mod:`.compiled_rk` (same
 tableaux, taken from scipy; same initial step, error norm, step-size control and dense output), with the
-right-hand side and the contact law of :mod:`weftsim.reference.compiled_kernel`.  What
+right-hand side and the contact law of :mod:`weftsim.kernel.chain`.  What
 the scipy path pays per step in Python (stage combinations, error norm, dense-output
 objects, event location; ~50 us per step attempt, docs/reference-solver.md section 4)
 becomes a few microseconds.  Events, impact velocity, recorded steps (accepted steps,
@@ -26,7 +26,7 @@ import math
 import numpy as np
 from numba import njit
 
-from weftsim.reference.compiled_kernel import CLEARANCE, TRACK_MAX, V_MIN, penetration
+from weftsim.kernel.chain import CLEARANCE, TRACK_MAX, V_MIN, penetration
 from weftsim.reference.compiled_rk import (
     _MAX_FACTOR, _MIN_FACTOR, _SAFETY, DOP853, RK45, N, _dense, _dense_coefficients, _error_norm, _f,
     _initial_step, _stages,
