@@ -182,11 +182,13 @@ def test_startup_impact_is_step_converged_under_max_approach():
 
 def test_callback_routes_agree_in_the_model():
     peaks = {}
-    for route in ("python", "symbolic"):
+    for route in ("python", "numba"):
         r = solve(scene(0.25e-3, 400.0, 10.0 / 360.0), callback=route)
         peaks[route] = r.steps["contact_force_N"].max()
-    # Same formula, same Newton path: round-off only (1e-9 of ~2.4e5 N).
-    assert peaks["python"] == pytest.approx(peaks["symbolic"], rel=1e-9)
+    # Same kernel, same Newton path: round-off only (1e-9 of ~2.4e5 N).
+    assert peaks["python"] == pytest.approx(peaks["numba"], rel=1e-9)
+    r = solve(scene(0.25e-3, 400.0, 10.0 / 360.0), callback="symbolic")
+    assert r.status == "failed" and "symbolic route was removed" in r.message
 
 
 def test_output_grid_and_every_step(startup):

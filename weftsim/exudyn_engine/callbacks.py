@@ -39,6 +39,7 @@ import numpy as np
 
 from weftsim.kernel import chain as kernel_chain
 from weftsim.kernel import joint as kernel_joint
+from weftsim.kernel.hold import RESTING_RATE_FRACTION
 
 ROUTES = ("python", "numba")
 REMOVED_ROUTES = {"symbolic": "the symbolic route was removed (it was a second copy of every contact law "
@@ -62,6 +63,7 @@ def connector_parameters(law, clearance: float, min_impact_velocity: float, max_
     prm[kernel_joint.CLEARANCE] = clearance
     prm[kernel_joint.V_MIN] = min_impact_velocity
     prm[kernel_joint.TRACK_MAX] = 1.0 if max_approach else 0.0
+    prm[kernel_joint.DEAD_RATE] = RESTING_RATE_FRACTION * min_impact_velocity
     return prm
 
 
@@ -121,6 +123,8 @@ def make_tree_force(prm: np.ndarray, memory: list, stash: list, route: str = "nu
     the accepted state, so the bookkeeping needs no ``GetObjectOutput``.
     """
     force = _kernel(kernel_chain.moving_bearing_force, route)
+    prm = prm.copy()
+    prm[kernel_joint.DEAD_RATE] = RESTING_RATE_FRACTION * prm[kernel_joint.V_MIN]
     counter = [0] if counter is None else counter
     if route == "numba":
         force(prm, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0)  # load (or compile) now

@@ -30,15 +30,16 @@ from weftsim.kernel.hold import effective_impact_velocity
 from weftsim.kernel.laws import friction_factor, normal_force
 
 # Indices into the joint parameter block.
-(KIND, COEF, CLEARANCE, XI, BEARING_RADIUS, MU, V0, V1, V_MIN, TRACK_MAX) = range(10)  # fmt: skip
-N_JOINT = 10
+(KIND, COEF, CLEARANCE, XI, BEARING_RADIUS, MU, V0, V1, V_MIN, TRACK_MAX, DEAD_RATE) = range(11)  # fmt: skip
+N_JOINT = 11
 
 
 def joint_parameters(joint, law) -> np.ndarray:
-    """The joint block: the law's (kind, coef, c, xi), R_b, mu, friction ramp, v_min, rule flag.
+    """The joint block: the law's (kind, coef, c, xi), R_b, mu, friction ramp, v_min, rule flag, dead zone.
 
     ``joint``: a :class:`weftsim.params.ClearanceJoint`; ``law``: a law of :mod:`weftsim.contact`
-    (its ``parameters``).  ``TRACK_MAX`` is 1.0 under the "max_approach" rule, 0.0 under "onset".
+    (its ``parameters``).  ``TRACK_MAX`` is 1.0 under the "max_approach" rule, 0.0 under "onset";
+    ``DEAD_RATE`` = RESTING_RATE_FRACTION v_min, the damping dead zone of :func:`connector_force`.
     """
     out = np.zeros(N_JOINT)
     out[KIND], out[COEF], out[CLEARANCE], out[XI] = law.parameters
@@ -48,6 +49,7 @@ def joint_parameters(joint, law) -> np.ndarray:
     out[V0], out[V1] = joint.friction_velocities
     out[V_MIN] = joint.min_impact_velocity
     out[TRACK_MAX] = 1.0 if joint.impact_velocity_rule == "max_approach" else 0.0
+    out[DEAD_RATE] = RESTING_RATE_FRACTION * joint.min_impact_velocity
     return out
 
 
@@ -94,7 +96,7 @@ def connector_force(prm, ex, ey, vx, vy, held, delta0, rate0):
     ``held``, ``delta0``, ``rate0``: the held impact velocity and the penetration and rate of the
     last accepted state (the connector's memory).  The impact velocity is
     :func:`~weftsim.kernel.hold.callback_impact_velocity`, the damping rate has the resting-contact
-    dead zone of :func:`~weftsim.kernel.hold.damping_rate` (+-RESTING_RATE_FRACTION v_min).
+    dead zone of :func:`~weftsim.kernel.hold.damping_rate` (+-``prm[DEAD_RATE]``).
 
     Returns
     -------
@@ -109,8 +111,7 @@ def connector_force(prm, ex, ey, vx, vy, held, delta0, rate0):
     rate = vx * nx + vy * ny
     if delta <= 0.0:
         return 0.0, 0.0, delta, rate
-    v_min = prm[V_MIN]
-    v_imp = callback_impact_velocity(held, delta0, rate0, delta, rate, v_min, prm[TRACK_MAX] != 0.0)
-    f = normal_force(prm[KIND], prm[COEF], prm[CLEARANCE], prm[XI], delta,
-                     damping_rate(rate, RESTING_RATE_FRACTION * v_min), v_imp)  # fmt: skip
+    v_imp = callback_impact_velocity(held, delta0, rate0, delta, rate, prm[V_MIN], prm[TRACK_MAX] != 0.0)
+    f = normal_force(prm[KIND], prm[COEF], prm[CLEARANCE], prm[XI], delta, damping_rate(rate, prm[DEAD_RATE]),
+                     v_imp)  # fmt: skip
     return f * nx, f * ny, delta, rate
