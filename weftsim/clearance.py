@@ -45,11 +45,13 @@ from weftsim.contact import check_impact_velocity
 from weftsim.kernel import hold
 from weftsim.kernel import joint as kernel_joint
 from weftsim.kernel.joint import joint_parameters
+from weftsim.kernel.python import python_form
 from weftsim.params import ClearanceJoint
 
-_EFFECTIVE_IMPACT_VELOCITY = np.vectorize(hold.effective_impact_velocity.py_func, otypes=[float])
+# Array forms for analysis and tests, plain Python per element (the engines call the compiled kernel).
+_EFFECTIVE_IMPACT_VELOCITY = np.vectorize(python_form(hold.effective_impact_velocity), otypes=[float])
 # The joint's parameter array is passed whole to every element (excluded from broadcasting).
-_CLEARANCE_FORCE = np.vectorize(kernel_joint.clearance_force.py_func, otypes=[float] * 8, excluded={0})
+_CLEARANCE_FORCE = np.vectorize(python_form(kernel_joint.clearance_force), otypes=[float] * 8, excluded={0})
 
 
 class ClearanceContact(NamedTuple):
@@ -217,7 +219,7 @@ def make_clearance_kernel(law, joint: ClearanceJoint, jit: bool = False) -> Clea
             return fx, fy, f_n, delta, delta_dot, m_j, m_b
 
         return compiled
-    force = kernel_joint.clearance_force.py_func
+    force = python_form(kernel_joint.clearance_force)
 
     def kernel(ex: float, ey: float, ex_dot: float, ey_dot: float, v_t: float, v_imp: float):
         fx, fy, f_n, _, delta, delta_dot, m_j, m_b = force(prm, ex, ey, ex_dot, ey_dot, v_t, v_imp)

@@ -76,26 +76,34 @@ from typing import Callable, ClassVar
 
 import numpy as np
 
+from numba import njit
+
 from weftsim.kernel import laws as kernel
+from weftsim.kernel.python import python_form
 from weftsim.params import ClearanceJoint
 
 ScalarLaw = Callable[[float, float, float], float]
 
 
-def _mapped(fn):
-    """``fn`` of :mod:`weftsim.kernel.laws` over arrays (broadcast), in plain Python (no compilation).
-
-    These array forms serve analysis, studies, plots and tests; the integrators and callbacks
-    call the compiled kernel directly.
-    """
-    return np.vectorize(fn.py_func, otypes=[float])
+@njit(cache=True, error_model="numpy")
+def _map_law(fn, kind, coef, clearance, delta, out):
+    for i in range(delta.size):
+        out[i] = fn(kind, coef, clearance, delta[i])
 
 
-_STIFFNESS = _mapped(kernel.stiffness)
-_ELASTIC_FORCE = _mapped(kernel.elastic_force)
-_NORMAL_FORCE = _mapped(kernel.normal_force)
-_ELASTIC_ENERGY = _mapped(kernel.elastic_energy)
-_FRICTION_FACTOR = _mapped(kernel.friction_factor)
+@njit(cache=True, error_model="numpy")
+def _map_normal_force(kind, coef, clearance, xi, delta, rate, impact_velocity, out):
+    for i in range(delta.size):
+        out[i] = kernel.normal_force(kind, coef, clearance, xi, delta[i], rate[i], impact_velocity[i])
+
+
+def _law_array(fn, kind, coef, clearance, penetration):
+    """``fn`` of :mod:`weftsim.kernel.laws` (compiled) at every element of ``penetration``."""
+    delta = np.asarray(penetration, dtype=float)
+    flat = np.ascontiguousarray(delta).ravel()
+    out = np.empty(flat.size)
+    _map_law(fn, kind, coef, clearance, flat, out)
+    return out.reshape(delta.shape)[()]
 
 
 def lankarani_nikravesh_stiffness(joint: ClearanceJoint) -> float:
@@ -111,7 +119,8 @@ def bai_zhao_stiffness(penetration, clearance: float, effective_modulus: float):
 
     Empirical SI stiffness (N/m^2 dimensionally, used as N/m^1.5); 0 for delta <= 0.
     """
-    return _STIFFNESS(kernel.LAW_VARIABLE_KD, math.pi / 8.0 * effective_modulus, clearance, penetration)[()]
+    return _law_array(kernel.stiffness, kernel.LAW_VARIABLE_KD, math.pi / 8.0 * effective_modulus, clearance,
+                      penetration)  # fmt: skip
 
 
 def check_impact_velocity(delta, impact_velocity) -> None:
@@ -158,17 +167,17 @@ class _Law:
     def stiffness(self, penetration):
         """K(delta), N/m^1.5 (at delta <= 0 the value at 0)."""
         kind, coef, c, _ = self.parameters
-        return _STIFFNESS(kind, coef, c, penetration)[()]
+        return _law_array(kernel.stiffness, kind, coef, c, penetration)
 
     def elastic_force(self, penetration):
         """F_el = K(delta) delta^1.5 for delta > 0, else 0, N."""
         kind, coef, c, _ = self.parameters
-        return _ELASTIC_FORCE(kind, coef, c, penetration)[()]
+        return _law_array(kernel.elastic_force, kind, coef, c, penetration)
 
     def elastic_energy(self, penetration):
         """W = integral_0^delta F_el, J (0 for delta <= 0); closed forms in :func:`weftsim.kernel.laws.elastic_energy`."""
         kind, coef, c, _ = self.parameters
-        return _ELASTIC_ENERGY(kind, coef, c, penetration)[()]
+        return _law_array(kernel.elastic_energy, kind, coef, c, penetration)
 
     def damping(self, penetration, impact_velocity):
         """D = xi K(delta) delta^1.5 / v_imp, N s/m (paper Eqs. 19, 23)."""
@@ -190,12 +199,14 @@ class _Law:
         d = np.asarray(penetration, dtype=float)
         v = np.asarray(impact_velocity, dtype=float)
         check_impact_velocity(d, v)
-        v_safe = np.where(v > 0.0, v, 1.0)
-        return _NORMAL_FORCE(*self.parameters, d, np.asarray(penetration_rate, dtype=float), v_safe)[()]
+        d, rate, v = np.broadcast_arrays(d, np.asarray(penetration_rate, dtype=float), np.where(v > 0.0, v, 1.0))
+        out = np.empty(d.size)
+        _map_normal_force(*self.parameters, *(np.ascontiguousarray(x).ravel() for x in (d, rate, v)), out)
+        return out.reshape(d.shape)[()]
 
     def scalar(self) -> ScalarLaw:
         """F_N(delta, delta_dot, v_imp), float -> float, in plain Python (the kernel's source)."""
-        return functools.partial(kernel.normal_force.py_func, *self.parameters)
+        return functools.partial(python_form(kernel.normal_force), *self.parameters)
 
     def numba(self) -> ScalarLaw:
         """F_N(delta, delta_dot, v_imp) compiled with ``numba.njit`` around the kernel.
@@ -421,6 +432,11 @@ def restored_restitution(hysteresis: float) -> float:
     return brentq(lambda ce: _excess_over_log(-xi * ce) - target, 0.0, hi, xtol=1e-16, rtol=1e-15)
 
 
+_friction_factor = python_form(kernel.friction_factor)
+# Array form for analysis and tests (plain Python per element; the integrators call the kernel).
+_FRICTION_FACTOR = np.vectorize(_friction_factor, otypes=[float])
+
+
 def friction_factor(tangential_speed, v0: float, v1: float):
     """Dynamic correction factor c_d of the modified Coulomb law (Ambrosio 2003), in [0, 1].
 
@@ -441,4 +457,4 @@ def friction_factor(tangential_speed, v0: float, v1: float):
 
 def friction_factor_scalar(tangential_speed: float, v0: float, v1: float) -> float:
     """:func:`friction_factor` of one float, in plain Python (the kernel's source; no checks)."""
-    return kernel.friction_factor.py_func(tangential_speed, v0, v1)
+    return _friction_factor(tangential_speed, v0, v1)

@@ -26,8 +26,9 @@ bearing moves with the crank, :func:`weftsim.kernel.chain.moving_bearing_force`)
 
 - ``"numba"``: the compiled kernel called from a thin Python callback (numba's cache: nothing
   to compile in a new process after the first run on a machine);
-- ``"python"``: the same kernel's plain-Python source (``py_func``), for debugging and for
-  machines where the compiled call is slower.
+- ``"python"``: the same kernel's plain-Python source
+  (:func:`weftsim.kernel.python.python_form`), for debugging and for machines where the compiled
+  call is slower.
 
 Removed: ``"symbolic"`` (an Exudyn expression tree, a second copy of every law; it measured no
 faster on the rigid-body model and ~6x slower on the kinematic tree, docs/clearance-joint.md).
@@ -40,6 +41,7 @@ import numpy as np
 from weftsim.kernel import chain as kernel_chain
 from weftsim.kernel import joint as kernel_joint
 from weftsim.kernel.hold import RESTING_RATE_FRACTION
+from weftsim.kernel.python import python_form
 
 ROUTES = ("python", "numba")
 REMOVED_ROUTES = {"symbolic": "the symbolic route was removed (it was a second copy of every contact law "
@@ -69,7 +71,7 @@ def connector_parameters(law, clearance: float, min_impact_velocity: float, max_
 
 def _kernel(function, route: str):
     if route == "python":
-        return function.py_func
+        return python_form(function)
     if route == "numba":
         return function
     raise ValueError(route_error(route) or f"`callback` = {route!r} has no kernel form")

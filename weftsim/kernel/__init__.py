@@ -10,11 +10,10 @@ Every engine and route evaluates the same definitions:
 - :mod:`.joint`: the force of the clearance joint from its eccentricity (normal force, friction,
   moments), and the connector force of the Exudyn callbacks;
 - :mod:`.chain`: the 2-DOF chain (members 4-8) driven by the prescribed crank side, its
-  right-hand side, eccentricity and penetration, on one parameter array;
-- :mod:`.roots`: the Illinois root finder and the golden-section maximum of the event search.
+  right-hand side, eccentricity and penetration, on one parameter array.
 
 Each function is ``@njit(cache=True, error_model="numpy")``: the compiled paths call it from
 compiled code (one compilation per machine, loaded from numba's cache afterwards); plain Python
-callers that run off the hot path call the same source through ``fn.py_func`` (no compilation),
-and array callers map it over their elements.  A fix to the physics lands in one place.
+callers that run off the hot path call the same source in plain Python (:mod:`.python`: no
+compilation), and array callers map it over their elements.  A fix to the physics lands in one place.
 """
