@@ -10,7 +10,11 @@ Every engine and route evaluates the same definitions:
 - :mod:`.joint`: the force of the clearance joint from its eccentricity (normal force, friction,
   moments), and the connector force of the Exudyn callbacks;
 - :mod:`.chain`: the 2-DOF chain (members 4-8) driven by the prescribed crank side, its
-  right-hand side, eccentricity and penetration, on one parameter array.
+  right-hand side, eccentricity and penetration, on one parameter array;
+- :mod:`.roots`: the event search of the reference engine on a step's dense output (Illinois root
+  finder, golden-section maximum, first rising crossing, peak of the approach rate);
+- :mod:`.python`: the plain-Python form of any of these (same source, no compilation) and the
+  compiled specialization of the event search to a dense output.
 
 Each function is ``@njit(cache=True, error_model="numpy")``: the compiled paths call it from
 compiled code (one compilation per machine, loaded from numba's cache afterwards); plain Python
