@@ -97,12 +97,21 @@ def _map_normal_force(kind, coef, clearance, xi, delta, rate, impact_velocity, o
         out[i] = kernel.normal_force(kind, coef, clearance, xi, delta[i], rate[i], impact_velocity[i])
 
 
+# Arrays shorter than this are evaluated by the kernel's plain-Python form (~1 us per element): loading
+# the compiled loop from numba's cache costs ~0.3 s in a new process, the time of ~3e5 elements.
+_COMPILED_FROM = 100_000
+
+
 def _law_array(fn, kind, coef, clearance, penetration):
-    """``fn`` of :mod:`weftsim.kernel.laws` (compiled) at every element of ``penetration``."""
+    """``fn`` of :mod:`weftsim.kernel.laws` at every element of ``penetration``."""
     delta = np.asarray(penetration, dtype=float)
     flat = np.ascontiguousarray(delta).ravel()
-    out = np.empty(flat.size)
-    _map_law(fn, kind, coef, clearance, flat, out)
+    if flat.size < _COMPILED_FROM:
+        form = python_form(fn)
+        out = np.fromiter((form(kind, coef, clearance, d) for d in flat.tolist()), float, flat.size)
+    else:
+        out = np.empty(flat.size)
+        _map_law(fn, kind, coef, clearance, flat, out)
     return out.reshape(delta.shape)[()]
 
 
@@ -200,8 +209,13 @@ class _Law:
         v = np.asarray(impact_velocity, dtype=float)
         check_impact_velocity(d, v)
         d, rate, v = np.broadcast_arrays(d, np.asarray(penetration_rate, dtype=float), np.where(v > 0.0, v, 1.0))
-        out = np.empty(d.size)
-        _map_normal_force(*self.parameters, *(np.ascontiguousarray(x).ravel() for x in (d, rate, v)), out)
+        flat = [np.ascontiguousarray(x).ravel() for x in (d, rate, v)]
+        if d.size < _COMPILED_FROM:
+            form = functools.partial(python_form(kernel.normal_force), *self.parameters)
+            out = np.fromiter((form(*row) for row in zip(*(x.tolist() for x in flat))), float, d.size)
+        else:
+            out = np.empty(d.size)
+            _map_normal_force(*self.parameters, *flat, out)
         return out.reshape(d.shape)[()]
 
     def scalar(self) -> ScalarLaw:
