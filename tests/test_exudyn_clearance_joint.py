@@ -137,20 +137,24 @@ def _reference_force(law, e, e_dot, mem, max_approach=True):
 
 @pytest.mark.parametrize("max_approach", [True, False], ids=["max_approach", "onset"])
 @pytest.mark.parametrize("name", sorted(LAWS))
-def test_python_and_symbolic_routes_equal_the_law(name, max_approach):
+def test_callback_routes_equal_the_law(name, max_approach):
     law = make_law(dataclasses.replace(JOINT, law=name))
-    sc = exu.SystemContainer()
-    mbs = sc.AddSystem()
-    py = callbacks.make_python_force(law, C, JOINT.min_impact_velocity, max_approach=max_approach)
-    sym = callbacks.make_symbolic_force(mbs, law, C, JOINT.min_impact_velocity, max_approach)
+    routes = {route: callbacks.make_force(law, C, JOINT.min_impact_velocity, route, max_approach=max_approach)
+              for route in callbacks.ROUTES}  # fmt: skip
     for e, e_dot, mem in STATES:
         want = _reference_force(law, e, e_dot, mem, max_approach)
-        got_py = np.array(py(mbs, 0.0, 0, e, e_dot, mem, [0.0] * 3, [0.0] * 3)[:2])
-        got_sym = np.array(sym.Evaluate(mbs, 0.0, 0, e, e_dot, mem, [0.0] * 3, [0.0] * 3)[:2])
         scale = max(np.abs(want).max(), 1.0)
-        # Same formula in three codes: only round-off differences (forces up to ~1e4 N here).
-        np.testing.assert_allclose(got_py, want, rtol=0, atol=1e-12 * scale)
-        np.testing.assert_allclose(got_sym, want, rtol=0, atol=1e-12 * scale)
+        for route, force in routes.items():
+            got = np.array(force(None, 0.0, 0, e, e_dot, mem, [0.0] * 3, [0.0] * 3)[:2])
+            # The rule written out above against the kernel: round-off only (forces up to ~1e4 N here).
+            np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * scale, err_msg=route)
+
+
+def test_removed_symbolic_route_says_so():
+    sc = exu.SystemContainer()
+    mbs = sc.AddSystem()
+    with pytest.raises(ValueError, match="symbolic route was removed.*use callback 'auto'"):
+        add_clearance_joint(mbs, 0, 1, JOINT, callback="symbolic")
 
 
 @pytest.mark.parametrize("max_approach", [True, False], ids=["max_approach", "onset"])
@@ -303,10 +307,10 @@ def test_max_approach_bounds_the_damping_in_a_driven_contact():
 @pytest.mark.parametrize("rule", ["max_approach", "onset"])
 def test_routes_agree_in_a_driven_contact(rule):
     pytest.importorskip("numba")
-    runs = {route: _driven_contact(rule, route)[2] for route in ("python", "symbolic", "numba")}
+    runs = {route: _driven_contact(rule, route)[2] for route in ("python", "numba")}
     base = runs["python"][3]
     for route, (t, delta, rate, f_n) in runs.items():
-        # Same formula in three codes, same Newton path: round-off only (measured 1.1e-14 of the peak).
+        # One kernel, compiled or interpreted, same Newton path: round-off only (measured 1.1e-14 of the peak).
         np.testing.assert_allclose(f_n, base, rtol=0, atol=1e-12 * base.max())
 
 

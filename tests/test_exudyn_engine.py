@@ -188,11 +188,15 @@ def test_startup_impact_is_step_converged_under_max_approach():
 
 def test_callback_routes_agree_in_the_model():
     peaks = {}
-    for route in ("python", "symbolic"):
+    for route in ("python", "numba"):
         r = solve(scene(0.25e-3, 400.0, 10.0 / 360.0), callback=route)
         peaks[route] = r.steps["contact_force_N"].max()
-    # Same formula, same Newton path: round-off only (1e-9 of ~2.4e5 N).
-    assert peaks["python"] == pytest.approx(peaks["symbolic"], rel=1e-9)
+    # Same kernel, same Newton path: round-off only (1e-9 of ~2.4e5 N).
+    assert peaks["python"] == pytest.approx(peaks["numba"], rel=1e-9)
+    base = scene(0.25e-3, 400.0, 10.0 / 360.0)
+    r = solve(dataclasses.replace(base, exudyn_solver=dataclasses.replace(base.exudyn_solver, callback="symbolic")))
+    # The removed route: one line saying so and what to use, not a traceback.
+    assert r.status == "failed" and "symbolic route was removed" in r.message and "\n" not in r.message
 
 
 def test_output_grid_and_every_step(startup):

@@ -1,6 +1,6 @@
 """Clearance-mode equations of the reference solver: the 2-DOF chain against a Lagrangian
 built numerically from positions, the contact's generalized forces by virtual work, the
-link with the ideal-joint torque, and the float/array backends of the one kernel."""
+link with the ideal-joint torque (the one kernel, weftsim.kernel.chain)."""
 
 from __future__ import annotations
 
@@ -11,23 +11,23 @@ import numpy as np
 import pytest
 
 from weftsim import kinematics as kin
-from weftsim.contact import make_law
+from weftsim.kernel.chain import chain
 from weftsim.params import Scene
-from weftsim.reference.dynamics import (
-    OUTPUTS,
-    ChainConstants,
-    chain_dynamics,
-    eccentricity,
-    initial_state,
-    math_backend,
-    numpy_backend,
-    penetration,
-)
+from weftsim.reference.dynamics import ChainConstants, eccentricity, initial_state, pack_parameters, penetration
 from weftsim.reference.ideal import crank_side_inertia, crank_side_potential, ideal_torque
 
 SCENE = Scene()
 FRICTION = dataclasses.replace(SCENE, joint=dataclasses.replace(SCENE.joint, friction_coefficient=0.1))
-OUT = {name: i for i, name in enumerate(OUTPUTS)}
+
+
+def _chain(scene, t, q, q_dot, contact, impact_velocity):
+    """Accelerations and contact terms of the kernel: (q'' (2,), dict of named outputs)."""
+    out = np.empty(6)
+    y = np.array([q[0], q[1], q_dot[0], q_dot[1], 0.0, 0.0])
+    r = chain(pack_parameters(scene), float(t), y, contact, impact_velocity, out)
+    names = ("q3", "normal_force", "penetration", "ecc_y", "ecc_z", "sa", "ca", "sp", "cp",
+             "force_y", "force_z", "journal_moment", "bearing_moment")  # fmt: skip
+    return out[2:4].copy(), dict(zip(names, r))
 
 
 def _positions(scene, a, psi):
@@ -66,13 +66,10 @@ def _contact_state(scene, theta, offset):
 @pytest.mark.parametrize("theta", [0.4, 2.1, 4.0])
 def test_chain_equations_are_lagrange_equations_with_virtual_work_of_contact(scene, theta):
     """M q'' = d/dt dL/dq' - dL/dq residual is ~0 with Q = (dP_j/dq)^T f + (0, M_j) from positions."""
-    p = ChainConstants.from_scene(scene)
-    backend = math_backend(make_law(scene.joint), scene.joint)
     q, q_dot = _contact_state(scene, theta, 0.0068)  # ~0.34 mm journal offset: in contact at c = 0.25 mm
     t = theta / scene.drive.speed
-    out = chain_dynamics(backend, p, t, q[0], q[1], q_dot[0], q_dot[1], True, 0.5)
-    assert out[OUT["penetration"]] > 0.0 and out[OUT["normal_force"]] > 0.0
-    q_ddot = np.array(out[:2])
+    q_ddot, out = _chain(scene, t, q, q_dot, True, 0.5)
+    assert out["penetration"] > 0.0 and out["normal_force"] > 0.0
     # Numerical d/dt dL/dq' = (d2L/dq'2) q'' + (d2L/dq'dq) q' and dL/dq by nested central differences.
     # L is quadratic in q', so differences in q' are exact for any step: h_v = 1 rad/s keeps round-off
     # (eps L / h) negligible.  h_q = 1e-4 rad: truncation ~h^2 = 1e-8 relative, round-off ~1e-10.
@@ -84,9 +81,9 @@ def test_chain_equations_are_lagrange_equations_with_virtual_work_of_contact(sce
     h = h_q
     # Contact generalized force by virtual work: dP_j/dq from positions, f and M_j from the kernel.
     jac = np.array([(_positions(scene, *(q + h * e))[1] - _positions(scene, *(q - h * e))[1]) / (2 * h) for e in np.eye(2)])
-    force = np.array([out[OUT["force_y"]], out[OUT["force_z"]]])
-    f_t = -out[OUT["bearing_moment"]] / scene.joint.bearing_radius  # M_b = -R_b F_T
-    ecc = math.hypot(out[OUT["ecc_y"]], out[OUT["ecc_z"]])
+    force = np.array([out["force_y"], out["force_z"]])
+    f_t = -out["bearing_moment"] / scene.joint.bearing_radius  # M_b = -R_b F_T
+    ecc = math.hypot(out["ecc_y"], out["ecc_z"])
     moment_j = (scene.joint.bearing_radius - ecc) * f_t
     q_contact = jac @ force + np.array([0.0, moment_j])
     residual = hess_vv @ q_ddot + hess_vq @ q_dot - dl_dq - q_contact
@@ -101,49 +98,24 @@ def test_ideal_reaction_through_the_contact_gives_the_ideal_torque(theta):
     chain follow the ideal accelerations gives T = 1/2 J13' w^2 + U13' + f.dP_b/dtheta = ideal torque."""
     scene, omega = SCENE, SCENE.drive.speed
     p = ChainConstants.from_scene(scene)
-    backend = math_backend(make_law(scene.joint), scene.joint)
     st = kin.linkage_state(theta, scene.geometry, scene.inertia.rocker_com)
     a, psi = float(st.theta_fg), float(st.theta_ef)
     q_dot = omega * np.array([float(st.d_theta_fg), float(st.d_theta_ef)])
     q_ddot_ideal = omega**2 * np.array([float(st.dd_theta_fg), float(st.dd_theta_ef)])
-    free = chain_dynamics(backend, p, theta / omega, a, psi, q_dot[0], q_dot[1], False, 0.0)
-    assert abs(free[OUT["ecc_y"]]) < 1e-12 and abs(free[OUT["ecc_z"]]) < 1e-12  # journal centred
+    free_q_ddot, free = _chain(scene, theta / omega, (a, psi), q_dot, False, 0.0)
+    assert abs(free["ecc_y"]) < 1e-12 and abs(free["ecc_z"]) < 1e-12  # journal centred
     m12 = -p.coupling * math.cos(psi - a)
     mass = np.array([[p.m11, m12], [m12, p.m22]])
     geo = scene.geometry
     jac = np.array([[-geo.l_fg * math.sin(a), geo.l_ef * math.sin(psi)],
                     [geo.l_fg * math.cos(a), -geo.l_ef * math.cos(psi)]])  # columns dP_j/da, dP_j/dpsi
-    force = np.linalg.solve(jac.T, mass @ (q_ddot_ideal - np.array(free[:2])))
+    force = np.linalg.solve(jac.T, mass @ (q_ddot_ideal - free_q_ddot))
     _, dj13 = crank_side_inertia(theta, scene)
     _, du13 = crank_side_potential(theta, scene)
     torque = 0.5 * float(dj13) * omega**2 + float(du13) + force @ (st.d_point_e)
     # Same closed forms by two routes: agreement to round-off of the ~5e2 N m torque (~1e-12 relative
     # through a 2x2 solve with condition number ~1e3).
     assert torque == pytest.approx(float(ideal_torque(theta, scene)), rel=1e-9, abs=1e-9)
-
-
-@pytest.mark.parametrize("contact", [False, True])
-@pytest.mark.parametrize("scene", [SCENE, FRICTION], ids=["frictionless", "friction"])
-def test_float_and_array_backends_agree(scene, contact):
-    p = ChainConstants.from_scene(scene)
-    law = make_law(scene.joint)
-    rng = np.random.default_rng(7)
-    thetas = rng.uniform(0, 2 * np.pi, 12)
-    states = [_contact_state(scene, th, off) for th, off in zip(thetas, rng.uniform(-0.008, 0.008, 12))]
-    t = thetas / scene.drive.speed
-    a = np.array([s[0][0] for s in states]); psi = np.array([s[0][1] for s in states])  # noqa: E702
-    da = np.array([s[1][0] for s in states]); dpsi = np.array([s[1][1] for s in states])  # noqa: E702
-    impact = rng.uniform(0.01, 1.0, 12)
-    vec = chain_dynamics(numpy_backend(law, scene.joint), p, t, a, psi, da, dpsi, contact, impact)
-    fb = math_backend(law, scene.joint)
-    for i in range(12):
-        sca = chain_dynamics(fb, p, t[i], a[i], psi[i], da[i], dpsi[i], contact, impact[i])
-        for k, name in enumerate(OUTPUTS):
-            # Same formulas, different libm/ufunc round-off: 1e-9 relative to the output's scale.
-            scale = np.abs(vec[k]).max() + 1e-30
-            assert abs(sca[k] - vec[k][i]) <= 1e-9 * scale, (name, i)
-    if contact:
-        assert np.any(vec[OUT["normal_force"]] > 0) and np.any(vec[OUT["normal_force"]] == 0)
 
 
 def test_eccentricity_uses_the_kinematics_of_the_rocker():

@@ -134,14 +134,14 @@ def test_failures_are_results_not_exceptions(monkeypatch):
 
     import weftsim.reference.integrate as integrate_module
 
-    real = integrate_module.chain_dynamics
+    real = integrate_module.chain_rhs
 
-    def broken(xp, p, t, *args):
+    def broken(prm, t, *args):
         if t > 0.01:
             raise FloatingPointError("synthetic failure")
-        return real(xp, p, t, *args)
+        return real(prm, t, *args)
 
-    monkeypatch.setattr(integrate_module, "chain_dynamics", broken)
+    monkeypatch.setattr(integrate_module, "chain_rhs", broken)
     result = solve(_scene(revolutions=0.2))
     assert result.status == "failed"
     assert "crank angle" in result.message and "synthetic failure" in result.message

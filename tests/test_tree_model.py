@@ -11,13 +11,11 @@ import pytest
 
 pytest.importorskip("exudyn")
 
-from weftsim.contact import make_law  # noqa: E402
 from weftsim.exudyn_engine import solve  # noqa: E402
-from weftsim.exudyn_engine.onset import OnsetTracker  # noqa: E402
-from weftsim.exudyn_engine.tree import BearingMotion, make_numba_force, make_python_force  # noqa: E402
+from weftsim.exudyn_engine.callbacks import make_tree_force  # noqa: E402
 from weftsim.exudyn_engine.tree_solve import contact_work  # noqa: E402
-from weftsim.reference.dynamics import ChainConstants, eccentricity, initial_state  # noqa: E402
-from weftsim.reference.dynamics import MATH  # noqa: E402
+from weftsim.reference.dynamics import ChainConstants, eccentricity, initial_state, pack_parameters  # noqa: E402
+from weftsim.reference.dynamics import NUMPY  # noqa: E402
 from weftsim.scene import load_scene  # noqa: E402
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
@@ -47,30 +45,24 @@ def test_the_generalized_force_is_the_virtual_work_of_the_contact_force(route):
     against the reference engine's eccentricity (other coordinates: psi = q0 + q1 - pi)."""
     scene = load_scene(MODELS / "reference.toml")
     c = scene.joint.clearance
-    tracker = OnsetTracker(c, scene.joint.min_impact_velocity)
     memory, stash, calls = [0.05, 1e-6, 0.05], [math.nan] * 5, [0]
-    if route == "python":
-        force = make_python_force(make_law(scene.joint), c, scene.joint.min_impact_velocity,
-                                  BearingMotion.from_scene(scene), scene.geometry, memory, stash, calls)
-    else:
-        force, memory, stash, calls = make_numba_force(scene, tracker.callback_state)
-        memory[:] = [0.05, 1e-6, 0.05]
+    force = make_tree_force(pack_parameters(scene), memory, stash, route, calls)
     p = ChainConstants.from_scene(scene)
     a0, psi0, da0, dpsi0 = initial_state(scene)[:4]
     t = 0.0123
-    ey0, ez0 = eccentricity(MATH, p, t, a0, psi0, 0.0, 0.0)[:2]
+    ey0, ez0 = eccentricity(NUMPY, p, t, a0, psi0, 0.0, 0.0)[:2]
     # Move the rod angle until the journal penetrates 20 um (e is nearly along the rod at theta ~ 0).
     g = scene.geometry
     q = [a0, psi0 + math.pi - a0]
     for _ in range(50):
-        ey, ez = eccentricity(MATH, p, t, q[0], q[0] + q[1] - math.pi, 0.0, 0.0)[:2]
+        ey, ez = eccentricity(NUMPY, p, t, q[0], q[0] + q[1] - math.pi, 0.0, 0.0)[:2]
         d = math.hypot(ey, ez) - c - 20e-6
         q[1] -= d / (g.l_ef * ((ey * -math.sin(q[0] + q[1]) + ez * math.cos(q[0] + q[1])) / math.hypot(ey, ez)))
         if abs(d) < 1e-15:
             break
     q_t = [da0, dpsi0 - da0]
     gen = force(None, t, 0, q, q_t)
-    ey, ez, vy, vz = eccentricity(MATH, p, t, q[0], q[0] + q[1] - math.pi, q_t[0], q_t[0] + q_t[1])[:4]
+    ey, ez, vy, vz = eccentricity(NUMPY, p, t, q[0], q[0] + q[1] - math.pi, q_t[0], q_t[0] + q_t[1])[:4]
     length = math.hypot(ey, ez)
     # Same formula in other coordinates: ~1e-16 m of a 0.4 m chain.
     assert stash[1] == pytest.approx(length - c, abs=1e-13)

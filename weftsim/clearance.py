@@ -1,6 +1,7 @@
 """Planar revolute clearance joint: geometry, normal and friction force (SPEC.md section 2).
 
-Pure functions used by both engines (Flores-Ambrosio formulation)::
+Array forms of the joint's force for analysis and tests (Flores-Ambrosio formulation; the
+one scalar definition is :mod:`weftsim.kernel.joint`, which the engines call)::
 
              bearing (R_b), centre P_b
           .-----------.
@@ -40,8 +41,17 @@ from typing import Callable, NamedTuple
 
 import numpy as np
 
-from weftsim.contact import friction_factor
+from weftsim.contact import check_impact_velocity
+from weftsim.kernel import hold
+from weftsim.kernel import joint as kernel_joint
+from weftsim.kernel.joint import joint_parameters
+from weftsim.kernel.python import python_form
 from weftsim.params import ClearanceJoint
+
+# Array forms for analysis and tests, plain Python per element (the engines call the compiled kernel).
+_EFFECTIVE_IMPACT_VELOCITY = np.vectorize(python_form(hold.effective_impact_velocity), otypes=[float])
+# The joint's parameter array is passed whole to every element (excluded from broadcasting).
+_CLEARANCE_FORCE = np.vectorize(python_form(kernel_joint.clearance_force), otypes=[float] * 8, excluded={0})
 
 
 class ClearanceContact(NamedTuple):
@@ -121,20 +131,21 @@ def tangential_velocity(ecc, bearing_velocity, bearing_angular_velocity,
 
 
 def effective_impact_velocity(held, penetration_rate, joint: ClearanceJoint):
-    """The impact velocity delta_dot^- of the damping term, m/s (numpy, broadcasts).
+    """The impact velocity delta_dot^- of the damping term, m/s (arrays, broadcast).
 
     ``held``: the engine's held value (onset rate floored at v_min, raised at its updates);
-    under ``"max_approach"`` the current approach rate raises it further, under ``"onset"`` not.
+    under ``"max_approach"`` the current approach rate raises it further, under ``"onset"`` not
+    (:func:`weftsim.kernel.hold.effective_impact_velocity`).
     """
-    held = np.asarray(held, dtype=float)
-    if joint.impact_velocity_rule == "max_approach":
-        return np.maximum(held, penetration_rate)
-    return held
+    rule = joint.impact_velocity_rule == "max_approach"
+    return _EFFECTIVE_IMPACT_VELOCITY(held, penetration_rate, rule)[()]
 
 
 def clearance_contact(ecc, ecc_rate, rel_tangential_velocity, impact_velocity, law,
                       joint: ClearanceJoint) -> ClearanceContact:
-    """Normal and friction force of the clearance joint, with moments (numpy, broadcasts).
+    """Normal and friction force of the clearance joint, with moments (arrays, broadcast).
+
+    :func:`weftsim.kernel.joint.clearance_force` at every element.
 
     Parameters
     ----------
@@ -144,35 +155,31 @@ def clearance_contact(ecc, ecc_rate, rel_tangential_velocity, impact_velocity, l
         v_T, m/s: tangential component (along t) of the journal contact point's velocity
         relative to the bearing's (:func:`tangential_velocity`).  Ignored when mu = 0.
     impact_velocity : array_like (...,)
-        Held, floored impact velocity, m/s (> 0 wherever delta > 0); :func:`effective_impact_velocity`
-        applies the joint's rule to it.
+        Held, floored impact velocity, m/s (> 0 wherever delta > 0, else ``ValueError``); the
+        joint's rule raises it (:func:`effective_impact_velocity`).
     law : contact law of :mod:`weftsim.contact` (from ``make_law(joint)``).
     joint : ClearanceJoint
         Supplies c, R_b, mu, the friction ramp (v0, v1) and the impact-velocity rule.
     """
-    delta, delta_dot, n = contact_geometry(ecc, ecc_rate, joint.clearance)
-    f_n = law.normal_force(delta, delta_dot, effective_impact_velocity(impact_velocity, delta_dot, joint))
-    t = np.stack([-n[..., 1], n[..., 0]], axis=-1)
-    if joint.friction_coefficient > 0.0:
-        v_t = np.asarray(rel_tangential_velocity, dtype=float)
-        v0, v1 = joint.friction_velocities
-        f_t = -joint.friction_coefficient * friction_factor(v_t, v0, v1) * f_n * np.sign(v_t)
-    else:
-        f_t = np.zeros_like(f_n)
-    force_j = -f_n[..., None] * n + f_t[..., None] * t
-    r_b = joint.bearing_radius
-    lever_j = r_b - (delta + joint.clearance)  # R_b - |e|
+    delta, _, n = contact_geometry(ecc, ecc_rate, joint.clearance)
+    check_impact_velocity(delta, np.asarray(impact_velocity, dtype=float))
+    e = np.asarray(ecc, dtype=float)
+    e_dot = np.asarray(ecc_rate, dtype=float)
+    prm = joint_parameters(joint, law)
+    fx, fy, f_n, f_t, delta, delta_dot, m_j, m_b = (np.asarray(v) for v in _CLEARANCE_FORCE(
+        prm, e[..., 0], e[..., 1], e_dot[..., 0], e_dot[..., 1], rel_tangential_velocity, impact_velocity))
+    force_j = np.stack([fx, fy], axis=-1)
     return ClearanceContact(
         force_on_journal=force_j,
         force_on_bearing=-force_j,
-        moment_on_journal=lever_j * f_t,
-        moment_on_bearing=-r_b * f_t,
-        normal_force=f_n,
-        friction_force=f_t,
-        penetration=delta,
-        penetration_rate=delta_dot,
+        moment_on_journal=m_j[()],
+        moment_on_bearing=m_b[()],
+        normal_force=f_n[()],
+        friction_force=f_t[()],
+        penetration=delta[()],
+        penetration_rate=delta_dot[()],
         normal=n,
-        contact_offset=r_b * n,
+        contact_offset=joint.bearing_radius * n,
     )
 
 
@@ -189,47 +196,33 @@ ClearanceKernel = Callable[[float, float, float, float, float, float], tuple]
 
 
 def make_clearance_kernel(law, joint: ClearanceJoint, jit: bool = False) -> ClearanceKernel:
-    """Scalar fast path of :func:`clearance_contact` for inner loops (plain ``math``).
+    """Scalar form of :func:`clearance_contact` for inner loops.
 
     Returns ``kernel(ex, ey, ex_dot, ey_dot, v_t, v_imp) -> (fx, fy, F_N, delta, delta_dot,
     M_j, M_b)``: force on the journal (N), normal force, penetration (m) and its rate (m/s),
-    friction moments about P_j and P_b (N m); same values as :func:`clearance_contact`
-    (force on the bearing is (-fx, -fy)), with the joint's impact-velocity rule applied to the
-    held v_imp.  No argument checks: v_imp must be > 0 in contact.
-    ``jit=True`` compiles it with ``numba.njit`` (law compiled too; ImportError without numba).
+    friction moments about P_j and P_b (N m), from :func:`weftsim.kernel.joint.clearance_force`
+    (plain Python, or compiled with ``jit=True``), with the joint's impact-velocity rule applied
+    to the held v_imp.  No argument checks: v_imp must be > 0 in contact.
     """
-    normal_force = law.numba() if jit else law.scalar()
-    c = joint.clearance
-    r_b = joint.bearing_radius
-    mu = joint.friction_coefficient
     v0, v1 = joint.friction_velocities
-    track = joint.impact_velocity_rule == "max_approach"  # effective_impact_velocity, scalar
     if not 0.0 <= v0 < v1:
         raise ValueError(f"friction velocities must satisfy 0 <= v0 < v1, got {joint.friction_velocities}")
-
-    def kernel(ex: float, ey: float, ex_dot: float, ey_dot: float, v_t: float, v_imp: float):
-        length = math.sqrt(ex * ex + ey * ey)
-        delta = length - c
-        if length <= 0.0:
-            return 0.0, 0.0, 0.0, delta, 0.0, 0.0, 0.0
-        nx = ex / length
-        ny = ey / length
-        delta_dot = ex_dot * nx + ey_dot * ny
-        if track and delta_dot > v_imp:
-            v_imp = delta_dot
-        f_n = normal_force(delta, delta_dot, v_imp)
-        f_t = 0.0
-        if mu > 0.0 and f_n > 0.0:
-            s = abs(v_t)
-            if s > v0:
-                c_d = 1.0 if s >= v1 else (s - v0) / (v1 - v0)
-                f_t = -mu * c_d * f_n if v_t > 0.0 else mu * c_d * f_n
-        fx = -f_n * nx - f_t * ny
-        fy = -f_n * ny + f_t * nx
-        return fx, fy, f_n, delta, delta_dot, (r_b - length) * f_t, -r_b * f_t
-
+    prm = joint_parameters(joint, law)
     if jit:
         import numba
 
-        return numba.njit(cache=False)(kernel)
+        force = kernel_joint.clearance_force
+
+        @numba.njit(cache=False)
+        def compiled(ex, ey, ex_dot, ey_dot, v_t, v_imp):
+            fx, fy, f_n, _, delta, delta_dot, m_j, m_b = force(prm, ex, ey, ex_dot, ey_dot, v_t, v_imp)
+            return fx, fy, f_n, delta, delta_dot, m_j, m_b
+
+        return compiled
+    force = python_form(kernel_joint.clearance_force)
+
+    def kernel(ex: float, ey: float, ex_dot: float, ey_dot: float, v_t: float, v_imp: float):
+        fx, fy, f_n, _, delta, delta_dot, m_j, m_b = force(prm, ex, ey, ex_dot, ey_dot, v_t, v_imp)
+        return fx, fy, f_n, delta, delta_dot, m_j, m_b
+
     return kernel

@@ -76,14 +76,43 @@ from typing import Callable, ClassVar
 
 import numpy as np
 
+from numba import njit
+
+from weftsim.kernel import laws as kernel
+from weftsim.kernel.python import python_form
 from weftsim.params import ClearanceJoint
 
 ScalarLaw = Callable[[float, float, float], float]
 
-# Below this value of x = delta / c the energy integrals of the delta-dependent laws
-# are summed as binomial series (closed forms cancel catastrophically as x -> 0).
-_SERIES_LIMIT = 0.25
-_SERIES_TERMS = 40  # 0.25**40 ~ 1e-24: far below double round-off
+
+@njit(cache=True, error_model="numpy")
+def _map_law(fn, kind, coef, clearance, delta, out):
+    for i in range(delta.size):
+        out[i] = fn(kind, coef, clearance, delta[i])
+
+
+@njit(cache=True, error_model="numpy")
+def _map_normal_force(kind, coef, clearance, xi, delta, rate, impact_velocity, out):
+    for i in range(delta.size):
+        out[i] = kernel.normal_force(kind, coef, clearance, xi, delta[i], rate[i], impact_velocity[i])
+
+
+# Arrays shorter than this are evaluated by the kernel's plain-Python form (~1 us per element): loading
+# the compiled loop from numba's cache costs ~0.3 s in a new process, the time of ~3e5 elements.
+_COMPILED_FROM = 100_000
+
+
+def _law_array(fn, kind, coef, clearance, penetration):
+    """``fn`` of :mod:`weftsim.kernel.laws` at every element of ``penetration``."""
+    delta = np.asarray(penetration, dtype=float)
+    flat = np.ascontiguousarray(delta).ravel()
+    if flat.size < _COMPILED_FROM:
+        form = python_form(fn)
+        out = np.fromiter((form(kind, coef, clearance, d) for d in flat.tolist()), float, flat.size)
+    else:
+        out = np.empty(flat.size)
+        _map_law(fn, kind, coef, clearance, flat, out)
+    return out.reshape(delta.shape)[()]
 
 
 def lankarani_nikravesh_stiffness(joint: ClearanceJoint) -> float:
@@ -99,22 +128,12 @@ def bai_zhao_stiffness(penetration, clearance: float, effective_modulus: float):
 
     Empirical SI stiffness (N/m^2 dimensionally, used as N/m^1.5); 0 for delta <= 0.
     """
-    d = np.maximum(np.asarray(penetration, dtype=float), 0.0)
-    c = clearance
-    return math.pi / 8.0 * effective_modulus * np.sqrt(2.0 * d * (3.0 * c + 2.0 * d) ** 2 / (c + d) ** 3)
+    return _law_array(kernel.stiffness, kernel.LAW_VARIABLE_KD, math.pi / 8.0 * effective_modulus, clearance,
+                      penetration)  # fmt: skip
 
 
-def _binomial_moment(y, m: float, p: float):
-    """Series of integral_0^y x^m (1 + x)^p dx = sum_k C(p, k) y^(m+k+1) / (m+k+1), for 0 <= y <= 1/4."""
-    total = np.zeros_like(y)
-    coeff = 1.0
-    for k in range(_SERIES_TERMS):
-        total += coeff * y ** (m + k + 1.0) / (m + k + 1.0)
-        coeff *= (p - k) / (k + 1.0)
-    return total
-
-
-def _check_impact_velocity(delta, impact_velocity) -> None:
+def check_impact_velocity(delta, impact_velocity) -> None:
+    """``ValueError`` where delta > 0 and the impact velocity is not > 0 (arrays, broadcast)."""
     bad = (delta > 0.0) & ~(impact_velocity > 0.0)
     if np.any(bad):
         v = np.broadcast_to(impact_velocity, bad.shape)[bad].ravel()[0]
@@ -128,13 +147,15 @@ def _check_impact_velocity(delta, impact_velocity) -> None:
 class _Law:
     """Common part of all laws: F_N = max(0, K(delta) delta^n (1 + xi delta_dot / v_imp)), n = 1.5.
 
-    Subclasses define ``stiffness``, ``elastic_energy``, ``scalar`` and ``hysteresis_factor``.
+    Subclasses define ``kind`` (a law id of :mod:`weftsim.kernel.laws`), ``coefficient``
+    (its ``coef``) and ``hysteresis_factor``; the arithmetic is that of :mod:`weftsim.kernel.laws`.
     """
 
     hysteresis: float  # xi, dimensionless
     restitution: float  # ce the hysteresis factor was built from
 
     name: ClassVar[str] = ""
+    kind: ClassVar[int] = kernel.LAW_CONSTANT
     exponent: ClassVar[float] = 1.5
     valid_restitution: ClassVar[tuple[float, float]] = (0.0, 1.0)
 
@@ -143,13 +164,29 @@ class _Law:
         """xi(ce) of Lankarani-Nikravesh, 3 (1 - ce^2) / 4 (paper Eq. 16)."""
         return 0.75 * (1.0 - restitution**2)
 
-    def stiffness(self, penetration):
+    @property
+    def coefficient(self) -> float:
         raise NotImplementedError
+
+    @property
+    def parameters(self) -> tuple[int, float, float, float]:
+        """(kind, coef, clearance, xi): the law's numbers for :mod:`weftsim.kernel.laws`."""
+        return self.kind, self.coefficient, getattr(self, "clearance", 0.0), self.hysteresis
+
+    def stiffness(self, penetration):
+        """K(delta), N/m^1.5 (at delta <= 0 the value at 0)."""
+        kind, coef, c, _ = self.parameters
+        return _law_array(kernel.stiffness, kind, coef, c, penetration)
 
     def elastic_force(self, penetration):
         """F_el = K(delta) delta^1.5 for delta > 0, else 0, N."""
-        d = np.maximum(np.asarray(penetration, dtype=float), 0.0)
-        return (self.stiffness(d) * (d * np.sqrt(d)))[()]
+        kind, coef, c, _ = self.parameters
+        return _law_array(kernel.elastic_force, kind, coef, c, penetration)
+
+    def elastic_energy(self, penetration):
+        """W = integral_0^delta F_el, J (0 for delta <= 0); closed forms in :func:`weftsim.kernel.laws.elastic_energy`."""
+        kind, coef, c, _ = self.parameters
+        return _law_array(kernel.elastic_energy, kind, coef, c, penetration)
 
     def damping(self, penetration, impact_velocity):
         """D = xi K(delta) delta^1.5 / v_imp, N s/m (paper Eqs. 19, 23)."""
@@ -170,14 +207,23 @@ class _Law:
         """
         d = np.asarray(penetration, dtype=float)
         v = np.asarray(impact_velocity, dtype=float)
-        _check_impact_velocity(d, v)
-        v_safe = np.where(v > 0.0, v, 1.0)
-        rate = np.asarray(penetration_rate, dtype=float)
-        f = self.elastic_force(d) * (1.0 + self.hysteresis * rate / v_safe)
-        return np.where(d > 0.0, np.maximum(f, 0.0), 0.0)[()]
+        check_impact_velocity(d, v)
+        d, rate, v = np.broadcast_arrays(d, np.asarray(penetration_rate, dtype=float), np.where(v > 0.0, v, 1.0))
+        flat = [np.ascontiguousarray(x).ravel() for x in (d, rate, v)]
+        if d.size < _COMPILED_FROM:
+            form = functools.partial(python_form(kernel.normal_force), *self.parameters)
+            out = np.fromiter((form(*row) for row in zip(*(x.tolist() for x in flat))), float, d.size)
+        else:
+            out = np.empty(d.size)
+            _map_normal_force(*self.parameters, *flat, out)
+        return out.reshape(d.shape)[()]
+
+    def scalar(self) -> ScalarLaw:
+        """F_N(delta, delta_dot, v_imp), float -> float, in plain Python (the kernel's source)."""
+        return functools.partial(python_form(kernel.normal_force), *self.parameters)
 
     def numba(self) -> ScalarLaw:
-        """The scalar law compiled with ``numba.njit`` (ImportError if numba is missing).
+        """F_N(delta, delta_dot, v_imp) compiled with ``numba.njit`` around the kernel.
 
         Compiled once per distinct law (cached); the first call costs ~0.5 s of compilation.
         """
@@ -201,9 +247,16 @@ class _Law:
 
 @functools.lru_cache(maxsize=32)
 def _jit(law: _Law) -> ScalarLaw:
-    import numba  # optional: only this method needs it
+    import numba
 
-    return numba.njit(cache=False)(law.scalar())
+    kind, coef, c, xi = law.parameters
+    normal_force = kernel.normal_force
+
+    @numba.njit(cache=False)
+    def scalar_law(delta, delta_dot, impact_velocity):
+        return normal_force(kind, coef, c, xi, delta, delta_dot, impact_velocity)
+
+    return scalar_law
 
 
 @dataclass(frozen=True)
@@ -212,26 +265,10 @@ class _ConstantStiffnessLaw(_Law):
 
     stiffness_constant: float = 0.0  # K, N/m^1.5
 
-    def stiffness(self, penetration):
-        """K = K_LN, constant, N/m^1.5."""
-        return np.full(np.shape(penetration), self.stiffness_constant)[()]
-
-    def elastic_energy(self, penetration):
-        """integral_0^delta K s^1.5 ds = K delta^2.5 / 2.5, J (0 for delta <= 0)."""
-        d = np.maximum(np.asarray(penetration, dtype=float), 0.0)
-        return self.stiffness_constant * d**2.5 / 2.5
-
-    def scalar(self) -> ScalarLaw:
-        """Plain-``math`` F_N(delta, delta_dot, v_imp), float -> float (same as normal_force)."""
-        k, xi = self.stiffness_constant, self.hysteresis
-
-        def normal_force(delta: float, delta_dot: float, impact_velocity: float) -> float:
-            if delta <= 0.0:
-                return 0.0
-            f = k * (delta * math.sqrt(delta)) * (1.0 + xi * delta_dot / impact_velocity)
-            return f if f > 0.0 else 0.0
-
-        return normal_force
+    @property
+    def coefficient(self) -> float:
+        """k = K_LN, N/m^1.5."""
+        return self.stiffness_constant
 
     @staticmethod
     def _parameters(joint: ClearanceJoint) -> dict:
@@ -317,39 +354,12 @@ class VariableKD(_Law):
     name: ClassVar[str] = "variable_kd"
     valid_restitution: ClassVar[tuple[float, float]] = (0.8, 1.0)
 
-    def stiffness(self, penetration):
-        """K_BZ(delta), 0 for delta <= 0, SI ("N/m^1.5")."""
-        d = np.maximum(np.asarray(penetration, dtype=float), 0.0)
-        c = self.clearance
-        return self.modulus_factor * np.sqrt(2.0 * d * (3.0 * c + 2.0 * d) ** 2 / (c + d) ** 3)
+    kind: ClassVar[int] = kernel.LAW_VARIABLE_KD
 
-    def elastic_energy(self, penetration):
-        """W = a sqrt(2) c^2.5 g(delta/c), g(x) = integral_0^x t^2 (3 + 2t) (1 + t)^-1.5 dt, J.
-
-        g(x) = 4/5 u^2.5 - 2 u^1.5 - 2 u^-0.5 + 16/5 with u = 1 + x for x > 1/4; binomial
-        series below (relative error ~1e-14 everywhere).
-        """
-        x = np.maximum(np.asarray(penetration, dtype=float), 0.0) / self.clearance
-        small = x <= _SERIES_LIMIT
-        xs = np.where(small, x, 0.0)
-        series = 3.0 * _binomial_moment(xs, 2.0, -1.5) + 2.0 * _binomial_moment(xs, 3.0, -1.5)
-        u = 1.0 + np.where(small, 1.0, x)
-        closed = 0.8 * u**2.5 - 2.0 * u**1.5 - 2.0 / np.sqrt(u) + 3.2
-        g = np.where(small, series, closed)
-        return self.modulus_factor * math.sqrt(2.0) * self.clearance**2.5 * g
-
-    def scalar(self) -> ScalarLaw:
-        """Plain-``math`` F_N(delta, delta_dot, v_imp), float -> float (same as normal_force)."""
-        a, c, xi = self.modulus_factor, self.clearance, self.hysteresis
-
-        def normal_force(delta: float, delta_dot: float, impact_velocity: float) -> float:
-            if delta <= 0.0:
-                return 0.0
-            k = a * math.sqrt(2.0 * delta * (3.0 * c + 2.0 * delta) ** 2 / (c + delta) ** 3)
-            f = k * (delta * math.sqrt(delta)) * (1.0 + xi * delta_dot / impact_velocity)
-            return f if f > 0.0 else 0.0
-
-        return normal_force
+    @property
+    def coefficient(self) -> float:
+        """a = (pi/8) E*, Pa."""
+        return self.modulus_factor
 
     @staticmethod
     def _parameters(joint: ClearanceJoint) -> dict:
@@ -372,36 +382,12 @@ class ElasticFoundation(_Law):
     name: ClassVar[str] = "elastic_foundation"
     valid_restitution: ClassVar[tuple[float, float]] = (0.8, 1.0)
 
-    def stiffness(self, penetration):
-        """K(delta) = L_b (pi/2) E* / sqrt(2 (c + delta)), N/m^1.5 (at delta <= 0 the value at 0)."""
-        d = np.maximum(np.asarray(penetration, dtype=float), 0.0)
-        return self.length_modulus / np.sqrt(2.0 * (self.clearance + d))
+    kind: ClassVar[int] = kernel.LAW_ELASTIC_FOUNDATION
 
-    def elastic_energy(self, penetration):
-        """W = (b / sqrt(2)) c^2 h(delta/c), h(x) = integral_0^x t^1.5 (1 + t)^-0.5 dt, J.
-
-        h(x) = sqrt(x (1 + x)) (2x - 3) / 4 + 3/4 asinh(sqrt(x)) for x > 1/4; binomial series below.
-        """
-        x = np.maximum(np.asarray(penetration, dtype=float), 0.0) / self.clearance
-        small = x <= _SERIES_LIMIT
-        series = _binomial_moment(np.where(small, x, 0.0), 1.5, -0.5)
-        xl = np.where(small, 1.0, x)
-        closed = 0.25 * np.sqrt(xl * (1.0 + xl)) * (2.0 * xl - 3.0) + 0.75 * np.arcsinh(np.sqrt(xl))
-        h = np.where(small, series, closed)
-        return self.length_modulus / math.sqrt(2.0) * self.clearance**2 * h
-
-    def scalar(self) -> ScalarLaw:
-        """Plain-``math`` F_N(delta, delta_dot, v_imp), float -> float (same as normal_force)."""
-        b, c, xi = self.length_modulus, self.clearance, self.hysteresis
-
-        def normal_force(delta: float, delta_dot: float, impact_velocity: float) -> float:
-            if delta <= 0.0:
-                return 0.0
-            k = b / math.sqrt(2.0 * (c + delta))
-            f = k * (delta * math.sqrt(delta)) * (1.0 + xi * delta_dot / impact_velocity)
-            return f if f > 0.0 else 0.0
-
-        return normal_force
+    @property
+    def coefficient(self) -> float:
+        """b = L_b (pi/2) E*, N/m."""
+        return self.length_modulus
 
     @staticmethod
     def _parameters(joint: ClearanceJoint) -> dict:
@@ -460,6 +446,11 @@ def restored_restitution(hysteresis: float) -> float:
     return brentq(lambda ce: _excess_over_log(-xi * ce) - target, 0.0, hi, xtol=1e-16, rtol=1e-15)
 
 
+_friction_factor = python_form(kernel.friction_factor)
+# Array form for analysis and tests (plain Python per element; the integrators call the kernel).
+_FRICTION_FACTOR = np.vectorize(_friction_factor, otypes=[float])
+
+
 def friction_factor(tangential_speed, v0: float, v1: float):
     """Dynamic correction factor c_d of the modified Coulomb law (Ambrosio 2003), in [0, 1].
 
@@ -475,15 +466,9 @@ def friction_factor(tangential_speed, v0: float, v1: float):
     """
     if not 0.0 <= v0 < v1:
         raise ValueError(f"friction velocities must satisfy 0 <= v0 < v1, got v0={v0}, v1={v1}")
-    s = np.abs(np.asarray(tangential_speed, dtype=float))
-    return np.clip((s - v0) / (v1 - v0), 0.0, 1.0)
+    return _FRICTION_FACTOR(tangential_speed, v0, v1)[()]
 
 
 def friction_factor_scalar(tangential_speed: float, v0: float, v1: float) -> float:
-    """Plain-``math`` :func:`friction_factor` (no argument checks)."""
-    s = abs(tangential_speed)
-    if s <= v0:
-        return 0.0
-    if s >= v1:
-        return 1.0
-    return (s - v0) / (v1 - v0)
+    """:func:`friction_factor` of one float, in plain Python (the kernel's source; no checks)."""
+    return _friction_factor(tangential_speed, v0, v1)

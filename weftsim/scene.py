@@ -122,8 +122,8 @@ SCHEMA: tuple[Key, ...] = (
     Key("solver.reference.max_step_deg", "reference_solver.max_step", "float", DEG, 0, 90,
         doc="largest step, as crank angle"),
     Key("solver.exudyn.model", "exudyn_solver.model", "str", choices=EXUDYN_MODELS,
-        doc="Exudyn model: auto = kinematic_tree unless the scene needs rigid_body (ideal joint, friction, "
-            "symbolic callback); rigid_body = members 1-8, general; kinematic_tree = members 1-3 prescribed"),
+        doc="Exudyn model: auto = kinematic_tree unless the scene needs rigid_body (ideal joint, friction); "
+            "rigid_body = members 1-8, general; kinematic_tree = members 1-3 prescribed"),
     Key("solver.exudyn.step_control", "exudyn_solver.step_control", "str", choices=STEP_CONTROLS,
         doc="rigid_body model: adaptive (step from a local error estimate: large in free flight, small "
             "through impacts) or fixed (step_size_s)"),

@@ -65,7 +65,7 @@ def _tree(rtol: float, method: str = "DOPRI5", route: str = "python") -> Setting
                     "solver.exudyn.callback": route})  # fmt: skip
 
 
-def _rigid(step: float, route: str = "symbolic") -> Setting:
+def _rigid(step: float, route: str = "auto") -> Setting:
     return Setting("exudyn", f"exudyn rigid_body {route}", f"h {step:.0e} s",
                    {"solver.exudyn.model": "rigid_body", "solver.exudyn.step_control": "fixed",
                     "solver.exudyn.step_size_s": step, "solver.exudyn.callback": route})  # fmt: skip
@@ -90,7 +90,7 @@ def settings(case: str, quick: bool = False) -> list[Setting]:
     out += [_ref("DOP853", r) for r in (1e-6, 1e-8, 1e-10)] + [_ref("LSODA", 1e-8), _ref("RK45", 1e-7)]
     out += [_tree(r) for r in (1e-4, 3e-5, 1e-5, 3e-6, 1e-6, 1e-7, 1e-8)]
     out += [_tree(r, "ODE23") for r in (1e-4, 1e-5)]
-    out += [_tree(1e-6, route="numba")]  # the tree has no symbolic route (exudyn_engine/tree.py)
+    out += [_tree(1e-6, route=route) for route in ("numba", "python")]
     out += [_rigid(h) for h in (4e-6, 2e-6, 1e-6)]
     out += [_rigid_adaptive(tol) for tol in (1e-8, 3e-9, 1e-9, 3e-10)]
     if case == "c0.25mm-400rpm":
@@ -234,7 +234,7 @@ def startup_costs(models, log=print) -> dict:
         "reference DOP853 (scipy)": ("reference", _ref("DOP853", 1e-6).overrides),
         "exudyn tree python": ("exudyn", _tree(1e-6).overrides),
         "exudyn tree numba": ("exudyn", _tree(1e-6, route="numba").overrides),
-        "exudyn rigid_body symbolic": ("exudyn", _rigid(2e-6).overrides),
+        "exudyn rigid_body auto": ("exudyn", _rigid(2e-6).overrides),
     }
     for name, (engine, overrides) in paths.items():
         scene = load_case("c0.25mm-400rpm", models, 0.02, overrides)

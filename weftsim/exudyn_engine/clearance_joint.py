@@ -31,9 +31,10 @@ from weftsim.exudyn_engine import callbacks
 from weftsim.exudyn_engine.onset import OnsetTracker, penetration_state
 from weftsim.params import ClearanceJoint
 
-ROUTES = ("python", "symbolic", "numba")
-# Fastest correct route on the loom model (scripts/bench_callbacks.py, docs/clearance-joint.md).
-DEFAULT_ROUTE = "symbolic"
+ROUTES = callbacks.ROUTES
+# Fastest route on the loom model, rigid body and kinematic tree (scripts/bench_callbacks.py,
+# docs/clearance-joint.md).
+DEFAULT_ROUTE = "numba"
 
 _HOOKS = "weftsim_post_step_hooks"
 
@@ -116,9 +117,8 @@ def add_clearance_joint(mbs, marker_bearing, marker_journal, joint: ClearanceJoi
         Clearance c > 0, radii, materials, law name, restitution, v_min.
     law : contact law, optional
         Defaults to ``weftsim.contact.make_law(joint)``; any law of that library.
-    callback : {"auto", "python", "symbolic", "numba"}
-        Force callback route; "auto" = :data:`DEFAULT_ROUTE` (the fastest measured), or
-        "python" if the law has no symbolic form.
+    callback : {"auto", "python", "numba"}
+        Force callback route; "auto" = :data:`DEFAULT_ROUTE` (the fastest measured).
     call_counter : list, optional
         One-element list counting callback calls (python route only; benchmarks).
 
@@ -142,17 +142,10 @@ def add_clearance_joint(mbs, marker_bearing, marker_journal, joint: ClearanceJoi
             "cannot apply the friction moments about the joint centres); set "
             "`friction_coefficient` = 0 or use the reference engine (docs/clearance-joint.md)"
         )
-    if callback not in ROUTES + ("auto",):
-        raise ValueError(f"`callback` must be one of {('auto',) + ROUTES}, got {callback!r}")
+    if callbacks.route_error(callback):
+        raise ValueError(callbacks.route_error(callback))
     law = make_law(joint) if law is None else law
-    route = callback
-    if route == "auto":
-        route = DEFAULT_ROUTE
-        if route == "symbolic":
-            try:
-                callbacks.symbolic_elastic_force(law, 0.0, _MathLike)
-            except NotImplementedError:
-                route = "python"
+    route = DEFAULT_ROUTE if callback == "auto" else callback
     if call_counter is not None and route != "python":
         raise ValueError("`call_counter` works with callback='python' only")
     c, v_min = joint.clearance, joint.min_impact_velocity
@@ -161,10 +154,8 @@ def add_clearance_joint(mbs, marker_bearing, marker_journal, joint: ClearanceJoi
     keep = None
     if route == "python":
         force = callbacks.make_python_force(law, c, v_min, call_counter, max_approach)
-    elif route == "numba":
-        force = callbacks.make_numba_force(law, c, v_min, max_approach)
     else:
-        keep = force = callbacks.make_symbolic_force(mbs, law, c, v_min, max_approach)
+        force = callbacks.make_numba_force(law, c, v_min, max_approach)
     connector = mbs.AddObject(ObjectConnectorCartesianSpringDamper(
         markerNumbers=[marker_bearing, marker_journal],
         stiffness=tracker.callback_state, damping=[0.0, 0.0, 0.0], offset=[0.0, 0.0, 0.0],
@@ -185,10 +176,3 @@ def add_clearance_joint(mbs, marker_bearing, marker_journal, joint: ClearanceJoi
     register_post_step(mbs, accept)
     return model
 
-
-class _MathLike:
-    """Stand-in namespace to probe whether a law has a symbolic form."""
-
-    @staticmethod
-    def sqrt(x):
-        return x**0.5

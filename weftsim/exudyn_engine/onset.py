@@ -15,7 +15,7 @@ O(h^2)::
 The same formula runs inside the force callback (trial states of the onset step, so
 the force is a smooth function of the unknowns and Newton sees it) and in the
 accepted-step bookkeeping (:class:`OnsetTracker`, which then holds the value until
-separation).
+separation); both take it from :mod:`weftsim.kernel.hold`, the rules' one definition.
 
 Held impact velocity rules (``ClearanceJoint.impact_velocity_rule``):
 
@@ -40,89 +40,14 @@ import math
 
 import numpy as np
 
+from weftsim.kernel.hold import (  # noqa: F401 - the rules' one definition, re-exported here
+    RESTING_RATE_FRACTION,
+    callback_impact_velocity,
+    damping_rate,
+    onset_fraction,
+    onset_velocity,
+)
 from weftsim.scene import IMPACT_VELOCITY_RULES
-
-
-def onset_fraction(delta0: float, delta1: float) -> float:
-    """Fraction s in [0, 1] of the step at which delta crosses 0 (linear in delta).
-
-    Parameters
-    ----------
-    delta0, delta1 : float
-        Penetration at the start (<= 0) and end (> 0) of the step, m.
-    """
-    span = delta0 - delta1
-    if span >= 0.0:  # no crossing from below: the end of the step is the best estimate
-        return 1.0
-    s = delta0 / span
-    return 0.0 if s < 0.0 else (1.0 if s > 1.0 else s)
-
-
-def onset_velocity(delta0: float, rate0: float, delta1: float, rate1: float) -> float:
-    """Penetration rate at the zero crossing of delta, linear in-step interpolation, m/s."""
-    s = onset_fraction(delta0, delta1)
-    return rate0 + s * (rate1 - rate0)
-
-
-def callback_impact_velocity(held: float, delta0: float, rate0: float, delta: float, rate: float,
-                             v_min: float, max_approach: bool) -> float:
-    """Impact velocity the force law uses at a trial state in contact (delta > 0), m/s.
-
-    The one scalar definition of the rule inside a step; the python and numba callbacks
-    call (or compile) it, the symbolic route writes the same branches as an expression.
-
-    Parameters
-    ----------
-    held : float
-        Held impact velocity of the last accepted state, m/s.
-    delta0, rate0 : float
-        Penetration (m) and rate (m/s) of the last accepted state; ``delta0 > 0`` means the
-        contact was already on, otherwise the onset lies inside this step.
-    delta, rate : float
-        Trial penetration (> 0) and rate.
-    v_min : float
-        Floor, m/s.
-    max_approach : bool
-        True for the ``"max_approach"`` rule: v_imp = max(held or onset value, rate).
-
-    Returns
-    -------
-    float
-        ``max(v, v_min)`` with ``v`` the held value (``delta0 > 0``) or the interpolated
-        onset rate (never a non-positive one: then the trial rate), maxed with ``rate``
-        under ``"max_approach"``.
-    """
-    if delta0 > 0.0:
-        v = held
-    else:
-        v = rate0 + delta0 / (delta0 - delta) * (rate - rate0)
-        if v <= 0.0:  # graze within the step: no positive onset estimate, use the trial rate
-            v = rate
-    if max_approach and rate > v:
-        v = rate
-    return v if v > v_min else v_min
-
-
-# Half-width of the dead zone of the damping rate, as a fraction of v_min (1e-10 m/s by default).
-# A journal resting under load is otherwise locked by its own damper onto a round-off limit cycle
-# that generalized-alpha's Newton cannot leave (docs/clearance-joint.md, "Resting contact"): the
-# elastic force jumps by K'(delta) x one ulp of the marker positions between neighbouring floats, and
-# the damper holds the journal exactly there.  Removing rates below 1e-6 v_min from the damping term
-# changes the normal force by at most xi 1e-6 F_el.
-RESTING_RATE_FRACTION = 1e-6
-
-
-def damping_rate(rate: float, dead_rate: float) -> float:
-    """Penetration rate that drives the damping term: delta_dot less a dead zone +-dead_rate, m/s.
-
-    Continuous and piecewise linear: 0 for |rate| <= dead_rate, rate -+ dead_rate outside
-    (``dead_rate`` = :data:`RESTING_RATE_FRACTION` x v_min in every callback route).
-    """
-    if rate > dead_rate:
-        return rate - dead_rate
-    if rate < -dead_rate:
-        return rate + dead_rate
-    return 0.0
 
 
 def positive_onset_velocity(t0: float, delta0: float, rate0: float, t1: float, delta1: float,

@@ -9,13 +9,12 @@
   in free flight and short ones through the impacts.  Every scene weftsim describes today with a
   clearance at E is of this kind.
 - **rigid-body model** (:mod:`.mechanism`, generalized-alpha) when the scene needs bodies and joints
-  for members 1-3, or a route only that model has.  What forces it (:func:`rigid_body_needs`):
+  for members 1-3.  What forces it (:func:`rigid_body_needs`):
   an ideal joint at E (c = 0: no coordinate moves freely; the rigid-body model then steps
   0.25 deg of crank, :data:`weftsim.exudyn_engine.solver.IDEAL_JOINT_STEP_ANGLE`, and never a
   contact time scale); friction in the clearance joint (the tree's contact acts at the journal
   centre and carries no friction moment on the rocker; the Exudyn engine has no friction in
-  either model today, so such a scene is refused with a message); the symbolic callback route
-  (the tree has the python and numba routes).  A clearance or a flexible body anywhere in members
+  either model today, so such a scene is refused with a message).  A clearance or a flexible body anywhere in members
   1-3 would also need the rigid-body model (members 1-3 no longer move in closed form); weftsim's
   scenes have neither yet.
 
@@ -32,15 +31,13 @@ AUTO = "auto"
 
 def rigid_body_needs(scene: Scene) -> list[str]:
     """Reasons why ``scene`` needs the rigid-body model (empty: the kinematic tree carries it)."""
-    joint, s = scene.joint, scene.exudyn_solver
+    joint = scene.joint
     needs = []
     if joint.is_ideal:
         needs.append("ideal joint at E (c = 0): no free coordinate, one generalized-alpha step per "
                      "0.25 deg of crank")  # fmt: skip
     if joint.friction_coefficient > 0.0:
         needs.append("friction in the clearance joint (the kinematic tree carries no friction moment)")
-    if s.callback == "symbolic":
-        needs.append("solver.exudyn.callback = 'symbolic' (the kinematic tree has the python and numba routes)")
     return needs
 
 

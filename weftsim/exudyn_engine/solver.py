@@ -20,7 +20,8 @@ import time as _time
 
 import exudyn as exu
 
-from weftsim.exudyn_engine.clearance_joint import ROUTES, register_post_step
+from weftsim.exudyn_engine.callbacks import route_error
+from weftsim.exudyn_engine.clearance_joint import register_post_step
 from weftsim.exudyn_engine.mechanism import build_mechanism
 from weftsim.exudyn_engine.selection import select_model, select_path
 from weftsim.exudyn_engine.step_control import StepController
@@ -71,8 +72,8 @@ def check_settings(scene: Scene) -> str | None:
         return f"`exudyn_solver.step_control` must be one of {STEP_CONTROLS}, got {s.step_control!r}"
     if not (s.local_error > 0.0 and math.isfinite(s.local_error)):
         return f"`exudyn_solver.local_error` must be > 0 (m), got {s.local_error}"
-    if s.callback not in ROUTES + ("auto",):
-        return f"`exudyn_solver.callback` must be one of {('auto',) + ROUTES}, got {s.callback!r}"
+    if route_error(s.callback):
+        return f"`exudyn_solver.{route_error(s.callback)[1:]}"
     if s.callback == "numba" and not scene.joint.is_ideal:
         try:
             import numba  # noqa: F401 - optional dependency of this route only

@@ -3,10 +3,11 @@
 
 scipy's ``DOP853`` and ``RK45`` are re-implemented step for step in :mod:`.compiled_rk` (same
 tableaux, taken from scipy; same initial step, error norm, step-size control and dense output), with the
-right-hand side and the contact law of :mod:`weftsim.reference.compiled_kernel`.  What
+right-hand side and the contact law of :mod:`weftsim.kernel.chain`.  What
 the scipy path pays per step in Python (stage combinations, error norm, dense-output
 objects, event location; ~50 us per step attempt, docs/reference-solver.md section 4)
-becomes a few microseconds.  Events, impact velocity, recorded steps (accepted steps,
+becomes a few microseconds.  The event search is that of :mod:`weftsim.kernel.roots` (compiled here,
+in plain Python on the scipy path).  Events, impact velocity, recorded steps (accepted steps,
 events, ``_CONTACT_SUBSTEPS`` dense points inside contact steps) and output samples
 follow :mod:`weftsim.reference.integrate` and :mod:`weftsim.reference.events` exactly, so both
 paths agree to the integration tolerance (``tests/test_fast_paths.py``).
@@ -26,14 +27,16 @@ import math
 import numpy as np
 from numba import njit
 
-from weftsim.reference.compiled_kernel import CLEARANCE, TRACK_MAX, V_MIN, penetration
+from weftsim.kernel.chain import CLEARANCE, TRACK_MAX, V_MIN, penetration
 from weftsim.reference.compiled_rk import (
     _MAX_FACTOR, _MIN_FACTOR, _SAFETY, DOP853, RK45, N, _dense, _dense_coefficients, _error_norm, _f,
     _initial_step, _stages,
 )  # fmt: skip
 from weftsim.reference.compiled_rk import DENSE as _RK_DENSE
 from weftsim.reference.compiled_rk import NFEV as _RK_NFEV
-from weftsim.reference.events import _GOLDEN_ITERATIONS, _INV_PHI, END_FRACTION, SAMPLES
+from weftsim.kernel import roots
+from weftsim.kernel.python import specialize
+from weftsim.kernel.roots import SAMPLES
 from weftsim.reference.integrate import _CONTACT_SUBSTEPS, _ROOT_XTOL
 
 METHODS = {"numba_DOP853": DOP853, "numba_RK45": RK45}
@@ -57,121 +60,19 @@ N_INT_STATE = 12
 assert (NFEV, DENSE) == (_RK_NFEV, _RK_DENSE)  # compiled_rk counts evaluations into the same int state
 # Kinds of event (weftsim.reference.events).
 NO_EVENT, ONSET, SEPARATION, PEAK = 0, 1, 2, 3
-# What _maximum maximizes on the dense output: sign * delta, -sign * delta, delta_dot.
-_G, _MINUS_G, _RATE = 0, 1, 2
 
 
 @njit(cache=True, error_model="numpy")
-def _state(prm, method, F, t_old, h, y_old, t, tmp):
+def _state(t, prm, method, F, t_old, h, y_old, tmp):
     """(delta, delta_dot) on the dense output of the last step at time t."""
     _dense(method, F, t_old, h, y_old, t, tmp)
     return penetration(prm, t, tmp)
 
 
-@njit(cache=True, error_model="numpy")
-def _value(prm, method, F, t_old, h, y_old, t, tmp, what, sign):
-    d, r = _state(prm, method, F, t_old, h, y_old, t, tmp)
-    if what == _G:
-        return sign * d
-    if what == _MINUS_G:
-        return -sign * d
-    return r
-
-
-@njit(cache=True, error_model="numpy")
-def _locate(prm, method, F, t_old, h, y_old, sign, lo, hi, g_lo, g_hi, tmp):
-    """Root of g = sign * delta in [lo, hi] on its positive side (events.locate_root)."""
-    last = 0
-    for _ in range(200):
-        if hi - lo <= _ROOT_XTOL:
-            break
-        m = hi - g_hi * (hi - lo) / (g_hi - g_lo)
-        if not lo < m < hi:
-            m = 0.5 * (lo + hi)
-        g_m = _value(prm, method, F, t_old, h, y_old, m, tmp, _G, sign)
-        if g_m > 0.0:
-            hi, g_hi = m, g_m
-            if last == -1:
-                g_lo *= 0.5
-            last = -1
-        else:
-            lo, g_lo = m, g_m
-            if last == 1:
-                g_hi *= 0.5
-            last = 1
-    return hi
-
-
-@njit(cache=True, error_model="numpy")
-def _maximum(prm, method, F, t_old, h, y_old, what, sign, lo, hi, tmp):
-    """(t, value) of the largest value on [lo, hi], golden section (events.maximum)."""
-    a, b = lo, hi
-    x1 = b - _INV_PHI * (b - a)
-    x2 = a + _INV_PHI * (b - a)
-    f1 = _value(prm, method, F, t_old, h, y_old, x1, tmp, what, sign)
-    f2 = _value(prm, method, F, t_old, h, y_old, x2, tmp, what, sign)
-    for _ in range(_GOLDEN_ITERATIONS):
-        if f1 < f2:
-            a, x1, f1 = x1, x2, f2
-            x2 = a + _INV_PHI * (b - a)
-            f2 = _value(prm, method, F, t_old, h, y_old, x2, tmp, what, sign)
-        else:
-            b, x2, f2 = x2, x1, f1
-            x1 = b - _INV_PHI * (b - a)
-            f1 = _value(prm, method, F, t_old, h, y_old, x1, tmp, what, sign)
-    best_t, best = lo, _value(prm, method, F, t_old, h, y_old, lo, tmp, what, sign)
-    if f1 > best:
-        best_t, best = x1, f1
-    if f2 > best:
-        best_t, best = x2, f2
-    f_hi = _value(prm, method, F, t_old, h, y_old, hi, tmp, what, sign)
-    if f_hi > best:
-        best_t, best = hi, f_hi
-    return best_t, best
-
-
-@njit(cache=True, error_model="numpy")
-def _first_crossing(prm, method, F, t_old, h, y_old, times, deltas, rates, sign, tmp):
-    """(found, t, sign * delta_dot) of the first rising crossing of sign * delta (events.first_crossing)."""
-    if sign * deltas[0] > 0.0:
-        return True, times[0], sign * rates[0]
-    for k in range(times.size - 1):
-        lo, hi = times[k], times[k + 1]
-        g_lo, g_hi = sign * deltas[k], sign * deltas[k + 1]
-        if g_hi <= 0.0:
-            if not (sign * rates[k] > 0.0 > sign * rates[k + 1]):
-                continue
-            t_top, g_top = _maximum(prm, method, F, t_old, h, y_old, _G, sign, lo, hi, tmp)
-            if g_top <= 0.0:
-                continue
-            hi, g_hi = t_top, g_top
-        root = _locate(prm, method, F, t_old, h, y_old, sign, lo, hi, g_lo, g_hi, tmp)
-        rate = sign * _state(prm, method, F, t_old, h, y_old, root, tmp)[1]
-        if rate <= 0.0:
-            t_low, minus_g_low = _maximum(prm, method, F, t_old, h, y_old, _MINUS_G, sign, root, hi, tmp)
-            if -minus_g_low < 0.0:
-                root = _locate(prm, method, F, t_old, h, y_old, sign, t_low, hi, -minus_g_low, g_hi, tmp)
-                rate = sign * _state(prm, method, F, t_old, h, y_old, root, tmp)[1]
-        return True, root, rate
-    return False, 0.0, 0.0
-
-
-@njit(cache=True, error_model="numpy")
-def _rate_peak(prm, method, F, t_old, h, y_old, times, rates, n, held, tmp):
-    """(found, t, delta_dot) of a maximum of delta_dot above ``held`` before times[n - 1] (events.rate_peak)."""
-    k = 0
-    for i in range(1, n):
-        if rates[i] > rates[k]:
-            k = i
-    if rates[k] <= held:
-        return False, 0.0, 0.0
-    lo = times[max(k - 1, 0)]
-    hi = times[min(k + 1, n - 1)]
-    t_peak, r_peak = _maximum(prm, method, F, t_old, h, y_old, _RATE, 1.0, lo, hi, tmp)
-    end = times[n - 1]
-    if end - t_peak <= END_FRACTION * (end - times[0]) or r_peak <= held:
-        return False, 0.0, 0.0
-    return True, t_peak, r_peak
+# The event search of weftsim.kernel.roots on the dense output of the last step, compiled; its
+# ``args`` are (prm, method, F, t_old, h, y_old, tmp).
+_first_crossing = specialize(roots.first_crossing, state=_state)
+_rate_peak = specialize(roots.rate_peak, state=_state)
 
 
 @njit(cache=True, error_model="numpy")
@@ -288,10 +189,10 @@ def advance(prm, method, rtol, atol, max_step, t_end, t_pause, limits, y, f, fst
                 grid_t[i] = t + h * _GRID[i]
             grid_t[SAMPLES] = t_new
             for i in range(1, SAMPLES):
-                d, r = _state(prm, method, F, t, h, y, grid_t[i], tmp)
+                d, r = _state(grid_t[i], prm, method, F, t, h, y, tmp)
                 grid_d[i], grid_r[i] = d, r
             if possible:
-                found, t_root, rate = _first_crossing(prm, method, F, t, h, y, grid_t, grid_d, grid_r, sign, tmp)
+                found, t_root, rate = _first_crossing((prm, method, F, t, h, y, tmp), grid_t, grid_d, grid_r, sign)
                 if found:
                     t_stop = t_root
                     kind = SEPARATION if contact else ONSET
@@ -309,7 +210,7 @@ def advance(prm, method, rtol, atol, max_step, t_end, t_pause, limits, y, f, fst
                 else:
                     peak_t[:n] = grid_t
                     peak_r[:n] = grid_r
-                found, t_peak, r_peak = _rate_peak(prm, method, F, t, h, y, peak_t, peak_r, n, impact, tmp)
+                found, t_peak, r_peak = _rate_peak((prm, method, F, t, h, y, tmp), peak_t, peak_r, n, impact)
                 if found:
                     t_stop = t_peak
                     kind = PEAK

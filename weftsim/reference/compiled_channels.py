@@ -1,17 +1,16 @@
-"""Output channels of a compiled run, computed in numba (the compiled path's post-processing).
+"""Output channels of a clearance-mode run, computed in numba (post-processing of both paths).
 
-The same channels, from the same equations, as :func:`weftsim.reference.channels.clearance_channels`
-(see its docstring for the energy bookkeeping), at ~0.1 us per row instead of ~3 us:
+The channels come from the equations that were integrated (see
+:func:`weftsim.reference.channels.clearance_channels` for the energy bookkeeping), at ~0.1 us per row:
 
 - the chain terms (a'', F_N, delta, e, Q3) from the compiled right-hand side
-  (:mod:`.compiled_kernel`), the elastic energy from :func:`elastic_energy`;
+  (:mod:`weftsim.kernel.chain`), the elastic energy from :func:`weftsim.kernel.laws.elastic_energy`;
 - the crank-side terms J13, J13', U13, U13' of :mod:`weftsim.reference.ideal`, which depend on
   theta only and are periodic and analytic: they are sampled from those functions once per
   mechanism (:data:`TABLE_POINTS` per revolution) and read back through a periodic cubic
   spline, exact to ~1e-12 of their range (:func:`crank_side_table`; the closed forms are not
   written a second time).
 
-``tests/test_fast_paths.py`` checks these channels against ``clearance_channels``.
 """
 
 from __future__ import annotations
@@ -23,15 +22,14 @@ import numpy as np
 from numba import njit
 
 from weftsim.params import Geometry, Inertia, Scene
-from weftsim.reference.compiled_kernel import (
-    CLEARANCE, COUPLING, GRAVITY, L_EF, L_FG, LAW_COEF, LAW_CONSTANT, LAW_ID, LAW_VARIABLE_KD, M11, M22, OMEGA,
-    ROD_MASS, chain, pack_parameters, penetration,
+from weftsim.kernel.chain import (
+    CLEARANCE, COEF, COUPLING, GRAVITY, KIND, L_EF, L_FG, M11, M22, OMEGA, ROD_MASS, chain, penetration,
 )  # fmt: skip
-from weftsim.reference.dynamics import initial_state
+from weftsim.kernel.laws import elastic_energy
+from weftsim.reference.dynamics import initial_state, pack_parameters
 from weftsim.results import CHANNELS
 
 TABLE_POINTS = 4096  # spline knots per revolution: interpolation error ~ 5/384 h^4 |f''''| ~ 1e-12 relative
-_SERIES_LIMIT = 0.25  # as weftsim.contact: binomial series below x = delta/c = 1/4
 
 
 @functools.lru_cache(maxsize=16)
@@ -73,55 +71,6 @@ def crank_side_eval(table, theta, out):
         out[k] = ((table[k, i, 0] * x + table[k, i, 1]) * x + table[k, i, 2]) * x + table[k, i, 3]
 
 
-def _moment_coefficients(m: float, p: float) -> np.ndarray:
-    """c_k = C(p, k) / (m + k + 1): integral_0^y x^m (1 + x)^p dx = y^(m+1) sum_k c_k y^k (|y| < 1)."""
-    out = np.empty(_SERIES_TERMS)
-    coeff = 1.0
-    for k in range(_SERIES_TERMS):
-        out[k] = coeff / (m + k + 1.0)
-        coeff *= (p - k) / (k + 1.0)
-    return out
-
-
-# The binomial series of weftsim.contact (variable_kd: 3 M(2) + 2 M(3); elastic_foundation: M(1.5),
-# p = -1.5 and -0.5), as polynomials for Horner's rule: 32 terms reach round-off for y <= 1/4.
-_SERIES_TERMS = 32
-_VKD_3 = _moment_coefficients(2.0, -1.5) * 3.0
-_VKD_4 = _moment_coefficients(3.0, -1.5) * 2.0
-_EF = _moment_coefficients(1.5, -0.5)
-
-
-@njit(cache=True, error_model="numpy")
-def _horner(c, y):
-    acc = 0.0
-    for k in range(c.size - 1, -1, -1):
-        acc = acc * y + c[k]
-    return acc
-
-
-@njit(cache=True, error_model="numpy")
-def elastic_energy(prm, delta):
-    """integral_0^delta F_el, J (0 for delta <= 0): the laws' ``elastic_energy`` in numba."""
-    if delta <= 0.0:
-        return 0.0
-    law, coef, c = prm[LAW_ID], prm[LAW_COEF], prm[CLEARANCE]
-    if law == LAW_CONSTANT:
-        return coef * delta**2.5 / 2.5
-    x = delta / c
-    if law == LAW_VARIABLE_KD:
-        if x <= _SERIES_LIMIT:
-            g = x * x * x * (_horner(_VKD_3, x) + x * _horner(_VKD_4, x))
-        else:
-            u = 1.0 + x
-            g = 0.8 * u**2.5 - 2.0 * u**1.5 - 2.0 / math.sqrt(u) + 3.2
-        return coef * math.sqrt(2.0) * c**2.5 * g
-    if x <= _SERIES_LIMIT:
-        h = x * x * math.sqrt(x) * _horner(_EF, x)
-    else:
-        h = 0.25 * math.sqrt(x * (1.0 + x)) * (2.0 * x - 3.0) + 0.75 * math.asinh(math.sqrt(x))
-    return coef / math.sqrt(2.0) * c * c * h
-
-
 @njit(cache=True, error_model="numpy")
 def _fill(prm, table, a0, ratio, time, states, contact, impact, out):
     """Rows of :data:`CHANNELS` (in that order) into out (n, 18)."""
@@ -134,7 +83,7 @@ def _fill(prm, table, a0, ratio, time, states, contact, impact, out):
     for i in range(time.size):
         t = time[i]
         y = states[i]
-        q3, f_n, delta, ecc_y, ecc_z, sa, ca, sp, cp = chain(prm, t, y, contact[i], impact[i], d)
+        q3, f_n, delta, ecc_y, ecc_z, sa, ca, sp, cp = chain(prm, t, y, contact[i], impact[i], d)[:9]
         crank_side_eval(table, omega * t, crank)
         a, da, dpsi = y[0], y[2], y[3]
         m12 = -prm[COUPLING] * (cp * ca + sp * sa)  # -k cos(psi - a)
@@ -155,7 +104,7 @@ def _fill(prm, table, a0, ratio, time, states, contact, impact, out):
         out[i, 11] = 1.0 if (contact[i] and delta > 0.0) else 0.0
         out[i, 12] = kin13 + kin48
         out[i, 13] = crank[2] + pot48
-        out[i, 14] = elastic_energy(prm, delta)
+        out[i, 14] = elastic_energy(prm[KIND], prm[COEF], prm[CLEARANCE], delta)
         out[i, 15] = kin13 + crank[2] - work0 + y[4]
         out[i, 16] = y[5]
         out[i, 17] = penetration(prm, t, y)[1]

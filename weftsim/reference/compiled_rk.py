@@ -2,7 +2,7 @@
 
 Re-implemented step for step from scipy (same tableaux, taken from scipy; same initial step, error
 norm, step-size control and dense output), with the right-hand side of
-:mod:`weftsim.reference.compiled_kernel`.  :mod:`weftsim.reference.compiled` drives these in its
+:mod:`weftsim.kernel.chain`.  :mod:`weftsim.reference.compiled` drives these in its
 event-driven loop.  Every function is module-level ``@njit(cache=True, error_model="numpy")``.
 """
 
@@ -15,7 +15,7 @@ from numba import njit
 from scipy.integrate import RK45 as _SCIPY_RK45
 from scipy.integrate._ivp import dop853_coefficients as _D853
 
-from weftsim.reference.compiled_kernel import chain
+from weftsim.kernel.chain import chain
 
 DOP853, RK45 = 0, 1
 NFEV, DENSE = 4, 5  # counters in the int state of weftsim.reference.compiled (ist)

@@ -20,8 +20,7 @@ from weftsim.reference.compiled import (
     STEP_TOO_SMALL, STEPS, T, _STEP_BUFFER,
     advance,
 )  # fmt: skip
-from weftsim.reference.compiled_kernel import pack_parameters
-from weftsim.reference.dynamics import initial_state
+from weftsim.reference.dynamics import initial_state, pack_parameters
 from weftsim.reference.integrate import _PROGRESS_EVERY
 from weftsim.results import RunResult
 

@@ -1,101 +1,33 @@
-"""Equations of motion of the clearance mode in closed form (SPEC.md sections 2 and 4).
+"""Constants of the clearance-mode equations, their parameter array, and the initial state.
 
-Members 1-3 are prescribed by theta = omega t; the bearing centre P_b is E of the
-rocker.  Members 4-8 form a 2-DOF chain with coordinates q = (a, psi):
-
-    a   = theta_FG, angle of F - G (sector 5, gears 6/7 and rapier 8 follow it)
-    psi = theta_EF, angle of the rod vector from the journal centre to F
-
-in four-bar plane coordinates (Y, Z), angles from +Y towards +Z (about +x)::
-
-        P_b (bearing, rocker 3)
-         .  e = P_j - P_b          F = G + L_FG u(a)
-        P_j (journal, rod 4) ----- F          P_j = F - L_EF u(psi)
-                                    \\ L_FG   r4  = F - (L_EF/2) u(psi)
-                                     G = (L_OG, 0)
-
-with u(x) = (cos x, sin x), n(x) = (-sin x, cos x).  Lagrange's equations
-M(q) q'' = Q(q, q', t) read, with k = m4 L_FG L_EF / 2 and s = sin(psi - a),
-
-    M = [[m4 L_FG^2 + J_FG,  -k cos(psi - a)],
-         [-k cos(psi - a),    m4 L_EF^2/4 + J4]]
-    Q_a   = L_FG n(a).f  - m4 g L_FG cos a         - k psi'^2 s
-    Q_psi = -L_EF n(psi).f + M_f + m4 g (L_EF/2) cos psi + k a'^2 s
-
-where f is the contact force on the journal and M_j the contact moment about the
-journal centre, J_FG = J5 + J67 (d5/d6)^2 + m8 (d5 d7/d6)^2.
-
-Contact (SPEC.md section 2, :mod:`weftsim.clearance`): e = P_j - P_b, n = e/|e|,
-delta = |e| - c, delta_dot = e_dot.n, t = n turned +90 deg; f = -F_N n + F_T t acts on
-the journal and -f on the bearing, both at Q = P_b + R_b n, so only friction has moments:
-M_j = (R_b - |e|) F_T about P_j and M_b = -R_b F_T about P_b.  The generalized force of
-the contact on the crank side (members 1-3, coordinate theta) is
-
-    Q3 = -f . dP_b/dtheta + M_b dtheta_OE/dtheta
-
-and the driving torque T = 1/2 J13' omega^2 + U13' - Q3 (module :mod:`.ideal`).  The
-power -Q3 omega and the dissipated power (F_N - F_el) delta_dot - F_T v_T are integrated
-with the state so the energy balance closes to the solver tolerance.
-
-The kernel :func:`chain_dynamics` is written once for two numeric backends,
-:func:`math_backend` (floats, inside the integrator) and :func:`numpy_backend` (arrays,
-to evaluate channels after the run), so the channels are computed by exactly the equations that
-were integrated.  See docs/reference-solver.md for the derivation.
+The equations themselves (members 1-3 prescribed by theta = omega t, members 4-8 a 2-DOF chain
+q = (a, psi) forced through the contact at E) are written once, in :mod:`weftsim.kernel.chain`;
+both paths of the reference engine integrate that compiled right-hand side (the scipy path is
+the independent integrator check over the same physics) and its output channels come from it.
+This module turns a scene into the kernel's numbers (:class:`ChainConstants`,
+:func:`pack_parameters`) and gives array forms of the chain's geometry and energy for the
+post-processing of both engines.  Derivation: docs/reference-solver.md.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from types import SimpleNamespace
 
 import numpy as np
+from numba import njit
 
 from weftsim import kinematics as kin
-from weftsim.clearance import clearance_contact, make_clearance_kernel
-from weftsim.params import ClearanceJoint, Scene
+from weftsim.contact import make_law
+from weftsim.kernel import chain as kc
+from weftsim.kernel.joint import N_JOINT, joint_parameters
+from weftsim.params import Scene
 from weftsim.reference.ideal import sector_chain_inertia
 
-MATH = SimpleNamespace(sin=math.sin, cos=math.cos, atan=math.atan, hypot=math.hypot)
+# Kept for callers that name the array backend of :func:`eccentricity` (it is always numpy now).
 NUMPY = SimpleNamespace(sin=np.sin, cos=np.cos, atan=np.arctan, hypot=np.hypot)
-
-
-def math_backend(law, joint: ClearanceJoint) -> SimpleNamespace:
-    """Float backend for :func:`chain_dynamics`: plain ``math`` and the scalar contact kernel."""
-    elastic = law.scalar()
-    return SimpleNamespace(
-        **vars(MATH),
-        contact=make_clearance_kernel(law, joint),
-        elastic=lambda delta, v_imp: elastic(delta, 0.0, v_imp),
-        zero=0.0,
-    )
-
-
-def numpy_backend(law, joint: ClearanceJoint) -> SimpleNamespace:
-    """Array backend for :func:`chain_dynamics`: numpy and :func:`weftsim.clearance.clearance_contact`."""
-
-    def contact(ecc_y, ecc_z, v_y, v_z, v_t, v_imp):
-        r = clearance_contact(
-            np.stack([ecc_y, ecc_z], axis=-1), np.stack([v_y, v_z], axis=-1), v_t, v_imp, law, joint
-        )
-        f = r.force_on_journal
-        return (f[..., 0], f[..., 1], r.normal_force, r.penetration, r.penetration_rate,
-                r.moment_on_journal, r.moment_on_bearing)  # fmt: skip
-
-    return SimpleNamespace(
-        **vars(NUMPY),
-        contact=contact,
-        elastic=lambda delta, v_imp: law.elastic_force(delta),
-        zero=0.0,
-    )
-
-
-# Order of the values returned by chain_dynamics.
-OUTPUTS = (
-    "dd_a", "dd_psi", "crank_side_power", "dissipated_power",
-    "normal_force", "elastic_force", "penetration", "penetration_rate",
-    "ecc_y", "ecc_z", "force_y", "force_z", "bearing_moment", "q3",
-)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -144,96 +76,61 @@ class ChainConstants:
         )  # fmt: skip
 
 
-def eccentricity(xp, p: ChainConstants, t, a, psi, da, dpsi):
-    """Eccentricity e = P_j - P_b, its rate, and the bearing's motion (SPEC.md sections 1, 2).
+def _chain_block(p: ChainConstants) -> np.ndarray:
+    """The chain's constants of the kernel's parameter array (indices of :mod:`weftsim.kernel.chain`)."""
+    out = np.zeros(kc.N_PARAMETERS)
+    out[kc.OMEGA], out[kc.TAN_BETA] = p.omega, p.tan_beta
+    out[kc.COS_OE0], out[kc.SIN_OE0] = math.cos(p.rocker_arm_angle), math.sin(p.rocker_arm_angle)
+    out[kc.L_OE], out[kc.L_EF], out[kc.L_FG], out[kc.L_OG] = p.l_oe, p.l_ef, p.l_fg, p.l_og
+    out[kc.ROD_MASS], out[kc.GRAVITY] = p.rod_mass, p.gravity
+    out[kc.M11], out[kc.M22], out[kc.COUPLING] = p.m11, p.m22, p.coupling
+    out[kc.CLEARANCE] = p.clearance
+    return out
 
-    Crank side (prescribed): phi = -atan(tan(beta) cos theta), theta_OE = theta_OE0 + phi,
-    P_b = E = L_OE u(theta_OE).  Chain: P_j = G + L_FG u(a) - L_EF u(psi).
+
+def pack_parameters(scene: Scene) -> np.ndarray:
+    """Every number the kernel needs for this scene: the joint block, then the chain's constants."""
+    out = _chain_block(ChainConstants.from_scene(scene))
+    out[:N_JOINT] = joint_parameters(scene.joint, make_law(scene.joint))
+    return out
+
+
+@functools.lru_cache(maxsize=32)
+def _geometry_parameters(p: ChainConstants) -> np.ndarray:
+    return _chain_block(p)
+
+
+@njit(cache=True, error_model="numpy")
+def _eccentricity_rows(prm, t, a, psi, da, dpsi, out):
+    y = np.zeros(4)
+    for i in range(t.size):
+        y[0], y[1], y[2], y[3] = a[i], psi[i], da[i], dpsi[i]
+        ecc_y, ecc_z, v_y, v_z, db_y, db_z, dphi = kc.eccentricity(prm, t[i], y)[:7]
+        out[0, i], out[1, i], out[2, i], out[3, i] = ecc_y, ecc_z, v_y, v_z
+        out[4, i], out[5, i], out[6, i] = dphi, db_y, db_z
+
+
+def eccentricity(xp, p: ChainConstants, t, a, psi, da, dpsi):
+    """Eccentricity e = P_j - P_b, its rate and the bearing's motion, over arrays (broadcast).
+
+    :func:`weftsim.kernel.chain.eccentricity` at every element (``xp`` is ignored: kept for callers
+    that passed the numpy namespace).
 
     Returns
     -------
     e_Y, e_Z (m); e_dot_Y, e_dot_Z (m/s); phi' = dphi/dtheta; dP_b/dtheta (Y, Z) (m/rad).
     """
-    theta = p.omega * t
-    u = p.tan_beta * xp.cos(theta)
-    dphi = p.tan_beta * xp.sin(theta) / (1.0 + u * u)
-    q = p.rocker_arm_angle - xp.atan(u)
-    sq, cq = xp.sin(q), xp.cos(q)
-    db_y, db_z = -p.l_oe * sq * dphi, p.l_oe * cq * dphi
-    sa, ca, sp, cp = xp.sin(a), xp.cos(a), xp.sin(psi), xp.cos(psi)
-    ecc_y = p.l_og + p.l_fg * ca - p.l_ef * cp - p.l_oe * cq
-    ecc_z = p.l_fg * sa - p.l_ef * sp - p.l_oe * sq
-    v_y = -p.l_fg * sa * da + p.l_ef * sp * dpsi - p.omega * db_y
-    v_z = p.l_fg * ca * da - p.l_ef * cp * dpsi - p.omega * db_z
-    return ecc_y, ecc_z, v_y, v_z, dphi, db_y, db_z
+    args = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (t, a, psi, da, dpsi)))
+    shape = args[0].shape
+    flat = [np.ascontiguousarray(v).ravel() for v in args]
+    out = np.empty((7, flat[0].size))
+    _eccentricity_rows(_geometry_parameters(p), *flat, out)
+    return tuple(row.reshape(shape)[()] for row in out)
 
 
 def penetration(p: ChainConstants, t: float, y) -> tuple[float, float]:
-    """delta = |e| - c (m) and delta_dot = e_dot . n (m/s) of a state y (floats)."""
-    ecc_y, ecc_z, v_y, v_z, *_ = eccentricity(MATH, p, t, y[0], y[1], y[2], y[3])
-    ecc = math.hypot(ecc_y, ecc_z)
-    rate = (v_y * ecc_y + v_z * ecc_z) / ecc if ecc > 0.0 else 0.0
-    return ecc - p.clearance, rate
-
-
-def chain_dynamics(xp, p: ChainConstants, t, a, psi, da, dpsi, contact, impact_velocity):
-    """Accelerations of the 2-DOF chain and the contact quantities at time t.
-
-    Parameters
-    ----------
-    xp : namespace
-        :func:`math_backend` (floats) or :func:`numpy_backend` (arrays broadcast together).
-    p : ChainConstants
-    t : float or ndarray
-        Time, s (theta = omega t).
-    a, psi, da, dpsi : float or ndarray
-        theta_FG, theta_EF (rad) and their rates (rad/s).
-    contact : bool
-        False in free flight: the contact force is not evaluated (it is 0).
-    impact_velocity : float or ndarray
-        Held delta_dot at onset, floored, m/s (used only if ``contact``).
-
-    Returns
-    -------
-    tuple
-        Values named by :data:`OUTPUTS`: a'' and psi'' (rad/s^2); crank-side contact power
-        -Q3 omega (W); dissipated power (W); F_N, F_el (N); delta (m); delta_dot (m/s);
-        e_Y, e_Z (m); force on the journal f_Y, f_Z (N); friction moment on the bearing M_b (N m);
-        Q3 (N m, contact generalized force on the crank side w.r.t. theta).
-    """
-    ecc_y, ecc_z, v_y, v_z, dphi, db_y, db_z = eccentricity(xp, p, t, a, psi, da, dpsi)
-    if contact:
-        v_t = xp.zero
-        if p.friction_coefficient > 0.0:
-            # v_T = e_dot.t + w_j (R_b - |e|) - w_b R_b (weftsim.clearance.tangential_velocity).
-            ecc = xp.hypot(ecc_y, ecc_z)
-            v_t = (ecc_y * v_z - ecc_z * v_y) / ecc + dpsi * (p.bearing_radius - ecc) \
-                - p.omega * dphi * p.bearing_radius
-        f_y, f_z, f_n, delta, delta_dot, m_j, m_b = xp.contact(
-            ecc_y, ecc_z, v_y, v_z, v_t, impact_velocity
-        )
-        f_el = xp.elastic(delta, impact_velocity)
-        # Power of the contact on both bodies, f.e_dot + M_j w_j + M_b w_b = -F_N delta_dot + F_T v_T;
-        # what the elastic energy (rate F_el delta_dot) does not store is dissipated.
-        dissipated = -(f_y * v_y + f_z * v_z + m_j * dpsi + m_b * p.omega * dphi) - f_el * delta_dot
-    else:
-        ecc = xp.hypot(ecc_y, ecc_z)
-        delta = ecc - p.clearance
-        delta_dot = f_n = f_el = dissipated = f_y = f_z = m_j = m_b = 0.0 * ecc  # +0.0 (ecc >= 0)
-    # Generalized forces and the 2x2 solve.
-    sa, ca, sp, cp = xp.sin(a), xp.cos(a), xp.sin(psi), xp.cos(psi)
-    s, c = xp.sin(psi - a), xp.cos(psi - a)
-    k = p.coupling
-    q_a = p.l_fg * (ca * f_z - sa * f_y) - p.rod_mass * p.gravity * p.l_fg * ca - k * dpsi * dpsi * s
-    q_psi = p.l_ef * (sp * f_y - cp * f_z) + m_j + 0.5 * p.rod_mass * p.gravity * p.l_ef * cp + k * da * da * s
-    m12 = -k * c
-    det = p.m11 * p.m22 - m12 * m12
-    dd_a = (p.m22 * q_a - m12 * q_psi) / det
-    dd_psi = (p.m11 * q_psi - m12 * q_a) / det
-    # Crank side: Q3 = F_b.dP_b/dtheta + M_b dtheta_OE/dtheta with F_b = -f.
-    q3 = -(f_y * db_y + f_z * db_z) + m_b * dphi
-    return (dd_a, dd_psi, -q3 * p.omega, dissipated, f_n, f_el, delta, delta_dot,
-            ecc_y, ecc_z, f_y, f_z, m_b, q3)  # fmt: skip
+    """delta = |e| - c (m) and delta_dot = e_dot . n (m/s) of a state y (:func:`weftsim.kernel.chain.penetration`)."""
+    return kc.penetration(_geometry_parameters(p), float(t), np.asarray(y[:4], dtype=float))
 
 
 def chain_energy(p: ChainConstants, a, psi, da, dpsi):

@@ -36,17 +36,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, Radau
 
-from weftsim.contact import make_law
 from weftsim.guards import RunGuard, failure_message, non_finite_breach
+from weftsim.kernel import chain as kernel_chain
+from weftsim.kernel.chain import rhs as chain_rhs
 from weftsim.params import Scene
 from weftsim.reference import events
-from weftsim.reference.dynamics import (
-    ChainConstants,
-    chain_dynamics,
-    initial_state,
-    math_backend,
-    penetration,
-)
+from weftsim.reference.dynamics import initial_state, pack_parameters
 
 METHODS = {"DOP853": DOP853, "RK45": RK45, "RK23": RK23, "Radau": Radau, "BDF": BDF, "LSODA": LSODA}
 # "auto": DOP853 is the fastest accurate method without friction (1 revolution of the reference
@@ -70,9 +65,6 @@ _RK_EVALS = {"DOP853": 12, "RK45": 6, "RK23": 3}
 _DENSE_EVALS = {"DOP853": 3}
 _START_EVALS = 2
 
-# |state| beyond which an exception of the right-hand side is taken as the overflow of a
-# trial stage (angles in rad, rates in rad/s, energies in J: a real state is < ~1e4).
-_OVERFLOW_GUARD = 1e8
 _ROOT_XTOL = events.ROOT_XTOL
 _PROGRESS_EVERY = 0.001  # report progress every 0.1 % of the run: the first line of a 1000-revolution run
 # comes after one revolution, not ten, and the compiled loop (which pauses to report) sees a Ctrl-C within
@@ -124,40 +116,35 @@ class Trajectory:
             self.sample_impact.append(impact)
 
 
-def make_rhs(p: ChainConstants, backend, counter: list):
+def penetration(prm: np.ndarray, t: float, y) -> tuple[float, float]:
+    """(delta, delta_dot) of a state y at time t: :func:`weftsim.kernel.chain.penetration`."""
+    return kernel_chain.penetration(prm, float(t), np.ascontiguousarray(y, dtype=float))
+
+
+def make_rhs(prm: np.ndarray, counter: list):
     """Right-hand sides y' = f(t, y) for free flight and for contact with held v_imp.
 
-    y = [a, psi, a', psi', W3, D]: W3' = -Q3 omega (contact power drawn through the
-    rocker), D' = dissipated power.  ``counter[0]`` counts the evaluations, ``counter[1]``
-    those that came out NaN or inf (scipy rejects such a step and shrinks it).
+    The compiled right-hand side of :mod:`weftsim.kernel.chain` (the one the compiled path
+    integrates) on the scene's parameter array ``prm``; y = [a, psi, a', psi', W3, D] with
+    W3' = -Q3 omega (contact power drawn through the rocker), D' = dissipated power.
+    ``counter[0]`` counts the evaluations, ``counter[1]`` those that came out NaN or inf (scipy
+    rejects such a step and shrinks it).
     """
 
     def evaluate(t, y, in_contact, impact_velocity):
-        try:
-            return chain_dynamics(backend, p, t, y[0], y[1], y[2], y[3], in_contact, impact_velocity)
-        except (ValueError, OverflowError, ZeroDivisionError):
-            # The `math` backend raises where numpy would return inf or NaN: a trial stage of
-            # a too-long step overflows (e.g. max_step = 0.5 deg of crank is 4 ms at 20 rpm,
-            # against ~0.1 ms impacts).  NaN makes the step controller reject the step and
-            # shrink it; an error at a finite, moderate state is a real one and is raised.
-            if np.all(np.isfinite(y)) and np.max(np.abs(y)) < _OVERFLOW_GUARD:
-                raise
-            return (math.nan,) * 4
+        out = np.empty(6)
+        chain_rhs(prm, float(t), y, in_contact, impact_velocity, out)
+        counter[0] += 1
+        if not math.isfinite(out[2] + out[3] + out[4] + out[5]):
+            counter[1] += 1
+        return out
 
     def free(t, y):
-        counter[0] += 1
-        out = evaluate(t, y, False, 0.0)
-        if not math.isfinite(out[0] + out[1]):
-            counter[1] += 1
-        return np.array([y[2], y[3], out[0], out[1], 0.0, 0.0])
+        return evaluate(t, y, False, 0.0)
 
     def contact_factory(impact_velocity):
         def contact(t, y):
-            counter[0] += 1
-            out = evaluate(t, y, True, impact_velocity)
-            if not math.isfinite(out[0] + out[1] + out[2] + out[3]):
-                counter[1] += 1
-            return np.array([y[2], y[3], out[0], out[1], out[2], out[3]])
+            return evaluate(t, y, True, impact_velocity)
 
         return contact
 
@@ -183,11 +170,10 @@ def _integrate(scene: Scene, progress) -> Trajectory:
     omega = scene.drive.speed
     t_end = scene.drive.end_time
     method = METHODS[name]
-    p = ChainConstants.from_scene(scene)
+    p = pack_parameters(scene)
     joint = scene.joint
-    backend = math_backend(make_law(joint), joint)
     counter = [0, 0]
-    free_rhs, contact_rhs = make_rhs(p, backend, counter)
+    free_rhs, contact_rhs = make_rhs(p, counter)
     max_step = settings.max_step / omega
     sample_dt = scene.output.sample_angle / omega
     n_samples = int(math.floor(t_end / sample_dt * (1.0 + 1e-12))) + 1

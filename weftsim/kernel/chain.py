@@ -1,0 +1,180 @@
+"""The 2-DOF chain of members 4-8 driven through the clearance joint (the one definition).
+
+Members 1-3 are prescribed by theta = omega t; the bearing centre P_b is E of the rocker.
+Members 4-8 form a 2-DOF chain with coordinates q = (a, psi) (a = theta_FG, psi = theta_EF), in
+four-bar plane coordinates (Y, Z), u(x) = (cos x, sin x)::
+
+        P_b (bearing, rocker 3)  e = P_j - P_b      F = G + L_FG u(a)
+        P_j (journal, rod 4) ----- F               P_j = F - L_EF u(psi)
+                                    \\ L_FG        G = (L_OG, 0)
+
+Lagrange's equations M(q) q'' = Q(q, q', t), with k = m4 L_FG L_EF / 2 and s = sin(psi - a):
+
+    M = [[m4 L_FG^2 + J_FG,  -k cos(psi - a)], [-k cos(psi - a),  m4 L_EF^2/4 + J4]]
+    Q_a   = L_FG n(a).f  - m4 g L_FG cos a         - k psi'^2 s
+    Q_psi = -L_EF n(psi).f + M_j + m4 g (L_EF/2) cos psi + k a'^2 s
+
+with n(x) = (-sin x, cos x), f and M_j the contact force and moment on the journal
+(:func:`weftsim.kernel.joint.clearance_force`), J_FG = J5 + J67 (d5/d6)^2 + m8 (d5 d7/d6)^2.
+The contact's generalized force on the crank side is Q3 = -f . dP_b/dtheta + M_b dtheta_OE/dtheta;
+its power -Q3 omega and the dissipated power (F_N - F_el) delta_dot - F_T v_T are integrated with
+the state y = [a, psi, a', psi', W3, D] so the energy balance closes to the solver tolerance.
+Derivation: docs/reference-solver.md.
+
+Every number comes in one float array: the joint block of :mod:`weftsim.kernel.joint` followed by
+the chain's constants (indices below; :func:`weftsim.reference.dynamics.pack_parameters` builds it
+from a scene), so numba compiles these functions once per machine and loads them from its cache.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from weftsim.kernel.joint import connector_force
+from weftsim.kernel.joint import (  # noqa: F401 - the joint block is part of this array
+    BEARING_RADIUS, CLEARANCE, COEF, KIND, MU, N_JOINT, TRACK_MAX, V_MIN, clearance_force,
+)  # fmt: skip
+from weftsim.kernel.laws import elastic_force
+
+# Indices of the chain's constants, after the joint block.
+(OMEGA, TAN_BETA, COS_OE0, SIN_OE0, L_OE, L_EF, L_FG, L_OG, ROD_MASS, GRAVITY, M11, M22,
+ COUPLING) = range(N_JOINT, N_JOINT + 13)  # fmt: skip
+N_PARAMETERS = N_JOINT + 13
+
+
+@njit(cache=True, error_model="numpy")
+def crank_side(prm, t):
+    """Bearing centre P_b = E of the rocker: (P_b, dP_b/dtheta, phi') at time t.
+
+    phi = -atan(u), u = tan(beta) cos(theta); theta_OE = theta_OE0 + phi; sin and cos of
+    atan(u) from u directly (1/sqrt(1 + u^2), u/sqrt(1 + u^2)).
+    """
+    theta = prm[OMEGA] * t
+    st, ct = math.sin(theta), math.cos(theta)
+    u = prm[TAN_BETA] * ct
+    w = 1.0 + u * u
+    r = 1.0 / math.sqrt(w)
+    sq = prm[SIN_OE0] * r - prm[COS_OE0] * u * r  # sin(theta_OE0 - atan u)
+    cq = prm[COS_OE0] * r + prm[SIN_OE0] * u * r
+    dphi = prm[TAN_BETA] * st / w
+    l_oe = prm[L_OE]
+    return l_oe * cq, l_oe * sq, -l_oe * sq * dphi, l_oe * cq * dphi, dphi
+
+
+@njit(cache=True, error_model="numpy")
+def eccentricity(prm, t, y):
+    """e = P_j - P_b, its rate, and sin/cos of a, psi (m, m/s) of state y at time t."""
+    b_y, b_z, db_y, db_z, dphi = crank_side(prm, t)
+    sa, ca, sp, cp = math.sin(y[0]), math.cos(y[0]), math.sin(y[1]), math.cos(y[1])
+    l_fg, l_ef, omega = prm[L_FG], prm[L_EF], prm[OMEGA]
+    ecc_y = prm[L_OG] + l_fg * ca - l_ef * cp - b_y
+    ecc_z = l_fg * sa - l_ef * sp - b_z
+    v_y = -l_fg * sa * y[2] + l_ef * sp * y[3] - omega * db_y
+    v_z = l_fg * ca * y[2] - l_ef * cp * y[3] - omega * db_z
+    return ecc_y, ecc_z, v_y, v_z, db_y, db_z, dphi, sa, ca, sp, cp
+
+
+@njit(cache=True, error_model="numpy")
+def penetration(prm, t, y):
+    """(delta, delta_dot) = (|e| - c, e_dot . n) of state y at time t (m, m/s)."""
+    ecc_y, ecc_z, v_y, v_z = eccentricity(prm, t, y)[:4]
+    length = math.sqrt(ecc_y * ecc_y + ecc_z * ecc_z)
+    rate = (v_y * ecc_y + v_z * ecc_z) / length if length > 0.0 else 0.0
+    return length - prm[CLEARANCE], rate
+
+
+@njit(cache=True, error_model="numpy")
+def chain(prm, t, y, contact, impact_velocity, out):
+    """y' of the clearance mode into ``out`` (6,) (module docstring).
+
+    Free flight (``contact`` False): no contact force, W3' = D' = 0.
+
+    Returns
+    -------
+    q3 (N m, contact generalized force on the crank side), F_N (N), delta (m), e_Y, e_Z (m),
+    sin a, cos a, sin psi, cos psi, force on the journal f_Y, f_Z (N), friction moments M_j, M_b (N m).
+    """
+    ecc_y, ecc_z, v_y, v_z, db_y, db_z, dphi, sa, ca, sp, cp = eccentricity(prm, t, y)
+    da, dpsi, omega = y[2], y[3], prm[OMEGA]
+    f_y = f_z = m_j = m_b = dissipated = f_n = 0.0
+    length = math.sqrt(ecc_y * ecc_y + ecc_z * ecc_z)
+    delta = length - prm[CLEARANCE]
+    if contact and length > 0.0:
+        v_t = 0.0
+        if prm[MU] > 0.0:
+            # v_T = e_dot.t + w_j (R_b - |e|) - w_b R_b (weftsim.clearance.tangential_velocity)
+            r_b = prm[BEARING_RADIUS]
+            v_t = (ecc_y * v_z - ecc_z * v_y) / length + dpsi * (r_b - length) - omega * dphi * r_b
+        f_y, f_z, f_n, _, delta, delta_dot, m_j, m_b = clearance_force(prm, ecc_y, ecc_z, v_y, v_z, v_t,
+                                                                       impact_velocity)  # fmt: skip
+        f_el = elastic_force(prm[KIND], prm[COEF], prm[CLEARANCE], delta)
+        # Power of the contact on both bodies, f.e_dot + M_j w_j + M_b w_b = -F_N delta_dot + F_T v_T;
+        # what the elastic energy (rate F_el delta_dot) does not store is dissipated.
+        dissipated = -(f_y * v_y + f_z * v_z + m_j * dpsi + m_b * omega * dphi) - f_el * delta_dot
+    s = sp * ca - cp * sa  # sin(psi - a)
+    c = cp * ca + sp * sa  # cos(psi - a)
+    k = prm[COUPLING]
+    weight = prm[ROD_MASS] * prm[GRAVITY]
+    l_fg, l_ef = prm[L_FG], prm[L_EF]
+    q_a = l_fg * (ca * f_z - sa * f_y) - weight * l_fg * ca - k * dpsi * dpsi * s
+    q_psi = l_ef * (sp * f_y - cp * f_z) + m_j + 0.5 * weight * l_ef * cp + k * da * da * s
+    m11, m22, m12 = prm[M11], prm[M22], -k * c
+    det = m11 * m22 - m12 * m12
+    q3 = -(f_y * db_y + f_z * db_z) + m_b * dphi
+    out[0] = da
+    out[1] = dpsi
+    out[2] = (m22 * q_a - m12 * q_psi) / det
+    out[3] = (m11 * q_psi - m12 * q_a) / det
+    out[4] = -q3 * omega
+    out[5] = dissipated
+    return q3, f_n, delta, ecc_y, ecc_z, sa, ca, sp, cp, f_y, f_z, m_j, m_b
+
+
+@njit(cache=True, error_model="numpy")
+def rhs(prm, t, y, contact, impact_velocity, out):
+    """y' into ``out`` (:func:`chain`); returns q3 (N m)."""
+    return chain(prm, t, y, contact, impact_velocity, out)[0]
+
+
+@njit(cache=True, error_model="numpy")
+def moving_bearing_force(prm, t, px, py, vx, vy, held, delta0, rate0):
+    """Connector force with the bearing centre moving as the crank side prescribes (kinematic tree).
+
+    ``(px, py)``, ``(vx, vy)``: journal centre P_j and its velocity (m, m/s) at time t; the
+    eccentricity is P_j - P_b with P_b of :func:`crank_side`.  Returns
+    :func:`weftsim.kernel.joint.connector_force` (f_x, f_y, delta, delta_dot).
+    """
+    b_y, b_z, db_y, db_z, _ = crank_side(prm, t)
+    omega = prm[OMEGA]
+    return connector_force(prm, px - b_y, py - b_z, vx - omega * db_y, vy - omega * db_z, held, delta0, rate0)
+
+
+@njit(cache=True, error_model="numpy")
+def tree_joint_force(prm, t, a, q1, da, dq1, held, delta0, rate0):
+    """Generalized contact force on the two joints of the kinematic tree (Exudyn's tree model).
+
+    Joint coordinates q0 = a, q1 = psi + pi - a (b = q0 + q1 = psi + pi is the absolute angle of
+    the rod's axis from F to the journal).  The journal centre and its velocity,
+
+        P_j = G + L_FG u(a) + L_EF u(b),  v_j = L_FG a' u'(a) + L_EF b' u'(b),
+
+    go through :func:`moving_bearing_force` (the force F_b = F_N n on the bearing); the force on
+    the journal, -F_b, enters the joints by virtual work:
+
+        Q1 = -F_b . dP_j/dq1 = L_EF (F_bx sin b - F_by cos b),   Q0 = L_FG (F_bx sin a - F_by cos a) + Q1.
+
+    Returns (Q0, Q1, delta, delta_dot, F_bx, F_by): N m, N m, m, m/s, N, N.
+    """
+    l_fg, l_ef = prm[L_FG], prm[L_EF]
+    b = a + q1
+    db = da + dq1
+    sa, ca, sb, cb = math.sin(a), math.cos(a), math.sin(b), math.cos(b)
+    px = prm[L_OG] + l_fg * ca + l_ef * cb
+    py = l_fg * sa + l_ef * sb
+    vx = -l_fg * sa * da - l_ef * sb * db
+    vy = l_fg * ca * da + l_ef * cb * db
+    fx, fy, delta, rate = moving_bearing_force(prm, t, px, py, vx, vy, held, delta0, rate0)
+    g1 = l_ef * (fx * sb - fy * cb)
+    return l_fg * (fx * sa - fy * ca) + g1, g1, delta, rate, fx, fy

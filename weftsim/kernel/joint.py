@@ -1,0 +1,117 @@
+"""Force of the planar revolute clearance joint from its eccentricity (the one definition).
+
+Flores-Ambrosio formulation (Flores & Ambrosio, Comput. Struct. 82, 2004)::
+
+             bearing (R_b), centre P_b
+          .-----------.
+        /     journal   \\            e = P_j - P_b        eccentricity vector, m
+       |   P_b --e--> P_j|Q          n = e / |e|          contact normal (bearing -> journal)
+        \\               /            t = (-n_y, n_x)     n turned +90 deg
+          '-----------'              delta = |e| - c      penetration, m (< 0: free flight)
+
+F_N = law(delta, delta_dot, v_imp) with delta_dot = e_dot . n (:mod:`.laws`, :mod:`.hold`);
+modified Coulomb friction on the journal F_T = -mu c_d(|v_T|) F_N sign(v_T) (Ambrosio 2003);
+force on the journal f = -F_N n + F_T t at Q = P_b + R_b n, so only friction has moments:
+M_j = (R_b - |e|) F_T about P_j and M_b = -R_b F_T about P_b.  e = 0 is free flight.
+
+The joint's numbers come in one float array (:func:`joint_parameters`, indices below); the
+chain's parameter array (:mod:`.chain`) starts with the same block, so these functions take either.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from weftsim.kernel.hold import RESTING_RATE_FRACTION, callback_impact_velocity, damping_rate
+from weftsim.kernel.hold import effective_impact_velocity
+from weftsim.kernel.laws import friction_factor, normal_force
+
+# Indices into the joint parameter block.
+(KIND, COEF, CLEARANCE, XI, BEARING_RADIUS, MU, V0, V1, V_MIN, TRACK_MAX, DEAD_RATE) = range(11)  # fmt: skip
+N_JOINT = 11
+
+
+def joint_parameters(joint, law) -> np.ndarray:
+    """The joint block: the law's (kind, coef, c, xi), R_b, mu, friction ramp, v_min, rule flag, dead zone.
+
+    ``joint``: a :class:`weftsim.params.ClearanceJoint`; ``law``: a law of :mod:`weftsim.contact`
+    (its ``parameters``).  ``TRACK_MAX`` is 1.0 under the "max_approach" rule, 0.0 under "onset";
+    ``DEAD_RATE`` = RESTING_RATE_FRACTION v_min, the damping dead zone of :func:`connector_force`.
+    """
+    out = np.zeros(N_JOINT)
+    out[KIND], out[COEF], out[CLEARANCE], out[XI] = law.parameters
+    out[CLEARANCE] = joint.clearance
+    out[BEARING_RADIUS] = joint.bearing_radius
+    out[MU] = joint.friction_coefficient
+    out[V0], out[V1] = joint.friction_velocities
+    out[V_MIN] = joint.min_impact_velocity
+    out[TRACK_MAX] = 1.0 if joint.impact_velocity_rule == "max_approach" else 0.0
+    out[DEAD_RATE] = RESTING_RATE_FRACTION * joint.min_impact_velocity
+    return out
+
+
+@njit(cache=True, error_model="numpy")
+def clearance_force(prm, ex, ey, ex_dot, ey_dot, v_t, v_imp):
+    """Force of the joint at eccentricity e and its rate, with held impact velocity v_imp.
+
+    ``v_t``: relative tangential velocity of the contact points (journal relative to bearing), m/s,
+    read only with friction; ``v_imp`` > 0 in contact, raised by the joint's rule
+    (:func:`~weftsim.kernel.hold.effective_impact_velocity`).
+
+    Returns
+    -------
+    (f_x, f_y, F_N, F_T, delta, delta_dot, M_j, M_b): force on the journal (N), normal and
+    friction force (N, F_T along t), penetration (m) and its rate (m/s), friction moments about
+    P_j and P_b (N m).
+    """
+    length = math.sqrt(ex * ex + ey * ey)
+    delta = length - prm[CLEARANCE]
+    if length <= 0.0:
+        return 0.0, 0.0, 0.0, 0.0, delta, 0.0, 0.0, 0.0
+    nx = ex / length
+    ny = ey / length
+    delta_dot = ex_dot * nx + ey_dot * ny
+    v = effective_impact_velocity(v_imp, delta_dot, prm[TRACK_MAX] != 0.0)
+    f_n = normal_force(prm[KIND], prm[COEF], prm[CLEARANCE], prm[XI], delta, delta_dot, v)
+    f_t = 0.0
+    mu = prm[MU]
+    if mu > 0.0 and f_n > 0.0:
+        c_d = friction_factor(v_t, prm[V0], prm[V1])
+        if c_d > 0.0:
+            f_t = -mu * c_d * f_n if v_t > 0.0 else mu * c_d * f_n
+    r_b = prm[BEARING_RADIUS]
+    fx = -f_n * nx - f_t * ny
+    fy = -f_n * ny + f_t * nx
+    return fx, fy, f_n, f_t, delta, delta_dot, (r_b - length) * f_t, -r_b * f_t
+
+
+@njit(cache=True, error_model="numpy")
+def connector_force(prm, ex, ey, vx, vy, held, delta0, rate0):
+    """Force F_N n of the Exudyn clearance connector (on the bearing side; -F_N n on the journal).
+
+    ``(ex, ey)``, ``(vx, vy)``: eccentricity P_j - P_b (m) and its rate (m/s) at a trial state;
+    ``held``, ``delta0``, ``rate0``: the held impact velocity and the penetration and rate of the
+    last accepted state (the connector's memory).  The impact velocity is
+    :func:`~weftsim.kernel.hold.callback_impact_velocity`, the damping rate has the resting-contact
+    dead zone of :func:`~weftsim.kernel.hold.damping_rate` (+-``prm[DEAD_RATE]``).
+
+    Returns
+    -------
+    (f_x, f_y, delta, delta_dot): force (N), penetration (m) and its rate (m/s, 0 at e = 0).
+    """
+    length = math.sqrt(ex * ex + ey * ey)
+    delta = length - prm[CLEARANCE]
+    if length <= 0.0:
+        return 0.0, 0.0, delta, 0.0
+    nx = ex / length
+    ny = ey / length
+    rate = vx * nx + vy * ny
+    if delta <= 0.0:
+        return 0.0, 0.0, delta, rate
+    v_imp = callback_impact_velocity(held, delta0, rate0, delta, rate, prm[V_MIN], prm[TRACK_MAX] != 0.0)
+    f = normal_force(prm[KIND], prm[COEF], prm[CLEARANCE], prm[XI], delta, damping_rate(rate, prm[DEAD_RATE]),
+                     v_imp)  # fmt: skip
+    return f * nx, f * ny, delta, rate
