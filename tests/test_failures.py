@@ -38,6 +38,10 @@ FIRST_CONTACT_DEG = 6.637  # reference scene: onset of the start-up impact (docs
 # until issue 12): named here, so they keep testing that path; the compiled path's guards are
 # tested in tests/test_fast_paths.py.
 SCIPY_DOP853 = ReferenceSolver(method="DOP853", rtol=1e-9, atol=1e-12)
+# Likewise the Exudyn faults were written against the rigid-body model (Newton, the iteration matrix,
+# a fixed or adaptive implicit step); the automatic selection takes the kinematic tree, whose
+# failures the command-line tests below check.
+RIGID_BODY = ExudynSolver(model="rigid_body")
 
 
 def scene(degrees=20.0, youngs_modulus=207e9, exudyn=None, reference_solver=None, **limits) -> Scene:
@@ -53,7 +57,7 @@ def scene(degrees=20.0, youngs_modulus=207e9, exudyn=None, reference_solver=None
         steel,
         joint=dataclasses.replace(steel.joint, journal_material=material, bearing_material=material),
         drive=Drive(speed=400.0 * RPM, revolutions=degrees / 360.0),
-        exudyn_solver=exudyn or steel.exudyn_solver,
+        exudyn_solver=exudyn or RIGID_BODY,
         reference_solver=reference_solver or SCIPY_DOP853,
         limits=Limits(**limits),
     )
@@ -235,8 +239,22 @@ def test_absurd_stiffness_overflows_at_the_first_contact(engine):
     engine names the non-finite right-hand side (scipy rejected every trial step); Exudyn 1.13.6 could
     not factorize its iteration matrix on one package set and reported a Newton failure on another.
     Both stop at the onset of the start-up impact with what came before."""
-    r = SOLVERS[engine](scene(youngs_modulus=1e305))
+    exudyn = ExudynSolver(model="rigid_body", step_control="fixed")  # located within one 2e-6 s step
+    r = SOLVERS[engine](scene(youngs_modulus=1e305, exudyn=exudyn))
     assert_failed_at_an_unresolvable_impact(r)
+
+
+@pytest.mark.parametrize("settings", [ExudynSolver(model="rigid_body"), ExudynSolver(model="kinematic_tree")],
+                         ids=["rigid_body adaptive", "kinematic_tree"])  # fmt: skip
+def test_absurd_stiffness_fails_on_the_error_controlled_exudyn_paths(settings):
+    """The same overflow on Exudyn's error-controlled paths: they cross the free flight in steps of one
+    output sample (0.5 deg), and the step into the impact cannot be completed (measured: the rigid-body
+    model's matrix is not factorized, the tree's penetration guard), so the run fails naming the last
+    accepted state, at most one such step before the first contact, and keeps the free flight."""
+    r = exudyn_engine.solve(scene(youngs_modulus=1e305, exudyn=settings))
+    assert r.status == "failed" and "crank angle" in r.message and "Traceback" not in r.message
+    assert FIRST_CONTACT_DEG - 0.5 <= failure_angle(r) <= FIRST_CONTACT_DEG + 0.01, r.message
+    assert r.steps["penetration_m"][:-1].max() < 1e-12  # the free flight before it, kept
 
 
 def test_reference_step_size_floor_from_limits():
@@ -322,7 +340,7 @@ def test_unresolved_stiff_joint_fails_on_the_energy_balance():
     whatever the step lands on.  Measured against the reference engine's resolved 1.57e8 N: 0.64x with
     the python and numba callbacks, 940x with the symbolic one (numpy 2.4.6, exudyn 1.13.6), 2.7x in
     issue 11; the energy balance failed every time."""
-    stiff = scene(youngs_modulus=1e20, exudyn=ExudynSolver(step_control="fixed"))
+    stiff = scene(youngs_modulus=1e20, exudyn=ExudynSolver(model="rigid_body", step_control="fixed"))
     ref = reference.solve(stiff)
     assert ref.ok, ref.message
     # Why Exudyn cannot resolve it: the reference engine measures the first impact at 1.09e-6 s.
@@ -335,7 +353,7 @@ def test_unresolved_stiff_joint_fails_on_the_energy_balance():
     r = exudyn_engine.solve(stiff)
     assert_failed(r, "energy", "energy balance misses", "limits.max_energy_error", "smaller step")
     # The error-controlled step (the default) shortens its steps through the impact and resolves it.
-    adaptive = exudyn_engine.solve(dataclasses.replace(stiff, exudyn_solver=ExudynSolver()))
+    adaptive = exudyn_engine.solve(dataclasses.replace(stiff, exudyn_solver=ExudynSolver(model="rigid_body")))
     assert adaptive.ok, adaptive.message
     assert adaptive.solver_stats["step_size_s"] < first_impact_duration(ref)
     # The balance is checked once the run is over, so the failed run keeps every step to the end for
