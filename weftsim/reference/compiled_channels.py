@@ -32,20 +32,36 @@ from weftsim.results import CHANNELS
 TABLE_POINTS = 4096  # spline knots per revolution: interpolation error ~ 5/384 h^4 |f''''| ~ 1e-12 relative
 
 
+def periodic_spline(values: np.ndarray, h: float) -> np.ndarray:
+    """Coefficients (function, interval, power) of the periodic cubic spline through ``values``.
+
+    ``values`` (n, m): m functions at n equally spaced knots x_i = i h of one period (the knot
+    x_n = x_0 is implied).  The second derivatives M solve the circulant system
+    M_(i-1) + 4 M_i + M_(i+1) = 6 (y_(i+1) - 2 y_i + y_(i-1)) / h^2, diagonal in Fourier space
+    (eigenvalues 4 + 2 cos(2 pi k / n)); on [x_i, x_i+1], in powers of x - x_i (highest first):
+    (M_(i+1) - M_i) / 6h,  M_i / 2,  (y_(i+1) - y_i) / h - h (2 M_i + M_(i+1)) / 6,  y_i.
+    The same interpolant as ``scipy.interpolate.CubicSpline(bc_type="periodic")`` (tested), without
+    importing scipy in every run.
+    """
+    y = values
+    y_next = np.roll(y, -1, axis=0)
+    rhs = 6.0 * (y_next - 2.0 * y + np.roll(y, 1, axis=0)) / h**2
+    k = np.arange(y.shape[0])[:, None]
+    m = np.fft.ifft(np.fft.fft(rhs, axis=0) / (4.0 + 2.0 * np.cos(2.0 * math.pi * k / y.shape[0])), axis=0).real
+    m_next = np.roll(m, -1, axis=0)
+    coefficients = np.stack([(m_next - m) / (6.0 * h), 0.5 * m, (y_next - y) / h - h * (2.0 * m + m_next) / 6.0, y])
+    return np.ascontiguousarray(np.transpose(coefficients, (2, 1, 0)))
+
+
 @functools.lru_cache(maxsize=16)
 def _table(geometry: Geometry, inertia: Inertia) -> np.ndarray:
-    from scipy.interpolate import CubicSpline
-
     from weftsim.reference.ideal import crank_side_inertia, crank_side_potential
 
     scene = Scene(geometry=geometry, inertia=inertia)
-    theta = np.linspace(0.0, 2.0 * math.pi, TABLE_POINTS + 1)
+    theta = np.linspace(0.0, 2.0 * math.pi, TABLE_POINTS, endpoint=False)
     j13, dj13 = crank_side_inertia(theta, scene)
     u13, du13 = crank_side_potential(theta, scene)
-    values = np.stack([j13, dj13, u13, du13], axis=1)
-    values[-1] = values[0]  # periodic to round-off
-    spline = CubicSpline(theta, values, bc_type="periodic")
-    return np.ascontiguousarray(np.transpose(spline.c, (2, 1, 0)))  # (function, interval, power)
+    return periodic_spline(np.stack([j13, dj13, u13, du13], axis=1), 2.0 * math.pi / TABLE_POINTS)
 
 
 def crank_side_table(scene: Scene) -> np.ndarray:

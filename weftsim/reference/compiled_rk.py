@@ -1,6 +1,6 @@
 """Explicit Runge-Kutta machinery of the compiled reference path (numba): scipy's DOP853 and RK45.
 
-Re-implemented step for step from scipy (same tableaux, taken from scipy; same initial step, error
+Re-implemented step for step from scipy (same tableaux, copied from scipy in :mod:`.rk_tableaux`; same initial step, error
 norm, step-size control and dense output), with the right-hand side of
 :mod:`weftsim.kernel.chain`.  :mod:`weftsim.reference.compiled` drives these in its
 event-driven loop.  Every function is module-level ``@njit(cache=True, error_model="numpy")``.
@@ -12,21 +12,21 @@ import math
 
 import numpy as np
 from numba import njit
-from scipy.integrate import RK45 as _SCIPY_RK45
-from scipy.integrate._ivp import dop853_coefficients as _D853
-
 from weftsim.kernel.chain import chain
+from weftsim.reference import rk_tableaux as _T
 
 DOP853, RK45 = 0, 1
 NFEV, DENSE = 4, 5  # counters in the int state of weftsim.reference.compiled (ist)
-# Tableaux (scipy's own coefficients; DOP853 stages 12, f_new at row 12, 3 extra dense stages).
-_A853 = np.ascontiguousarray(_D853.A[: _D853.N_STAGES, : _D853.N_STAGES])
-_B853, _C853 = _D853.B.copy(), _D853.C[: _D853.N_STAGES].copy()
-_E3, _E5, _D = _D853.E3.copy(), _D853.E5.copy(), np.ascontiguousarray(_D853.D)
-_A853X = np.ascontiguousarray(_D853.A[_D853.N_STAGES + 1:])
-_C853X = _D853.C[_D853.N_STAGES + 1:].copy()
-_A45, _B45, _C45 = _SCIPY_RK45.A.copy(), _SCIPY_RK45.B.copy(), _SCIPY_RK45.C.copy()
-_E45, _P45 = _SCIPY_RK45.E.copy(), np.ascontiguousarray(_SCIPY_RK45.P)
+# Tableaux (scipy's own coefficients, copied by scripts/make_rk_tableaux.py so that a run need not
+# import scipy.integrate; DOP853 stages 12, f_new at row 12, 3 extra dense stages).
+_S = _T.DOP853_N_STAGES
+_A853 = np.ascontiguousarray(_T.DOP853_A[:_S, :_S])
+_B853, _C853 = _T.DOP853_B.copy(), _T.DOP853_C[:_S].copy()
+_E3, _E5, _D = _T.DOP853_E3.copy(), _T.DOP853_E5.copy(), np.ascontiguousarray(_T.DOP853_D)
+_A853X = np.ascontiguousarray(_T.DOP853_A[_S + 1:])
+_C853X = _T.DOP853_C[_S + 1:].copy()
+_A45, _B45, _C45 = _T.RK45_A.copy(), _T.RK45_B.copy(), _T.RK45_C.copy()
+_E45, _P45 = _T.RK45_E.copy(), np.ascontiguousarray(_T.RK45_P)
 _SAFETY, _MIN_FACTOR, _MAX_FACTOR = 0.9, 0.2, 10.0  # scipy's step-size control
 N = 6  # state size
 

@@ -34,7 +34,6 @@ import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, Radau
 
 from weftsim.guards import RunGuard, failure_message, non_finite_breach
 from weftsim.kernel import chain as kernel_chain
@@ -43,7 +42,8 @@ from weftsim.params import Scene
 from weftsim.reference import events
 from weftsim.reference.dynamics import initial_state, pack_parameters
 
-METHODS = {"DOP853": DOP853, "RK45": RK45, "RK23": RK23, "Radau": Radau, "BDF": BDF, "LSODA": LSODA}
+# scipy.integrate's solvers by name (imported when a scipy method runs: not on the compiled path).
+METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
 # "auto": DOP853 is the fastest accurate method without friction (1 revolution of the reference
 # scene: DOP853 0.7 s, LSODA 1.0 s, RK45 1.6 s, BDF 4.4 s, Radau 12 s); with friction the
 # modified-Coulomb ramp (slope mu F_N / (v1 - v0) ~ 1e8 N s/m) makes sticking phases stiff and
@@ -165,11 +165,13 @@ def integrate(scene: Scene, progress=None) -> Trajectory:
 
 
 def _integrate(scene: Scene, progress) -> Trajectory:
+    import scipy.integrate  # here, not at import: the compiled path never needs it (~0.5 s of a run)
+
     settings = scene.reference_solver
     name = resolve_method(scene)
     omega = scene.drive.speed
     t_end = scene.drive.end_time
-    method = METHODS[name]
+    method = getattr(scipy.integrate, name)
     p = pack_parameters(scene)
     joint = scene.joint
     counter = [0, 0]
