@@ -11,7 +11,7 @@ Only reproducible quantities are stored (SPEC.md section 6):
 
 Tolerances are measured, not guessed: each case is rerun with perturbations of the
 solver that change nothing but round-off and the error control (reference: rtol x (1 +
-1e-7), rtol / 10; Exudyn's rigid-body model: the numba callback route instead of the symbolic
+1e-7), rtol / 10; Exudyn's rigid-body model: the python callback route instead of the numba
 one, Newton tolerance / 10; its kinematic tree, the model its automatic selection takes for a
 clearance: the python callback route instead of numba, rtol x (1 + 1e-7), rtol / 10;
 statistics cases a few more, :data:`STATISTICS_PERTURBATIONS`) and
@@ -48,7 +48,7 @@ STAT_QUANTITIES = (("rapier_acceleration_m_s2", "rms"), ("driving_torque_Nm", "r
 PERTURBATIONS = {
     "reference": (("rtol x (1 + 1e-7)", {"solver.reference.rtol": "scale:1.0000001"}),
                   ("rtol / 10", {"solver.reference.rtol": "scale:0.1"})),
-    "exudyn": (("numba callback route", {"solver.exudyn.callback": "numba"}),
+    "exudyn": (("python callback route", {"solver.exudyn.callback": "python"}),
                ("Newton tolerance / 10", {"solver.exudyn.newton_relative_tolerance": "scale:0.1"})),
     "exudyn kinematic_tree": (("python callback route", {"solver.exudyn.callback": "python"}),
                               ("rtol x (1 + 1e-7)", {"solver.exudyn.relative_tolerance": "scale:1.0000001"}),
