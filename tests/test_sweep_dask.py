@@ -55,7 +55,7 @@ def test_reference_engine_cells_on_the_cluster_match_the_local_pool(tmp_path, sc
 
 def test_unreachable_scheduler_is_one_clear_error(tmp_path, capsys, monkeypatch):
     # Port 9 (discard) on loopback: nothing listens there; Dask retries until the timeout, cut to 1 s here.
-    monkeypatch.setattr("weftsim.sweep.runner.CONNECT_TIMEOUT_S", 1.0)
+    monkeypatch.setattr("weftsim.sweep.pool.CONNECT_TIMEOUT_S", 1.0)
     status = main(["sweep", str(REFERENCE), "--vary", "clearance_mm=0.1", "--set", "revolutions=0.25",
                    "-o", str(tmp_path), "--scheduler", "tcp://127.0.0.1:9"])
     assert status == 2
