@@ -110,12 +110,41 @@ def write_cell_record(cell_dir: Path, record: dict, detail: str = "") -> None:
     write_json(cell_dir / CELL_FILE, record)
 
 
+SCRATCH_IN_MEMORY = "/dev/shm"
 _CELLS_IN_THIS_PROCESS = 0  # cells this worker process has solved (it runs many; see worker_info)
 
 
 def worker_info() -> dict[str, Any]:
     """Where a cell ran: host, process id, and how many cells that process had solved (1 = its first)."""
     return {"host": socket.gethostname(), "pid": os.getpid(), "cell_number": _CELLS_IN_THIS_PROCESS}
+
+
+def _scratch_places() -> list[str | None]:
+    """Where to render a run: a memory file system first (Linux ``/dev/shm``), then the system's temp dir."""
+    places: list[str | None] = [None]
+    if os.path.isdir(SCRATCH_IN_MEMORY) and os.access(SCRATCH_IN_MEMORY, os.W_OK | os.X_OK):
+        places.insert(0, SCRATCH_IN_MEMORY)
+    return places
+
+
+def render_run(result, figure: bool) -> dict[str, bytes]:
+    """The files :func:`weftsim.output.write_run` writes for ``result``, as bytes (name -> content).
+
+    They are written to a private temporary directory of this process and read back; a memory
+    file system halves the cost of that detour (1 revolution: 13 ms against 24-32 ms on this
+    machine's disk, next to a 29 ms solve), and a full one falls back to the disk.
+    """
+    from weftsim.output import write_run
+
+    error: OSError | None = None
+    for place in _scratch_places():
+        try:
+            with tempfile.TemporaryDirectory(prefix="weftsim-cell-", dir=place) as private:
+                write_run(result, private, figure=figure, force=True)
+                return {p.name: p.read_bytes() for p in sorted(Path(private).iterdir()) if p.is_file()}
+        except OSError as exc:  # e.g. the memory file system is full: try the next place
+            error = exc
+    raise error
 
 
 def solve_cell(name: str, scene_keys: dict, engine: str, figure: bool = False) -> dict[str, Any]:
@@ -141,7 +170,6 @@ def solve_cell(name: str, scene_keys: dict, engine: str, figure: bool = False) -
         only interrupts pass.  Nothing is read from or written to the sweep directory.
     """
     global _CELLS_IN_THIS_PROCESS
-    from weftsim.output import write_run
     from weftsim.scene import scene_from_keys
     from weftsim.sweep.engines import engine_solve
 
@@ -151,9 +179,7 @@ def solve_cell(name: str, scene_keys: dict, engine: str, figure: bool = False) -
     try:
         scene = scene_from_keys(scene_keys, f"sweep cell {name}")
         result = engine_solve(engine)(scene, progress=None)
-        with tempfile.TemporaryDirectory(prefix="weftsim-cell-") as private:
-            write_run(result, private, figure=figure, force=True)
-            files = {p.name: p.read_bytes() for p in sorted(Path(private).iterdir()) if p.is_file()}
+        files = render_run(result, figure)
         metrics = cell_metrics(result)
         status, error = result.status, result.message
         if status != "success" and not error:
