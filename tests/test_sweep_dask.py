@@ -14,7 +14,6 @@ prove: workers on another machine (another Python, another weftsim version) beha
 
 import os
 import shutil
-import signal
 import subprocess
 import sys
 import tempfile

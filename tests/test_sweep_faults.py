@@ -19,7 +19,7 @@ import pytest
 from test_sweep import FAKE, REFERENCE, ROOT, SHORT, _terminal_sigint, sweep
 
 from weftsim.cli import EXIT_USAGE, main
-from weftsim.sweep import LARGE_GRID_CELLS, SweepError, plan_sweep, run_sweep
+from weftsim.sweep import LARGE_GRID_CELLS, SweepError, plan_sweep
 from weftsim.sweep.cell import CELL_FILE, SUMMARY_FILE, is_finished, read_record
 from weftsim.sweep.grid import parse_vary
 from weftsim.sweep.lock import LOCK_FILE
@@ -203,7 +203,7 @@ def test_a_live_lock_is_refused_naming_its_holder_and_a_stale_one_is_taken_over(
     # The holder is gone: its lock is stale, taken over with a message, and released at the end.
     report = sweep(tmp_path, ["clearance_mm=0.1,0.2"], jobs=1)
     assert (report.skipped, report.succeeded) == (1, 1)
-    assert f"stale sweep lock" in caplog.text and f"process {holder.pid}" in caplog.text
+    assert "stale sweep lock" in caplog.text and f"process {holder.pid}" in caplog.text
     assert not (tmp_path / LOCK_FILE).exists()
     _write_lock(tmp_path, 1, host="another-host.example")
     with pytest.raises(SweepError, match="another host"):

@@ -11,11 +11,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 from weftsim.sweep.cell import normalise
 from weftsim.sweep.engines import check_engine
 from weftsim.sweep.grid import Axis, Cell, SweepError, grid_cells, grid_size, parse_set, parse_vary
+
+if TYPE_CHECKING:
+    from weftsim.params import Scene
 
 # Beyond this many cells a sweep must be asked for with --yes.  The README's clearance x speed map
 # has 121 cells; 2000 cells of the reference engine at 2 revolutions are about an hour on 2 cores.
@@ -45,14 +48,14 @@ class SweepPlan:
     fixed: dict
     base_keys: dict
     cells: tuple[PlannedCell, ...]
-    base: object = None
+    base: Scene  # the base scene (after --set), from which each cell's scene is rebuilt
 
     @property
     def axis_names(self) -> list[str]:
         return [axis.name for axis in self.axes]
 
-    def scene(self, planned: PlannedCell):
-        """The cell's validated :class:`~weftsim.params.Scene`."""
+    def scene(self, planned: PlannedCell) -> Scene:
+        """The cell's validated scene."""
         from weftsim.scene import apply_overrides
 
         return apply_overrides(self.base, planned.overrides, CELL_NAME_CHECK)
