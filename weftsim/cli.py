@@ -93,8 +93,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
 
     p = sub.add_parser("sweep", help="run a grid of scene variants in parallel (table of peaks, plots)",
-                       description="Run every combination of the --vary values, each cell in its own process, "
-                       "into OUTPUT/<cell>/; rerunning skips finished cells.  See docs/sweeps.md.")
+                       description="Run every combination of the --vary values on a pool of worker processes "
+                       "(or a Dask cluster) into OUTPUT/<cell>/; rerunning skips finished cells.  See docs/sweeps.md.")
     p.add_argument("scene", help="base scene file (TOML), e.g. models/reference.toml")
     p.add_argument("--vary", action="append", required=True, metavar="KEY=VALUES",
                    help="a scene key (clearance_mm, speed_rpm, law, ... or a dotted key) and its values: "
