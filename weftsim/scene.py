@@ -414,12 +414,3 @@ def apply_overrides(scene: params.Scene, overrides: dict[str, Any], where: str =
         scene = _set(scene, key.target, value)
     _check_scene(scene, where, {})
     return scene
-
-
-def scene_data(scene: params.Scene) -> dict[str, Any]:
-    """The scene as plain data (file keys, file units, absent optional keys left out).
-
-    ``scene_from_keys(scene_data(scene))`` rebuilds the same scene anywhere, without its files:
-    this is what a sweep sends to a worker that cannot see the scene file.
-    """
-    return {key: value for key, value in to_file_keys(scene).items() if value is not None}

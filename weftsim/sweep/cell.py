@@ -2,7 +2,7 @@
 
 :func:`solve_cell` is the function sent to the local process pool or to a Dask
 cluster: top level, picklable, plain-data arguments.  It receives the cell's
-*resolved scene as data* (dotted file keys, see :func:`weftsim.scene.scene_data`),
+*resolved scene as data* (its dotted file keys in file units, as in ``summary.json``),
 never a path, so a worker needs neither the scene file nor the sweep directory: it
 renders the run's files in a private temporary directory and returns their bytes.
 The client then stores them with :func:`store_cell`: the run's files, then (on
@@ -155,7 +155,8 @@ def solve_cell(name: str, scene_keys: dict, engine: str, figure: bool = False) -
     name : str
         The cell's name (for messages).
     scene_keys : dict
-        The cell's resolved scene as dotted file keys (:func:`weftsim.scene.scene_data`).
+        The cell's resolved scene as dotted file keys in file units (absent optional keys left out);
+        :func:`weftsim.scene.scene_from_keys` rebuilds it without any file.
     engine : str
         ``reference``, ``exudyn`` or ``module:function`` (checked by the sweep before it starts).
     figure : bool

@@ -26,7 +26,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from weftsim.sweep.cell import cell_record, is_finished, solve_cell, store_cell, write_cell_record
+from weftsim.sweep.cell import CELL_FILE, cell_record, is_finished, solve_cell, store_cell, write_cell_record
 from weftsim.sweep.grid import SweepError
 from weftsim.sweep.lock import SweepLock
 from weftsim.sweep.plan import PlannedCell, SweepPlan
@@ -138,8 +138,8 @@ def run_sweep(plan: SweepPlan, outdir: str | Path, jobs: int | None = None, sche
     try:
         _open_directory(outdir, plan, lock)
         start = time.perf_counter()
-        keys = {p.cell.name: plan.scene_keys(p) for p in plan.cells}
-        todo = [p for p in plan.cells if not is_finished(outdir / p.cell.name, keys[p.cell.name], plan.engine)]
+        todo = [p for p in plan.cells if not _finished(plan, outdir, p)]
+        keys: dict[str, dict] = {}  # each cell's resolved scene, built when the cell is sent
         report = SweepReport(outdir, len(plan.cells), skipped=len(plan.cells) - len(todo))
         log.info("sweep %s: %d cells, %d already finished", outdir, report.total, report.skipped)
         bar = SweepProgress(report.total, report.skipped, stream) if progress else None
@@ -158,6 +158,12 @@ def run_sweep(plan: SweepPlan, outdir: str | Path, jobs: int | None = None, sche
         return report
     finally:
         lock.release()
+
+
+def _finished(plan: SweepPlan, outdir: Path, planned: PlannedCell) -> bool:
+    """True if the cell is finished on disk; its scene is rebuilt only where there is a record to compare."""
+    cell_dir = outdir / planned.cell.name
+    return (cell_dir / CELL_FILE).is_file() and is_finished(cell_dir, plan.scene_keys(planned), plan.engine)
 
 
 def _store(outdir: Path, plan: SweepPlan, planned: PlannedCell, scene_keys: dict, outcome: dict) -> dict:
@@ -183,10 +189,12 @@ def _run_cells(plan, outdir, todo, keys, remaining, report, jobs, scheduler, cel
     last_table = time.perf_counter()
 
     def submit(planned: PlannedCell):
-        from weftsim.scene import scene_data
-
-        data = scene_data(plan.scene(planned))  # the resolved scene travels, not the file's path
-        in_flight[pool.submit(solve_cell, planned.cell.name, data, plan.engine, cell_figures)] = planned
+        name = planned.cell.name
+        if name not in keys:
+            keys[name] = plan.scene_keys(planned)
+        # The resolved scene travels, not the file's path: the stored keys without the absent optional ones.
+        data = {key: value for key, value in keys[name].items() if value is not None}
+        in_flight[pool.submit(solve_cell, name, data, plan.engine, cell_figures)] = planned
 
     def finish(planned: PlannedCell, record: dict) -> None:
         del remaining[planned.cell.name]
