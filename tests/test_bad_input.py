@@ -93,7 +93,40 @@ SCENES = [
     ("extends-itself", 'extends = "scene.toml"\n', ["loops back"]),
     ("not-toml", "this is = = not toml\n", ["not valid TOML"]),
     ("duplicate-key", EXTENDS + "[drive]\nspeed_rpm = 400\nspeed_rpm = 500\n", ["not valid TOML"]),
+    # Issue 16 (round two).  The same key as a quoted dotted key at the top level and in its table:
+    # TOML sees two different keys, the scene one, given twice.
+    ("duplicate-key-across-tables", EXTENDS + '"joint_e.clearance_mm" = 0.01\n[joint_e]\nclearance_mm = 0.25\n',
+     ["key 'joint_e.clearance_mm' is given twice", '"joint_e.clearance_mm" at the top level',
+      "clearance_mm in [joint_e]"]),
+    ("duplicate-key-one-level-down", EXTENDS + '[joint_e]\n"journal_material.poisson_ratio" = 0.3\n'
+     "[joint_e.journal_material]\npoisson_ratio = 0.29\n",
+     ["given twice", '"journal_material.poisson_ratio" in [joint_e]', "poisson_ratio in [joint_e.journal_material]"]),
+    # A newline and a terminal escape sequence (clear screen) in a key: escaped in the one line.
+    ("newline-and-escape-in-key", EXTENDS + '[joint_e]\n"clear\\nance\\u001b[2J" = 1\n',
+     ["unknown key 'joint_e.clear\\nance\\x1b[2J'"]),
+    ("newline-in-name", EXTENDS + 'name = "two\\nlines"\n', ["key 'name'", "printable", "'two\\nlines'"]),
+    ("escape-in-name", EXTENDS + 'name = "\\u001b[31mred"\n', ["key 'name'", "printable", "\\x1b[31mred"]),
+    ("extends-a-fifo", 'extends = "fifo"\n', ["fifo", "not a regular file"]),
+    ("extends-dev-zero", 'extends = "/dev/zero"\n', ["/dev/zero", "not a regular file"]),
+    ("extends-chain-of-1500", 'extends = "chain/1499.toml"\n', ["'extends' chain is longer than 64 files"]),
+    ("extends-a-huge-file", 'extends = "huge.toml"\n', ["huge.toml", "2097152 bytes", "more than a scene file's"]),
+    ("sample-deg-1e-9", EXTENDS + "[output]\nsample_deg = 1e-9\n",
+     ["output.sample_deg = 1e-09", "drive.revolutions = 2", "7.2e+11 output samples", "memory"]),
 ]
+# Rows whose message names a file outside the test directory (the scene extends it).
+NAMES_A_SYSTEM_FILE = {"extends-dev-zero"}
+
+
+def make_hostile_files(directory: Path) -> None:
+    """A FIFO (reading it would block until a writer comes), a 2 MiB file, and a chain of 1500
+    scene files each extending the one before (the first extends the reference scene)."""
+    os.mkfifo(directory / "fifo")
+    (directory / "huge.toml").write_text(("# padding" + " " * 54 + "\n") * (1 << 15))  # 2 MiB of comments
+    chain = directory / "chain"
+    chain.mkdir()
+    (chain / "0.toml").write_text(EXTENDS)
+    for k in range(1, 1500):
+        (chain / f"{k}.toml").write_text(f'extends = "{k - 1}.toml"\n')
 
 # Command lines: (id, arguments after the program, words).  "{scene}" is the reference scene,
 # "{dir}" the test directory.
@@ -125,6 +158,17 @@ FLAGS = [
     ("kinematics-bad-scene", ["kinematics", "{dir}/nan.toml"], ["drive.speed_rpm", "finite"]),
     ("sweep-bad-key", ["sweep", "{scene}", "--vary", "clearence_mm=0.1,0.2", "-o", "{dir}/sweep-out"],
      ["clearence_mm"]),
+    # Issue 16 (round two).  No -o: the default output directory out/<name> must stay under out/.
+    ("scene-is-a-fifo", ["run", "{dir}/fifo"], ["fifo", "not a regular file"]),
+    ("scene-is-dev-zero", ["run", "/dev/zero"], ["/dev/zero", "not a regular file"]),
+    ("name-climbs-out-of-out", ["run", "{dir}/climb.toml"],
+     ["key 'name' = '../../escaped'", "out/<name>", "plain file name", "-o"]),
+    ("name-is-absolute", ["run", "{dir}/absolute.toml"], ["key 'name' = '{dir}/escaped'", "out/<name>", "-o"]),
+    ("name-leaves-out-compare", ["compare", "{dir}/climb.toml"], ["key 'name' = '../../escaped'", "-o"]),
+    ("name-leaves-out-kinematics", ["kinematics", "{dir}/climb.toml"], ["key 'name' = '../../escaped'", "-o"]),
+    ("kinematics-sample-deg-1e-9", ["kinematics", "{dir}/fine.toml"],
+     ["output.sample_deg = 1e-09 over one revolution", "3.6e+11 output samples"]),
+    ("compare-sample-deg-1e-9", ["compare", "{dir}/fine.toml"], ["output.sample_deg = 1e-09", "7.2e+11"]),
 ]
 
 
@@ -134,6 +178,7 @@ def outcomes(tmp_path_factory):
     jobs = {}
     for name, text, _ in SCENES:
         directory = tmp_path_factory.mktemp(name)
+        make_hostile_files(directory)
         (directory / "scene.toml").write_text(text)
         jobs[f"scene:{name}"] = (["run", directory / "scene.toml", "-o", directory / "out"], directory)
     for name, args, _ in FLAGS:
@@ -143,6 +188,10 @@ def outcomes(tmp_path_factory):
         (directory / "thesis" / "chapter1.tex").write_text("mine")
         (directory / "latin1.toml").write_bytes("name = \"caf\xe9\"\n".encode("latin-1"))
         (directory / "nan.toml").write_text(EXTENDS + "[drive]\nspeed_rpm = nan\n")
+        (directory / "fine.toml").write_text(EXTENDS + "[output]\nsample_deg = 1e-9\n")
+        (directory / "climb.toml").write_text(EXTENDS + 'name = "../../escaped"\n')
+        (directory / "absolute.toml").write_text(EXTENDS + f'name = "{directory}/escaped"\n')
+        os.mkfifo(directory / "fifo")
         subst = [str(a).replace("{scene}", str(REFERENCE)).replace("{dir}", str(directory)) for a in args]
         jobs[f"flag:{name}"] = (subst, directory)
     with ThreadPoolExecutor(max_workers=4) as pool:
@@ -153,6 +202,7 @@ def outcomes(tmp_path_factory):
 def assert_one_clear_line(done: subprocess.CompletedProcess, words) -> None:
     assert done.returncode == EXIT_USAGE, (done.returncode, done.stderr, done.stdout)
     assert "Traceback" not in done.stderr
+    assert "\x1b" not in done.stderr  # no terminal escape sequence reaches the terminal raw
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1, done.stderr
     assert "error" in lines[0]
@@ -164,14 +214,20 @@ def assert_one_clear_line(done: subprocess.CompletedProcess, words) -> None:
 def test_bad_scene_file(outcomes, name, text, words):
     done, directory = outcomes[f"scene:{name}"]
     assert_one_clear_line(done, words)
-    assert str(directory) in done.stderr  # the file is named (the scene or the one it extends)
+    if name not in NAMES_A_SYSTEM_FILE:
+        assert str(directory) in done.stderr  # the file is named (the scene or the one it extends)
     assert not (directory / "out").exists()  # refused before anything is written
 
 
 @pytest.mark.parametrize("name, args, words", FLAGS, ids=[row[0] for row in FLAGS])
 def test_bad_flag_or_output(outcomes, name, args, words):
     done, directory = outcomes[f"flag:{name}"]
+    words = [w.replace("{dir}", str(directory)) for w in words]
     assert_one_clear_line(done, words)
+    # Run in the test directory: a refused command creates no default out/ there, and nothing
+    # lands where a scene's name points outside it.
+    assert not (directory / "out").exists()
+    assert not (directory.parent.parent / "escaped").exists() and not (directory / "escaped").exists()
     # A refused directory keeps exactly what it held.
     assert (directory / "blocker").read_text() == "x"
     assert [p.name for p in (directory / "thesis").iterdir()] == ["chapter1.tex"]

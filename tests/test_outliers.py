@@ -86,7 +86,8 @@ def test_segment_bookkeeping_on_synthetic_rows():
 @pytest.fixture(scope="module")
 def short_run():
     """0.3 revolution of the reference scene (scipy DOP853, rtol 1e-9): ~a dozen onsets, ~1 s."""
-    scene = load_scene(MODELS / "reference.toml", {"drive.revolutions": 0.3, "solver.reference.method": "DOP853"})
+    scene = load_scene(MODELS / "reference.toml", {"drive.revolutions": 0.3, "solver.reference.method": "DOP853",
+                                                   "solver.reference.rtol": 1e-9, "solver.reference.atol": 1e-12})
     raw = {}
     result = solve(scene, step_states=lambda t, y, c, i: raw.update(t=t, y=y, contact=c, impact=i))
     assert result.ok, result.message

@@ -7,12 +7,19 @@ line on stderr and a non-zero exit status; tracebacks only for real bugs.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
 import math
+import os
+import signal
 import sys
+import threading
 from pathlib import Path
 
 from weftsim.exitcodes import EXIT_DISAGREE, EXIT_FAILED, EXIT_USAGE  # noqa: F401 (re-exported)
+
+EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a command stopped by Ctrl-C
+EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE: the reader of stdout went away (`| head`), as for any Unix tool
 
 
 class CliError(Exception):
@@ -126,7 +133,10 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Time every engine setting on an easy and two hard scenes against a converged "
                        "solution: tables, log-log figures and JSON.  The full mode takes ~30 min on 2 cores.")
     p.add_argument("--quick", action="store_true", help="a few settings, 2 revolutions (a few minutes)")
-    p.add_argument("-o", "--output", default=None, help="output directory (default: out/bench or out/bench-quick)")
+    p.add_argument("--targets", action="store_true",
+                   help="the speed targets of the default paths against the 0.1 defaults (about 10 min)")
+    p.add_argument("-o", "--output", default=None,
+                   help="output directory (default: out/bench, out/bench-quick or out/bench-targets)")
     p.add_argument("--case", action="append", help="only this case (repeatable): c0.25mm-400rpm, c0.01mm-800rpm, "
                    "c0.50mm-800rpm")
     p.add_argument("--models", default="models", help="directory of the scene files (default: models)")
@@ -152,20 +162,122 @@ def _load(args):
 
 
 def _outdir(args, scene, suffix: str = "") -> Path:
-    return Path(args.output) if args.output else Path("out") / (scene.name + suffix)
+    """``-o``, or ``out/<scene name><suffix>``: a name that would leave ``out/`` is refused."""
+    if args.output:
+        return Path(args.output)
+    name = scene.name
+    if name in (".", "..") or "/" in name or "\\" in name or (os.altsep and os.altsep in name):
+        raise CliError(f"the scene's key 'name' = {name!r} cannot name the default output directory "
+                       "out/<name>: it must be one plain file name (no '/' or '\\', not '.' or '..'); "
+                       "change it or choose the output directory with -o")
+    return Path("out") / (name + suffix)
+
+
+def _check_fits(scene, outdir: Path, runs: int = 1) -> None:
+    """Refuse a run whose output grid cannot be held or written (before anything is created)."""
+    from weftsim.output import check_output_fits, output_rows
+    from weftsim.results import CHANNELS
+
+    what = (f"output.sample_deg = {math.degrees(scene.output.sample_angle):g} over "
+            f"drive.revolutions = {scene.drive.revolutions:g}")
+    check_output_fits(output_rows(scene), len(CHANNELS), outdir, what, runs)
+
+
+def _announce_run_time(scene, engines: tuple[str, ...], command: str) -> None:
+    """One line on stderr with the estimated run time of a long run (a warning above LONG_RUN_S)."""
+    from weftsim.progress import LONG_RUN_S, SHOW_ESTIMATE_S, estimate_run_time, format_duration
+
+    estimate = sum(estimate_run_time(scene, engine) for engine in engines)
+    if estimate < SHOW_ESTIMATE_S:
+        return
+    prefix = "warning: " if estimate > LONG_RUN_S else ""
+    print(f"weftsim {command}: {prefix}estimated run time ~{format_duration(estimate)} for "
+          f"{scene.drive.revolutions:g} revolutions (within a factor of ~3); Ctrl-C stops it and keeps what was "
+          "computed", file=sys.stderr, flush=True)
+
+
+# Signals that stop a run gracefully: the engine ends at its next step and what it computed is
+# written.  SIGINT is Ctrl-C; SIGTERM is what `kill`, a batch scheduler at its time limit or a
+# container stop sends first.
+STOP_SIGNALS = {signal.SIGINT: "Ctrl-C, SIGINT", signal.SIGTERM: "SIGTERM"}
+
+
+@contextlib.contextmanager
+def _stop_on_interrupt(command: str):
+    """While the block runs, SIGINT (Ctrl-C) or SIGTERM asks the running engine to stop at its next
+    step and keep what it computed (weftsim.guards.request_stop); a second signal abandons at once.
+
+    Yields a dict whose ``"signal"`` is the signal number once one came (else None).
+    """
+    from weftsim.guards import clear_stop, request_stop
+
+    state = {"signal": None}
+    previous = {signum: signal.getsignal(signum) for signum in STOP_SIGNALS}
+
+    def handler(signum, frame):
+        state["signal"] = signum
+        request_stop(f"stopped by the user ({STOP_SIGNALS[signum]})")
+        for other in STOP_SIGNALS:  # the next one ends the process at once
+            signal.signal(other, signal.default_int_handler if other == signal.SIGINT else signal.SIG_DFL)
+        if sys.stderr.isatty():  # at a terminal, say at once that the key was seen
+            sys.stderr.write(f"\nweftsim {command}: stopping at the next step, keeping what was computed "
+                             "(Ctrl-C again to abandon it)\n")
+
+    clear_stop()
+    if threading.current_thread() is not threading.main_thread():  # only the main thread may set handlers
+        previous = {}
+    for signum in previous:
+        signal.signal(signum, handler)
+    try:
+        yield state
+    finally:
+        for signum, old in previous.items():
+            signal.signal(signum, old)
+        clear_stop()
+
+
+@contextlib.contextmanager
+def _stdout_to_stderr():
+    """Send everything written to file descriptor 1 (Python's or a C library's, e.g. Exudyn's notes
+    on import and its solver banners) to stderr while the block runs, so stdout holds only what is
+    printed after it (``--json``)."""
+    import ctypes
+
+    sys.stdout.flush()
+    saved = os.dup(1)
+    os.dup2(2, 1)
+    try:
+        yield
+    finally:
+        sys.stdout.flush()
+        with contextlib.suppress(OSError, AttributeError):
+            ctypes.CDLL(None).fflush(None)  # C stdio buffers still holding library output
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
+# The columns of kinematics.csv, in order (their number sizes the output before it is computed).
+KINEMATICS_COLUMNS = ("crank_angle_deg", "rapier_displacement_m", "rapier_velocity_m_s", "rapier_acceleration_m_s2",
+                      "rocker_angle_deg", "rocker_arm_angle_deg", "sector_angle_deg", "rod_angle_deg",
+                      "transmission_angle_deg")
 
 
 def cmd_kinematics(args) -> int:
     import numpy as np
 
     from weftsim.kinematics import linkage_state
-    from weftsim.output import finish_directory, prepare_directory, write_csv, write_figure
+    from weftsim.output import check_output_fits, prepare_directory, write_csv, write_figure, write_files
     from weftsim.plots import plot_kinematics
 
     scene = _load(args)
-    outdir = prepare_directory(_outdir(args, scene, "-kinematics"), args.force)
     step = scene.output.sample_angle
-    theta = np.linspace(0.0, 2.0 * math.pi, int(round(2.0 * math.pi / step)) + 1)
+    rows = int(round(2.0 * math.pi / step)) + 1
+    outdir = _outdir(args, scene, "-kinematics")
+    check_output_fits(rows, len(KINEMATICS_COLUMNS), outdir,
+                      f"output.sample_deg = {math.degrees(step):g} over one revolution",
+                      fix="a coarser output.sample_deg (any value up to 0.5 deg)")
+    outdir = prepare_directory(outdir, args.force)
+    theta = np.linspace(0.0, 2.0 * math.pi, rows)
     state = linkage_state(theta, scene.geometry, scene.inertia.rocker_com)
     w = scene.drive.speed
     columns = {
@@ -179,13 +291,15 @@ def cmd_kinematics(args) -> int:
         "rod_angle_deg": np.degrees(state.theta_ef),
         "transmission_angle_deg": np.degrees(state.transmission_angle),
     }
-    csv = write_csv(outdir / "kinematics.csv", columns)
     rpm = scene.drive.speed * 30 / math.pi
-    fig = plot_kinematics(columns["crank_angle_deg"], columns["rapier_displacement_m"],
-                          columns["rapier_velocity_m_s"], columns["rapier_acceleration_m_s2"],
-                          f"{scene.name}: ideal rapier motion at {rpm:g} rpm")
-    png = write_figure(outdir / "kinematics.png", fig)
-    finish_directory(outdir, {"csv": csv, "png": png}, {"kind": "kinematics", "scene": scene.name})
+    title = f"{scene.name}: ideal rapier motion at {rpm:g} rpm"
+    written = write_files(outdir, {"kind": "kinematics", "scene": scene.name}, {
+        "csv": ("kinematics.csv", lambda target: write_csv(target, columns)),
+        "png": ("kinematics.png", lambda target: write_figure(target, plot_kinematics(
+            columns["crank_angle_deg"], columns["rapier_displacement_m"], columns["rapier_velocity_m_s"],
+            columns["rapier_acceleration_m_s2"], title))),
+    })
+    csv, png = written["csv"], written["png"]
     s, v, a = columns["rapier_displacement_m"], columns["rapier_velocity_m_s"], columns["rapier_acceleration_m_s2"]
     print(f"scene {scene.name}: {rpm:g} rpm, ideal joints")
     print(f"  stroke        {s.max() - s.min():.6f} m at {columns['crank_angle_deg'][s.argmax()]:.1f} deg")
@@ -197,7 +311,7 @@ def cmd_kinematics(args) -> int:
     return 0
 
 
-def _solve(scene, engine: str, label: str | None = None):
+def _solve(scene, engine: str, label: str | None = None, announce: bool = False):
     from weftsim.progress import Progress
 
     if engine == "reference":
@@ -206,17 +320,22 @@ def _solve(scene, engine: str, label: str | None = None):
         from weftsim.exudyn_engine import solve
     else:
         raise CliError(f"--engine must be 'reference' or 'exudyn', got {engine!r}")
-    if label is None:  # a run's first line: the model and method it takes, and why
-        from importlib import import_module
-
-        select = import_module("weftsim.reference" if engine == "reference" else "weftsim.exudyn_engine").select_path
-        path = select(scene)
+    if announce:  # `run`: its first line is the model and method it takes, and why
+        path = _select(engine)(scene)
         print(f"scene {scene.name}, engine {engine}: {path['model']}, {path['method']} ({path['reason']})", flush=True)
     progress = Progress(label or f"{engine} {scene.name}")
     try:
         return solve(scene, progress=progress)
     finally:
         progress.close()
+
+
+def _select(engine: str):
+    if engine == "reference":
+        from weftsim.reference import select_path
+    else:
+        from weftsim.exudyn_engine import select_path
+    return select_path
 
 
 def _report_run(result, written) -> None:
@@ -236,16 +355,30 @@ def _report_run(result, written) -> None:
         print(f"  wrote {path}")
 
 
+def _interrupted_line(result, outdir: Path, signum: int) -> str:
+    from weftsim.guards import where
+
+    t = float(result.steps["time_s"][-1]) if result.steps["time_s"].size else 0.0
+    return (f"stopped by {STOP_SIGNALS[signum]} at {where(t, result.scene.drive.speed)}: the results up to "
+            f"there are in {outdir} (summary.json says complete: false); rerun to compute the whole run")
+
+
 def cmd_run(args) -> int:
     from weftsim.output import prepare_directory, write_run
     from weftsim.plausibility import report_lines
 
     scene = _load(args)
-    outdir = prepare_directory(_outdir(args, scene), args.force)
-    result = _solve(scene, args.engine)
+    outdir = _outdir(args, scene)
+    _check_fits(scene, outdir)
+    outdir = prepare_directory(outdir, args.force)
+    _announce_run_time(scene, (args.engine,), "run")
+    with _stop_on_interrupt("run") as stop:
+        result = _solve(scene, args.engine, announce=True)
     written = write_run(result, outdir, figure=not args.no_plot, force=args.force)
     _report_run(result, written)
     report_lines(result, "run")
+    if stop["signal"] is not None and not result.ok:
+        raise CliError(_interrupted_line(result, outdir, stop["signal"]), 128 + stop["signal"])
     if not result.ok:
         raise CliError(f"simulation failed: {result.message} (results up to the failure written to {outdir}, "
                        "marked incomplete in summary.json)", EXIT_FAILED)
@@ -253,10 +386,20 @@ def cmd_run(args) -> int:
 
 
 def cmd_compare(args) -> int:
-    from weftsim.compare import run_compare
+    from weftsim.compare import format_report, run_compare
+    from weftsim.output import prepare_directory, to_json
 
     scene = _load(args)
-    return run_compare(scene, _outdir(args, scene, "-compare"), as_json=args.json, solve=_solve, force=args.force)
+    outdir = _outdir(args, scene, "-compare")
+    _check_fits(scene, outdir, runs=2)
+    prepare_directory(outdir, args.force)  # refused before the estimate is shown
+    with _stdout_to_stderr() if args.json else contextlib.nullcontext():  # the estimate imports Exudyn
+        _announce_run_time(scene, ("reference", "exudyn"), "compare")
+        report, status, problem = run_compare(scene, outdir, solve=_solve, force=args.force)
+    print(to_json(report) if args.json else format_report(report), end="" if args.json else "\n")
+    if status:
+        raise CliError(problem, status)
+    return 0
 
 
 class _SweepTerminated(KeyboardInterrupt):
@@ -323,6 +466,13 @@ def cmd_bench(args) -> int:
     unknown = [c for c in args.case or [] if c not in CASES]
     if unknown:
         raise CliError(f"unknown --case {', '.join(unknown)}; choose from {', '.join(CASES)}")
+    if args.targets:
+        from weftsim.bench.targets import run_targets, write_targets
+
+        report = run_targets(args.models, repeats=args.repeats, log=lambda text: print(text, file=sys.stderr))
+        files = write_targets(report, args.output or "out/bench-targets", args.force)
+        print(f"targets measured in {report['total_time_s']:.0f} s; wrote " + ", ".join(map(str, files)))
+        return 0
     outdir = args.output or ("out/bench-quick" if args.quick else "out/bench")
     report = run_benchmark(outdir, args.models, args.quick, args.case, repeats=args.repeats, force=args.force)
     print(f"benchmark done in {report['total_time_s']:.0f} s; wrote " + ", ".join(map(str, report["files"])))
@@ -333,25 +483,46 @@ COMMANDS = {"kinematics": cmd_kinematics, "run": cmd_run, "compare": cmd_compare
             "study": cmd_study, "bench": cmd_bench}
 
 
+def _one_line(text: str) -> str:
+    """A message as one terminal line: newlines and escape sequences from file names or values escaped."""
+    from weftsim.scene import shown
+
+    return shown(str(text))
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(name)s: %(message)s")
-    from weftsim.output import OutputError
+    from weftsim.output import OutputError, WriteFailed
     from weftsim.scene import SceneError
 
     try:
         return COMMANDS[args.command](args)
+    except WriteFailed as exc:  # the results were computed: where each file went is in the message
+        print(f"weftsim {args.command}: error: {_one_line(exc)}", file=sys.stderr)
+        return EXIT_FAILED
     except (SceneError, OutputError) as exc:
-        print(f"weftsim {args.command}: error: {exc}", file=sys.stderr)
+        print(f"weftsim {args.command}: error: {_one_line(exc)}", file=sys.stderr)
         return EXIT_USAGE
     except CliError as exc:
-        print(f"weftsim {args.command}: error: {exc}", file=sys.stderr)
+        print(f"weftsim {args.command}: error: {_one_line(exc)}", file=sys.stderr)
         return exc.status
+    except MemoryError:
+        print(f"weftsim {args.command}: error: out of memory; use a coarser output.sample_deg or fewer "
+              "drive.revolutions", file=sys.stderr)
+        return EXIT_FAILED
+    except BrokenPipeError:
+        # The reader of stdout is gone (`weftsim ... | head`): nothing more can be shown, and the
+        # files were written before the report.  Point stdout at /dev/null so that Python's final
+        # flush does not fail again, and end as a Unix tool does on SIGPIPE, without a message.
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return EXIT_BROKEN_PIPE
     except KeyboardInterrupt:
         print(f"weftsim {args.command}: interrupted", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
 
 
 if __name__ == "__main__":

@@ -151,12 +151,38 @@ def format_report(report: dict) -> str:
     return "\n".join(lines)
 
 
-def run_compare(scene, outdir, as_json: bool, solve, force: bool = False) -> int:
-    """Run both engines, write the overlay figure and both runs' files, print the report; exit status."""
+def verdict(report: dict, outdir) -> tuple[int, str]:
+    """Exit status of a comparison and, when it is not 0, the one line that says why.
+
+    3 when an engine failed (its message, and where its partial results are), 4 when both ran
+    but a check missed its tolerance (how many, the first one, and where the report is).
+    """
     from weftsim.exitcodes import EXIT_DISAGREE, EXIT_FAILED
+
+    failed = [(name, info) for name, info in report["engines"].items() if info["status"] != "success"]
+    if failed:
+        name, info = failed[0]
+        others = f" (and {len(failed) - 1} more)" if len(failed) > 1 else ""
+        return EXIT_FAILED, (f"engine {name} failed{others}: {info['message']} (its results up to the failure "
+                             f"are in {outdir}/{name}, the comparison in {outdir}/compare.json)")
+    missed = [c for c in report["checks"] if not c["passed"]]
+    if missed:
+        first = missed[0]
+        difference = "none" if first["difference"] is None else f"{first['difference']:.3g}"
+        return EXIT_DISAGREE, (f"engines disagree on {len(missed)} of {len(report['checks'])} checks; first: "
+                               f"{first['name']}: difference {difference} above tolerance {first['tolerance']:g} "
+                               f"(all checks in {outdir}/compare.json)")
+    return 0, ""
+
+
+def run_compare(scene, outdir, solve, force: bool = False) -> tuple[dict, int, str]:
+    """Run both engines, write the overlay figure and both runs' files.
+
+    Returns the report (:func:`compare_results`), the exit status and the line saying why it is
+    not 0 (:func:`verdict`); the caller prints them.
+    """
     from weftsim.plausibility import report_lines
-    from weftsim.output import finish_directory, prepare_directory, to_json, write_figure, write_json, write_run
-    from weftsim.plots import plot_channels
+    from weftsim.output import prepare_directory, write_files, write_json, write_run
 
     outdir = prepare_directory(outdir, force)
     results = {engine: solve(scene, engine) for engine in ("reference", "exudyn")}
@@ -164,12 +190,19 @@ def run_compare(scene, outdir, as_json: bool, solve, force: bool = False) -> int
         write_run(result, outdir / engine, figure=False, force=force)
         report_lines(result, f"compare: {engine}")
     report = compare_results(results["exudyn"], results["reference"])
-    written = {"json": write_json(outdir / "compare.json", report)}
-    written["figure"] = write_figure(outdir / "compare.png", plot_channels(
-        [results["reference"], results["exudyn"]], labels=["reference (closed form)", "exudyn"],
-        title=f"{scene.name}: exudyn vs reference"))
-    finish_directory(outdir, written, {"kind": "compare", "scene": scene.name, "agree": report["agree"]})
-    print(to_json(report) if as_json else format_report(report), end="" if as_json else "\n")
-    if not all(r.ok for r in results.values()):
-        return EXIT_FAILED
-    return 0 if report["agree"] else EXIT_DISAGREE
+    write_files(outdir, {"kind": "compare", "scene": scene.name, "agree": report["agree"]}, {
+        "json": ("compare.json", lambda target: write_json(target, report)),
+        "figure": ("compare.png", lambda target: _overlay_figure(target, results, scene.name)),
+    })
+    status, problem = verdict(report, outdir)
+    return report, status, problem
+
+
+def _overlay_figure(target, results: dict, name: str):
+    """The overlay of both engines' channels."""
+    from weftsim.output import write_figure
+    from weftsim.plots import plot_channels
+
+    return write_figure(target, plot_channels([results["reference"], results["exudyn"]],
+                                              labels=["reference (closed form)", "exudyn"],
+                                              title=f"{name}: exudyn vs reference"))

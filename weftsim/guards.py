@@ -17,6 +17,7 @@ kind              fails when                                  limit (scene ``[li
 ``wall_time``     wall-clock time since the start > budget    ``max_wall_time_s`` (0 = none)
 ``energy``        W - dKE - dPE - E_contact - E_diss > limit  ``max_energy_error`` (0.01)
 ``plausibility``  a broken contact history (see below)        ``max_damping_ratio`` (1)
+``interrupted``   the user stopped the run (Ctrl-C, SIGTERM)  :func:`request_stop`
 ================  ==========================================  ==============================
 
 The last two need the whole run's channels: :func:`vet_result` checks them (and again the
@@ -42,7 +43,22 @@ import numpy as np
 
 from weftsim.params import Scene
 
-KINDS = ("non_finite", "penetration", "step_size", "steps", "wall_time", "energy", "plausibility")
+KINDS = ("non_finite", "penetration", "step_size", "steps", "wall_time", "energy", "plausibility", "interrupted")
+
+# A stop asked for from outside the run (the command line's SIGINT handler): the signal is
+# process-wide, so the request is too.  Every RunGuard sees it at its next check, and the engine
+# ends the run as for any other breach, keeping what it computed.
+_STOP_REQUEST: list[str] = []
+
+
+def request_stop(reason: str) -> None:
+    """Make every running :class:`RunGuard` report an ``interrupted`` breach at its next check."""
+    _STOP_REQUEST[:] = [reason]
+
+
+def clear_stop() -> None:
+    """Withdraw :func:`request_stop` (before the next run)."""
+    _STOP_REQUEST.clear()
 
 
 @dataclass(frozen=True)
@@ -137,6 +153,9 @@ class RunGuard:
         Breach or None
         """
         self.steps += steps
+        if _STOP_REQUEST:
+            return Breach("interrupted", _STOP_REQUEST[0],
+                          "what was computed up to here is kept; rerun to compute the whole run")
         if not finite or (penetration is not None and not math.isfinite(penetration)):
             return non_finite_breach()
         if penetration is not None and penetration > self.max_penetration:

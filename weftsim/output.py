@@ -2,7 +2,17 @@
 
 Every file is written to a temporary name in the target directory and then
 renamed over the final name, so a run that dies leaves either the complete
-previous file or the complete new one, never half of one.
+previous file or the complete new one, never half of one.  Files get the mode
+the user's umask gives a new file (as ``open`` would), not the 0600 of a temporary file.
+
+A write that fails (a full disk, a quota) does not lose the computed result: the
+other files are still written, the ones that failed are kept in a rescue directory
+under the system's temporary directory where it can be written, the directory's
+manifest says ``"state": "incomplete"`` and which files are missing, and
+:class:`WriteFailed` says where everything is.  The manifest is written with room
+to spare when the directory is opened, so its last update fits on a full disk.
+The size of a run's output is estimated from the scene before anything is created
+(:func:`check_output_fits`).
 """
 
 from __future__ import annotations
@@ -10,6 +20,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import shutil
 import tempfile
 from pathlib import Path
 from typing import Callable
@@ -23,7 +34,21 @@ class OutputError(OSError):
     """The output directory or a file in it cannot be written."""
 
 
+class WriteFailed(OutputError):
+    """The results were computed but some files could not be written; the message says where
+    each one is (written, rescued, or lost with the reason)."""
+
+
 MANIFEST = ".weftsim-output.json"
+# Bytes the manifest reserves on disk when a directory is opened (JSON allows trailing blanks):
+# its final state (a few hundred bytes for the files of a run) is then written over blocks the
+# file already holds, which needs no free space.
+MANIFEST_RESERVE = 4096
+# Characters per value in channels.csv: "%.10g" gives at most 17 ("-1.234567891e-100") and a comma.
+CSV_BYTES_PER_VALUE = 18
+# Bytes of memory per output value while a run is held: 8 for the sample, and at least as many for
+# the solver steps (Exudyn takes one or more steps per output sample) and the array building the CSV.
+MEMORY_BYTES_PER_VALUE = 24
 
 
 def prepare_directory(path: str | Path, force: bool = False) -> Path:
@@ -49,11 +74,23 @@ def prepare_directory(path: str | Path, force: bool = False) -> Path:
     return path
 
 
+def _umask() -> int:
+    mask = os.umask(0o022)  # the only way to read it is to set it; put it back at once
+    os.umask(mask)
+    return mask
+
+
 def write_atomic(target: Path, write: Callable[[Path], None]) -> Path:
-    """Call ``write(tmp_path)`` and rename the temporary file onto ``target``."""
+    """Call ``write(tmp_path)`` and rename the temporary file onto ``target``.
+
+    The file gets mode 0666 less the umask, as a file opened for writing would.
+    """
     target = Path(target)
     fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=target.parent)
-    os.close(fd)
+    try:
+        os.fchmod(fd, 0o666 & ~_umask())
+    finally:
+        os.close(fd)
     try:
         write(Path(tmp))
         os.replace(tmp, target)
@@ -108,12 +145,13 @@ def write_csv(target: Path, columns: dict[str, np.ndarray]) -> Path:
 
 
 def write_figure(target: Path, figure) -> Path:
-    import matplotlib.pyplot as plt
+    import sys
 
     try:
         return write_atomic(target, lambda p: figure.savefig(p, format=target.suffix.lstrip("."), dpi=130))
     finally:
-        plt.close(figure)
+        if "matplotlib.pyplot" in sys.modules:  # a pyplot figure: free it (weftsim.plots.figure() are not held)
+            sys.modules["matplotlib.pyplot"].close(figure)
 
 
 def _manifest_files(outdir: Path) -> set[str]:
@@ -123,13 +161,36 @@ def _manifest_files(outdir: Path) -> set[str]:
         return set()
 
 
+def _overwrite_in_place(target: Path, text: str) -> None:
+    """Write ``text`` over the blocks ``target`` already holds (padded with blanks to its size)."""
+    data = text.encode("utf-8")
+    with target.open("r+b") as file:
+        size = file.seek(0, os.SEEK_END)
+        if len(data) > size:
+            raise OSError(f"{target.name} has no room reserved for {len(data)} bytes")
+        file.seek(0)
+        file.write(data + b" " * (size - len(data)))
+
+
+def _set_manifest(outdir: Path, data: dict, reserve: bool = False) -> None:
+    """Write the manifest atomically; on a full disk over its reserved room instead."""
+    text = to_json(data)
+    try:
+        write_text(outdir / MANIFEST, text.ljust(MANIFEST_RESERVE) if reserve else text)
+    except OSError:
+        if reserve or not (outdir / MANIFEST).exists():
+            raise
+        _overwrite_in_place(outdir / MANIFEST, text)
+
+
 def begin_directory(outdir: Path, what: dict) -> None:
     """Mark the directory as being written: a run killed between two files leaves this mark.
 
     Each file is atomic on its own; this manifest (``"state": "writing"``) tells a reader that
-    the directory may hold a mix of the previous run's and this run's complete files.
+    the directory may hold a mix of the previous run's and this run's complete files.  It is
+    padded to :data:`MANIFEST_RESERVE` bytes, so its final state fits even on a full disk.
     """
-    write_json(outdir / MANIFEST, {**what, "state": "writing", "files": sorted(_manifest_files(outdir))})
+    _set_manifest(outdir, {**what, "state": "writing", "files": sorted(_manifest_files(outdir))}, reserve=True)
     for leftover in outdir.glob(".*.part"):  # temporary files of a run that was killed while writing
         leftover.unlink(missing_ok=True)
 
@@ -141,25 +202,163 @@ def finish_directory(outdir: Path, written: dict[str, Path], what: dict) -> None
     """
     old = _manifest_files(outdir)
     names = sorted(p.name for p in written.values())
-    write_json(outdir / MANIFEST, {**what, "state": "complete", "files": names})
+    _set_manifest(outdir, {**what, "state": "complete", "files": names})
     for stale in old - set(names):
         if "/" not in stale and stale != MANIFEST:
             (outdir / stale).unlink(missing_ok=True)
 
 
+def _rescue(failed: dict[str, tuple[str, Callable[[Path], Path]]]) -> tuple[Path | None, dict[str, str]]:
+    """Write the files that failed into a new directory under the system's temporary directory."""
+    try:
+        rescue = Path(tempfile.mkdtemp(prefix="weftsim-rescue-"))
+    except OSError as exc:
+        return None, {name: exc.strerror or str(exc) for name, _ in failed.values()}
+    errors = {}
+    for name, write in failed.values():
+        try:
+            write(rescue / name)
+        except OSError as exc:
+            errors[name] = exc.strerror or str(exc)
+    if len(errors) == len(failed):
+        shutil.rmtree(rescue, ignore_errors=True)
+        return None, errors
+    return rescue, errors
+
+
+def write_files(outdir: Path, what: dict, files: dict[str, tuple[str, Callable[[Path], Path]]]) -> dict[str, Path]:
+    """Write a set of files into ``outdir`` under its manifest; keep what fails elsewhere.
+
+    Parameters
+    ----------
+    outdir : Path
+        A directory checked by :func:`prepare_directory`.
+    what : dict
+        What the files are (kind, scene, ...), copied into the manifest.
+    files : dict
+        kind -> (file name, ``write(target) -> Path``), written in this order; after a failure
+        the later ones are still attempted (a small summary may fit where a large CSV did not).
+
+    Returns
+    -------
+    dict
+        kind -> written path.
+
+    Raises
+    ------
+    WriteFailed
+        A file could not be written.  Every other file was still attempted, the failed ones
+        went to a rescue directory where possible, and the manifest says ``"incomplete"``.
+    """
+    begin_directory(outdir, what)
+    written, failed, reasons = {}, {}, {}
+    for kind, (name, write) in files.items():
+        try:
+            written[kind] = write(outdir / name)
+        except OSError as exc:
+            failed[kind] = (name, write)
+            reasons[name] = exc.strerror or str(exc)
+    if not failed:
+        finish_directory(outdir, written, what)
+        return written
+    rescue, lost = _rescue(failed)
+    missing = sorted(reasons)
+    state = {**what, "state": "incomplete", "files": sorted(p.name for p in written.values()),
+             "missing": {name: reasons[name] for name in missing},
+             "rescued_to": str(rescue) if rescue else None}  # fmt: skip
+    try:
+        _set_manifest(outdir, state)
+        marked = " (manifest state 'incomplete')"
+    except OSError:
+        marked = " (the manifest could not be updated: it still says 'writing')"
+    kept = [name for name in missing if name not in lost]
+    text = f"cannot write {', '.join(missing)} to {outdir}: {reasons[missing[0]]}"
+    if written:
+        text += f"; {', '.join(sorted(p.name for p in written.values()))} written there"
+    text += marked
+    if kept:
+        text += f"; {', '.join(kept)} kept in {rescue}"
+    if lost:
+        text += f"; {', '.join(sorted(lost))} could not be kept anywhere ({lost[sorted(lost)[0]]}): free space and rerun"
+    raise WriteFailed(text)
+
+
+def _available_memory() -> int | None:
+    """Bytes of memory a new allocation can get without swapping (Linux MemAvailable), or None."""
+    try:
+        for line in Path("/proc/meminfo").read_text().splitlines():
+            if line.startswith("MemAvailable:"):
+                return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+def _free_disk(path: Path) -> int | None:
+    """Free bytes on the file system that would hold ``path`` (its nearest existing ancestor), or
+    None where that says nothing (a pseudo file system such as /proc reports a size of 0)."""
+    path = Path(os.path.abspath(path))
+    for candidate in (path, *path.parents):
+        if candidate.exists():
+            try:
+                usage = shutil.disk_usage(candidate)
+            except OSError:
+                return None
+            return usage.free if usage.total > 0 else None
+    return None
+
+
+def _size(n: float) -> str:
+    for unit in ("bytes", "kB", "MB", "GB", "TB"):
+        if n < 1000 or unit == "TB":
+            return f"{n:.3g} {unit}"
+        n /= 1000
+    raise AssertionError("unreachable")
+
+
+def check_output_fits(rows: float, columns: int, outdir: Path, what: str, runs: int = 1,
+                      fix: str = "a coarser output.sample_deg (any value up to 0.5 deg) or fewer drive.revolutions") -> None:
+    """Refuse, before anything is created, an output grid that cannot be held or written.
+
+    ``runs`` results of ``rows`` x ``columns`` values are held in memory
+    (:data:`MEMORY_BYTES_PER_VALUE` each) and written as CSV (:data:`CSV_BYTES_PER_VALUE`).
+    Raises :class:`OutputError` when the memory available or the free disk space under
+    ``outdir`` is smaller: ``what`` names the scene keys that set the size, ``fix`` what to change.
+    """
+    values = float(rows) * columns * runs
+    memory, disk = values * MEMORY_BYTES_PER_VALUE, values * CSV_BYTES_PER_VALUE
+    available, free = _available_memory(), _free_disk(outdir)
+    short = []
+    if available is not None and memory > available:
+        short.append(f"~{_size(memory)} of memory (available: {_size(available)})")
+    if free is not None and disk > free:
+        short.append(f"~{_size(disk)} of CSV (free under {outdir}: {_size(free)})")
+    if short:
+        raise OutputError(f"{what} gives {rows:.3g} output samples, {' and '.join(short)}: use {fix}")
+
+
+def output_rows(scene) -> float:
+    """Samples of a run's output grid: one per ``output.sample_deg`` of crank over the run, and the end."""
+    return math.floor(scene.drive.end_time * scene.drive.speed / scene.output.sample_angle) + 2
+
+
 def write_run(result: RunResult, outdir: str | Path, figure: bool = True, force: bool = False) -> dict[str, Path]:
-    """Write ``channels.csv``, ``summary.json`` and ``channels.png`` for one run, atomically each."""
+    """Write ``channels.csv``, ``summary.json`` and ``channels.png`` for one run, atomically each.
+
+    Raises :class:`WriteFailed` (after writing what it can) when a file cannot be written.
+    """
     from weftsim.analysis import summary
     from weftsim.plots import plot_channels
 
     outdir = prepare_directory(outdir, force)
     what = {"kind": "run", "engine": result.engine, "scene": result.scene.name, "status": result.status}
-    begin_directory(outdir, what)
-    written = {
-        "channels": write_csv(outdir / "channels.csv", {n: result.samples[n] for n in CHANNELS}),
-        "summary": write_json(outdir / "summary.json", summary(result)),
+    files = {
+        "channels": ("channels.csv", lambda target: write_csv(target, {n: result.samples[n] for n in CHANNELS})),
+        "summary": ("summary.json", lambda target: write_json(target, summary(result))),
     }
     if figure and result.steps["time_s"].size:
-        written["figure"] = write_figure(outdir / "channels.png", plot_channels([result]))
-    finish_directory(outdir, written, what)
-    return written
+        files["figure"] = ("channels.png", lambda target: write_figure(target, plot_channels([result])))
+    return write_files(outdir, what, files)

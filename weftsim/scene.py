@@ -13,6 +13,7 @@ scene reference is written from it.
 from __future__ import annotations
 
 import math
+import stat
 import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -114,7 +115,7 @@ SCHEMA: tuple[Key, ...] = (
     Key("drive.revolutions", "drive.revolutions", "float", 1, 0, 1000, doc="crank revolutions to simulate"),
     Key("solver.reference.method", "reference_solver.method", "str", choices=INTEGRATORS,
         doc="method of the reference engine: scipy's, or numba_* (compiled, docs/performance.md); "
-            "auto = DOP853, or LSODA when friction is on"),
+            "auto = numba_DOP853 (the fastest path meeting the accuracy targets)"),
     Key("solver.reference.rtol", "reference_solver.rtol", "float", 1, 0, 1e-2, doc="relative tolerance"),
     Key("solver.reference.atol", "reference_solver.atol", "float", 1, 0, 1e-2, doc="absolute tolerance"),
     Key("solver.reference.max_step_deg", "reference_solver.max_step", "float", DEG, 0, 90,
@@ -172,24 +173,74 @@ REQUIRED = tuple(key.path for key in SCHEMA
                  if key.path.partition(".")[0] in REQUIRED_SECTIONS and key.path not in OPTIONAL)
 
 
-def _flatten(table: dict, prefix: str = "") -> dict[str, Any]:
+# A scene file is a few kilobytes (models/reference.toml: 2.5 kB).  Anything beyond this bound
+# is not a scene (a log, an image, /dev/zero): it is refused before it is read into memory.
+MAX_SCENE_BYTES = 1 << 20
+# Longest `extends` chain: the deepest in models/ is 2 files; 64 leaves room for any layering
+# a user builds and stops a runaway chain with one line instead of a RecursionError.
+MAX_EXTENDS_DEPTH = 64
+
+
+def shown(text: str) -> str:
+    """``text`` with every non-printable character escaped (``\\n``, ``\\x1b``, ...).
+
+    Keys and names come from the user's file: a newline or a terminal escape sequence in one
+    must not split a one-line message or reach the terminal raw.
+    """
+    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii") for c in text)
+
+
+def _spelling(table: tuple[str, ...], name: str) -> str:
+    """Where a key is written in the file: ``clearance_mm in [joint_e]`` or ``"a.b" at the top level``."""
+    key = f'"{name}"' if "." in name else name
+    return shown(f"{key} in [{'.'.join(table)}]" if table else f"{key} at the top level")
+
+
+def _flatten(table: dict, where: str, prefix: tuple[str, ...] = (),
+             seen: dict[str, str] | None = None) -> dict[str, Any]:
+    """Dotted keys of a TOML table; one key given twice (a quoted dotted key at one level and
+    the same key in its table) is a :class:`SceneError` naming both places."""
+    seen = {} if seen is None else seen
     flat = {}
     for name, value in table.items():
-        path = f"{prefix}{name}"
+        path = ".".join(prefix + (name,))
         if isinstance(value, dict):
-            flat.update(_flatten(value, path + "."))
-        else:
-            flat[path] = value
+            flat.update(_flatten(value, where, prefix + (name,), seen))
+            continue
+        if path in seen:
+            raise SceneError(f"{where}: key '{shown(path)}' is given twice, as {seen[path]} and as "
+                             f"{_spelling(prefix, name)}; give it once")
+        seen[path] = _spelling(prefix, name)
+        flat[path] = value
     return flat
 
 
 def _read_toml(path: Path) -> dict:
+    """The TOML table of one scene file: a regular file of at most :data:`MAX_SCENE_BYTES`.
+
+    Checked with ``stat`` before opening, so a FIFO (which would block) or a device such as
+    ``/dev/zero`` (which never ends) is refused without being read.
+    """
     try:
-        text = path.read_text(encoding="utf-8")
+        info = path.stat()
     except FileNotFoundError:
         raise SceneError(f"{path}: scene file not found") from None
-    except IsADirectoryError:
-        raise SceneError(f"{path}: is a directory, expected a scene file (.toml)") from None
+    except OSError as exc:
+        raise SceneError(f"{path}: cannot be read ({exc.strerror})") from None
+    if stat.S_ISDIR(info.st_mode):
+        raise SceneError(f"{path}: is a directory, expected a scene file (.toml)")
+    if not stat.S_ISREG(info.st_mode):
+        raise SceneError(f"{path}: is not a regular file (a pipe, device or socket); a scene must be a "
+                         "regular .toml file")
+    if info.st_size > MAX_SCENE_BYTES:
+        raise SceneError(f"{path}: is {info.st_size} bytes, more than a scene file's {MAX_SCENE_BYTES} "
+                         "bytes; a scene file holds only keys and values (.toml)")
+    try:
+        with path.open("rb") as file:
+            data = file.read(MAX_SCENE_BYTES + 1)  # bounded even if the file grows after the stat
+        if len(data) > MAX_SCENE_BYTES:
+            raise SceneError(f"{path}: grew beyond a scene file's {MAX_SCENE_BYTES} bytes while being read")
+        text = data.decode("utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise SceneError(f"{path}: cannot be read ({exc})") from None
     try:
@@ -198,24 +249,35 @@ def _read_toml(path: Path) -> dict:
         raise SceneError(f"{path}: not valid TOML ({exc})") from None
 
 
-def _read_merged(path: Path, chain: tuple[Path, ...] = ()) -> tuple[dict[str, Any], dict[str, Path]]:
-    """Flattened keys of a scene and its ``extends`` chain, and the file each key came from."""
+def _read_merged(path: Path) -> tuple[dict[str, Any], dict[str, Path]]:
+    """Flattened keys of a scene and its ``extends`` chain, and the file each key came from.
+
+    The chain is followed in a loop (not by recursion), at most :data:`MAX_EXTENDS_DEPTH` files.
+    """
+    chain: list[tuple[Path, dict[str, Any]]] = []
     path = path.resolve()
-    if path in chain:
-        raise SceneError(f"{path}: 'extends' loops back to itself via {[str(p) for p in chain]}")
-    table = _read_toml(path)
-    flat = _flatten(table)
-    base, origin = {}, {}
-    if "extends" in flat:
+    while True:
+        if path in [p for p, _ in chain]:
+            raise SceneError(f"{path}: 'extends' loops back to itself via {[str(p) for p, _ in chain]}")
+        if len(chain) == MAX_EXTENDS_DEPTH:
+            raise SceneError(f"{chain[0][0]}: the 'extends' chain is longer than {MAX_EXTENDS_DEPTH} files "
+                             f"(reached {path}); a scene may extend at most {MAX_EXTENDS_DEPTH} files deep")
+        flat = _flatten(_read_toml(path), str(path))
+        chain.append((path, flat))
+        if "extends" not in flat:
+            break
         parent = flat.pop("extends")
         if not isinstance(parent, str):
             raise SceneError(f"{path}: key 'extends' must be a path string, got {parent!r}")
-        base, origin = _read_merged(path.parent / parent, chain + (path,))
-    base.pop("name", None)
-    base.pop("description", None)
-    base.update(flat)
-    origin.update({key: path for key in flat})
-    return base, origin
+        path = (path.parent / parent).resolve()
+    merged, origin = {}, {}
+    for index, (path, flat) in enumerate(reversed(chain)):
+        if index:  # a base file's name and description do not describe the scene extending it
+            merged.pop("name", None)
+            merged.pop("description", None)
+        merged.update(flat)
+        origin.update({key: path for key in flat})
+    return merged, origin
 
 
 def _convert(key: Key, value: Any, where: str) -> Any:
@@ -308,7 +370,7 @@ def _known(path: str, where: str) -> Key:
         near = [k.path for k in SCHEMA if k.path.rpartition(".")[0] == section] or sorted(
             {k.path.partition(".")[0] for k in SCHEMA}
         )
-        raise SceneError(f"{where}: unknown key '{path}'; allowed here: {', '.join(near)}")
+        raise SceneError(f"{where}: unknown key '{shown(path)}'; allowed here: {', '.join(near)}")
     return key
 
 
@@ -318,6 +380,9 @@ def scene_from_keys(flat: dict[str, Any], where: str = "scene", origin: dict[str
     name = flat.get("name", "scene")
     if not isinstance(name, str):
         raise SceneError(f"{where}: key 'name' must be a string, got {name!r}")
+    if not name or not name.isprintable():  # it heads every report line and figure title
+        raise SceneError(f"{where}: key 'name' must be a non-empty line of printable characters "
+                         f"(no newline or escape sequence), got {name!r}")
     scene = params.Scene(name=name, source=where)
     for path, value in flat.items():
         if path in TOP_LEVEL:

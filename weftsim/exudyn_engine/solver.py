@@ -33,7 +33,7 @@ MODELS = ("rigid_body", "kinematic_tree")  # kinematic_tree: tree.py, tree_solve
 # Exudyn's 8: 3.75 instead of 5.9 iterations per step, ~30 % less time, identical results
 # at the same tolerance (2: 2.97 iterations but 4x the Jacobians, slower).
 MODIFIED_NEWTON_ITERATIONS = 3
-_PROGRESS_CALLS = 100
+_PROGRESS_CALLS = 1000  # every 0.1 % of the run: a long run shows its first line soon (issue 16)
 # Step of the ideal joint, as crank angle.  The error of the ideal curves against the closed form
 # (largest difference at a sample / peak, reference mechanism, 2 revolutions) depends on the crank
 # angle of the step alone, at 50, 300, 400 and 800 rpm alike: 2.3-4.2e-6 at 0.025 deg (round-off,

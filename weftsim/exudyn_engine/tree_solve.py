@@ -41,7 +41,7 @@ from weftsim.results import RunResult, angle_grid, empty_channels
 
 OVT = exu.OutputVariableType
 EXPLICIT_METHODS = {"DOPRI5": exu.DynamicSolverType.DOPRI5, "ODE23": exu.DynamicSolverType.ODE23}
-_PROGRESS_EVERY = 0.01
+_PROGRESS_EVERY = 0.001  # every 0.1 % of the run: a long run shows its first line soon (issue 16)
 
 
 def check_tree_settings(scene: Scene) -> str | None:

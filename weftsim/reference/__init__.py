@@ -41,11 +41,11 @@ def _check(scene: Scene) -> str | None:
     allowed = [AUTO] + sorted(METHODS) + list(COMPILED_METHODS)
     if settings.method not in allowed:
         return f"`reference_solver.method` must be one of {allowed}, got {settings.method!r}"
-    if settings.method in COMPILED_METHODS:
+    if compiled_method(scene) is not None:
         try:
-            import numba  # noqa: F401 - optional dependency of the compiled methods only
+            import numba  # noqa: F401 - a dependency; checked for installs that lost it
         except ImportError:
-            return f"`reference_solver.method` = {settings.method!r} needs numba installed; use 'auto' or 'DOP853'"
+            return f"`reference_solver.method` = {settings.method!r} needs numba installed; use 'DOP853' (scipy)"
     for name in ("rtol", "atol", "max_step"):
         value = getattr(settings, name)
         if not (value > 0.0 and math.isfinite(value)):
@@ -78,22 +78,27 @@ def _solve_ideal(scene: Scene, progress) -> RunResult:
 
 
 def compiled_method(scene: Scene) -> str | None:
-    """The compiled method (:data:`COMPILED_METHODS`) a clearance scene names, or None for scipy.
+    """The compiled method (:data:`COMPILED_METHODS`) a clearance scene runs on, or None for scipy.
 
-    ``"auto"`` stays on scipy (DOP853 / LSODA); ``numba_DOP853`` is the same DOP853 step for
-    step, 10-20x faster (docs/performance.md).
+    ``"auto"`` is ``numba_DOP853``: scipy's DOP853 step for step, compiled, 10-100x faster
+    (docs/performance.md); a scipy method runs only when named.
     """
     method = scene.reference_solver.method
+    if method == AUTO:
+        return "numba_DOP853"
     return method if method in COMPILED_METHODS else None
 
 
 def select_path(scene: Scene) -> dict:
     """``{"model", "method", "reason"}`` of the run :func:`solve` makes of ``scene``."""
     if scene.joint.is_ideal:
-        return {"model": "ideal joint", "method": "closed form", "reason": "clearance 0: no free coordinate"}
+        return {"model": "ideal joint", "method": "closed form",
+                "reason": "clearance 0: no free coordinate, nothing to integrate"}
     s = scene.reference_solver
     method = compiled_method(scene) or s.method
-    return {"model": "clearance chain", "method": f"{method} rtol {s.rtol:g}", "reason": "scene key solver.reference.method"}
+    why = ("solver.reference.method = 'auto': the fastest path meeting the accuracy targets" if s.method == AUTO
+           else f"set by solver.reference.method = {s.method!r}")
+    return {"model": "clearance chain (2 DOF)", "method": f"{method} rtol {s.rtol:g} atol {s.atol:g}", "reason": why}
 
 
 def _solve_clearance(scene: Scene, progress, step_states) -> RunResult:
@@ -132,8 +137,8 @@ def solve(scene: Scene, progress=None, step_states=None) -> RunResult:
     scene : Scene
         ``scene.joint.clearance == 0`` selects the ideal joint (closed form); otherwise the
         clearance mode is integrated with ``scene.reference_solver`` (method by name from
-        :data:`METHODS` or :data:`COMPILED_METHODS`, or ``"auto"``: DOP853 without friction,
-        LSODA with friction; rtol, atol, max_step as crank angle).
+        :data:`METHODS` or :data:`COMPILED_METHODS`, or ``"auto"``: the compiled DOP853;
+        rtol, atol, max_step as crank angle).  :func:`select_path` says which.
     progress : callable, optional
         Called with the completed fraction in [0, 1].
     step_states : callable, optional

@@ -13,7 +13,7 @@ paths agree to the integration tolerance (``tests/test_fast_paths.py``).
 
 Every function is module-level ``@njit(cache=True, error_model="numpy")`` and takes the scene as a parameter
 array: numba compiles once per machine (~9 s) and loads from its cache afterwards (~0.3 s).
-The loop (:func:`advance`) returns to Python every 1 % of the run (progress) or when its step
+The loop (:func:`advance`) returns to Python every 0.1 % of the run (progress) or when its step
 buffer is full; :mod:`.compiled_run` drives it and builds the result.
 
 Methods (``reference_solver.method``): ``"numba_DOP853"``, ``"numba_RK45"``.

@@ -74,7 +74,9 @@ _START_EVALS = 2
 # trial stage (angles in rad, rates in rad/s, energies in J: a real state is < ~1e4).
 _OVERFLOW_GUARD = 1e8
 _ROOT_XTOL = events.ROOT_XTOL
-_PROGRESS_EVERY = 0.01  # report progress every 1 % of the run
+_PROGRESS_EVERY = 0.001  # report progress every 0.1 % of the run: the first line of a 1000-revolution run
+# comes after one revolution, not ten, and the compiled loop (which pauses to report) sees a Ctrl-C within
+# 0.1 % of the run (issue 16)
 # Dense-output points recorded inside every step of a contact segment (besides the step ends):
 # an impact pulse spans a few tens of steps, and its peak read at the step ends alone is low by
 # up to ~1e-4 relative (DOP853, rtol 1e-9); 3 interior points cut that ~16-fold.

@@ -1,0 +1,171 @@
+"""The speed targets of the default paths (``weftsim bench --targets``), measured as ratios in one run.
+
+On the easy case (``models/reference.toml``: 400 rpm, c = 0.25 mm, 10 revolutions) it measures
+
+- ``reference.solve`` and ``exudyn_engine.solve`` with no solver key set (the automatic path);
+- the Exudyn rigid-body model, forced (``solver.exudyn.model = "rigid_body"``, its other keys default);
+- the slow defaults of version 0.1 in the same process, as the baselines of the ratios
+  (scipy DOP853 at rtol 1e-9, the rigid-body model at a fixed step of 2e-6 s);
+- ``weftsim run`` as a new process, start to exit, for 2 revolutions on each engine (after one
+  warm-up process, so the numba cache exists: "after the first run on the machine");
+- the 121-cell clearance x speed map of ``scripts/paper_sweeps.py`` at 10 revolutions per cell
+  on ``jobs`` processes (``map_repeats`` times; it is the longest item).
+
+Each timed item is the median of ``repeats`` runs.  The accuracy of the in-process runs comes
+from :func:`weftsim.bench.measure.measure`: first-revolution peaks against the converged
+solution (target 1 %) and the 10-revolution statistics against the scatter of the converged
+ensemble.  Nothing here asserts a time; the report says which targets are met.
+"""
+
+from __future__ import annotations
+
+import statistics as _stats
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from weftsim.bench.measure import Setting, converged_solution, measure
+
+CASE = "c0.25mm-400rpm"
+# Issue 12's targets: loom time / wall time of the in-process solves, wall seconds of the rest.
+TARGETS = {
+    "reference default": {"ratio_at_least": 30.0},
+    "exudyn default": {"ratio_at_least": 2.0},
+    "exudyn rigid_body (forced)": {"ratio_at_least": 0.2},
+    "weftsim run reference, new process, 2 rev": {"wall_at_most_s": 2.0},
+    "weftsim run exudyn, new process, 2 rev": {"wall_at_most_s": 2.0},
+    "121-cell map, 10 rev per cell": {"wall_at_most_s": 60.0},
+}
+PEAK_TARGET = 0.01  # first-revolution peaks within 1 % of the converged solution
+SOLVES = {
+    "reference default": Setting("reference", "reference", "default", {}),
+    "exudyn default": Setting("exudyn", "exudyn", "default", {}),
+    "exudyn rigid_body (forced)": Setting("exudyn", "exudyn", "rigid_body", {"solver.exudyn.model": "rigid_body"}),
+    "baseline: reference scipy DOP853 rtol 1e-9 (0.1 default)": Setting(
+        "reference", "reference", "scipy", {"solver.reference.method": "DOP853", "solver.reference.rtol": 1e-9,
+                                            "solver.reference.atol": 1e-12}),
+    "baseline: exudyn rigid_body h 2e-6 s (0.1 default)": Setting(
+        "exudyn", "exudyn", "rigid h2e-6", {"solver.exudyn.model": "rigid_body", "solver.exudyn.step_size_s": 2e-6}),
+}
+MAP_VARY = ["clearance_mm=0.01,0.05,0.1,0.15,0.2,0.25,0.3,0.35,0.4,0.45,0.5", "speed_rpm=300:800:11"]
+
+
+def _process_wall(command: list[str], repeats: int) -> dict:
+    """Median wall time of ``command`` run ``repeats`` times after one warm-up run; exit codes kept."""
+    walls, codes = [], []
+    for i in range(repeats + 1):
+        t0 = time.perf_counter()
+        done = subprocess.run(command, capture_output=True, text=True)
+        wall = time.perf_counter() - t0
+        codes.append(done.returncode)
+        if i > 0:
+            walls.append(wall)
+        if done.returncode != 0:
+            return {"status": "failed", "exit": done.returncode, "stderr": done.stderr[-400:], "wall_s": walls}
+    return {"status": "success", "wall_s": walls, "wall_median_s": _stats.median(walls), "warmup_s": None}
+
+
+def cli_run(engine: str, models, repeats: int, workdir: Path) -> dict:
+    """``weftsim run`` as a new process, 2 revolutions, start to exit."""
+    command = [sys.executable, "-m", "weftsim.cli", "run", str(Path(models) / "reference.toml"), "--engine", engine,
+               "--revolutions", "2", "-o", str(workdir / f"run-{engine}"), "--force"]
+    return {"command": " ".join(command[1:]), **_process_wall(command, repeats)}
+
+
+def clearance_speed_map(models, jobs: int, repeats: int, workdir: Path) -> dict:
+    """The 121-cell map at 10 revolutions per cell, from scratch each time (a fresh output directory)."""
+    walls = []
+    for i in range(repeats):
+        out = workdir / f"map-{i}"
+        command = [sys.executable, "-m", "weftsim.cli", "sweep", str(Path(models) / "reference.toml"),
+                   "--vary", MAP_VARY[0], "--vary", MAP_VARY[1], "--set", "revolutions=10", "--engine", "reference",
+                   "--jobs", str(jobs), "-o", str(out)]  # fmt: skip
+        t0 = time.perf_counter()
+        done = subprocess.run(command, capture_output=True, text=True)
+        walls.append(time.perf_counter() - t0)
+        if done.returncode != 0:
+            return {"status": "failed", "exit": done.returncode, "stderr": done.stderr[-400:], "wall_s": walls,
+                    "command": " ".join(command[1:])}
+    return {"status": "success", "command": " ".join(command[1:]), "jobs": jobs, "wall_s": walls,
+            "wall_median_s": _stats.median(walls)}
+
+
+def _met(name: str, item: dict) -> bool | None:
+    target = TARGETS.get(name)
+    if target is None or item.get("status") != "success":
+        return None if target is None else False
+    if "ratio_at_least" in target:
+        peak = (item.get("errors") or {}).get("peak_max")
+        return item["realtime_ratio"] >= target["ratio_at_least"] and peak is not None and peak <= PEAK_TARGET
+    return item["wall_median_s"] <= target["wall_at_most_s"]
+
+
+def run_targets(models="models", repeats: int = 5, jobs: int = 2, map_repeats: int = 1, log=print) -> dict:
+    """Measure every target and its baseline in one process; returns the report (see module doc)."""
+    started = time.perf_counter()
+    log(f"converged solution of {CASE}")
+    ref = converged_solution(CASE, models, 10.0, log)
+    report = {"case": CASE, "repeats": repeats, "floor": ref["floor"], "items": {}}
+    for name, setting in SOLVES.items():
+        row = measure(CASE, setting, ref, models, 10.0, repeats, 8.0, 1.0)
+        report["items"][name] = row
+        log(f"  {name}: x{row['realtime_ratio']:.2f} real time, peak err "
+            f"{(row['errors'] or {}).get('peak_max')}, stats err {(row['errors'] or {}).get('stats_max')}")
+    with tempfile.TemporaryDirectory(prefix="weftsim-targets-") as tmp:
+        for engine in ("reference", "exudyn"):
+            name = f"weftsim run {engine}, new process, 2 rev"
+            report["items"][name] = cli_run(engine, models, repeats, Path(tmp))
+            log(f"  {name}: {report['items'][name].get('wall_median_s')} s")
+        name = "121-cell map, 10 rev per cell"
+        report["items"][name] = clearance_speed_map(models, jobs, map_repeats, Path(tmp))
+        log(f"  {name}: {report['items'][name].get('wall_median_s')} s")
+    for name, item in report["items"].items():
+        item["target"] = TARGETS.get(name)
+        item["met"] = _met(name, item)
+    report["total_time_s"] = time.perf_counter() - started
+    return report
+
+
+def markdown(report: dict) -> str:
+    """The targets table: what was measured, the target, met or not, and the ratio to the 0.1 baseline."""
+    items = report["items"]
+    base = {"reference": items.get("baseline: reference scipy DOP853 rtol 1e-9 (0.1 default)"),
+            "exudyn": items.get("baseline: exudyn rigid_body h 2e-6 s (0.1 default)")}
+    lines = [f"Case {report['case']}, medians of {report['repeats']} runs; converged-ensemble floor: peaks "
+             f"{report['floor']['peak']:.1e}, statistics {report['floor']['stats']:.1e}.", "",
+             "| item | measured | target | met | vs 0.1 default | peak error | statistics error |",
+             "|---|---|---|---|---|---|---|"]  # fmt: skip
+    for name, item in items.items():
+        target = item.get("target") or {}
+        if "realtime_ratio" in item:
+            measured = f"x{item['realtime_ratio']:.2f} real time"
+            engine = item["engine"]
+            speedup = (f"{item['realtime_ratio'] / base[engine]['realtime_ratio']:.1f}x faster"
+                       if base.get(engine) and not name.startswith("baseline") else "")
+            err = item.get("errors") or {}
+            peak, stats = err.get("peak_max"), err.get("stats_max")
+        else:
+            measured = f"{item['wall_median_s']:.2f} s" if item.get("status") == "success" else item.get("status")
+            speedup, peak, stats = "", None, None
+        goal = (f">= x{target['ratio_at_least']:g}" if "ratio_at_least" in target
+                else f"<= {target['wall_at_most_s']:g} s" if target else "baseline")
+        met = {True: "yes", False: "**no**", None: ""}[item.get("met")]
+        fmt = (lambda v: "-" if v is None else f"{v:.1e}")
+        lines.append(f"| {name} | {measured} | {goal} | {met} | {speedup} | {fmt(peak)} | {fmt(stats)} |")
+    return "\n".join(lines) + "\n"
+
+
+def write_targets(report: dict, outdir, force: bool = False) -> list[Path]:
+    """targets.json and targets.md into ``outdir``; returns the files."""
+    from weftsim.bench.report import machine_info
+    from weftsim.output import begin_directory, finish_directory, prepare_directory, write_json, write_text
+
+    outdir = prepare_directory(outdir, force)
+    begin_directory(outdir, {"kind": "bench", "mode": "targets"})
+    report.setdefault("machine", machine_info())
+    written = {"md": write_text(outdir / "targets.md", markdown(report)),
+               "json": write_json(outdir / "targets.json", report)}
+    finish_directory(outdir, written, {"kind": "bench", "mode": "targets"})
+    return sorted(written.values())
