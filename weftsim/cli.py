@@ -416,8 +416,6 @@ def _raise_terminated(signum, frame):
 
 
 def cmd_sweep(args) -> int:
-    import signal
-
     from weftsim.sweep import SweepError, format_report, plan_sweep, run_sweep
 
     handled = (signal.SIGTERM, signal.SIGHUP)
