@@ -68,7 +68,7 @@ def make_scene(case: Case, degrees: float = 360.0, rtol: float = 1e-9, step: flo
     return dataclasses.replace(
         STEEL, joint=joint, drive=Drive(speed=case.rpm * RPM, revolutions=degrees / 360.0),
         reference_solver=ReferenceSolver(rtol=rtol, atol=rtol * 1e-3),
-        exudyn_solver=ExudynSolver(step_size=step or case.exudyn_step),
+        exudyn_solver=ExudynSolver(model="rigid_body", step_control="fixed", step_size=step or case.exudyn_step),
     )  # fmt: skip
 
 

@@ -106,7 +106,8 @@ def test_fifty_revolutions_without_drift(long_reference):
 
 @pytest.mark.slow
 def test_exudyn_steady_running_matches_the_long_reference_run(long_reference):
-    r = exudyn_engine.solve(revolutions(STEEL, EXUDYN_REVOLUTIONS))
+    rigid = dataclasses.replace(STEEL, exudyn_solver=ExudynSolver(model="rigid_body"))
+    r = exudyn_engine.solve(revolutions(rigid, EXUDYN_REVOLUTIONS))
     assert_finite_and_bounded(r)
     balance = energy_balance(r)
     # Trapezoid sums and the integrator's damping at each impact (tests/test_exudyn_engine.py): 1e-3 of
@@ -266,7 +267,8 @@ def test_exudyn_grazing_window_agrees_with_reference_and_ignores_the_floor():
     runs = {}
     for v in (1e-6, 1e-3):
         scene = revolutions(CREEP, 0.1, min_impact_velocity=v)
-        runs[v] = exudyn_engine.solve(dataclasses.replace(scene, exudyn_solver=ExudynSolver(step_size=1e-5)))
+        runs[v] = exudyn_engine.solve(dataclasses.replace(scene, exudyn_solver=ExudynSolver(
+            model="rigid_body", step_control="fixed", step_size=1e-5)))
         assert_finite_and_bounded(runs[v])
         inside = runs[v].steps["in_contact"] > 0
         assert np.all(runs[v].steps["impact_velocity_m_s"][inside] >= v)

@@ -202,14 +202,19 @@ class ReferenceSolver:
 class ExudynSolver:
     """Settings of the Exudyn engine.
 
-    ``model``: "rigid_body" (members 1-8 as bodies and joints, generalized-alpha with
-    ``step_size``, ``spectral_radius`` and the Newton settings) or "kinematic_tree" (members
-    1-3 prescribed, 4-8 in minimal coordinates, explicit ``explicit_method`` with automatic
-    step size to ``relative_tolerance`` / ``absolute_tolerance``; docs/performance.md).
+    ``model``: "auto" (the kinematic tree unless the scene needs the rigid-body model:
+    :mod:`weftsim.exudyn_engine.selection`), "rigid_body" (members 1-8 as bodies and joints,
+    generalized-alpha with ``spectral_radius`` and the Newton settings; its step is error-controlled
+    to ``local_error`` under ``step_control = "adaptive"``, or ``step_size`` under ``"fixed"``) or
+    "kinematic_tree" (members 1-3 prescribed, 4-8 in minimal coordinates, explicit
+    ``explicit_method`` with automatic step size to ``relative_tolerance`` /
+    ``absolute_tolerance``; docs/performance.md).
     """
 
-    model: str = "rigid_body"
-    step_size: float = 2e-6  # s; with the ideal joint at least 0.05 deg of crank (exudyn_engine.solver)
+    model: str = "auto"
+    step_control: str = "adaptive"  # rigid_body: "adaptive" (local error control, step_control.py) or "fixed"
+    local_error: float = 3e-10  # m; rigid_body, adaptive: local error tolerance on the eccentricity at E
+    step_size: float = 2e-6  # s; fixed: the step (ideal joint: see exudyn_engine.solver); adaptive: unused
     spectral_radius: float = 0.8
     modified_newton: bool = True
     newton_relative_tolerance: float = 1e-8

@@ -63,6 +63,9 @@ SECONDS_PER_REVOLUTION = {
     "reference scipy": 3.9,  # DOP853 at rtol 1e-9 (the default): 2.1 s for 1 revolution, 9.9 s for 3
     "reference numba": 0.08,  # numba_DOP853 at rtol 1e-9: 0.30 s of solver wall time for 4 revolutions
     "exudyn kinematic_tree": 0.22,  # DOPRI5 at the default tolerances: 0.90 s for 1 revolution, 1.34 s for 3
+    # The rigid-body model's adaptive step (docs/performance.md): ~29,000 steps per revolution at
+    # 400 rpm and c = 0.25 mm, 20-35 % dearer than a fixed step (95 us): 2.8 s.
+    "exudyn rigid_body adaptive": 2.8,
 }
 # The Exudyn rigid-body model takes fixed steps: its cost is per step (5.5 s for the 75 000 steps of
 # one revolution at 400 rpm with h = 2e-6 s, 73 us a step; 16.6 s for 3 revolutions).
@@ -82,11 +85,14 @@ def estimate_run_time(scene, engine: str) -> float:
 
         method = select_path(scene)["method"]
         return revolutions * SECONDS_PER_REVOLUTION["reference numba" if "numba" in method else "reference scipy"]
-    if scene.exudyn_solver.model == "kinematic_tree":
-        return revolutions * SECONDS_PER_REVOLUTION["exudyn kinematic_tree"]
-    from weftsim.exudyn_engine.solver import step_plan  # the steps the engine will take (longer for an ideal joint)
+    from weftsim.exudyn_engine.selection import select_model
+    from weftsim.exudyn_engine.solver import adaptive, step_plan
 
-    return step_plan(scene)[1] * EXUDYN_SECONDS_PER_STEP
+    if select_model(scene)[0] == "kinematic_tree":
+        return revolutions * SECONDS_PER_REVOLUTION["exudyn kinematic_tree"]
+    if adaptive(scene):
+        return revolutions * SECONDS_PER_REVOLUTION["exudyn rigid_body adaptive"]
+    return step_plan(scene)[1] * EXUDYN_SECONDS_PER_STEP  # the fixed steps it will take (longer for an ideal joint)
 
 
 def format_duration(seconds: float) -> str:

@@ -22,8 +22,9 @@ from typing import Any, Callable
 from weftsim import params
 
 INTEGRATORS = ("auto", "DOP853", "RK45", "RK23", "Radau", "LSODA", "BDF", "numba_DOP853", "numba_RK45")
-EXUDYN_MODELS = ("rigid_body", "kinematic_tree")
+EXUDYN_MODELS = ("auto", "rigid_body", "kinematic_tree")
 EXPLICIT_METHODS = ("DOPRI5", "ODE23")
+STEP_CONTROLS = ("adaptive", "fixed")
 CALLBACK_ROUTES = ("auto", "python", "symbolic", "numba")
 BRANCHES = {"+": 1, "-": -1}
 IMPACT_VELOCITY_RULES = ("max_approach", "onset")
@@ -121,9 +122,16 @@ SCHEMA: tuple[Key, ...] = (
     Key("solver.reference.max_step_deg", "reference_solver.max_step", "float", DEG, 0, 90,
         doc="largest step, as crank angle"),
     Key("solver.exudyn.model", "exudyn_solver.model", "str", choices=EXUDYN_MODELS,
-        doc="Exudyn model: rigid_body (members 1-8, general) or kinematic_tree (members 1-3 prescribed)"),
+        doc="Exudyn model: auto = kinematic_tree unless the scene needs rigid_body (ideal joint, friction, "
+            "symbolic callback); rigid_body = members 1-8, general; kinematic_tree = members 1-3 prescribed"),
+    Key("solver.exudyn.step_control", "exudyn_solver.step_control", "str", choices=STEP_CONTROLS,
+        doc="rigid_body model: adaptive (step from a local error estimate: large in free flight, small "
+            "through impacts) or fixed (step_size_s)"),
+    Key("solver.exudyn.local_error_m", "exudyn_solver.local_error", "float", 1, 0, 1e-3,
+        doc="rigid_body model, adaptive: tolerance of the local error estimate of the journal centre at E per step"),
     Key("solver.exudyn.step_size_s", "exudyn_solver.step_size", "float", 1, 0, 1e-2,
-        doc="generalized-alpha step size (ideal joint: at least 0.05 deg of crank, nothing to resolve)"),
+        doc="generalized-alpha step when fixed (adaptive: unused; an ideal joint then steps 0.25 deg of "
+            "crank, nothing to resolve)"),
     Key("solver.exudyn.spectral_radius", "exudyn_solver.spectral_radius", "float", 1, 0, 1, False, False,
         doc="generalized-alpha spectral radius (<= 0.9 for smooth constraint torques)"),
     Key("solver.exudyn.modified_newton", "exudyn_solver.modified_newton", "bool", doc="modified Newton"),

@@ -67,8 +67,14 @@ def _tree(rtol: float, method: str = "DOPRI5", route: str = "python") -> Setting
 
 def _rigid(step: float, route: str = "symbolic") -> Setting:
     return Setting("exudyn", f"exudyn rigid_body {route}", f"h {step:.0e} s",
-                   {"solver.exudyn.model": "rigid_body", "solver.exudyn.step_size_s": step,
-                    "solver.exudyn.callback": route})  # fmt: skip
+                   {"solver.exudyn.model": "rigid_body", "solver.exudyn.step_control": "fixed",
+                    "solver.exudyn.step_size_s": step, "solver.exudyn.callback": route})  # fmt: skip
+
+
+def _rigid_adaptive(local_error: float, route: str = "symbolic") -> Setting:
+    return Setting("exudyn", f"exudyn rigid_body adaptive {route}", f"tol {local_error:.0e} m",
+                   {"solver.exudyn.model": "rigid_body", "solver.exudyn.step_control": "adaptive",
+                    "solver.exudyn.local_error_m": local_error, "solver.exudyn.callback": route})  # fmt: skip
 
 
 def settings(case: str, quick: bool = False) -> list[Setting]:
@@ -77,15 +83,16 @@ def settings(case: str, quick: bool = False) -> list[Setting]:
         out = [_ref("numba_DOP853", r) for r in (1e-5, 1e-7)] + [_ref("DOP853", 1e-7)]
         out += [_tree(r) for r in (1e-5, 1e-6)]
         if case == "c0.25mm-400rpm":
-            out.append(_rigid(2e-6))
+            out += [_rigid(2e-6), _rigid_adaptive(3e-10)]
         return out
     out = [_ref("numba_DOP853", r) for r in (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9)]
     out += [_ref("numba_RK45", r) for r in (1e-4, 1e-5, 1e-6, 1e-7, 1e-8)]
     out += [_ref("DOP853", r) for r in (1e-6, 1e-8, 1e-10)] + [_ref("LSODA", 1e-8), _ref("RK45", 1e-7)]
     out += [_tree(r) for r in (1e-4, 3e-5, 1e-5, 3e-6, 1e-6, 1e-7, 1e-8)]
     out += [_tree(r, "ODE23") for r in (1e-4, 1e-5)]
-    out += [_tree(1e-6, route=route) for route in ("numba", "symbolic")]
+    out += [_tree(1e-6, route="numba")]  # the tree has no symbolic route (exudyn_engine/tree.py)
     out += [_rigid(h) for h in (4e-6, 2e-6, 1e-6)]
+    out += [_rigid_adaptive(tol) for tol in (1e-8, 3e-9, 1e-9, 3e-10)]
     if case == "c0.25mm-400rpm":
         out += [_rigid(2e-6, route) for route in ("python", "numba")]
     return out

@@ -1,19 +1,73 @@
-"""Which Exudyn model and method a scene runs on (``RunResult.path``).
+"""Which Exudyn model and method a scene runs on (``RunResult.path``): the automatic selection.
 
-Today this reports what the scene's keys force (``exudyn_solver.model``); the automatic
-selection of issue 12 replaces it.
+``solver.exudyn.model = "auto"`` (the default) picks the smallest model that carries the scene:
+
+- **kinematic tree** (:mod:`.tree`, :mod:`.tree_solve`) when members 1-3 are ideal and rigid and
+  the clearance joint at E is the only free joint.  Then the crank, coupler and rocker move in
+  closed form with the crank angle, and only the two coordinates of the chain 4-8 behind the
+  clearance are integrated, by an explicit error-controlled solver (DOPRI5) that takes large steps
+  in free flight and short ones through the impacts.  Every scene weftsim describes today with a
+  clearance at E is of this kind.
+- **rigid-body model** (:mod:`.mechanism`, generalized-alpha) when the scene needs bodies and joints
+  for members 1-3, or a route only that model has.  What forces it (:func:`rigid_body_needs`):
+  an ideal joint at E (c = 0: no coordinate moves freely; the rigid-body model then steps
+  0.25 deg of crank, :data:`weftsim.exudyn_engine.solver.IDEAL_JOINT_STEP_ANGLE`, and never a
+  contact time scale); friction in the clearance joint (the tree's contact acts at the journal
+  centre and carries no friction moment on the rocker; the Exudyn engine has no friction in
+  either model today, so such a scene is refused with a message); the symbolic callback route
+  (the tree has the python and numba routes).  A clearance or a flexible body anywhere in members
+  1-3 would also need the rigid-body model (members 1-3 no longer move in closed form); weftsim's
+  scenes have neither yet.
+
+``"rigid_body"`` and ``"kinematic_tree"`` stay explicit choices.  :func:`weftsim.exudyn_engine.solve`
+runs exactly the model this module names.
 """
 
 from __future__ import annotations
 
 from weftsim.params import Scene
 
+AUTO = "auto"
+
+
+def rigid_body_needs(scene: Scene) -> list[str]:
+    """Reasons why ``scene`` needs the rigid-body model (empty: the kinematic tree carries it)."""
+    joint, s = scene.joint, scene.exudyn_solver
+    needs = []
+    if joint.is_ideal:
+        needs.append("ideal joint at E (c = 0): no free coordinate, one generalized-alpha step per "
+                     "0.25 deg of crank")  # fmt: skip
+    if joint.friction_coefficient > 0.0:
+        needs.append("friction in the clearance joint (the kinematic tree carries no friction moment)")
+    if s.callback == "symbolic":
+        needs.append("solver.exudyn.callback = 'symbolic' (the kinematic tree has the python and numba routes)")
+    return needs
+
+
+def select_model(scene: Scene) -> tuple[str, str]:
+    """(model, reason): the scene key if it names a model, else the automatic choice."""
+    model = scene.exudyn_solver.model
+    if model != AUTO:
+        return model, "scene key solver.exudyn.model"
+    needs = rigid_body_needs(scene)
+    if needs:
+        return "rigid_body", "auto: " + "; ".join(needs)
+    return "kinematic_tree", "auto: members 1-3 ideal and rigid, only the chain 4-8 behind the clearance moves freely"
+
 
 def select_path(scene: Scene) -> dict:
     """``{"model", "method", "reason"}`` of the run :func:`weftsim.exudyn_engine.solve` makes of ``scene``."""
     s = scene.exudyn_solver
-    if s.model == "kinematic_tree":
-        return {"model": "kinematic_tree", "method": f"{s.explicit_method} rtol {s.relative_tolerance:g}",
-                "reason": "scene key solver.exudyn.model"}
-    return {"model": "rigid_body", "method": f"generalized-alpha h {s.step_size:g} s",
-            "reason": "scene key solver.exudyn.model"}
+    model, reason = select_model(scene)
+    if model == "kinematic_tree":
+        from weftsim.exudyn_engine.tree import tree_route
+
+        return {"model": model, "reason": reason,
+                "method": f"{s.explicit_method} rtol {s.relative_tolerance:g}, {tree_route(s.callback)} callback"}
+    from weftsim.exudyn_engine.solver import adaptive, step_plan
+
+    if adaptive(scene):
+        method = f"generalized-alpha, adaptive step (local error {s.local_error:g} m at E)"
+    else:
+        method = f"generalized-alpha, fixed step h {step_plan(scene)[0]:.3g} s"
+    return {"model": model, "method": method, "reason": reason}

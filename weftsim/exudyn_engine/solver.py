@@ -14,6 +14,7 @@ No files are written (solution and sensor files off) and the solver prints nothi
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time as _time
 
@@ -21,24 +22,30 @@ import exudyn as exu
 
 from weftsim.exudyn_engine.clearance_joint import ROUTES, register_post_step
 from weftsim.exudyn_engine.mechanism import build_mechanism
-from weftsim.exudyn_engine.selection import select_path
+from weftsim.exudyn_engine.selection import select_model, select_path
+from weftsim.exudyn_engine.step_control import StepController
 from weftsim.exudyn_engine.sensors import add_sensors, first_nonfinite_row, sample_channels, silence, step_channels
 from weftsim.guards import RunGuard, failure_message, non_finite_breach, vet_result
 from weftsim.params import Scene
-from weftsim.scene import IMPACT_VELOCITY_RULES
+from weftsim.scene import IMPACT_VELOCITY_RULES, STEP_CONTROLS
 from weftsim.results import RunResult, angle_grid, empty_channels
 
-MODELS = ("rigid_body", "kinematic_tree")  # kinematic_tree: tree.py, tree_solve.py
+MODELS = ("auto", "rigid_body", "kinematic_tree")  # auto: selection.py; kinematic_tree: tree.py, tree_solve.py
 # Modified Newton: iterations with one Jacobian before it is updated.  3 instead of
 # Exudyn's 8: 3.75 instead of 5.9 iterations per step, ~30 % less time, identical results
 # at the same tolerance (2: 2.97 iterations but 4x the Jacobians, slower).
 MODIFIED_NEWTON_ITERATIONS = 3
 _PROGRESS_CALLS = 1000  # every 0.1 % of the run: a long run shows its first line soon (issue 16)
-# Step of the ideal joint, as crank angle.  The error of the ideal curves against the closed form
+# Step of the ideal joint, as crank angle.  The ideal mechanism has no free coordinate: its motion
+# is a function of theta = omega t alone, so the error of the ideal curves against the closed form
 # (largest difference at a sample / peak, reference mechanism, 2 revolutions) depends on the crank
-# angle of the step alone, at 50, 300, 400 and 800 rpm alike: 2.3-4.2e-6 at 0.025 deg (round-off,
-# ~1/h^2), 0.8-1.1e-6 at 0.05 deg, 1.5-1.7e-6 at 0.1 deg (truncation, ~h^2).  0.05 deg is the minimum.
-IDEAL_JOINT_STEP_ANGLE = math.radians(0.05)
+# angle of the step and not on the speed; measured identical at 400 and 800 rpm: 0.8-1.0e-6 at
+# 0.05 deg, 1.5-1.7e-6 at 0.1 deg, 1.0e-5 at 0.25 deg, 6.3e-5 at 0.5 deg (rapier acceleration; the
+# torque 4.0e-6 and 1.6e-5).  Truncation of the second-order method grows as ~(omega h)^2.7 here;
+# below 0.05 deg the round-off of the constraint reactions (~1/h^2) takes over.  0.5 deg, the
+# largest output spacing (a step must end on every sample), stays within the compare tolerance of
+# 1e-4 but only by 1.6x; 0.25 deg keeps 10x below it at 5x fewer steps than 0.05 deg.
+IDEAL_JOINT_STEP_ANGLE = math.radians(0.25)
 
 
 def check_settings(scene: Scene) -> str | None:
@@ -46,7 +53,7 @@ def check_settings(scene: Scene) -> str | None:
     s = scene.exudyn_solver
     if s.model not in MODELS:
         return f"`exudyn_solver.model` must be one of {MODELS}, got {s.model!r}"
-    if s.model == "kinematic_tree":
+    if select_model(scene)[0] == "kinematic_tree":
         from weftsim.exudyn_engine.tree_solve import check_tree_settings
 
         problem = check_tree_settings(scene)
@@ -60,6 +67,10 @@ def check_settings(scene: Scene) -> str | None:
         return f"`exudyn_solver.newton_relative_tolerance` must be > 0, got {s.newton_relative_tolerance}"
     if not s.newton_max_iterations >= 1:
         return f"`exudyn_solver.newton_max_iterations` must be >= 1, got {s.newton_max_iterations}"
+    if s.step_control not in STEP_CONTROLS:
+        return f"`exudyn_solver.step_control` must be one of {STEP_CONTROLS}, got {s.step_control!r}"
+    if not (s.local_error > 0.0 and math.isfinite(s.local_error)):
+        return f"`exudyn_solver.local_error` must be > 0 (m), got {s.local_error}"
     if s.callback not in ROUTES + ("auto",):
         return f"`exudyn_solver.callback` must be one of {('auto',) + ROUTES}, got {s.callback!r}"
     if s.callback == "numba" and not scene.joint.is_ideal:
@@ -79,14 +90,15 @@ def check_settings(scene: Scene) -> str | None:
 
 
 def requested_step(scene: Scene) -> float:
-    """The step to aim for, s: the scene's, or with the ideal joint at least :data:`IDEAL_JOINT_STEP_ANGLE`.
+    """The fixed step to aim for, s: the scene's, or with the ideal joint :data:`IDEAL_JOINT_STEP_ANGLE`.
 
     A scene's step is chosen to resolve impacts (about 2e-6 s).  With an ideal joint there is none,
     and such a step only adds round-off: the constraint reactions of generalized-alpha carry an error
-    growing as 1/h^2, 9e-5 of the peak driving torque at 2e-6 s against 1e-6 at the ideal step.
+    growing as 1/h^2, 9e-5 of the peak driving torque at 2e-6 s against 1e-5 at the ideal step.
+    Under ``step_control = "fixed"`` the scene's step is taken as it is, ideal joint or not.
     """
     step = scene.exudyn_solver.step_size
-    if scene.joint.is_ideal:
+    if scene.joint.is_ideal and scene.exudyn_solver.step_control == "adaptive":
         step = max(step, IDEAL_JOINT_STEP_ANGLE / scene.drive.speed)
     return step
 
@@ -115,8 +127,22 @@ def simulation_settings(scene: Scene, n_steps: int) -> exu.SimulationSettings:
     ti.discontinuous.ignoreMaxIterations = False
     # Newton failures halve the step down to this floor; then the run fails (step-size collapse).
     ti.minimumStepSize = scene.limits.min_step
+    if adaptive(scene):
+        # The controller sets every step from its post-step hook (the first one at t = 0: one output
+        # sample, free flight from the centred journal); Exudyn's own lengthening after easy Newton
+        # steps is off.  numberOfSteps only sets Exudyn's initial and largest step.
+        ti.numberOfSteps = max(1, math.ceil(scene.drive.end_time * scene.drive.speed / scene.output.sample_angle))
+        ti.adaptiveStep = True
+        ti.adaptiveStepRecoverySteps = 2**30
     silence(ss)
     return ss
+
+
+def adaptive(scene: Scene) -> bool:
+    """True when the step is error-controlled (:mod:`.step_control`): a clearance joint under
+    ``step_control = "adaptive"``.  The ideal joint always takes the fixed step of :func:`step_plan`
+    (nothing but the prescribed kinematics to follow; :data:`IDEAL_JOINT_STEP_ANGLE`)."""
+    return scene.exudyn_solver.step_control == "adaptive" and not scene.joint.is_ideal
 
 
 def _failed(scene: Scene, message: str, wall: float) -> RunResult:
@@ -126,6 +152,10 @@ def _failed(scene: Scene, message: str, wall: float) -> RunResult:
 
 def _what_to_try(scene: Scene, h: float) -> str:
     s = scene.exudyn_solver
+    if adaptive(scene):
+        return (f"try a smaller `exudyn_solver.local_error` (now {s.local_error:.3g} m), or step_control = 'fixed' "
+                f"with a small `exudyn_solver.step_size`, a spectral radius below {s.spectral_radius} or more "
+                f"`newton_max_iterations` (now {s.newton_max_iterations})")  # fmt: skip
     return (f"try a smaller `exudyn_solver.step_size` (now {h:.3g} s), a spectral radius below "
             f"{s.spectral_radius} or more `newton_max_iterations` (now {s.newton_max_iterations})")  # fmt: skip
 
@@ -167,16 +197,19 @@ def solve(scene: Scene, progress=None, callback: str | None = None) -> RunResult
         time; ``events["first_contact_time_s"]`` located within its step.
     """
     wall0 = _time.perf_counter()
+    if callback is not None:  # the route is part of the scene the selection sees (selection.py)
+        scene = dataclasses.replace(scene, exudyn_solver=dataclasses.replace(scene.exudyn_solver, callback=callback))
     problem = check_settings(scene)
     if problem is not None:
         return _failed(scene, problem, 0.0)
-    result = _solve_model(scene, progress, callback, wall0)
-    object.__setattr__(result, "path", select_path(scene))
+    path = select_path(scene)
+    result = _solve_model(scene, path["model"], progress, None, wall0)
+    object.__setattr__(result, "path", path)
     return result
 
 
-def _solve_model(scene: Scene, progress, callback: str | None, wall0: float) -> RunResult:
-    if scene.exudyn_solver.model == "kinematic_tree":
+def _solve_model(scene: Scene, model: str, progress, callback: str | None, wall0: float) -> RunResult:
+    if model == "kinematic_tree":
         from weftsim.exudyn_engine.tree_solve import solve_tree
 
         return solve_tree(scene, progress, callback)
@@ -187,14 +220,16 @@ def _solve_model(scene: Scene, progress, callback: str | None, wall0: float) -> 
     model = build_mechanism(mbs, scene, callback=callback)
     sensors = add_sensors(mbs, model)
     counter = {"steps": 0}
-    report_every = max(1, n_steps // _PROGRESS_CALLS)
+    # The adaptive step takes about 1/3 of the fixed plan's steps (docs/performance.md).
+    report_every = max(1, (n_steps // 3 if adaptive(scene) else n_steps) // _PROGRESS_CALLS)
     guard = RunGuard(scene)
     breach = []
 
     def count(mbs, t):
         counter["steps"] += 1
         if progress is not None and counter["steps"] % report_every == 0:
-            progress(min(1.0, counter["steps"] / n_steps))
+            # Simulated time, not the step count: the adaptive step's count is not known ahead.
+            progress(min(1.0, t / scene.drive.end_time))
         # Exudyn also calls this once at t = 0: not a step.  Runs after the clearance
         # joint's own post-step hook, so the tracker holds this step's penetration.
         found = guard.check(penetration=model.clearance.tracker.delta if model.clearance else None,
@@ -205,13 +240,17 @@ def _solve_model(scene: Scene, progress, callback: str | None, wall0: float) -> 
         return True
 
     register_post_step(mbs, count)
+    solver = exu.MainSolverImplicitSecondOrder()
+    control = None
+    if adaptive(scene):
+        control = StepController.for_mechanism(mbs, solver, model, scene)
+        control.install()
     mbs.Assemble()
     if model.clearance is not None:
         model.clearance.reset(mbs)
     if progress is not None:
         progress(0.0)
     status, message, kind = "success", "", None
-    solver = exu.MainSolverImplicitSecondOrder()
     wall_solve = _time.perf_counter()
     try:
         if not solver.SolveSystem(mbs, simulation_settings(scene, n_steps)):
@@ -250,7 +289,9 @@ def _solve_model(scene: Scene, progress, callback: str | None, wall0: float) -> 
     n_done = max(len(steps["time_s"]) - 1, 0)
     stats = {
         "method": "generalized_alpha",
-        "step_size_s": h,
+        "step_control": "adaptive" if control else "fixed",
+        # adaptive: the smallest accepted step (the resolution through impacts); fixed: the step.
+        "step_size_s": control.counters()["smallest_step_s"] or h if control else h,
         "steps": n_done,
         "rejected_steps": int(it.rejectedModifiedNewtonSteps),
         "newton_iterations": int(it.newtonStepsCount),
@@ -258,6 +299,7 @@ def _solve_model(scene: Scene, progress, callback: str | None, wall0: float) -> 
         "function_evaluations": int(it.newtonStepsCount),
         **(model.clearance.tracker.counters() if model.clearance else {"contact_events": 0}),
         "callback": model.clearance.route if model.clearance else None,
+        **({k: v for k, v in control.counters().items() if k != "smallest_step_s"} if control else {}),
         "solve_time_s": wall_solve,
         "wall_time_s": _time.perf_counter() - wall0,
     }

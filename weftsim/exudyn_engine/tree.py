@@ -14,23 +14,25 @@ two revolute joints about Exudyn Z (the four-bar plane is Exudyn's XY plane, as 
                                               centre of mass at L_EF/2, journal at L_EF
 
 (psi = theta_EF of :mod:`weftsim.reference.dynamics`: P_j = F - L_EF u(psi)).  The bearing
-centre P_b(t) = E of the prescribed rocker is not a body: the clearance connector joins
-the journal to a ground marker at O, and its force callback subtracts P_b(t) and its
-velocity (closed form) from the connector's displacement and velocity,
+centre P_b(t) = E of the prescribed rocker is not a body.  The contact enters as the tree's
+generalized force (``forceUserFunction``, :func:`make_python_force`): the callback computes the
+journal centre and its velocity from the joint coordinates, subtracts P_b(t) and its velocity
+(closed form),
 
-    e = (P_j - O) - P_b(t),   e_dot = v_j - V_b(t),
+    e = P_j - P_b(t),   e_dot = v_j - V_b(t),
 
-then applies the same law, onset interpolation and held impact velocity rule
-(``joint.impact_velocity_rule``) as :mod:`.callbacks` / :mod:`.onset`.  No constraints
-remain, so an error-controlled explicit solver (DOPRI5 with automatic step size) integrates
-it; there is no Jacobian and no Newton iteration.
+applies the same law, onset interpolation and held impact velocity rule
+(``joint.impact_velocity_rule``) as :mod:`.callbacks` / :mod:`.onset`, and returns the joint
+torques of the contact force by virtual work.  No constraints remain, so an error-controlled
+explicit solver (DOPRI5 with automatic step size) integrates it; there is no Jacobian and no
+Newton iteration.
 
 The driving torque comes from the contact force in closed form, with the crank-side
 terms of :mod:`weftsim.reference.ideal` (SPEC.md 4, docs/reference-solver.md):
 
     T = 1/2 J13'(theta) omega^2 + U13'(theta) - Q3,   Q3 = F_b . dP_b/dtheta
 
-(F_b = F_N n, the force on the bearing, the connector's ``Force``).  The full rigid-body
+(F_b = F_N n, the force on the bearing, recorded by the callback at every accepted state).  The full rigid-body
 model (:mod:`.mechanism`) stays the general path; ``tests/test_fast_paths.py`` checks the
 two against each other.
 """
@@ -42,33 +44,40 @@ from dataclasses import dataclass, field
 
 import exudyn as exu
 import numpy as np
-from exudyn.itemInterface import (
-    MarkerBodyPosition,
-    MarkerKinematicTreeRigid,
-    NodeGenericODE2,
-    ObjectConnectorCartesianSpringDamper,
-    ObjectGround,
-    ObjectKinematicTree,
-)
+from exudyn.itemInterface import NodeGenericODE2, ObjectKinematicTree
 
 from weftsim.contact import make_law
-from weftsim.exudyn_engine.callbacks import symbolic_clearance_force
 from weftsim.exudyn_engine.onset import (
     RESTING_RATE_FRACTION,
     OnsetTracker,
     callback_impact_velocity,
     damping_rate,
-    penetration_state,
 )
 from weftsim.params import Scene
 from weftsim.reference.dynamics import initial_state
 from weftsim.reference.ideal import sector_chain_inertia
 
 UNSPECIFIED_MASS = 1.0  # sector mass (balanced, on its fixed axis: no effect), kg
-# "auto" route of this model: the symbolic route's expression tree repeats the bearing motion in
-# every use of e (Exudyn evaluates it as a tree, not a graph): 51 us per call against 3.4 us for
-# the fixed-bearing expression of callbacks.py; the plain-Python callback is ~1.5 us.
-AUTO_ROUTE = "python"
+# Callback routes of this model.  No symbolic route: Exudyn's symbolic user functions do not take the
+# tree's forceUserFunction (its coordinate vectors have no size when the expression is recorded), and
+# as an expression tree the bearing motion was repeated in every use of e (51 us per call in the
+# connector form this model had before, against ~1.5 us for plain Python).
+TREE_ROUTES = ("auto", "python", "numba")
+
+
+def tree_route(callback: str) -> str:
+    """The route a ``solver.exudyn.callback`` value runs on the tree: "auto" = numba when installed.
+
+    The numba core costs ~1 us per call against ~2 us for the plain-Python body (the numba dispatch
+    is most of it; docs/performance.md), and compiles once per machine (numba's cache).
+    """
+    if callback != "auto":
+        return callback
+    try:
+        import numba  # noqa: F401 - a dependency of weftsim; "python" only where it is missing
+    except ImportError:
+        return "python"
+    return "numba"
 
 
 @dataclass(frozen=True)
@@ -110,122 +119,87 @@ class BearingMotion:
 
 
 def make_python_force(law, clearance: float, min_impact_velocity: float, bearing: BearingMotion,
-                      memory: list, stash: list, counter: list | None = None, max_approach: bool = True):
-    """Plain-Python force callback with the moving bearing (see :mod:`.callbacks`).
+                      geometry, memory: list, stash: list, counter: list | None = None,
+                      max_approach: bool = True):
+    """Plain-Python generalized contact force of the tree, ``forceUserFunction(mbs, t, i, q, q_t)``.
 
-    ``memory`` = [v_held, delta0, rate0] of the last accepted step (written by the post-step
-    bookkeeping; the connector's ``stiffness`` parameter is not needed); every call leaves
-    [t, delta, delta_dot] in ``stash``: the last call of a step is at the accepted state
-    (end-of-step accelerations), so the bookkeeping needs no ``GetObjectOutput``.
+    The journal centre and its velocity follow from the joint coordinates in closed form
+    (``geometry``: :class:`weftsim.params.Geometry`, lengths L_OG, L_FG, L_EF; b = q0 + q1 = psi + pi
+    is the absolute angle of the rod's x axis from F to the journal),
+
+        P_j = G + L_FG u(a) + L_EF u(b),  v_j = L_FG a' u'(a) + L_EF b' u'(b),  b = q0 + q1,
+
+    the eccentricity from e = P_j - P_b(t) (:class:`BearingMotion`), the normal force F_N from the
+    law with the held impact velocity (:mod:`.onset`), and the joint torques from the force on the
+    journal, F_j = -F_N n (n = e/|e|), by virtual work:
+
+        Q1 = F_j . dP_j/dq1 = F_N L_EF (n_x sin b - n_y cos b),
+        Q0 = F_j . dP_j/dq0 = F_N L_FG (n_x sin a - n_y cos a) + Q1.
+
+    (An Exudyn connector between a ground marker and a kinematic-tree marker does the same
+    projection in C++, but its marker kinematics cost about twice the whole tree per evaluation:
+    docs/performance.md.)  ``memory`` = [v_held, delta0, rate0] of the last accepted step (written by
+    the post-step bookkeeping); every call leaves [t, delta, delta_dot, F_b,x, F_b,y] in ``stash``
+    (F_b = F_N n, the force on the bearing): the last call of an accepted step is at its end state
+    (the last DOPRI5 / ODE23 stage), so the bookkeeping needs no extra evaluation.
     """
     normal_force = law.scalar()
     c, v_min, sqrt, cos, sin = clearance, min_impact_velocity, math.sqrt, math.cos, math.sin
-    omega, tb, c0, s0, l_oe = bearing.omega, bearing.tan_beta, bearing.cos_oe0, bearing.sin_oe0, bearing.l_oe
+    l_og, l_fg, l_ef = geometry.l_og, geometry.l_fg, geometry.l_ef
     counter = [0] if counter is None else counter
     impact_velocity, damped = callback_impact_velocity, damping_rate
     v_dead = RESTING_RATE_FRACTION * min_impact_velocity
 
-    def spring_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
+    def tree_force(mbs, t, itemNumber, q, q_t):
         counter[0] += 1
-        # BearingMotion.terms inlined (this runs ~13 times per step): P_b = L_OE (cos q, sin q).
-        theta = omega * t
-        u = tb * cos(theta)
-        w = 1.0 + u * u
-        r = 1.0 / sqrt(w)
-        sq = (s0 - c0 * u) * r
-        cq = (c0 + s0 * u) * r
-        k = omega * l_oe * tb * sin(theta) / w  # omega L_OE phi'
-        ex = displacement[0] - l_oe * cq
-        ey = displacement[1] - l_oe * sq
+        b_y, b_z, vb_y, vb_z = bearing(t)
+        a = q[0]
+        b = a + q[1]
+        da = q_t[0]
+        db = da + q_t[1]
+        sa, ca, sb, cb = sin(a), cos(a), sin(b), cos(b)
+        ex = l_og + l_fg * ca + l_ef * cb - b_y
+        ey = l_fg * sa + l_ef * sb - b_z
         length = sqrt(ex * ex + ey * ey)
         delta = length - c
         if length <= 0.0:
-            stash[0], stash[1], stash[2] = t, delta, 0.0
-            return [0.0, 0.0, 0.0]
+            stash[0], stash[1], stash[2], stash[3], stash[4] = t, delta, 0.0, 0.0, 0.0
+            return [0.0, 0.0]
         nx = ex / length
         ny = ey / length
-        rate = (velocity[0] + k * sq) * nx + (velocity[1] - k * cq) * ny
-        stash[0], stash[1], stash[2] = t, delta, rate
+        rate = (-l_fg * sa * da - l_ef * sb * db - vb_y) * nx + (l_fg * ca * da + l_ef * cb * db - vb_z) * ny
         if delta <= 0.0:
-            return [0.0, 0.0, 0.0]
+            stash[0], stash[1], stash[2], stash[3], stash[4] = t, delta, rate, 0.0, 0.0
+            return [0.0, 0.0]
         v_imp = impact_velocity(memory[0], memory[1], memory[2], delta, rate, v_min, max_approach)
         f = normal_force(delta, damped(rate, v_dead), v_imp)
-        return [f * nx, f * ny, 0.0]
+        stash[0], stash[1], stash[2], stash[3], stash[4] = t, delta, rate, f * nx, f * ny
+        q1 = f * l_ef * (nx * sb - ny * cb)
+        return [f * l_fg * (nx * sa - ny * ca) + q1, q1]
 
-    return spring_force
+    return tree_force
 
 
-def make_numba_force(law, clearance: float, min_impact_velocity: float, bearing: BearingMotion,
-                     memory: list, stash: list, max_approach: bool = True):
-    """Python wrapper around an ``@njit`` core of the whole force, bearing motion included.
+def make_numba_force(scene: Scene, memory: list):
+    """Compiled generalized force (as :func:`make_python_force`): (callback, memory, stash, call count).
 
-    ``memory`` and ``stash`` as in :func:`make_python_force`.
+    The callback only unpacks Exudyn's lists; the numba dispatch (~0.7 us) is most of its cost,
+    against ~2 us for the plain-Python body.  The memory, stash and count returned are views of
+    the core's state array (indexable as the python route's lists).
     """
-    import numba
+    from weftsim.exudyn_engine.tree_kernel import CALLS, HELD, N_SLOTS, STASH, tree_force_core
+    from weftsim.reference.compiled_kernel import N_PARAMETERS, pack_parameters
 
-    normal_force = law.numba()
-    impact_velocity, damped = numba.njit(callback_impact_velocity), numba.njit(damping_rate)
-    c, v_min, v_dead = clearance, min_impact_velocity, RESTING_RATE_FRACTION * min_impact_velocity
-    omega, tb, c0, s0, l_oe = bearing.omega, bearing.tan_beta, bearing.cos_oe0, bearing.sin_oe0, bearing.l_oe
+    state = np.concatenate([pack_parameters(scene), np.zeros(N_SLOTS)])
+    slots = state[N_PARAMETERS:]
+    slots[HELD:HELD + 3] = memory
+    slots[STASH] = math.nan
+    core = tree_force_core
 
-    @numba.njit(cache=False)
-    def core(t, px, py, vx, vy, held, delta0, rate0):
-        theta = omega * t
-        u = tb * math.cos(theta)
-        w = 1.0 + u * u
-        r = 1.0 / math.sqrt(w)
-        sq = s0 * r - c0 * u * r
-        cq = c0 * r + s0 * u * r
-        dphi = tb * math.sin(theta) / w
-        ex = px - l_oe * cq
-        ey = py - l_oe * sq
-        length = math.sqrt(ex * ex + ey * ey)
-        delta = length - c
-        if length <= 0.0:
-            return 0.0, 0.0, delta, 0.0
-        nx = ex / length
-        ny = ey / length
-        rate = (vx + omega * l_oe * sq * dphi) * nx + (vy - omega * l_oe * cq * dphi) * ny
-        if delta <= 0.0:
-            return 0.0, 0.0, delta, rate
-        v_imp = impact_velocity(held, delta0, rate0, delta, rate, v_min, max_approach)
-        f = normal_force(delta, damped(rate, v_dead), v_imp)
-        return f * nx, f * ny, delta, rate
+    def tree_force(mbs, t, itemNumber, q, q_t):
+        return core(state, t, q[0], q[1], q_t[0], q_t[1])
 
-    core(0.0, 1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0)  # compile now, not inside the first step
-
-    def spring_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
-        fx, fy, delta, rate = core(t, displacement[0], displacement[1], velocity[0], velocity[1],
-                                   memory[0], memory[1], memory[2])  # fmt: skip
-        stash[0], stash[1], stash[2] = t, delta, rate
-        return [fx, fy, 0.0]
-
-    return spring_force
-
-
-def make_symbolic_force(mbs, law, clearance: float, min_impact_velocity: float, bearing: BearingMotion,
-                        max_approach: bool = True):
-    """Exudyn symbolic user function (C++ expression tree) of the force with the moving bearing.
-
-    Same guards as :func:`weftsim.exudyn_engine.callbacks.make_symbolic_force` (both branches of
-    ``IfThenElse`` are evaluated).  Keep the returned object alive as long as the system.
-    """
-    esym = exu.symbolic
-    from exudyn.advancedUtilities import CreateSymbolicUserFunction
-
-    c, v_min, omega = clearance, min_impact_velocity, bearing.omega
-    real = esym.Real
-
-    def springForceUserFunction(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
-        by, bz, dby, dbz = bearing.terms(t, esym)
-        return symbolic_clearance_force(law, c, v_min, displacement[0] - by, displacement[1] - bz,
-                                        velocity[0] - real(omega) * dby, velocity[1] - real(omega) * dbz,
-                                        stiffness, max_approach)
-
-    return CreateSymbolicUserFunction(
-        mbs, springForceUserFunction, "springForceUserFunction",
-        itemTypeName="ObjectConnectorCartesianSpringDamper",
-    )  # fmt: skip
+    return tree_force, slots[HELD:HELD + 3], slots[STASH:STASH + 5], slots[CALLS:CALLS + 1]
 
 
 @dataclass
@@ -234,41 +208,55 @@ class TreeModel:
 
     scene: Scene
     node: object  # NodeGenericODE2 with q = [a, psi + pi - a]
-    tree: object  # ObjectKinematicTree
-    connector: object  # ObjectConnectorCartesianSpringDamper, Force = F_N n on the bearing side
+    tree: object  # ObjectKinematicTree, contact through its forceUserFunction
+    force: object  # the forceUserFunction (python or numba route)
     bearing: BearingMotion
     tracker: OnsetTracker
     route: str
-    memory: list  # [v_held, delta0, rate0] read by the python and numba callbacks
-    stash: list  # [t, delta, delta_dot] of the last callback (python, numba)
-    callback_calls: list = field(default_factory=lambda: [0])
-    keep_alive: object = field(default=None, repr=False)
+    memory: list  # [v_held, delta0, rate0] read by the force callback (numba: a view of its state)
+    stash: list  # [t, delta, delta_dot, F_b,x, F_b,y] of the last callback (numba: a view)
+    callback_calls: list = field(default_factory=lambda: [0])  # [count] (numba: a view)
+    bearing_force: list = field(default_factory=list)  # [t, F_b,x, F_b,y] per accepted state
 
     def accept(self, mbs, t: float) -> None:
-        """Post-step bookkeeping: onset, held impact velocity, callback memory."""
-        if self.stash[0] == t:  # the callback's last call was at this accepted state
-            delta, rate = self.stash[1], self.stash[2]
-        else:
-            u = mbs.GetObjectOutput(self.connector, exu.OutputVariableType.Displacement)
-            v = mbs.GetObjectOutput(self.connector, exu.OutputVariableType.Velocity)
-            by, bz, vby, vbz = self.bearing(t)
-            delta, rate = penetration_state(u[0] - by, u[1] - bz, v[0] - vby, v[1] - vbz,
-                                            self.scene.joint.clearance)  # fmt: skip
-        self.tracker.accept(t, delta, rate)
-        self.memory[:] = self.tracker.callback_state
-        if self.route == "symbolic":
-            mbs.SetObjectParameter(self.connector, "stiffness", self.memory)
+        """Post-step bookkeeping: onset, held impact velocity, callback memory, force on the bearing."""
+        read = self.stash.tolist if isinstance(self.stash, np.ndarray) else self.stash.copy
+        t_call, delta, rate, fx, fy = read()
+        if t_call != t:  # no evaluation at this state yet (the initial state)
+            q = mbs.GetNodeOutput(self.node, exu.OutputVariableType.Coordinates)
+            q_t = mbs.GetNodeOutput(self.node, exu.OutputVariableType.Coordinates_t)
+            self.force(mbs, t, self.tree, q, q_t)
+            t_call, delta, rate, fx, fy = read()
+        tracker = self.tracker
+        tracker.accept(t, delta, rate)
+        self.memory[0], self.memory[1], self.memory[2] = tracker.held, delta, rate
+        self.bearing_force.append((t, fx, fy))
 
 
 def build_tree(mbs, scene: Scene, callback: str = "auto") -> TreeModel:
-    """Add the kinematic tree of members 4-8, gravity and the clearance connector to ``mbs``.
+    """Add the kinematic tree of members 4-8, gravity and the clearance contact to ``mbs``.
 
     Initial state: the ideal mechanism at theta = 0, journal centred
-    (:func:`weftsim.reference.dynamics.initial_state`).  ``callback``: "auto" (= :data:`AUTO_ROUTE`),
-    "symbolic", "python" or "numba".  Needs ``scene.joint.clearance > 0`` and no friction.
+    (:func:`weftsim.reference.dynamics.initial_state`).  ``callback``: "auto" (:func:`tree_route`),
+    "python" or "numba".  Needs ``scene.joint.clearance > 0`` and no friction.
     """
     g, m, joint = scene.geometry, scene.inertia, scene.joint
     a0, psi0, da0, dpsi0 = initial_state(scene)[:4]
+    law = make_law(joint)
+    bearing = BearingMotion.from_scene(scene)
+    route = tree_route(callback)
+    calls = [0]
+    c, v_min = joint.clearance, joint.min_impact_velocity
+    max_approach = joint.impact_velocity_rule == "max_approach"
+    tracker = OnsetTracker(c, v_min, rule=joint.impact_velocity_rule)
+    memory = list(tracker.callback_state)
+    stash = [math.nan, 0.0, 0.0, 0.0, 0.0]
+    if route == "python":
+        force = make_python_force(law, c, v_min, bearing, g, memory, stash, calls, max_approach)
+    elif route == "numba":
+        force, memory, stash, calls = make_numba_force(scene, memory)
+    else:
+        raise ValueError(f"`callback` of the kinematic tree must be one of {TREE_ROUTES}, got {callback!r}")
     node = mbs.AddNode(NodeGenericODE2(
         referenceCoordinates=[0.0, 0.0], initialCoordinates=[a0, psi0 + math.pi - a0],
         initialCoordinates_t=[da0, dpsi0 - da0], numberOfODE2Coordinates=2,
@@ -280,30 +268,6 @@ def build_tree(mbs, scene: Scene, callback: str = "auto") -> TreeModel:
         linkInertiasCOM=exu.Matrix3DList([np.eye(3) * sector_chain_inertia(scene), np.eye(3) * m.rod_inertia]),
         linkCOMs=exu.Vector3DList([[0.0, 0.0, 0.0], [0.5 * g.l_ef, 0.0, 0.0]]),
         linkMasses=[UNSPECIFIED_MASS, m.rod_mass], baseOffset=[g.l_og, 0.0, 0.0], gravity=[0.0, -m.gravity, 0.0],
+        forceUserFunction=force,
     ))  # fmt: skip
-    ground = mbs.AddObject(ObjectGround())
-    m_origin = mbs.AddMarker(MarkerBodyPosition(bodyNumber=ground, localPosition=[0.0, 0.0, 0.0]))
-    m_journal = mbs.AddMarker(MarkerKinematicTreeRigid(objectNumber=tree, linkNumber=1, localPosition=[g.l_ef, 0, 0]))
-    law = make_law(joint)
-    bearing = BearingMotion.from_scene(scene)
-    route = AUTO_ROUTE if callback == "auto" else callback
-    calls = [0]
-    keep = None
-    c, v_min = joint.clearance, joint.min_impact_velocity
-    max_approach = joint.impact_velocity_rule == "max_approach"
-    tracker = OnsetTracker(c, v_min, rule=joint.impact_velocity_rule)
-    memory = list(tracker.callback_state)
-    stash = [math.nan, 0.0, 0.0]
-    if route == "python":
-        force = make_python_force(law, c, v_min, bearing, memory, stash, calls, max_approach)
-    elif route == "numba":
-        force = make_numba_force(law, c, v_min, bearing, memory, stash, max_approach)
-    elif route == "symbolic":
-        keep = force = make_symbolic_force(mbs, law, c, v_min, bearing, max_approach)
-    else:
-        raise ValueError(f"`callback` must be one of 'auto', 'python', 'symbolic', 'numba', got {callback!r}")
-    connector = mbs.AddObject(ObjectConnectorCartesianSpringDamper(
-        markerNumbers=[m_origin, m_journal], stiffness=tracker.callback_state, damping=[0.0, 0.0, 0.0],
-        offset=[0.0, 0.0, 0.0], springForceUserFunction=force,
-    ))  # fmt: skip
-    return TreeModel(scene, node, tree, connector, bearing, tracker, route, memory, stash, calls, keep)
+    return TreeModel(scene, node, tree, force, bearing, tracker, route, memory, stash, calls)

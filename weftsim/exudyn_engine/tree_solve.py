@@ -28,11 +28,11 @@ import time as _time
 
 import exudyn as exu
 import numpy as np
-from exudyn.itemInterface import SensorNode, SensorObject
+from exudyn.itemInterface import SensorNode
 
 from weftsim.contact import make_law
 from weftsim.exudyn_engine.sensors import first_nonfinite_row, sample_channels, silence
-from weftsim.exudyn_engine.tree import TreeModel, build_tree
+from weftsim.exudyn_engine.tree import TREE_ROUTES, TreeModel, build_tree
 from weftsim.guards import RunGuard, failure_message, non_finite_breach, vet_result
 from weftsim.params import Scene
 from weftsim.reference.dynamics import NUMPY, ChainConstants, chain_energy, eccentricity, initial_state
@@ -42,6 +42,7 @@ from weftsim.results import RunResult, angle_grid, empty_channels
 OVT = exu.OutputVariableType
 EXPLICIT_METHODS = {"DOPRI5": exu.DynamicSolverType.DOPRI5, "ODE23": exu.DynamicSolverType.ODE23}
 _PROGRESS_EVERY = 0.001  # every 0.1 % of the run: a long run shows its first line soon (issue 16)
+END_OF_STEP_ACCELERATIONS = False
 
 
 def check_tree_settings(scene: Scene) -> str | None:
@@ -50,6 +51,9 @@ def check_tree_settings(scene: Scene) -> str | None:
     if scene.joint.is_ideal:
         return ("the 'kinematic_tree' Exudyn model needs a clearance joint (with an ideal joint nothing moves "
                 "freely); use `exudyn_solver.model` = 'rigid_body' or the reference engine")  # fmt: skip
+    if s.callback not in TREE_ROUTES:
+        return (f"the 'kinematic_tree' Exudyn model has the callback routes {TREE_ROUTES}, got {s.callback!r}; "
+                "use `exudyn_solver.model` = 'rigid_body' for it")  # fmt: skip
     if s.explicit_method not in EXPLICIT_METHODS:
         return f"`exudyn_solver.explicit_method` must be one of {tuple(EXPLICIT_METHODS)}, got {s.explicit_method!r}"
     for name in ("relative_tolerance", "absolute_tolerance"):
@@ -59,10 +63,52 @@ def check_tree_settings(scene: Scene) -> str | None:
     return None
 
 
-def _cumtrapz(y, x):
+def contact_work(y, t, delta):
+    """Running integral of a contact power y (0 in free flight) over the stored steps, J.
+
+    In contact the steps (~15 us) are not short against the contact oscillation (~0.15 ms): a
+    trapezoid loses (h w)^2 / 12 of each oscillation, which accumulated to 0.17 J per revolution at
+    c = 0.5 mm (rtol 1e-6) and failed the energy guard after ~30 revolutions.  So a step whose
+    neighbour is in contact too is integrated with the quadratic through three step ends (the
+    step's two and the next one's, or the previous one's for the last step; weights of the
+    non-uniform Simpson rule, error O(h^4)):
+
+        int_{x0}^{x1} = h1/6 [ (3H - h1)/H y0 + (3H - 2 h1)/h2 y1 - h1^2/(H h2) y2 ],
+        h1 = x1 - x0, h2 = x2 - x1, H = h1 + h2.
+
+    A step where the contact starts or ends: y is 0 from the crossing of delta = 0 (linear in the
+    step, s = delta0 / (delta0 - delta1), as the onset tracking) to the free end, so only the part
+    in contact counts, 1/2 y_in (fraction in contact) h.  Other steps: trapezoids.
+    """
+    n = len(y)
     out = np.zeros_like(y)
-    if len(y) > 1:
-        out[1:] = np.cumsum(0.5 * (y[1:] + y[:-1]) * np.diff(x))
+    if n < 2:
+        return out
+    h = np.diff(t)
+    d0, d1 = delta[:-1], delta[1:]
+    area = 0.5 * (y[1:] + y[:-1]) * h
+    inside = delta > 0.0
+    if n >= 3:
+        # forward stencil (i, i+1, i+2) for steps 0..n-3, backward (i-1, i, i+1) for the last one
+        h1, h2 = h[:-1], h[1:]
+        big = h1 + h2
+        fwd = inside[:-2] & inside[1:-1] & inside[2:]
+        fw = (h1 / 6.0) * ((3.0 * big - h1) / big * y[:-2] + (3.0 * big - 2.0 * h1) / h2 * y[1:-1]
+                           - h1 * h1 / (big * h2) * y[2:])  # fmt: skip
+        area[:-1][fwd] = fw[fwd]
+        if inside[-3] and inside[-2] and inside[-1]:  # mirror of the forward rule on the last step
+            g1, g2 = h[-1], h[-2]
+            gb = g1 + g2
+            area[-1] = (g1 / 6.0) * ((3.0 * gb - g1) / gb * y[-1] + (3.0 * gb - 2.0 * g1) / g2 * y[-2]
+                                     - g1 * g1 / (gb * g2) * y[-3])  # fmt: skip
+    onset = (d0 <= 0.0) & (d1 > 0.0)
+    separation = (d0 > 0.0) & (d1 <= 0.0)
+    crossing = onset | separation
+    s = np.zeros_like(h)
+    s[crossing] = d0[crossing] / (d0[crossing] - d1[crossing])
+    area[onset] = 0.5 * y[1:][onset] * (1.0 - s[onset]) * h[onset]
+    area[separation] = 0.5 * y[:-1][separation] * s[separation] * h[separation]
+    out[1:] = np.cumsum(area)
     return out
 
 
@@ -79,7 +125,7 @@ def tree_settings(scene: Scene) -> exu.SimulationSettings:
     ti.relativeTolerance = s.relative_tolerance
     ti.absoluteTolerance = s.absolute_tolerance
     ti.minimumStepSize = scene.limits.min_step
-    ti.explicit.computeEndOfStepAccelerations = True
+    ti.explicit.computeEndOfStepAccelerations = END_OF_STEP_ACCELERATIONS
     silence(ss)
     return ss
 
@@ -89,6 +135,8 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
     scene = model.scene
     n = min(len(v) for v in data.values())
     q, q_t, q_tt, force = (data[k][:n] for k in ("q", "q_t", "q_tt", "force"))
+    if n and np.any(force[:, 0] != q[:, 0]):
+        raise RuntimeError("kinematic tree: the recorded contact forces are not at the sensors' times")
     t = q[:, 0]
     a, psi = q[:, 1], q[:, 1] + q[:, 2] - math.pi
     da, dpsi = q_t[:, 1], q_t[:, 1] + q_t[:, 2]
@@ -133,8 +181,8 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
         "kinetic_energy_J": kin13 + kin48,
         "potential_energy_J": u13 + pot48,
         "contact_energy_J": energy,
-        "driving_work_J": kin13 + u13 - (0.5 * float(j13_0) * omega**2 + float(u13_0)) + _cumtrapz(-q3 * omega, t),
-        "dissipated_energy_J": _cumtrapz((f_n - f_el) * rate, t),
+        "driving_work_J": kin13 + u13 - (0.5 * float(j13_0) * omega**2 + float(u13_0)) + contact_work(-q3 * omega, t, delta),
+        "dissipated_energy_J": contact_work((f_n - f_el) * rate, t, delta),
         "penetration_rate_m_s": rate,
     }
 
@@ -151,7 +199,6 @@ def solve_tree(scene: Scene, progress=None, callback: str | None = None) -> RunR
         "q": mbs.AddSensor(SensorNode(nodeNumber=model.node, outputVariableType=OVT.Coordinates, **store)),
         "q_t": mbs.AddSensor(SensorNode(nodeNumber=model.node, outputVariableType=OVT.Coordinates_t, **store)),
         "q_tt": mbs.AddSensor(SensorNode(nodeNumber=model.node, outputVariableType=OVT.Coordinates_tt, **store)),
-        "force": mbs.AddSensor(SensorObject(objectNumber=model.connector, outputVariableType=OVT.Force, **store)),
     }
     guard = RunGuard(scene)
     breach = []
@@ -191,6 +238,7 @@ def solve_tree(scene: Scene, progress=None, callback: str | None = None) -> RunR
         kind = "non_finite" if isinstance(exc, exu.SolverError) else "model" if isinstance(exc, exu.ModelError) else "solver"
     wall_solve = _time.perf_counter() - wall_solve
     data = {k: mbs.GetSensorStoredData(v) for k, v in sensors.items()}
+    data["force"] = np.array(model.bearing_force).reshape(-1, 3)
     steps = tree_channels(model, data) if min(len(v) for v in data.values()) else empty_channels()
     bad = first_nonfinite_row(steps)
     if bad is not None:
@@ -219,7 +267,7 @@ def solve_tree(scene: Scene, progress=None, callback: str | None = None) -> RunR
         "rejected_steps": int(it.rejectedAutomaticStepSizeSteps),
         "min_step_s": state["min_step"],
         "callback": model.route,
-        "callback_calls": model.callback_calls[0] if model.route == "python" else None,
+        "callback_calls": int(model.callback_calls[0]),
         **model.tracker.counters(),  # contact_events, nonpositive_onsets, separations, missed_*
         "solve_time_s": wall_solve,
         "wall_time_s": _time.perf_counter() - wall0,

@@ -11,8 +11,10 @@ Only reproducible quantities are stored (SPEC.md section 6):
 
 Tolerances are measured, not guessed: each case is rerun with perturbations of the
 solver that change nothing but round-off and the error control (reference: rtol x (1 +
-1e-7), rtol / 10; exudyn: the numba callback route instead of the symbolic one, Newton
-tolerance / 10; statistics cases a few more, :data:`STATISTICS_PERTURBATIONS`) and
+1e-7), rtol / 10; Exudyn's rigid-body model: the numba callback route instead of the symbolic
+one, Newton tolerance / 10; its kinematic tree, the model its automatic selection takes for a
+clearance: the python callback route instead of numba, rtol x (1 + 1e-7), rtol / 10;
+statistics cases a few more, :data:`STATISTICS_PERTURBATIONS`) and
 each quantity's tolerance is ``SAFETY[kind]`` times its largest relative shift, but at
 least ``FLOOR[kind]``.  The table records the shifts, the
 perturbations and the rule next to each value.  ``scripts/regenerate_regression.py``
@@ -48,12 +50,16 @@ PERTURBATIONS = {
                   ("rtol / 10", {"solver.reference.rtol": "scale:0.1"})),
     "exudyn": (("numba callback route", {"solver.exudyn.callback": "numba"}),
                ("Newton tolerance / 10", {"solver.exudyn.newton_relative_tolerance": "scale:0.1"})),
+    "exudyn kinematic_tree": (("python callback route", {"solver.exudyn.callback": "python"}),
+                              ("rtol x (1 + 1e-7)", {"solver.exudyn.relative_tolerance": "scale:1.0000001"}),
+                              ("rtol / 10", {"solver.exudyn.relative_tolerance": "scale:0.1"})),
 }
 # Statistics scatter like samples of a chaotic impact sequence: more perturbations for a fairer largest shift.
 STATISTICS_PERTURBATIONS = {
     "reference": (("rtol x (1 - 1e-7)", {"solver.reference.rtol": "scale:0.9999999"}),
                   ("atol x 10", {"solver.reference.atol": "scale:10"})),
     "exudyn": (("Newton tolerance / 2", {"solver.exudyn.newton_relative_tolerance": "scale:0.5"}),),
+    "exudyn kinematic_tree": (("rtol x (1 - 1e-7)", {"solver.exudyn.relative_tolerance": "scale:0.9999999"}),),
 }
 
 
@@ -91,10 +97,24 @@ CASES: tuple[Case, ...] = (
 )
 
 
+def perturbation_key(case: Case) -> str:
+    """The engine, or for Exudyn's kinematic tree (what its selection takes for the case) "exudyn kinematic_tree"."""
+    if case.engine != "exudyn":
+        return case.engine
+    from pathlib import Path
+
+    from weftsim.exudyn_engine.selection import select_model
+    from weftsim.scene import load_scene
+
+    scene = load_scene(Path(__file__).resolve().parents[2] / case.scene, case.overrides)
+    return "exudyn kinematic_tree" if select_model(scene)[0] == "kinematic_tree" else "exudyn"
+
+
 def perturbations(case: Case) -> tuple:
     """(label, overrides) of the perturbed reruns that set the case's tolerances."""
-    extra = STATISTICS_PERTURBATIONS[case.engine] if case.kind == "statistics" else ()
-    return PERTURBATIONS[case.engine] + extra
+    key = perturbation_key(case)
+    extra = STATISTICS_PERTURBATIONS[key] if case.kind == "statistics" else ()
+    return PERTURBATIONS[key] + extra
 
 
 def case_from_entry(entry: dict) -> Case:

@@ -1,0 +1,135 @@
+"""Error-controlled step of the Exudyn rigid-body model (weftsim.exudyn_engine.step_control, issue 12.2).
+
+The energy balance through the start-up impacts under this step is tests/test_exudyn_engine.py's
+``test_energy_balance_with_clearance`` (its scene uses the default, adaptive step).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from weftsim import reference
+from weftsim.exudyn_engine import solve
+from weftsim.exudyn_engine.step_control import newmark_beta, to_sample_grid
+from weftsim.params import ClearanceJoint, Drive, ExudynSolver, Scene
+from weftsim.scene import SceneError, load_scene
+
+RPM = math.pi / 30.0
+MODELS = Path(__file__).resolve().parents[1] / "models"
+START = 30.0 / 360.0  # revolutions: free flight to the first contact (6.6 deg), the start-up impacts (9.4 deg)
+
+
+def scene(revolutions=START, **solver) -> Scene:
+    return Scene(joint=ClearanceJoint(clearance=0.25e-3), drive=Drive(speed=400.0 * RPM, revolutions=revolutions),
+                 exudyn_solver=ExudynSolver(**solver))  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def startup():
+    return solve(scene())
+
+
+def test_newmark_beta_of_generalized_alpha():
+    # rho = 1: the trapezoidal rule (beta = 1/4); rho = 0.8: alpha_m = 1/3, alpha_f = 4/9, beta = (10/9)^2 / 4.
+    assert newmark_beta(1.0) == pytest.approx(0.25, rel=1e-15)
+    assert newmark_beta(0.8) == pytest.approx((10.0 / 9.0) ** 2 / 4.0, rel=1e-15)
+
+
+def test_steps_end_on_every_sample_without_slivers():
+    period = 1e-3
+    assert to_sample_grid(0.0, 2e-3, period) == pytest.approx(period)  # never across a sample
+    assert to_sample_grid(0.0, 0.9e-3, period) == pytest.approx(period)  # within 1.2 h: land on it
+    assert to_sample_grid(0.0, 0.6e-3, period) == pytest.approx(0.5e-3)  # within 2 h: two equal steps
+    assert to_sample_grid(0.0, 1e-4, period) == 1e-4  # far from it: the planned step
+    assert to_sample_grid(period * (1.0 - 1e-15), 2e-3, period) == pytest.approx(period)  # on a sample: the next
+
+
+def test_samples_are_step_ends_and_the_step_varies(startup):
+    r = startup
+    assert r.ok, r.message
+    assert r.solver_stats["step_control"] == "adaptive"
+    t = r.steps["time_s"]
+    # Every output time is an accepted step (to round-off of the accumulated time), so samples are states.
+    nearest = np.min(np.abs(t[None, :] - r.samples["time_s"][:, None]), axis=1)
+    assert np.max(nearest) < 1e-12
+    h = np.diff(t)
+    t_contact = r.events["first_contact_time_s"]
+    free, impact = h[t[1:] < t_contact], h[(t[1:] > t_contact) & (r.steps["in_contact"][1:] > 0)]
+    # Free flight: the mechanism's own motion; the controller grows the step to the sample period
+    # (0.5 deg = 2.08e-4 s at 400 rpm) within a few steps.  Through the start-up impact the
+    # journal's acceleration jumps by F_N / m ~ 1e5 m/s^2 per microsecond: steps of ~1e-6 s.
+    period = r.scene.output.sample_angle / r.scene.drive.speed
+    assert np.max(free) == pytest.approx(period, rel=1e-9)
+    assert np.min(impact) < 3e-6
+    assert np.median(free) > 30.0 * np.median(impact)
+
+
+def test_first_contact_and_startup_peaks_match_the_reference_engine(startup):
+    ex, ref = startup, reference.solve(startup.scene)
+    assert ex.ok and ref.ok
+    # The onset is located within its step: measured 7.4e-6 deg from the reference engine's event
+    # location at 3e-9 m and below (7.1e-5 deg at 3e-8 m); the scene's compare tolerance is 0.1 deg.
+    assert abs(ex.first_contact_angle_deg - ref.first_contact_angle_deg) < 1e-3
+    for name in ("contact_force_N", "rapier_acceleration_m_s2", "driving_torque_Nm"):
+        # The start-up impacts up to 30 deg, at the default tolerance 3e-10 m: measured 5e-6 (F_N) and
+        # 6.8e-4 (torque; 5.4e-3 at 3e-9 m, 6.0e-3 at 3e-8 m); 1 % is the issue's criterion.
+        assert ex.steps[name].max() == pytest.approx(ref.steps[name].max(), rel=0.01), name
+
+
+def test_a_tighter_tolerance_takes_more_steps_and_converges(startup):
+    tight = solve(scene(local_error=startup.scene.exudyn_solver.local_error / 10.0))
+    assert tight.ok
+    # The local error scales as h^3: a 10x tighter tolerance asks for 10^(1/3) = 2.15x more steps
+    # where the error controls the step (impacts, contact); measured 2.09-2.14x from 3e-8 to 3e-11 m.
+    ratio = tight.solver_stats["steps"] / startup.solver_stats["steps"]
+    assert 1.8 < ratio < 2.5
+    # The energy the start-up impacts dissipate (an integral over the whole impact sequence, not a
+    # sampled peak) against the reference engine: measured relative errors 2.7e-2, 9.6e-3, 1.2e-3,
+    # 2.4e-4 at 3e-8, 3e-9, 3e-10, 3e-11 m, so each 10x tighter tolerance cuts it 3-8x; asking for 2x
+    # fails if the control stops converging.
+    done = reference.solve(startup.scene).steps["dissipated_energy_J"][-1]
+    err = [abs(r.steps["dissipated_energy_J"][-1] / done - 1.0) for r in (startup, tight)]
+    assert err[1] < 0.5 * err[0], err
+
+
+@pytest.mark.slow
+def test_first_revolution_peaks_match_the_fixed_small_step_run():
+    adaptive = solve(scene(1.0))
+    fixed = solve(scene(1.0, step_control="fixed", step_size=2e-6))
+    assert adaptive.ok and fixed.ok
+    assert adaptive.solver_stats["steps"] < fixed.solver_stats["steps"] / 2.0  # measured 29 000 against 75 600
+    for name in ("contact_force_N", "rapier_acceleration_m_s2", "driving_torque_Nm"):
+        # Issue 12: 1 %.  Measured against the converged reference ensemble (weftsim.bench.measure):
+        # fixed 2e-6 s 3.1e-3 / 4e-5 / 3e-5 (torque / a / F_N), adaptive at the default 3e-10 m
+        # 6e-4 / 2e-5 / 3e-5, so the two differ by at most 4e-3.  The torque maximum comes from the
+        # impacts near 48 deg, whose sequence is sensitive to the step: 1.1e-2 at 1e-9 m, 1.9e-3 at
+        # 3e-9 m, 1.9e-2 at a fixed 5e-6 s.
+        a, b = adaptive.steps[name].max(), fixed.steps[name].max()
+        assert a == pytest.approx(b, rel=0.01), name
+
+
+def test_bad_step_control_settings_are_one_line_errors():
+    for key, value, words in (("solver.exudyn.step_control", "sometimes", ("step_control", "adaptive", "fixed")),
+                              ("solver.exudyn.local_error_m", -1.0, ("local_error_m", "> 0"))):
+        with pytest.raises(SceneError) as err:
+            load_scene(MODELS / "reference.toml", {key: value})
+        text = str(err.value)
+        assert "\n" not in text and all(w in text for w in words), text
+    r = solve(dataclasses.replace(scene(), exudyn_solver=ExudynSolver(step_control="sometimes")))
+    assert r.status == "failed" and "step_control" in r.message and "adaptive" in r.message
+
+
+def test_progress_follows_the_simulated_time():
+    seen = []
+    r = solve(scene(0.1), progress=seen.append)
+    assert r.ok
+    # Reported from the simulated time (the step count is not known ahead): from 0 to 1, never back,
+    # and spread over the run (measured 134 calls for this 36 deg run).
+    assert seen[0] == 0.0 and seen[-1] == 1.0
+    assert all(b >= a for a, b in zip(seen, seen[1:]))
+    assert len(seen) > 20 and max(b - a for a, b in zip(seen, seen[1:])) < 0.25

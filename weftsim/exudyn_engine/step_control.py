@@ -1,0 +1,199 @@
+"""Step-size control of generalized-alpha for the rigid-body model: large steps in free flight, small through impacts.
+
+Exudyn's generalized-alpha has no error control of its own (its ``adaptiveStep`` only cuts the step
+after a Newton failure).  This module adds one from two of its hooks:
+
+- a post-Newton user function (``mbs.SetPostNewtonUserFunction``) sees each converged trial step and
+  rejects it when its local error estimate exceeds the tolerance; Exudyn then repeats the step from
+  the start-of-step state with the recommended smaller step;
+- a post-step hook (accepted steps only) sets the size of the next step on the solver
+  (``solver.it.currentStepSize``), shortened so that a step ends on every output sample.
+
+Local error estimate (Zienkiewicz and Xie 1991, for the Newmark family, which contains
+generalized-alpha): the displacement after one step differs from the exact solution through the
+same start state by
+
+    e = |beta - 1/6| h^2 |a(t + h) - a(t)|
+
+with beta the Newmark parameter of the method (0.309 at spectral radius 0.8).  It is applied to the
+point the impacts act on: the journal centre at E, whose acceleration is bounded from its body's
+node (centre of mass of the rod, member 4: translation plus arm x angular acceleration; one cheap
+call per step).  The bearing on the rocker follows the prescribed kinematics of members 1-3, which
+change far more slowly.  In free flight a(t) varies with the mechanism's kinematics (the estimate
+allows steps of up to one output sample, 0.5 deg); through an impact it jumps by F_N / m within
+microseconds (it asks for microsecond steps); in a lasting, smoothly loaded contact it lets the
+step grow again.  The new step follows the usual controller for
+an error of order h^3 (Hairer, Norsett and Wanner, Solving ODEs I, section II.4)::
+
+    h_new = h * min(GROWTH_MAX, max(SHRINK_MIN, SAFETY * (tol / e)^(1/3)))
+
+clamped to [min_step, max_step]; a step whose estimate exceeds ``REJECT_FACTOR * tol`` is repeated
+with that step.  The ideal joint does not use it (solver.py: a fixed crank-angle step).
+"""
+
+from __future__ import annotations
+
+import math
+
+import exudyn as exu
+
+from weftsim.exudyn_engine.clearance_joint import register_post_step
+
+# Controller constants (Hairer, Norsett and Wanner, section II.4): aim at 0.9 of the tolerance,
+# never shrink below 0.2 or grow beyond 2x in one step (a step that grows faster meets an impact
+# it has not seen coming with too large a step, and the rejection costs a whole Newton solve).
+SAFETY = 0.9
+SHRINK_MIN = 0.2
+GROWTH_MAX = 2.0
+# A step is repeated only when its estimate exceeds this multiple of the tolerance: between 1 and 2
+# the next step is shortened instead (standard practice; a rejection costs a full Newton solve).
+REJECT_FACTOR = 2.0
+# Rejections report this error to Exudyn (compared with discontinuous.iterationTolerance = 1).
+_REJECT = 2.0
+_ACCEPT = 0.0
+_NO_RECOMMENDATION = -1.0
+_OVT = exu.OutputVariableType
+
+
+class StepController:
+    """Error-controlled step size of one generalized-alpha run (module docstring).
+
+    Parameters
+    ----------
+    mbs : exudyn.MainSystem
+        The assembled mechanism.
+    solver : exudyn.MainSolverImplicitSecondOrder
+        The solver that will run it (its step size is set between steps).
+    node : exudyn NodeIndex
+        The 2-D rigid-body node of the journal's body (the rod, member 4).
+    arm : float
+        Distance from that node (the body's centre of mass) to the journal centre, m.
+    tolerance : float
+        Local error tolerance on the eccentricity, m.
+    min_step, max_step : float
+        Step range, s.
+    sample_period : float
+        Output sample spacing, s: every sample time is a step end.
+    newmark_beta : float
+        beta of the generalized-alpha method in use.
+    """
+
+    def __init__(self, mbs, solver, node, arm: float, tolerance: float, min_step: float, max_step: float,
+                 sample_period: float, newmark_beta: float):
+        self.mbs = mbs
+        self.it = solver.it  # the solver's step data (a live reference: writes reach the solver)
+        self.node = node
+        self.arm = arm
+        self.tolerance = tolerance
+        self.min_step = min_step
+        self.max_step = min(max_step, sample_period)
+        self.sample_period = sample_period
+        self.factor = abs(newmark_beta - 1.0 / 6.0)
+        self.accel_start = None  # relative acceleration at the last accepted state
+        self.accel_trial = None
+        self.error_trial = 0.0
+        self.next_step = self.max_step
+        self.rejected = 0
+        self.smallest = math.inf
+        self.largest = 0.0
+
+    @classmethod
+    def for_mechanism(cls, mbs, solver, model, scene) -> "StepController":
+        """The controller of a built mechanism (:func:`~weftsim.exudyn_engine.mechanism.build_mechanism`)
+        under the scene's settings: tolerance ``exudyn_solver.local_error``, steps between
+        ``limits.min_step`` and one output sample period."""
+        s = scene.exudyn_solver
+        period = scene.output.sample_angle / scene.drive.speed
+        journal = mbs.GetMarker(model.marker_journal)["localPosition"]
+        return cls(mbs, solver, model.nodes["rod"], math.hypot(journal[0], journal[1]), s.local_error, scene.limits.min_step, period, period,
+                   newmark_beta(s.spectral_radius))
+
+    def acceleration(self):
+        """Acceleration (x, y, angular) of the journal's body in the current trial or accepted state."""
+        return self.mbs.GetNodeOutput(self.node, _OVT.Coordinates_tt)
+
+    def error(self, h: float, a1) -> float:
+        """Local error estimate of a step of size h ending with journal-body acceleration a1, m.
+
+        |a1 - a0| of the journal point is bounded by that of the body's centre plus |r| times the
+        change of its angular acceleration (r = centre to journal; the change of the centripetal
+        term within a step is far smaller).
+        """
+        a0 = self.accel_start
+        jump = math.hypot(a1[0] - a0[0], a1[1] - a0[1]) + self.arm * abs(a1[2] - a0[2])
+        return self.factor * h * h * jump
+
+    def proposal(self, h: float, error: float) -> float:
+        """Next step after a step h with estimate ``error`` (controller of the module docstring)."""
+        if error <= 0.0:
+            ratio = GROWTH_MAX
+        else:
+            ratio = min(GROWTH_MAX, max(SHRINK_MIN, SAFETY * (self.tolerance / error) ** (1.0 / 3.0)))
+        return min(self.max_step, max(self.min_step, h * ratio))
+
+    def post_newton(self, mbs, t):
+        """Exudyn post-Newton function: [error flag, recommended step] of the converged trial step."""
+        h = self.it.currentStepSize
+        a1 = self.acceleration()
+        err = self.error(h, a1)
+        if err > REJECT_FACTOR * self.tolerance and h > self.min_step * (1.0 + 1e-9):
+            # Exudyn repeats the step with min(0.75 h, recommendation) from the start-of-step state.
+            self.rejected += 1
+            return [_REJECT, self.proposal(h, err)]
+        self.accel_trial, self.error_trial = a1, err
+        return [_ACCEPT, _NO_RECOMMENDATION]
+
+    def post_step(self, mbs, t):
+        """After an accepted step (and once at t = 0): plan the next step, ending on the sample grid."""
+        if t <= 0.0 or self.accel_trial is None:
+            self.accel_start = self.acceleration()
+            h_next = self.next_step
+        else:
+            h = self.it.currentStepSize
+            self.smallest = min(self.smallest, h)
+            self.largest = max(self.largest, h)
+            self.accel_start = self.accel_trial
+            h_next = self.proposal(h, self.error_trial)
+        self.accel_trial = None
+        self.next_step = h_next
+        self.it.currentStepSize = to_sample_grid(t, h_next, self.sample_period)
+        return True
+
+    def install(self) -> None:
+        """Register both hooks on the system."""
+        self.mbs.SetPostNewtonUserFunction(self.post_newton)
+        register_post_step(self.mbs, self.post_step)
+
+    def counters(self) -> dict:
+        return {"rejected_error_steps": self.rejected,
+                "smallest_step_s": self.smallest if math.isfinite(self.smallest) else None,
+                "largest_step_s": self.largest or None}  # fmt: skip
+
+
+def newmark_beta(spectral_radius: float) -> float:
+    """Newmark beta of generalized-alpha at spectral radius rho (Chung and Hulbert 1993; as in Exudyn).
+
+    alpha_m = (2 rho - 1) / (rho + 1), alpha_f = rho / (rho + 1), beta = (1 - alpha_m + alpha_f)^2 / 4.
+    """
+    rho = spectral_radius
+    alpha_m = (2.0 * rho - 1.0) / (rho + 1.0)
+    alpha_f = rho / (rho + 1.0)
+    return 0.25 * (1.0 - alpha_m + alpha_f) ** 2
+
+
+def to_sample_grid(t: float, h: float, period: float) -> float:
+    """Step from time t of at most h that does not cross the next sample time k * period.
+
+    Within 1.2 h of the sample the step ends on it (a step up to 20 % longer than planned rather than
+    a sliver); within 2 h the remainder is split in two equal steps.
+    """
+    k = math.floor(t / period * (1.0 + 1e-12)) + 1
+    remaining = k * period - t
+    if remaining <= period * 1e-9:  # t sits on a sample within round-off: aim at the next one
+        remaining += period
+    if remaining <= 1.2 * h:
+        return remaining
+    if remaining <= 2.0 * h:
+        return 0.5 * remaining
+    return h
+
