@@ -100,8 +100,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
 
     p = sub.add_parser("sweep", help="run a grid of scene variants in parallel (table of peaks, plots)",
-                       description="Run every combination of the --vary values, each cell in its own process, "
-                       "into OUTPUT/<cell>/; rerunning skips finished cells.  See docs/sweeps.md.")
+                       description="Run every combination of the --vary values on a pool of worker processes "
+                       "(or a Dask cluster) into OUTPUT/<cell>/; rerunning skips finished cells.  See docs/sweeps.md.")
     p.add_argument("scene", help="base scene file (TOML), e.g. models/reference.toml")
     p.add_argument("--vary", action="append", required=True, metavar="KEY=VALUES",
                    help="a scene key (clearance_mm, speed_rpm, law, ... or a dotted key) and its values: "
@@ -109,10 +109,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="fixed override for every cell")
     p.add_argument("-o", "--output", default=None, help="sweep directory (default: out/<scene name>-sweep)")
     p.add_argument("--engine", default="exudyn",
-                   help="exudyn (default), reference, or module:function of your own engine (checked by the sweep)")
+                   help="exudyn (default), reference, or module:function of your own engine: a plug-in, "
+                   "imported and run like any code (docs/sweeps.md)")
+    p.add_argument("--allow-cwd-engine", action="store_true",
+                   help="allow a --engine module:function found in the current directory (refused by default)")
     p.add_argument("--jobs", type=_positive(int), help="local worker processes (default: number of CPUs)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="run on an existing Dask cluster, e.g. tcp://host:8786")
     p.add_argument("--cell-figures", action="store_true", help="also draw each cell's channels.png")
+    p.add_argument("--yes", action="store_true", help="run a grid of more than 2000 cells (refused without it)")
 
     p = sub.add_parser("study", help="one of the paper's studies: figures, CSV and JSON (docs/paper-comparison.md)",
                        description="Run a study of the paper: contact-law (Fig. 7-9), clearance (Fig. 12), "
@@ -398,15 +402,39 @@ def cmd_compare(args) -> int:
     return 0
 
 
+class _SweepTerminated(KeyboardInterrupt):
+    """SIGTERM or SIGHUP during a sweep: handled as Ctrl-C is (queued cells cancelled, workers ended,
+    table rewritten, lock released), then reported with the signal's own exit status."""
+
+    def __init__(self, signum: int):
+        super().__init__(signum)
+        self.signum = signum
+
+
+def _raise_terminated(signum, frame):
+    raise _SweepTerminated(signum)
+
+
 def cmd_sweep(args) -> int:
     from weftsim.sweep import SweepError, format_report, plan_sweep, run_sweep
 
+    handled = (signal.SIGTERM, signal.SIGHUP)
+    previous = {sig: signal.signal(sig, _raise_terminated) for sig in handled}
     try:
-        plan = plan_sweep(args.scene, args.vary, args.set, args.engine)
+        plan = plan_sweep(args.scene, args.vary, args.set, args.engine, allow_large=args.yes,
+                          allow_cwd_engine=args.allow_cwd_engine,
+                          announce=lambda line: print(line, file=sys.stderr, flush=True))
         outdir = Path(args.output) if args.output else Path("out") / (Path(args.scene).stem + "-sweep")
         report = run_sweep(plan, outdir, jobs=args.jobs, scheduler=args.scheduler, cell_figures=args.cell_figures)
     except SweepError as exc:
         raise CliError(str(exc)) from None
+    except _SweepTerminated as exc:
+        name = signal.Signals(exc.signum).name
+        raise CliError(f"terminated by {name}; finished cells are kept, run the same command again to resume",
+                       128 + exc.signum) from None
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
     print(format_report(report))
     if report.failed:
         raise CliError(f"{report.failed} of {report.total} cells failed (see {report.table} and each failed cell's "

@@ -14,8 +14,10 @@ Each cell is named by its parameters, sorted by short name, e.g.
 
 from __future__ import annotations
 
+import collections
 import difflib
 import itertools
+import math
 import re
 from dataclasses import dataclass
 from typing import Any
@@ -133,8 +135,8 @@ def parse_values(key: Key, text: str, flag: str = "--vary") -> list[Any]:
     if not text.strip():
         raise SweepError(f"{flag}: no values given for '{key.path}'")
     values = _range(key, text, flag) if ":" in text else [_scalar(key, t, flag) for t in text.split(",")]
-    names = [format_value(v) for v in values]
-    repeated = sorted({n for n in names if names.count(n) > 1})
+    counts = collections.Counter(format_value(v) for v in values)  # linear: a range may hold a million values
+    repeated = sorted(name for name, count in counts.items() if count > 1)
     if repeated:
         raise SweepError(f"{flag}: value(s) {', '.join(repeated)} of '{key.path}' given more than once")
     return values
@@ -187,6 +189,11 @@ def cell_name(params: dict[str, Any]) -> str:
     return ",".join(f"{name}={format_value(params[name])}" for name in sorted(params))
 
 
+def grid_size(axes: list[Axis] | tuple[Axis, ...]) -> int:
+    """Number of cells of the product of the axes, computed without building them."""
+    return math.prod(len(axis.values) for axis in axes)
+
+
 def grid_cells(axes: list[Axis] | tuple[Axis, ...], fixed: dict[str, Any] | None = None) -> list[Cell]:
     """All cells of the product of the axes (first axis outermost), each with ``fixed`` overrides added.
 
@@ -196,8 +203,8 @@ def grid_cells(axes: list[Axis] | tuple[Axis, ...], fixed: dict[str, Any] | None
         If a key is varied twice or both varied and fixed.
     """
     fixed = dict(fixed or {})
-    keys = [axis.key for axis in axes]
-    twice = sorted({k for k in keys if keys.count(k) > 1})
+    keys = collections.Counter(axis.key for axis in axes)
+    twice = sorted(k for k, count in keys.items() if count > 1)
     if twice:
         raise SweepError(f"--vary: key(s) {', '.join(twice)} given more than once; put all values in one --vary")
     both = sorted(set(keys) & set(fixed))

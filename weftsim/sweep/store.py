@@ -3,6 +3,7 @@
 Layout::
 
     OUT/sweep.json                        base scene, engine, varied keys and values
+    OUT/sweep.lock                        while a sweep runs: who holds the directory (weftsim.sweep.lock)
     OUT/<cell name>/cell.json             one per cell, written last (see weftsim.sweep.cell)
     OUT/<cell name>/summary.json, channels.csv[, channels.png, error.txt]
     OUT/sweep.csv                         one row per cell, rebuilt from the cell.json files
@@ -26,6 +27,7 @@ from typing import Any
 from weftsim import __version__
 from weftsim.sweep.cell import METRIC_CHANNELS, finite_or_none, read_record
 from weftsim.sweep.grid import Axis, SweepError, format_value
+from weftsim.sweep.lock import LOCK_FILE
 
 SWEEP_FILE = "sweep.json"
 TABLE_FILE = "sweep.csv"
@@ -62,7 +64,27 @@ def read_manifest(outdir: Path) -> dict | None:
         raise SweepError(f"{path} cannot be read ({exc}); move it away to start a new sweep there") from None
     if not isinstance(data, dict) or data.get("format") != SWEEP_FORMAT:
         raise SweepError(f"{path} is not a weftsim sweep manifest; choose another output directory")
+    problem = _manifest_problem(data)
+    if problem:
+        raise SweepError(f"{path} is damaged ({problem}); move it away (the cell directories can stay) "
+                         "and rerun the sweep to rebuild it")
     return data
+
+
+def _manifest_problem(data: dict) -> str:
+    """What is missing or malformed in a manifest of the right format ('' if nothing)."""
+    if not isinstance(data.get("engine"), str):
+        return "no engine"
+    if not isinstance(data.get("base_scene"), dict):
+        return "no base scene"
+    axes = data.get("axes")
+    if not isinstance(axes, list) or not axes:
+        return "no varied keys"
+    for axis in axes:
+        if not isinstance(axis, dict) or not isinstance(axis.get("key"), str) \
+                or not isinstance(axis.get("values"), list):
+            return f"a varied key is not of the form {{key, values}}: {axis!r:.80}"
+    return ""
 
 
 def _differences(old: dict, new: dict) -> list[str]:
@@ -94,7 +116,7 @@ def merge_manifest(outdir: Path, new: dict) -> dict:
     outdir = Path(outdir)
     old = read_manifest(outdir)
     if old is None:
-        if outdir.exists() and any(outdir.iterdir()):
+        if outdir.exists() and any(p.name != LOCK_FILE for p in outdir.iterdir()):
             raise SweepError(f"output directory {outdir} is not empty and holds no {SWEEP_FILE}; "
                              "choose a new or empty directory")
         return new
