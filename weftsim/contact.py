@@ -85,10 +85,22 @@ from weftsim.params import ClearanceJoint
 ScalarLaw = Callable[[float, float, float], float]
 
 
+# Which law function _map_law evaluates (a number, not a function argument: numba compiles a function
+# passed as an argument again in every process, ~0.2 s; this loop loads from its cache in ~5 ms).
+_STIFFNESS, _ELASTIC_FORCE, _ELASTIC_ENERGY = 0, 1, 2
+_LAW_FUNCTIONS = {kernel.stiffness: _STIFFNESS, kernel.elastic_force: _ELASTIC_FORCE,
+                  kernel.elastic_energy: _ELASTIC_ENERGY}  # fmt: skip
+
+
 @njit(cache=True, error_model="numpy")
-def _map_law(fn, kind, coef, clearance, delta, out):
+def _map_law(which, kind, coef, clearance, delta, out):
     for i in range(delta.size):
-        out[i] = fn(kind, coef, clearance, delta[i])
+        if which == _STIFFNESS:
+            out[i] = kernel.stiffness(kind, coef, clearance, delta[i])
+        elif which == _ELASTIC_FORCE:
+            out[i] = kernel.elastic_force(kind, coef, clearance, delta[i])
+        else:
+            out[i] = kernel.elastic_energy(kind, coef, clearance, delta[i])
 
 
 @njit(cache=True, error_model="numpy")
@@ -97,9 +109,11 @@ def _map_normal_force(kind, coef, clearance, xi, delta, rate, impact_velocity, o
         out[i] = kernel.normal_force(kind, coef, clearance, xi, delta[i], rate[i], impact_velocity[i])
 
 
-# Arrays shorter than this are evaluated by the kernel's plain-Python form (~1 us per element): loading
-# the compiled loop from numba's cache costs ~0.3 s in a new process, the time of ~3e5 elements.
-_COMPILED_FROM = 100_000
+# Arrays shorter than this are evaluated by the kernel's plain-Python form (~1 us per element): the
+# compiled loops load from numba's cache in ~5 ms once numba is set up in the process (an engine run
+# has done that), but the first compiled call of a process costs ~0.3 s.  Measured: a 10-revolution
+# run's 69 000 steps took 40-80 ms in plain Python against ~1 ms compiled.
+_COMPILED_FROM = 2_000
 
 
 def _law_array(fn, kind, coef, clearance, penetration):
@@ -111,7 +125,7 @@ def _law_array(fn, kind, coef, clearance, penetration):
         out = np.fromiter((form(kind, coef, clearance, d) for d in flat.tolist()), float, flat.size)
     else:
         out = np.empty(flat.size)
-        _map_law(fn, kind, coef, clearance, flat, out)
+        _map_law(_LAW_FUNCTIONS[fn], kind, coef, clearance, flat, out)
     return out.reshape(delta.shape)[()]
 
 

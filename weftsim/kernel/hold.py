@@ -32,7 +32,7 @@ from numba import njit
 RESTING_RATE_FRACTION = 1e-6
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def effective_impact_velocity(held, penetration_rate, max_approach):
     """v_imp of the damping term, m/s: ``max(held, delta_dot)`` under "max_approach", else ``held``."""
     if max_approach and penetration_rate > held:

@@ -53,7 +53,7 @@ def joint_parameters(joint, law) -> np.ndarray:
     return out
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def clearance_force(prm, ex, ey, ex_dot, ey_dot, v_t, v_imp):
     """Force of the joint at eccentricity e and its rate, with held impact velocity v_imp.
 

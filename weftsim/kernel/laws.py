@@ -55,7 +55,7 @@ _VKD_CUBE = _moment_coefficients(3.0, -1.5) * 2.0
 _EF_SERIES = _moment_coefficients(1.5, -0.5)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def stiffness(kind, coef, clearance, delta):
     """K(delta) of the law, N/m^1.5 (delta <= 0 gives the value at 0)."""
     d = delta if delta > 0.0 else 0.0
@@ -68,7 +68,7 @@ def stiffness(kind, coef, clearance, delta):
     return coef
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def elastic_force(kind, coef, clearance, delta):
     """F_el = K(delta) delta^1.5 for delta > 0, else 0, N."""
     if delta <= 0.0:
@@ -76,7 +76,7 @@ def elastic_force(kind, coef, clearance, delta):
     return stiffness(kind, coef, clearance, delta) * delta * math.sqrt(delta)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def normal_force(kind, coef, clearance, xi, delta, delta_dot, impact_velocity):
     """F_N = max(0, F_el(delta) (1 + xi delta_dot / v_imp)) for delta > 0, else 0, N (v_imp > 0)."""
     if delta <= 0.0:
