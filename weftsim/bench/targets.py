@@ -47,7 +47,8 @@ SOLVES = {
         "reference", "reference", "scipy", {"solver.reference.method": "DOP853", "solver.reference.rtol": 1e-9,
                                             "solver.reference.atol": 1e-12}),
     "baseline: exudyn rigid_body h 2e-6 s (0.1 default)": Setting(
-        "exudyn", "exudyn", "rigid h2e-6", {"solver.exudyn.model": "rigid_body", "solver.exudyn.step_size_s": 2e-6}),
+        "exudyn", "exudyn", "rigid h2e-6", {"solver.exudyn.model": "rigid_body", "solver.exudyn.step_control": "fixed",
+                                            "solver.exudyn.step_size_s": 2e-6}),
 }
 MAP_VARY = ["clearance_mm=0.01,0.05,0.1,0.15,0.2,0.25,0.3,0.35,0.4,0.45,0.5", "speed_rpm=300:800:11"]
 
