@@ -32,8 +32,9 @@ MAP_CLEARANCES = "0.01," + ",".join(f"{0.05 * k:.2f}" for k in range(1, 11))
 STUDIES = {
     "clearance": (["clearance_mm=0.01,0.25,0.5"], []),
     "speed": (["speed_rpm=300,500,800"], []),
-    # 11 x 11 = 121 cells of 2 revolutions; speed every 50 rpm holds 300, 400, 500 and 800.
-    "map": ([f"clearance_mm={MAP_CLEARANCES}", "speed_rpm=300:800:11"], ["revolutions=2"]),
+    # 11 x 11 = 121 cells of 10 revolutions (~35 s on 2 cores with the default compiled path, issue 12;
+    # 2 revolutions before); speed every 50 rpm holds 300, 400, 500 and 800.
+    "map": ([f"clearance_mm={MAP_CLEARANCES}", "speed_rpm=300:800:11"], ["revolutions=10"]),
 }
 
 
