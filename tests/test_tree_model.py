@@ -115,3 +115,43 @@ def test_energy_balance_closes_over_six_revolutions_at_half_a_millimetre():
     # The energy guard fails a run at 1 % of the largest kinetic energy (5.5 J here); 0.2 % over 6
     # revolutions keeps 40 revolutions (tests/test_engine_agreement.py) below it.
     assert np.abs(residual).max() < 2e-3 * st["kinetic_energy_J"].max()
+
+
+def test_the_hermite_onset_rate_is_the_cubics_slope_at_its_first_zero():
+    """A whole light impact inside one step (approach at 0.3 m/s, turned back by the end): the linear
+    in-step estimate goes negative, the cubic Hermite interpolant's first rising zero gives the approach
+    rate.  For delta itself a cubic, the interpolant is exact: its slope there is the answer to round-off."""
+    from weftsim.exudyn_engine.onset import hermite_onset_rate, onset_velocity, positive_onset_velocity
+
+    h = 2e-5
+    roots = (0.2, 1.05, 1.1)  # delta(s) = k (s - 0.2)(s - 1.05)(s - 1.1): enters at s = 0.2, turns back by s = 1
+
+    def delta(s, k=2e-6):
+        return k * (s - roots[0]) * (s - roots[1]) * (s - roots[2])
+
+    def rate(s, k=2e-6):  # d delta / dt = (d delta / ds) / h
+        r0, r1, r2 = roots
+        return k * ((s - r1) * (s - r2) + (s - r0) * (s - r2) + (s - r0) * (s - r1)) / h
+
+    d0, v0, d1, v1 = delta(0.0), rate(0.0), delta(1.0), rate(1.0)
+    assert d0 < 0.0 < d1 and v1 < 0.0 and onset_velocity(d0, v0, d1, v1) <= 0.0  # the linear estimate fails
+    expected = rate(roots[0])
+    assert expected > 0.0
+    assert hermite_onset_rate(d0, v0, d1, v1, h) == pytest.approx(expected, rel=1e-9)
+    assert positive_onset_velocity(0.0, d0, v0, h, d1, v1) == (pytest.approx(expected, rel=1e-9), True)
+    assert hermite_onset_rate(-1e-6, 0.01, -2e-7, 0.0, h) == 0.0  # no zero inside: nothing to report
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("clearance_mm, rpm, perturbation", [(0.1, 600, 0), (0.25, 700, 2)])
+def test_no_light_impact_falls_inside_one_free_flight_step(clearance_mm, rpm, perturbation):
+    """With one step per output sample (0.5 deg) these two 10-revolution runs of the default path failed the
+    plausibility guard: a light impact began and turned back inside one free-flight step, so the onset step
+    ended with delta_dot <= 0 (2 of 32 such runs over four scenes; tree_solve.STEPS_PER_SAMPLE).  Exudyn is
+    bitwise deterministic, so these are the runs that failed."""
+    scene = load_scene(MODELS / "reference.toml", {
+        "joint_e.clearance_mm": clearance_mm, "drive.speed_rpm": rpm, "drive.revolutions": 10,
+        "solver.exudyn.relative_tolerance": 1e-6 * (1 + perturbation * 1e-7)})  # fmt: skip
+    r = solve(scene)
+    assert r.ok, r.message
+    assert r.plausibility["nonpositive_onsets"] == 0

@@ -29,9 +29,10 @@ Held impact velocity rules (``ClearanceJoint.impact_velocity_rule``):
 
 An onset is a crossing of delta from <= 0 to > 0 with delta_dot > 0.  Within one step
 the linear interpolation can give a non-positive rate at the crossing (a graze or a
-turnaround inside the step: delta and delta_dot are then not both linear); such an
-estimate is never held, the best positive one is (:func:`positive_onset_velocity`), and
-the tracker counts it.
+turnaround inside the step: delta and delta_dot are then not both linear); the tracker
+then takes the slope of the cubic Hermite interpolant at its first rising zero
+(:func:`hermite_onset_rate`), and only if that fails too (no rising zero) the best positive
+estimate, counting the onset as non-positive (:func:`positive_onset_velocity`).
 """
 
 from __future__ import annotations
@@ -61,8 +62,51 @@ def positive_onset_velocity(t0: float, delta0: float, rate0: float, t1: float, d
     v = onset_velocity(delta0, rate0, delta1, rate1)
     if v > 0.0:
         return v, True
+    if t1 > t0:
+        v = hermite_onset_rate(delta0, rate0, delta1, rate1, t1 - t0)
+        if v > 0.0:
+            return v, True
     secant = (delta1 - delta0) / (t1 - t0) if t1 > t0 else 0.0
     return max(rate1, secant), False
+
+
+# Scan points and bisections of hermite_onset_rate: the first sign change of the cubic is bracketed
+# to 1/64 of the step, then halved 60 times (to round-off of s).
+_ONSET_SCAN = 64
+_ONSET_BISECTIONS = 60
+
+
+def hermite_onset_rate(delta0: float, rate0: float, delta1: float, rate1: float, h: float) -> float:
+    """Slope, m/s, of the cubic Hermite interpolant of delta at its first zero inside the step.
+
+    When the linear estimate fails (the rate falls below zero within the step: the journal met the
+    wall and turned back before the step ended, a whole light impact inside one explicit step), the
+    cubic through (delta0, rate0) and (delta1, rate1) still enters the wall from delta0 <= 0: its
+    first rising zero s* in (0, 1] has p'(s*) >= 0, the approach rate there.  Returns 0 if the
+    cubic has no rising zero (delta1 <= 0, or a tangency).
+    """
+    m0, m1 = h * rate0, h * rate1
+    a = 2.0 * delta0 - 2.0 * delta1 + m0 + m1
+    b = -3.0 * delta0 + 3.0 * delta1 - 2.0 * m0 - m1
+
+    def p(s: float) -> float:
+        return ((a * s + b) * s + m0) * s + delta0
+
+    lo = 0.0
+    for k in range(1, _ONSET_SCAN + 1):
+        hi = k / _ONSET_SCAN
+        if p(hi) > 0.0:
+            break
+        lo = hi
+    else:
+        return 0.0
+    for _ in range(_ONSET_BISECTIONS):
+        mid = 0.5 * (lo + hi)
+        if p(mid) > 0.0:
+            hi = mid
+        else:
+            lo = mid
+    return max(0.0, ((3.0 * a * hi + 2.0 * b) * hi + m0) / h)
 
 
 def hermite_extremum(delta0: float, rate0: float, delta1: float, rate1: float, h: float) -> float:
