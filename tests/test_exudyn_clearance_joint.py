@@ -76,15 +76,23 @@ def test_tracker_max_approach_holds_the_largest_rate_since_onset():
     assert tr.contact_events == 2 and tr.nonpositive_onsets == 0
 
 
-def test_tracker_never_holds_a_nonpositive_onset_and_counts_it():
+def test_tracker_never_holds_a_nonpositive_onset():
     # A graze inside the step: delta goes from -1e-8 to +1e-8 while the sampled rates say the
-    # journal leaves at both ends; linear interpolation gives a negative "onset" rate.  The
-    # secant rate (2e-8 m / 1e-6 s = 0.02 m/s) is a positive approach rate the step really had.
+    # journal leaves at both ends; linear interpolation gives a negative "onset" rate.  The cubic
+    # Hermite interpolant through the ends (the journal turns back into the wall inside the step)
+    # crosses zero rising: its slope there is held, a positive approach rate the step really had.
+    h, d0, v0, d1, v1 = 1e-6, -1e-8, -0.2, 1e-8, -1e-9
+    s = np.linspace(0.0, 1.0, 2_000_001)
+    cubic = (2 * s**3 - 3 * s**2 + 1) * d0 + (s**3 - 2 * s**2 + s) * h * v0 + (-2 * s**3 + 3 * s**2) * d1 \
+        + (s**3 - s**2) * h * v1  # fmt: skip
+    first = np.flatnonzero(cubic > 0.0)[0]
+    slope = (cubic[first] - cubic[first - 1]) / (s[1] * h)  # the chord over 5e-7 of the step at the zero
     for rule in ("max_approach", "onset"):
-        tr = OnsetTracker(C, 1e-4, t0=4e-6, delta0=-1e-8, rate0=-0.2, rule=rule)
-        tr.accept(5e-6, 1e-8, -1e-9)
-        assert tr.nonpositive_onsets == 1 and tr.contact_events == 1
-        assert tr.held == pytest.approx(0.02, rel=1e-9)  # secant: round-off of 2e-8 / 1e-6
+        tr = OnsetTracker(C, 1e-4, t0=4e-6, delta0=d0, rate0=v0, rule=rule)
+        tr.accept(4e-6 + h, d1, v1)
+        assert tr.nonpositive_onsets == 0 and tr.contact_events == 1
+        # The chord on a 5e-7 grid against the exact slope: |p''| ~ 1e-6 m over the step, so ~1e-6 relative.
+        assert tr.held == pytest.approx(slope, rel=1e-5) and tr.held > 0.0
 
 
 def test_tracker_detects_a_separation_inside_one_step():
