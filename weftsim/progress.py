@@ -54,19 +54,19 @@ class Progress:
 
 
 # Run-time estimate shown before a long run starts.  Wall-clock seconds per crank revolution of
-# models/reference.toml at 400 rpm (c = 0.25 mm, 28 onsets in the first revolution), measured with
-# `weftsim run models/reference.toml --revolutions 1` and 3 (the difference gives the cost of one
-# more revolution) on the project's 2-core machine while other jobs ran: the start-up (imports,
-# model build, numba compilation) is not included.  Other scenes differ by the number of impacts
-# and the step a contact needs: the estimate is meant to tell seconds from hours, within ~3x.
+# models/reference.toml at 400 rpm (c = 0.25 mm), measured by `weftsim bench --targets` (issue 12,
+# medians of 5 in one warm process, the 2-core machine otherwise idle): the start-up (imports, model
+# build, numba cache) is not included.  Other scenes differ by the number of impacts and the step a
+# contact needs: the estimate is meant to tell seconds from hours, within ~3x.
 SECONDS_PER_REVOLUTION = {
-    "reference scipy": 3.9,  # DOP853 at rtol 1e-9 (the default): 2.1 s for 1 revolution, 9.9 s for 3
-    "reference numba": 0.08,  # numba_DOP853 at rtol 1e-9: 0.30 s of solver wall time for 4 revolutions
-    "exudyn kinematic_tree": 0.22,  # DOPRI5 at the default tolerances: 0.90 s for 1 revolution, 1.34 s for 3
-    # The rigid-body model's adaptive step (docs/performance.md): ~29,000 steps per revolution at
-    # 400 rpm and c = 0.25 mm, 20-35 % dearer than a fixed step (95 us): 2.8 s.
-    "exudyn rigid_body adaptive": 2.8,
+    "reference scipy": 0.8,  # DOP853 at rtol 1e-9 on the compiled right-hand side: 0.78-0.89 s (1st revolution)
+    "reference numba": 0.008,  # numba_DOP853 at rtol 1e-5 (the default): 79 ms for 10 revolutions
+    "exudyn kinematic_tree": 0.10,  # the default path (DOPRI5 rtol 1e-6, numba route): 0.97-1.02 s for 10
+    "exudyn rigid_body adaptive": 1.95,  # local error 3e-10 m: 1.94-2.00 s (1st revolution)
 }
+# Steps of the Runge-Kutta paths grow about as rtol^(-1/4) on this contact (the compiled DOP853: 0.08 s per
+# revolution at rtol 1e-9, 10x its cost at 1e-5); the figures above are at these tolerances.
+REFERENCE_RTOL = {"reference scipy": 1e-9, "reference numba": 1e-5}
 # The Exudyn rigid-body model takes fixed steps: its cost is per step (5.5 s for the 75 000 steps of
 # one revolution at 400 rpm with h = 2e-6 s, 73 us a step; 16.6 s for 3 revolutions).
 EXUDYN_SECONDS_PER_STEP = 7.3e-5
@@ -83,8 +83,9 @@ def estimate_run_time(scene, engine: str) -> float:
             return 0.0
         from weftsim.reference import select_path
 
-        method = select_path(scene)["method"]
-        return revolutions * SECONDS_PER_REVOLUTION["reference numba" if "numba" in method else "reference scipy"]
+        path = "reference numba" if "numba" in select_path(scene)["method"] else "reference scipy"
+        scale = (REFERENCE_RTOL[path] / scene.reference_solver.rtol) ** 0.25
+        return revolutions * SECONDS_PER_REVOLUTION[path] * scale
     from weftsim.exudyn_engine.selection import select_model
     from weftsim.exudyn_engine.solver import adaptive, step_plan
 
