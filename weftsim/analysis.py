@@ -120,6 +120,7 @@ def energy_balance(result: RunResult) -> dict[str, float]:
 
 def summary(result: RunResult) -> dict:
     """The content of ``summary.json`` (see the README's output reference)."""
+    from weftsim.provenance import commit, versions
     from weftsim.scene import to_file_keys
 
     n = complete_revolutions(result)
@@ -147,4 +148,7 @@ def summary(result: RunResult) -> dict:
         "plausibility": dict(result.plausibility) or None,
         "solver": dict(result.solver_stats),
         "wall_time_s": result.wall_time_s,
+        # What computed it: Python and package versions, and the git commit when run from a checkout.
+        "versions": versions(),
+        "commit": commit(),
     }

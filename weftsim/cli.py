@@ -30,6 +30,19 @@ class CliError(Exception):
         self.status = status
 
 
+class _Version(argparse.Action):
+    """``--version``: the versions line (read from package metadata only when asked), then exit 0."""
+
+    def __init__(self, option_strings, dest, **kwargs):
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from weftsim.provenance import version_line
+
+        print(version_line())
+        parser.exit()
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse with one-line errors (the usage stays behind --help) and no abbreviated flags
     (``--speed 400`` must not silently mean ``--speed-rpm``)."""
@@ -84,6 +97,8 @@ def build_parser() -> argparse.ArgumentParser:
         "Exudyn multibody model and closed-form Lagrange cross-check.",
     )
     parser.add_argument("-v", "--verbose", action="store_true", help="log what happens")
+    parser.add_argument("--version", action=_Version,
+                        help="the versions of weftsim and the packages it runs on, and exit")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     p = sub.add_parser("kinematics", help="ideal rapier motion over one revolution (CSV + plot)")
