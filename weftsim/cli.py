@@ -326,31 +326,29 @@ def cmd_kinematics(args) -> int:
     return 0
 
 
+def _engine(engine: str):
+    """The engine package (``solve``, ``select_path``) named by ``--engine``."""
+    if engine == "reference":
+        import weftsim.reference as module
+    elif engine == "exudyn":
+        import weftsim.exudyn_engine as module
+    else:
+        raise CliError(f"--engine must be 'reference' or 'exudyn', got {engine!r}")
+    return module
+
+
 def _solve(scene, engine: str, label: str | None = None, announce: bool = False):
     from weftsim.progress import Progress
 
-    if engine == "reference":
-        from weftsim.reference import solve
-    elif engine == "exudyn":
-        from weftsim.exudyn_engine import solve
-    else:
-        raise CliError(f"--engine must be 'reference' or 'exudyn', got {engine!r}")
+    module = _engine(engine)
     if announce:  # `run`: its first line is the model and method it takes, and why
-        path = _select(engine)(scene)
+        path = module.select_path(scene)
         print(f"scene {scene.name}, engine {engine}: {path['model']}, {path['method']} ({path['reason']})", flush=True)
     progress = Progress(label or f"{engine} {scene.name}")
     try:
-        return solve(scene, progress=progress)
+        return module.solve(scene, progress=progress)
     finally:
         progress.close()
-
-
-def _select(engine: str):
-    if engine == "reference":
-        from weftsim.reference import select_path
-    else:
-        from weftsim.exudyn_engine import select_path
-    return select_path
 
 
 def _report_run(result, written) -> None:
