@@ -85,9 +85,7 @@ def hermite_onset_rate(delta0: float, rate0: float, delta1: float, rate1: float,
     first rising zero s* in (0, 1] has p'(s*) >= 0, the approach rate there.  Returns 0 if the
     cubic has no rising zero (delta1 <= 0, or a tangency).
     """
-    m0, m1 = h * rate0, h * rate1
-    a = 2.0 * delta0 - 2.0 * delta1 + m0 + m1
-    b = -3.0 * delta0 + 3.0 * delta1 - 2.0 * m0 - m1
+    a, b, m0 = hermite_cubic(delta0, rate0, delta1, rate1, h)
 
     def p(s: float) -> float:
         return ((a * s + b) * s + m0) * s + delta0
@@ -109,6 +107,16 @@ def hermite_onset_rate(delta0: float, rate0: float, delta1: float, rate1: float,
     return max(0.0, ((3.0 * a * hi + 2.0 * b) * hi + m0) / h)
 
 
+def hermite_cubic(delta0: float, rate0: float, delta1: float, rate1: float, h: float) -> tuple[float, float, float]:
+    """(a, b, m0) of the cubic Hermite interpolant of delta over a step of length h.
+
+    p(s) = a s^3 + b s^2 + m0 s + delta0 through (delta0, rate0) at s = 0 and (delta1, rate1) at
+    s = 1 (s = time / h, so p'(s) = h delta_dot); p'(s) = 3 a s^2 + 2 b s + m0.
+    """
+    m0, m1 = h * rate0, h * rate1
+    return 2.0 * delta0 - 2.0 * delta1 + m0 + m1, -3.0 * delta0 + 3.0 * delta1 - 2.0 * m0 - m1, m0
+
+
 def hermite_extremum(delta0: float, rate0: float, delta1: float, rate1: float, h: float) -> float:
     """Interior extremum of the cubic Hermite interpolant of delta over a step of length h, m.
 
@@ -118,10 +126,7 @@ def hermite_extremum(delta0: float, rate0: float, delta1: float, rate1: float, h
     interior stationary point.  Used to detect a separation and a re-contact (or a contact and
     a separation) inside one accepted step.
     """
-    m0, m1 = h * rate0, h * rate1
-    # p(s) = a s^3 + b s^2 + m0 s + delta0; p'(s) = 3 a s^2 + 2 b s + m0
-    a = 2.0 * delta0 - 2.0 * delta1 + m0 + m1
-    b = -3.0 * delta0 + 3.0 * delta1 - 2.0 * m0 - m1
+    a, b, m0 = hermite_cubic(delta0, rate0, delta1, rate1, h)
     roots = []
     if abs(a) > 1e-300:
         disc = b * b - 3.0 * a * m0

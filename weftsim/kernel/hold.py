@@ -74,7 +74,7 @@ def callback_impact_velocity(held, delta0, rate0, delta, rate, v_min, max_approa
     if delta0 > 0.0:
         v = held
     else:
-        v = rate0 + delta0 / (delta0 - delta) * (rate - rate0)
+        v = onset_velocity(delta0, rate0, delta, rate)
         if v <= 0.0:
             v = rate
     if max_approach and rate > v:
