@@ -44,8 +44,16 @@ from weftsim.kernel.hold import RESTING_RATE_FRACTION
 from weftsim.kernel.python import python_form
 
 ROUTES = ("python", "numba")
+# Fastest route on the loom model, rigid body and kinematic tree (scripts/bench_callbacks.py,
+# docs/clearance-joint.md).
+DEFAULT_ROUTE = "numba"
 REMOVED_ROUTES = {"symbolic": "the symbolic route was removed (it was a second copy of every contact law "
                               "and measured no faster); use callback 'auto', 'numba' or 'python'"}
+
+
+def resolve_route(callback: str) -> str:
+    """The route a ``callback`` setting runs on: "auto" is :data:`DEFAULT_ROUTE`."""
+    return DEFAULT_ROUTE if callback == "auto" else callback
 
 
 def route_error(callback: str) -> str | None:

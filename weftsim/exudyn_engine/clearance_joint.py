@@ -32,9 +32,7 @@ from weftsim.exudyn_engine.onset import OnsetTracker, penetration_state
 from weftsim.params import ClearanceJoint
 
 ROUTES = callbacks.ROUTES
-# Fastest route on the loom model, rigid body and kinematic tree (scripts/bench_callbacks.py,
-# docs/clearance-joint.md).
-DEFAULT_ROUTE = "numba"
+DEFAULT_ROUTE = callbacks.DEFAULT_ROUTE
 
 _HOOKS = "weftsim_post_step_hooks"
 
@@ -145,7 +143,7 @@ def add_clearance_joint(mbs, marker_bearing, marker_journal, joint: ClearanceJoi
     if callbacks.route_error(callback):
         raise ValueError(callbacks.route_error(callback))
     law = make_law(joint) if law is None else law
-    route = DEFAULT_ROUTE if callback == "auto" else callback
+    route = callbacks.resolve_route(callback)
     if call_counter is not None and route != "python":
         raise ValueError("`call_counter` works with callback='python' only")
     c, v_min = joint.clearance, joint.min_impact_velocity

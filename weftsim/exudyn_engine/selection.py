@@ -57,10 +57,10 @@ def select_path(scene: Scene) -> dict:
     s = scene.exudyn_solver
     model, reason = select_model(scene)
     if model == "kinematic_tree":
-        from weftsim.exudyn_engine.tree import tree_route
+        from weftsim.exudyn_engine.callbacks import resolve_route
 
         return {"model": model, "reason": reason,
-                "method": f"{s.explicit_method} rtol {s.relative_tolerance:g}, {tree_route(s.callback)} callback"}
+                "method": f"{s.explicit_method} rtol {s.relative_tolerance:g}, {resolve_route(s.callback)} callback"}
     from weftsim.exudyn_engine.solver import adaptive, step_plan
 
     if adaptive(scene):

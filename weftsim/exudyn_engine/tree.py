@@ -54,26 +54,6 @@ from weftsim.reference.dynamics import initial_state, pack_parameters
 from weftsim.reference.ideal import sector_chain_inertia
 
 UNSPECIFIED_MASS = 1.0  # sector mass (balanced, on its fixed axis: no effect), kg
-# Callback routes of this model.  No symbolic route: Exudyn's symbolic user functions do not take the
-# tree's forceUserFunction (its coordinate vectors have no size when the expression is recorded), and
-# as an expression tree the bearing motion was repeated in every use of e (51 us per call in the
-# connector form this model had before, against ~1.5 us for plain Python).
-TREE_ROUTES = ("auto", "python", "numba")
-
-
-def tree_route(callback: str) -> str:
-    """The route a ``solver.exudyn.callback`` value runs on the tree: "auto" = numba when installed.
-
-    The numba core costs ~1 us per call against ~2 us for the plain-Python body (the numba dispatch
-    is most of it; docs/performance.md), and compiles once per machine (numba's cache).
-    """
-    if callback != "auto":
-        return callback
-    try:
-        import numba  # noqa: F401 - a dependency of weftsim; "python" only where it is missing
-    except ImportError:
-        return "python"
-    return "numba"
 
 
 @dataclass
@@ -109,7 +89,7 @@ def build_tree(mbs, scene: Scene, callback: str = "auto") -> TreeModel:
     """Add the kinematic tree of members 4-8, gravity and the clearance contact to ``mbs``.
 
     Initial state: the ideal mechanism at theta = 0, journal centred
-    (:func:`weftsim.reference.dynamics.initial_state`).  ``callback``: "auto" (:func:`tree_route`),
+    (:func:`weftsim.reference.dynamics.initial_state`).  ``callback``: "auto" (:func:`weftsim.exudyn_engine.callbacks.resolve_route`),
     "python" or "numba"; both evaluate :func:`weftsim.kernel.chain.tree_joint_force`.  Needs ``scene.joint.clearance > 0`` and no friction.
     """
     g, m, joint = scene.geometry, scene.inertia, scene.joint
@@ -117,7 +97,7 @@ def build_tree(mbs, scene: Scene, callback: str = "auto") -> TreeModel:
     problem = callbacks.route_error(callback)
     if problem is not None:
         raise ValueError(problem)
-    route = tree_route(callback)
+    route = callbacks.resolve_route(callback)
     calls = [0]
     tracker = OnsetTracker(joint.clearance, joint.min_impact_velocity, rule=joint.impact_velocity_rule)
     memory = list(tracker.callback_state)

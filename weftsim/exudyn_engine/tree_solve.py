@@ -32,7 +32,8 @@ from exudyn.itemInterface import SensorNode
 
 from weftsim.contact import make_law
 from weftsim.exudyn_engine.sensors import first_nonfinite_row, sample_channels, silence
-from weftsim.exudyn_engine.tree import TREE_ROUTES, TreeModel, build_tree
+from weftsim.exudyn_engine import callbacks
+from weftsim.exudyn_engine.tree import TreeModel, build_tree
 from weftsim.guards import RunGuard, failure_message, non_finite_breach, vet_result
 from weftsim.params import Scene
 from weftsim.reference.dynamics import NUMPY, ChainConstants, chain_energy, eccentricity, initial_state
@@ -58,8 +59,9 @@ def check_tree_settings(scene: Scene) -> str | None:
     if scene.joint.is_ideal:
         return ("the 'kinematic_tree' Exudyn model needs a clearance joint (with an ideal joint nothing moves "
                 "freely); use `exudyn_solver.model` = 'rigid_body' or the reference engine")  # fmt: skip
-    if s.callback not in TREE_ROUTES:
-        return (f"the 'kinematic_tree' Exudyn model has the callback routes {TREE_ROUTES}, got {s.callback!r}; "
+    routes = ("auto",) + callbacks.ROUTES
+    if s.callback not in routes:
+        return (f"the 'kinematic_tree' Exudyn model has the callback routes {routes}, got {s.callback!r}; "
                 "use `exudyn_solver.model` = 'rigid_body' for it")  # fmt: skip
     if s.explicit_method not in EXPLICIT_METHODS:
         return f"`exudyn_solver.explicit_method` must be one of {tuple(EXPLICIT_METHODS)}, got {s.explicit_method!r}"
