@@ -53,44 +53,38 @@ SOLVES = {
 MAP_VARY = ["clearance_mm=0.01,0.05,0.1,0.15,0.2,0.25,0.3,0.35,0.4,0.45,0.5", "speed_rpm=300:800:11"]
 
 
-def _process_wall(command: list[str], repeats: int) -> dict:
-    """Median wall time of ``command`` run ``repeats`` times after one warm-up run; exit codes kept."""
-    walls, codes = [], []
-    for i in range(repeats + 1):
+def _process_walls(commands: list[list[str]], warmup: int = 0) -> dict:
+    """Wall time of each command run as a new process, in turn; the first ``warmup`` are not counted.
+
+    Stops at the first command that fails, keeping its exit status and the end of its stderr.
+    """
+    walls = []
+    for i, command in enumerate(commands):
         t0 = time.perf_counter()
         done = subprocess.run(command, capture_output=True, text=True)
         wall = time.perf_counter() - t0
-        codes.append(done.returncode)
-        if i > 0:
-            walls.append(wall)
         if done.returncode != 0:
-            return {"status": "failed", "exit": done.returncode, "stderr": done.stderr[-400:], "wall_s": walls}
-    return {"status": "success", "wall_s": walls, "wall_median_s": _stats.median(walls), "warmup_s": None}
+            return {"status": "failed", "exit": done.returncode, "stderr": done.stderr[-400:], "wall_s": walls,
+                    "command": " ".join(command[1:])}
+        if i >= warmup:
+            walls.append(wall)
+    return {"status": "success", "command": " ".join(commands[-1][1:]), "wall_s": walls,
+            "wall_median_s": _stats.median(walls)}
 
 
 def cli_run(engine: str, models, repeats: int, workdir: Path) -> dict:
-    """``weftsim run`` as a new process, 2 revolutions, start to exit."""
+    """``weftsim run`` as a new process, 2 revolutions, start to exit; ``repeats`` runs after one warm-up run."""
     command = [sys.executable, "-m", "weftsim.cli", "run", str(Path(models) / "reference.toml"), "--engine", engine,
                "--revolutions", "2", "-o", str(workdir / f"run-{engine}"), "--force"]
-    return {"command": " ".join(command[1:]), **_process_wall(command, repeats)}
+    return _process_walls([command] * (repeats + 1), warmup=1)
 
 
 def clearance_speed_map(models, jobs: int, repeats: int, workdir: Path) -> dict:
     """The 121-cell map at 10 revolutions per cell, from scratch each time (a fresh output directory)."""
-    walls = []
-    for i in range(repeats):
-        out = workdir / f"map-{i}"
-        command = [sys.executable, "-m", "weftsim.cli", "sweep", str(Path(models) / "reference.toml"),
-                   "--vary", MAP_VARY[0], "--vary", MAP_VARY[1], "--set", "revolutions=10", "--engine", "reference",
-                   "--jobs", str(jobs), "-o", str(out)]  # fmt: skip
-        t0 = time.perf_counter()
-        done = subprocess.run(command, capture_output=True, text=True)
-        walls.append(time.perf_counter() - t0)
-        if done.returncode != 0:
-            return {"status": "failed", "exit": done.returncode, "stderr": done.stderr[-400:], "wall_s": walls,
-                    "command": " ".join(command[1:])}
-    return {"status": "success", "command": " ".join(command[1:]), "jobs": jobs, "wall_s": walls,
-            "wall_median_s": _stats.median(walls)}
+    commands = [[sys.executable, "-m", "weftsim.cli", "sweep", str(Path(models) / "reference.toml"),
+                 "--vary", MAP_VARY[0], "--vary", MAP_VARY[1], "--set", "revolutions=10", "--engine", "reference",
+                 "--jobs", str(jobs), "-o", str(workdir / f"map-{i}")] for i in range(repeats)]  # fmt: skip
+    return {"jobs": jobs, **_process_walls(commands)}
 
 
 def _met(name: str, item: dict) -> bool | None:
