@@ -57,7 +57,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{case.name} ({case.engine}, {case.kind})", flush=True)
         entries.append(regression.build_entry(case, ROOT, log=lambda text: print(text, flush=True)))
     table = {
-        "description": "Peaks of reproducible quantities (SPEC.md section 6) for tests/test_regression.py; "
+        "description": "Peaks of reproducible quantities (docs/physics.md section 6) for tests/test_regression.py; "
                        "see weftsim/studies/regression.py for the cases and the tolerance rule.",
         "command": COMMAND + "".join(f" --case {name}" for name in args.case or ()),
         "environment": regression.environment(),

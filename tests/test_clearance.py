@@ -1,4 +1,4 @@
-"""Physics checks of the planar clearance-joint force (weftsim.clearance, SPEC.md section 2)."""
+"""Physics checks of the planar clearance-joint force (weftsim.clearance, docs/physics.md section 2)."""
 
 import dataclasses
 

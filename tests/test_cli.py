@@ -33,7 +33,7 @@ def test_kinematics_writes_csv_with_units_and_reproduces_spec(tmp_path):
                                  "rapier_acceleration_m_s2"]
     s = [float(r["rapier_displacement_m"]) for r in rows]
     v = [float(r["rapier_velocity_m_s"]) for r in rows]
-    # SPEC.md 1: stroke 1.052348 m at 180 deg (on the grid: 180 deg is a grid point, so exact to 7 digits).
+    # docs/physics.md section 1: stroke 1.052348 m at 180 deg (on the grid: 180 deg is a grid point, so exact to 7 digits).
     assert max(s) == pytest.approx(1.052348, abs=5e-7)
     assert float(rows[s.index(max(s))]["crank_angle_deg"]) == 180.0
     # Velocity extrema fall between 0.5 deg samples; the flat top keeps the grid value within 1e-4 relative.

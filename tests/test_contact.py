@@ -1,4 +1,4 @@
-"""Physics checks of the contact force laws (weftsim.contact, SPEC.md section 3).
+"""Physics checks of the contact force laws (weftsim.contact, docs/physics.md section 3).
 
 Restored coefficient of restitution, single mass m = 1 kg hitting the law at v0 = 0.5 m/s,
 c = 0.25 mm, steel, R_j = 10 mm (DOP853, rtol 1e-11, event at separation), ce_out = -v_sep/v0:
@@ -93,7 +93,7 @@ def test_continuous_at_first_contact(name):
 
 
 def test_lankarani_nikravesh_stiffness_check_values():
-    # SPEC.md 3 gives 3 significant digits: compare to half a unit of the last digit.
+    # docs/physics.md section 3 gives 3 significant digits: compare to half a unit of the last digit.
     for clearance, expected in ((0.5e-3, 6.95e10), (0.25e-3, 9.71e10), (0.01e-3, 4.80e11)):
         k = lankarani_nikravesh_stiffness(ClearanceJoint(clearance=clearance))
         assert k == pytest.approx(expected, abs=0.005 * 10 ** math.floor(math.log10(expected)))
@@ -104,7 +104,7 @@ def test_bai_zhao_stiffness_check_value():
     joint = ClearanceJoint(clearance=0.01e-3)
     k = make_law(joint).stiffness(5e-6)
     assert k == bai_zhao_stiffness(5e-6, joint.clearance, joint.effective_modulus)
-    # We get 9.7248e10; SPEC.md gives 9.73e10 (apparently double-rounded 9.7248 -> 9.725 -> 9.73),
+    # We get 9.7248e10; docs/physics.md section 3 gives 9.73e10 (apparently double-rounded 9.7248 -> 9.725 -> 9.73),
     # so allow one unit of the last given digit instead of half of it.
     assert k == pytest.approx(9.73e10, abs=0.01e10)
     assert round(k / 1e10, 2) in (9.72, 9.73)

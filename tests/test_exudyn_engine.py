@@ -107,7 +107,7 @@ def test_reflected_gear_inertia_equals_separate_gear_bodies():
     np.testing.assert_allclose(torques[0], torques[1], rtol=0, atol=2e-5 * np.abs(torques[0]).max())
 
 
-# --- Clearance: the start-up impact from the centred journal (SPEC.md 6: reproducible) ----
+# --- Clearance: the start-up impact from the centred journal (docs/physics.md section 6: reproducible) ----
 
 START = 30.0 / 360.0  # revolutions: covers the first contact (6.6 deg) and its impacts (9.4 deg)
 
@@ -277,7 +277,7 @@ def test_first_revolution_peaks_converge_when_the_step_is_halved():
     for name, tol in (("contact_force_N", 1e-3), ("rapier_acceleration_m_s2", 1e-3), ("driving_torque_Nm", 5e-3)):
         a, b = (r.steps[name].max() for r in runs)
         # Start-up impact (F_N, a): O(h^2), measured 3e-5.  The torque maximum comes from the
-        # impact sequence near 48 deg, already sensitive to the step (SPEC.md 6): measured 2.3e-3.
+        # impact sequence near 48 deg, already sensitive to the step (docs/physics.md section 6): measured 2.3e-3.
         assert a == pytest.approx(b, rel=tol), name
 
 

@@ -10,7 +10,7 @@ Every case asserts physics, not stored numbers:
   bodies).  It is *not* small against the clearance: the start-up impact penetrates 0.69 c at
   c = 0.25 mm and 18.5 c at c = 0.01 mm (docs/hard-cases.md, "Penetration");
 - the energy balance W = dKE + dPE + E_contact + E_dissipated closes (analysis.energy_balance);
-- the start-up impact (SPEC.md 6: the reproducible part) is converged in tolerance (reference
+- the start-up impact (docs/physics.md section 6: the reproducible part) is converged in tolerance (reference
   engine) or step size (Exudyn), and the two engines agree on it;
 - the physics each case is about: the free flight from the centred journal lasts a crank angle
   proportional to sqrt(c), a stiffer joint penetrates less and pushes harder, a low restitution
@@ -149,7 +149,7 @@ def test_reference_engine(name, reference_runs):
     tight = reference.solve(make_scene(CASES[name], WINDOW_DEG, rtol=1e-10))
     assert tight.ok, tight.message
     for key, value in window(tight).items():
-        # SPEC.md 6: the start-up impact is reproducible to 0.1 %; measured <= 2e-5 here.
+        # docs/physics.md section 6: the start-up impact is reproducible to 0.1 %; measured <= 2e-5 here.
         assert window(r)[key] == pytest.approx(value, rel=1e-3), key
     figures.update({f"startup_{k}": v for k, v in window(r).items()})
     report(f"reference {name}", figures)
@@ -201,7 +201,7 @@ def test_exudyn_engine(name, reference_runs):
     assert half.ok, half.message
     for key, value in window(half).items():
         # Start-up impact O(h^2) (tests/test_exudyn_engine.py): measured <= 3.3e-4 (torque, flores);
-        # the stiff joint at 2e-6 s was 7.5e-4 off, hence its 1e-6 s.  1e-3 = SPEC.md 6.
+        # the stiff joint at 2e-6 s was 7.5e-4 off, hence its 1e-6 s.  1e-3 = docs/physics.md section 6.
         assert window(r)[key] == pytest.approx(value, rel=1e-3), key
     ref = reference_runs[name]
     # Issue 4's tolerances between the engines: first contact within 0.1 deg, peaks within 1 %.

@@ -4,7 +4,7 @@ keeps the contact damping finite.  Figures in docs/hard-cases.md.
 
 Long runs: the reference engine runs 50 revolutions (~1 min); Exudyn runs 4 (~30 s: 50 would take
 ~7 min at its 2e-6 s step) and is compared with the reference engine's long-run statistics.  The
-impact sequence after the start-up is chaotic (SPEC.md 6), so "no drift" is judged on
+impact sequence after the start-up is chaotic (docs/physics.md section 6), so "no drift" is judged on
 per-revolution statistics, not on one revolution matching the next.
 """
 

@@ -1,4 +1,4 @@
-"""Tests of weftsim.kinematics: SPEC.md section 1 check values, closure identities,
+"""Tests of weftsim.kinematics: docs/physics.md section 1 check values, closure identities,
 analytic derivatives against finite differences, assembly failure detection."""
 
 from __future__ import annotations
@@ -68,7 +68,7 @@ def refined_extremum(func, sign, grid=np.linspace(0.0, 2.0 * np.pi, 3601)):
     return res.x % (2.0 * np.pi), sign * -res.fun
 
 
-# --- SPEC.md section 1 check values --------------------------------------------------
+# --- docs/physics.md section 1 check values --------------------------------------------------
 
 
 def test_check_values_at_theta_zero():
@@ -264,7 +264,7 @@ def test_coupler_angular_velocity_both_chains_agree():
 
 
 def closure_residual(theta_in, phi_out, a1, a2, a3, a4):
-    """b . c - cos(alpha3) with the vectors of SPEC.md in the law's own frame."""
+    """b . c - cos(alpha3) with the vectors of docs/physics.md section 1 in the law's own frame."""
     b = np.stack([np.sin(a2) * np.cos(theta_in), np.sin(a2) * np.sin(theta_in),
                   np.full_like(theta_in, np.cos(a2))], axis=-1)
     v = np.stack([np.sin(a4) * np.cos(phi_out), np.sin(a4) * np.sin(phi_out),

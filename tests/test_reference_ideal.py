@@ -110,7 +110,7 @@ def test_ideal_solve_channels_and_energy():
         s["potential_energy_J"] - s["potential_energy_J"][0]
     )
     assert np.abs(balance).max() < 1e-9
-    # The ideal acceleration is the kinematic one (SPEC check values, 6 digits).
+    # The ideal acceleration is the kinematic one (the check values of docs/physics.md section 1, 6 digits).
     a = result.steps["rapier_acceleration_m_s2"]
     assert math.isclose(a.max(), 1142.05, abs_tol=0.005) and math.isclose(a.min(), -829.42, abs_tol=0.005)
     # The work of T over a whole revolution is 0: KE and PE are periodic (round-off of ~500 J).

@@ -103,7 +103,7 @@ def _errors_after_startup(result, start_deg=30.0):
 def test_small_clearance_tends_to_the_ideal_joint():
     """c = 0.1, 0.01, 0.001 mm: the acceleration and torque errors w.r.t. the ideal joint shrink.
 
-    The first revolution is left out: the journal starts centred and force-free (SPEC.md 2), so the
+    The first revolution is left out: the journal starts centred and force-free (docs/physics.md section 2), so the
     chain first falls behind and is then caught by an impact, whatever c is.  That start-up impact is
     driven (the approach rate keeps growing after the onset: 0.011 -> 0.06 m/s at c = 1 um), so under
     the "max_approach" rule its damping is the law's (xi = 0.14 at ce = 0.9) and the contact rings down
@@ -116,7 +116,7 @@ def test_small_clearance_tends_to_the_ideal_joint():
               for c in (1e-4, 1e-5, 1e-6)]  # fmt: skip
     acc, torque = zip(*errors)
     assert acc[0] > acc[1] > acc[2] and torque[0] > torque[1] > torque[2]
-    ideal_acc, ideal_torque_amplitude = 1142.05, 505.43  # SPEC check value; ideal run of the reference scene
+    ideal_acc, ideal_torque_amplitude = 1142.05, 505.43  # the check value of docs/physics.md section 1; ideal run of the reference scene
     # The compliance floor above (1.4 % acceleration, 3.0 % torque at c = 1 um) with a margin of ~1.7x.
     assert acc[2] < 0.025 * ideal_acc and torque[2] < 0.05 * ideal_torque_amplitude
 
@@ -151,7 +151,7 @@ def test_failures_are_results_not_exceptions(monkeypatch):
 
 @pytest.mark.slow
 def test_first_revolution_peaks_converge_with_tolerance():
-    """First-revolution peaks (the start-up impact, SPEC.md 6) agree across rtol 1e-8 .. 1e-10."""
+    """First-revolution peaks (the start-up impact, docs/physics.md section 6) agree across rtol 1e-8 .. 1e-10."""
     results = {rtol: solve(_scene(rtol=rtol)) for rtol in (1e-8, 1e-9, 1e-10)}
     reference = peaks(results[1e-10], 0)
     for rtol in (1e-8, 1e-9):
@@ -159,7 +159,7 @@ def test_first_revolution_peaks_converge_with_tolerance():
         for name in ("contact_force_N", "rapier_acceleration_m_s2", "driving_torque_Nm", "penetration_m"):
             # Measured spread <= 1.4e-4 (torque at rtol 1e-8), mostly 1e-5: the penetration is a
             # difference of coordinates ~0.3 m long, so rtol L ~ 3e-10 m of its ~2e-4 m.  1e-3 is the
-            # SPEC's 0.1 % first-revolution agreement.
+            # docs/physics.md section 6's 0.1 % first-revolution agreement.
             assert p[name]["max"] == pytest.approx(reference[name]["max"], rel=1e-3), (rtol, name)
     # The solution itself converges: the state shortly after the first impact (crank angle 20 deg,
     # before the impact sequence becomes sensitive) moves less as rtol tightens.
@@ -181,7 +181,7 @@ def test_methods_agree_on_first_revolution_peaks():
     for method in ("LSODA", "RK45"):
         p = peaks(results[method], 0)
         for name in ("contact_force_N", "rapier_acceleration_m_s2", "driving_torque_Nm"):
-            # Measured within 1e-5 relative; 1e-3 = SPEC.md 6 first-revolution agreement.
+            # Measured within 1e-5 relative; 1e-3 = docs/physics.md section 6 first-revolution agreement.
             assert p[name]["max"] == pytest.approx(reference[name]["max"], rel=1e-3), (method, name)
         assert results[method].first_contact_angle_deg == pytest.approx(results["DOP853"].first_contact_angle_deg, abs=1e-6)
 

@@ -1,7 +1,7 @@
 """Regression guard: recompute the stored peaks of tests/regression/peaks.json.
 
 The table holds reproducible quantities only (ideal-joint peaks, first-revolution peaks,
-statistics over revolutions 2..N; SPEC.md section 6) for both engines, each with the
+statistics over revolutions 2..N; docs/physics.md section 6) for both engines, each with the
 tolerance measured when the table was made and the reason for it (see
 weftsim/studies/regression.py).  These are not physics checks: the other tests are.
 A failure names the scene, the engine and the channel.  After an intended physics

@@ -1,4 +1,4 @@
-"""Scene files: the reference and paper scenes load to the SPEC values; bad input is named precisely."""
+"""Scene files: the reference and paper scenes load to the values of docs/physics.md section 1; bad input is named precisely."""
 
 import math
 from dataclasses import replace

@@ -148,7 +148,7 @@ def test_stiffness_curve_is_the_law_and_its_log_slope_the_analytic_one():
     curve = stiffness_curve(joint, points=101)
     law = make_law(joint)
     np.testing.assert_allclose(curve["stiffness"], law.stiffness(curve["penetration_mm"] * 1e-3), rtol=1e-14)
-    # SPEC check value 9.73e10 is given to 3 digits (the law gives 9.7248e10; see tests/test_contact.py).
+    # the check value of docs/physics.md section 1 9.73e10 is given to 3 digits (the law gives 9.7248e10; see tests/test_contact.py).
     assert curve["numbers"]["stiffness_at_0p005mm"] == pytest.approx(9.73e10, abs=0.01e10)
     c = joint.clearance
     for delta in (0.5e-6, 5e-6, 15e-6):
@@ -189,7 +189,7 @@ def test_acceleration_deviation_of_the_ideal_run_is_round_off():
     assert centres.size == 36
     assert np.nanmax(rms) < 1e-9 * 1142.0  # same closed form on both sides
     features = ideal_features(result.scene.geometry, result.scene.drive.speed)
-    assert features["velocity_zeros_deg"] == pytest.approx([0.0, 180.0], abs=1e-6)  # s extremes (SPEC 1)
+    assert features["velocity_zeros_deg"] == pytest.approx([0.0, 180.0], abs=1e-6)  # s extremes (docs/physics.md section 1)
     assert features["acceleration_max_deg"] == pytest.approx([0.0], abs=0.01)  # grid spacing 0.01 deg
 
 

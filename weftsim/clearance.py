@@ -1,4 +1,4 @@
-"""Planar revolute clearance joint: geometry, normal and friction force (SPEC.md section 2).
+"""Planar revolute clearance joint: geometry, normal and friction force (docs/physics.md section 2).
 
 Array forms of the joint's force for analysis and tests (Flores-Ambrosio formulation; the
 one scalar definition is :mod:`weftsim.kernel.joint`, which the engines call)::
@@ -78,7 +78,7 @@ class ClearanceContact(NamedTuple):
 
 
 def contact_geometry(ecc, ecc_rate, clearance: float):
-    """Penetration, its rate and the normal from the eccentricity (SPEC.md 2).
+    """Penetration, its rate and the normal from the eccentricity (docs/physics.md section 2).
 
     Parameters
     ----------

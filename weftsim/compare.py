@@ -1,6 +1,6 @@
 """Exudyn against the closed-form reference engine on one scene (``weftsim compare``).
 
-What is compared follows SPEC.md section 6 and issue 4: after the first impacts the
+What is compared follows docs/physics.md section 6 and issue 4: after the first impacts the
 impact sequence is sensitive to step and tolerance, so the checks that decide the
 exit status are the reproducible quantities:
 

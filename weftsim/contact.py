@@ -1,4 +1,4 @@
-"""Continuous contact force laws of the clearance joint (SPEC.md section 3).
+"""Continuous contact force laws of the clearance joint (docs/physics.md section 3).
 
 Every law gives the normal contact force of a journal pressed into its bearing,
 
@@ -476,7 +476,7 @@ def friction_factor(tangential_speed, v0: float, v1: float):
     tangential_speed : array_like
         Relative tangential velocity v_T (sign ignored), m/s.
     v0, v1 : float
-        Ramp limits, m/s, 0 <= v0 < v1 (SPEC.md 2: 1e-4 and 2e-4).
+        Ramp limits, m/s, 0 <= v0 < v1 (docs/physics.md section 2: 1e-4 and 2e-4).
     """
     if not 0.0 <= v0 < v1:
         raise ValueError(f"friction velocities must satisfy 0 <= v0 < v1, got v0={v0}, v1={v1}")

@@ -1,4 +1,4 @@
-"""Ideal-joint kinematics of the weft insertion linkage (SPEC.md section 1).
+"""Ideal-joint kinematics of the weft insertion linkage (docs/physics.md section 1).
 
 Pure numpy, vectorised over the crank angle theta.  Every quantity comes with its
 first and second derivatives w.r.t. theta (prefixes ``d_`` and ``dd_``), computed
@@ -114,7 +114,7 @@ class FourBarState:
 def fourbar(theta_oe, geometry: Geometry) -> FourBarState:
     """Solve the planar four-bar for the rocker-arm angle theta_OE.
 
-    Position (SPEC.md, branch = ``geometry.fourbar_branch``, +1 = SPEC "+")::
+    Position (docs/physics.md section 1, branch = ``geometry.fourbar_branch``, +1 = "+")::
 
         theta_FG = atan2(b', a) + branch * acos((L_EF^2 - D^2 - L_FG^2) / (2 L_FG D))
         F = G + L_FG u(theta_FG),  theta_EF = atan2(F_Z - E_Z, F_Y - E_Y)
@@ -222,7 +222,7 @@ def linkage_state(theta, geometry: Geometry, rocker_com_distance: float | None =
     geometry : Geometry
     rocker_com_distance : float, optional
         Distance of the rocker's centre of mass from O along OE, m.  Defaults to
-        ``Inertia().rocker_com`` (0.040 m, SPEC reference mechanism).
+        ``Inertia().rocker_com`` (0.040 m, docs/physics.md section 1 reference mechanism).
 
     Returns
     -------

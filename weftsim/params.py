@@ -4,7 +4,7 @@ Scene files (TOML) speak mm, deg, rpm and GPa; :mod:`weftsim.scene` converts the
 and validates them once, so every object here holds checked SI values (m, rad,
 rad/s, kg, kg m^2, Pa).  Variants are made with :func:`dataclasses.replace`.
 
-Frames follow SPEC.md section 1: O is the origin, x = rocker axis D (normal of the
+Frames follow docs/physics.md section 1: O is the origin, x = rocker axis D (normal of the
 four-bar plane), y along OG, z = x cross y, gravity along -z.  Four-bar plane
 coordinates are (Y, Z) = (y, z).
 """
@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 @dataclass(frozen=True)
 class Geometry:
-    """Link lengths and angles of the spatial linkage (SPEC.md section 1).
+    """Link lengths and angles of the spatial linkage (docs/physics.md section 1).
 
     Attributes
     ----------
@@ -28,7 +28,7 @@ class Geometry:
     l_oe, l_ef, l_fg, l_og : float
         Lengths of rocker arm OE, connecting rod EF, sector arm FG and frame OG, m.
     fourbar_branch : int
-        +1 or -1: sign in front of the acos of the four-bar assembly (SPEC "+" branch is +1).
+        +1 or -1: sign in front of the acos of the four-bar assembly (the "+" branch of docs/physics.md section 1 is +1).
     sector_pitch_radius, pinion_pitch_radius, rapier_gear_pitch_radius : float
         d5, d6, d7, m.  Rapier s = (d5 d7 / d6) (theta_FG - theta_FG(0)).
     """
@@ -57,7 +57,7 @@ class Geometry:
 
 @dataclass(frozen=True)
 class Inertia:
-    """Masses and inertias of members 1-8 (SPEC.md section 1, reference mechanism).
+    """Masses and inertias of members 1-8 (docs/physics.md section 1, reference mechanism).
 
     Attributes
     ----------
@@ -105,13 +105,13 @@ class Material:
 
     @property
     def compliance(self) -> float:
-        """sigma = (1 - nu^2) / E, 1/Pa (SPEC.md section 3)."""
+        """sigma = (1 - nu^2) / E, 1/Pa (docs/physics.md section 3)."""
         return (1.0 - self.poisson_ratio**2) / self.youngs_modulus
 
 
 @dataclass(frozen=True)
 class ClearanceJoint:
-    """The revolute joint at E with radial clearance (SPEC.md sections 2 and 3).
+    """The revolute joint at E with radial clearance (docs/physics.md sections 2 and 3).
 
     Attributes
     ----------
@@ -234,7 +234,7 @@ class Output:
 
 @dataclass(frozen=True)
 class CompareTolerance:
-    """Agreement the two engines must reach (relative, see issue text / SPEC.md section 6)."""
+    """Agreement the two engines must reach (relative, see issue text / docs/physics.md section 6)."""
 
     first_contact_angle: float = math.radians(0.1)
     first_revolution_peaks: float = 0.01

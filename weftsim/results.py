@@ -49,7 +49,7 @@ CONTACT_CHANNELS: tuple[str, ...] = (
     "penetration_rate_m_s",
 )
 
-# Channels summarised by peaks and statistics (SPEC.md section 4; paper Fig. 12).
+# Channels summarised by peaks and statistics (docs/physics.md section 4; paper Fig. 12).
 PEAK_CHANNELS: tuple[str, ...] = (
     "rapier_displacement_m",
     "rapier_velocity_m_s",

@@ -1,4 +1,4 @@
-"""Spherical 4R part of the weft insertion linkage (members 0-3, SPEC.md section 1).
+"""Spherical 4R part of the weft insertion linkage (members 0-3, docs/physics.md section 1).
 
 Pure numpy kernels, vectorised over the crank angle.  Every function returns the
 quantity together with its first and second derivative with respect to the input
@@ -6,7 +6,7 @@ angle, computed analytically (closed form or implicit differentiation of the
 closure equation), so that at constant crank speed omega a velocity is
 ``omega * d`` and an acceleration ``omega**2 * dd``.
 
-Frames (SPEC.md section 1)::
+Frames (docs/physics.md section 1)::
 
             z = axis A (crank)
             |    b(theta): crank axis B, arc A-B = beta
@@ -99,7 +99,7 @@ def spherical_4r_assembles(theta_in, alpha1, alpha2, alpha3, alpha4):
 
 
 def spherical_4r(theta_in, alpha1, alpha2, alpha3, alpha4, branch):
-    """General spherical 4R input-output law (SPEC.md section 1) with derivatives.
+    """General spherical 4R input-output law (docs/physics.md section 1) with derivatives.
 
     In the mechanism's own frame (a = z, d = R_y(alpha1) z,
     b = (sin a2 cos th', sin a2 sin th', cos a2),

@@ -1,4 +1,4 @@
-"""A planar revolute clearance joint for any Exudyn mechanism (SPEC.md sections 2-3).
+"""A planar revolute clearance joint for any Exudyn mechanism (docs/physics.md sections 2-3).
 
 :func:`add_clearance_joint` puts the joint between a bearing marker and a journal marker
 (``MarkerBodyPosition`` at the two joint centres, bodies moving in Exudyn's XY plane,

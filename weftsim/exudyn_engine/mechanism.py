@@ -1,11 +1,11 @@
-"""The weft insertion mechanism (members 1-8, SPEC.md section 1) as an Exudyn model.
+"""The weft insertion mechanism (members 1-8, docs/physics.md section 1) as an Exudyn model.
 
 Exudyn's global frame is rotated so that the four-bar plane is its XY plane (2-D bodies
 live there and are 4-5x cheaper than 3-D ones)::
 
-    Exudyn X = SPEC y (along OG)      SPEC (Y, Z) four-bar coordinates = Exudyn (X, Y)
-    Exudyn Y = SPEC z (crank axis A, up; gravity along -Y)
-    Exudyn Z = SPEC x (rocker axis D, normal of the four-bar plane)
+    Exudyn X = model y (along OG)      model (Y, Z) four-bar coordinates = Exudyn (X, Y)
+    Exudyn Y = model z (crank axis A, up; gravity along -Y)
+    Exudyn Z = model x (rocker axis D, normal of the four-bar plane)
 
 Members and joints (all joints ideal except E when the scene has a clearance)::
 
@@ -50,7 +50,7 @@ from weftsim.exudyn_engine.clearance_joint import ClearanceJointModel, add_clear
 from weftsim.kinematics import coupler_angular_velocity, coupler_frame, crank_axis, linkage_state, rocker_axis
 from weftsim.params import Scene
 
-# SPEC vector (x, y, z) -> Exudyn (X, Y, Z) = (y, z, x).
+# Model-frame vector (x, y, z) (docs/physics.md section 1) -> Exudyn (X, Y, Z) = (y, z, x).
 SPEC_TO_EXUDYN = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
 # Mass given to balanced members whose mass the scene does not specify (no effect on results), kg.
 UNSPECIFIED_MASS = 1.0
@@ -59,7 +59,7 @@ ROTATION_2D = 2  # coordinate index of the angle of a 2-D rigid body node
 
 
 def to_exudyn(vector) -> np.ndarray:
-    """SPEC-frame vector(s) (..., 3) to Exudyn's frame."""
+    """Model-frame vector(s) (docs/physics.md section 1) (..., 3) to Exudyn's frame."""
     return np.asarray(vector, dtype=float) @ SPEC_TO_EXUDYN.T
 
 
@@ -204,7 +204,7 @@ def build_mechanism(mbs, scene: Scene, callback: str | None = None, reflect_gear
 def _gear_train(mbs, scene: Scene, ground, sector, gravity) -> dict:
     """Pinion/rapier gear 6/7 and rapier 8 as bodies with ideal gear constraints.
 
-    Gear 6/7 angle q67 = -(d5/d6) q5 and rapier s = -d7 q67 (SPEC.md 1), written as
+    Gear 6/7 angle q67 = -(d5/d6) q5 and rapier s = -d7 q67 (docs/physics.md section 1), written as
     Exudyn coordinate constraints factor1 q(m1) - q(m0) = 0.  Gear 6/7 sits at the mesh
     distance d5 + d6 beyond G (its position has no effect: balanced, pinned).
     """

@@ -1,12 +1,12 @@
 """Sensors of the mechanism and their conversion to the result channels.
 
 Every sensor stores internally at every accepted step (``storeInternal=True``,
-``writePeriod = 0``, no files).  Channels (SPEC.md 4 signs; Exudyn frame in mechanism.py)::
+``writePeriod = 0``, no files).  Channels (docs/physics.md section 4 signs; Exudyn frame in mechanism.py)::
 
     crank angle       theta = rz of the crank node
     rapier s, v, a    (d5 d7/d6) x (angle, rate, acceleration of the sector node)
     driving torque    T = -lambda_drive (the motor's torque on the crank about +z)
-    contact           e = connector Displacement (X, Y) = SPEC (y, z); F_N = |connector Force|;
+    contact           e = connector Displacement (X, Y) = model (y, z); F_N = |connector Force|;
                       delta = |e| - c, delta_dot = e_dot . e/|e|; held impact velocity and
                       contact flag from the tracker
     kinetic energy    sum of the bodies' KineticEnergy outputs

@@ -1,7 +1,7 @@
 """Kinematic-tree model of the loom: only the free members in minimal coordinates, explicit solver.
 
 With members 1-3 ideal and rigid, their motion is known in closed form from the crank
-angle theta = omega t (SPEC.md section 1); only the chain 4-8 behind the clearance joint
+angle theta = omega t (docs/physics.md section 1); only the chain 4-8 behind the clearance joint
 moves freely.  This model integrates that chain alone, as an ``ObjectKinematicTree`` with
 two revolute joints about Exudyn Z (the four-bar plane is Exudyn's XY plane, as in
 :mod:`.mechanism`)::
@@ -29,7 +29,7 @@ explicit solver (DOPRI5 with automatic step size) integrates it; there is no Jac
 Newton iteration.
 
 The driving torque comes from the contact force in closed form, with the crank-side
-terms of :mod:`weftsim.reference.ideal` (SPEC.md 4, docs/reference-solver.md):
+terms of :mod:`weftsim.reference.ideal` (docs/physics.md section 4, docs/reference-solver.md):
 
     T = 1/2 J13'(theta) omega^2 + U13'(theta) - Q3,   Q3 = F_b . dP_b/dtheta
 

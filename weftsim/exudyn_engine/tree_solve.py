@@ -6,7 +6,7 @@ angles, rad, and rates, rad/s), end-of-step accelerations on (else the rapier ac
 lags a stage), largest step = half an output sample period (:data:`STEPS_PER_SAMPLE`).  Output samples are interpolated
 linearly between accepted steps (peaks and statistics use the steps themselves).
 
-Channels, at every accepted step (SPEC.md 4 signs):
+Channels, at every accepted step (docs/physics.md section 4 signs):
 
     a, psi           q0, q0 + q1 - pi;   rapier s, v, a = (d5 d7/d6) (a - a(0), a', a'')
     e, delta, F_N    from a, psi and the closed-form bearing motion

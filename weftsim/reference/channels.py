@@ -5,7 +5,7 @@ Everything is recomputed with the compiled right-hand side that was integrated
 acceleration is the equation of motion's a'' (not a finite difference) and the contact force is
 the one the solver saw.
 
-Energy channels (SPEC.md section 4, COMMON interface)::
+Energy channels (docs/physics.md section 4, COMMON interface)::
 
     kinetic   = 1/2 J13(theta) omega^2 + 1/2 q'^T M(q) q'
     potential = U13(theta) + m4 g z4

@@ -142,7 +142,7 @@ def chain_energy(p: ChainConstants, a, psi, da, dpsi):
 
 
 def initial_state(scene: Scene) -> np.ndarray:
-    """State at t = 0: journal centred (e = 0), ideal-mechanism velocities (SPEC.md section 2).
+    """State at t = 0: journal centred (e = 0), ideal-mechanism velocities (docs/physics.md section 2).
 
     Returns [a, psi, a', psi', W3, D] with a = theta_FG(0), psi = theta_EF(0) (angle of
     F - E, so P_j = F - L_EF u(psi) = E), rates omega * d/dtheta of the ideal kinematics,

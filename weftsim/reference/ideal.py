@@ -5,11 +5,11 @@ member's kinetic energy is (1/2) J_k(theta) theta_dot^2, so the Lagrangian is
 
     L = 1/2 J_eq(theta) theta_dot^2 - U(theta)
 
-and the driving torque (paper Eq. 48, SPEC.md section 4) at constant omega is
+and the driving torque (paper Eq. 48, docs/physics.md section 4) at constant omega is
 
     T(theta) = d/dt dL/dtheta_dot - dL/dtheta = 1/2 J_eq'(theta) omega^2 + U'(theta).
 
-Generalized inertias (primes are d/dtheta; SPEC.md section 1 frames):
+Generalized inertias (primes are d/dtheta; docs/physics.md section 1 frames):
 
     crank 1        J1
     coupler 2      w^T I_O w,  I_O = R diag(I_b, I_c, I_n) R^T,  R = [b, c, b x c],

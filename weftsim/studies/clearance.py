@@ -1,7 +1,7 @@
 """Clearance study, like the paper's Fig. 12: c = 0.01, 0.25, 0.50 mm at 400 rpm (reference engine).
 
 The curves of the last revolution are overlaid as in the paper (an illustration: after
-the first impacts the impact sequence is not reproducible, SPEC.md section 6); the
+the first impacts the impact sequence is not reproducible, docs/physics.md section 6); the
 clearance trend is read from the reproducible numbers of each run (first-revolution
 peaks, statistics over revolutions 2..N), with the ideal joint as the baseline.
 

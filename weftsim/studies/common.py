@@ -1,6 +1,6 @@
 """Shared parts of the studies: scene files, engine runs, the reproducible numbers of a run.
 
-SPEC.md section 6: after the first impacts the impact sequence depends on round-off,
+docs/physics.md section 6: after the first impacts the impact sequence depends on round-off,
 step and tolerance, so each run is summarised by quantities that do not:
 
 - ``first_revolution``: min and max of each peak channel over revolution 1 (the start-up

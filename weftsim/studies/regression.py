@@ -1,6 +1,6 @@
 """Regression table of peaks (tests/regression/peaks.json): cases, quantities, tolerances.
 
-Only reproducible quantities are stored (SPEC.md section 6):
+Only reproducible quantities are stored (docs/physics.md section 6):
 
 - ideal joint: min and max of the driving torque and the rapier acceleration;
 - clearance, first revolution: min and max of the driving torque and the rapier
