@@ -26,7 +26,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from weftsim.bench.measure import Setting, converged_solution, measure
+from weftsim.bench.measure import Setting, _ref, _rigid, converged_solution, measure
 
 CASE = "c0.25mm-400rpm"
 # Issue 12's targets: loom time / wall time of the in-process solves, wall seconds of the rest.
@@ -43,12 +43,8 @@ SOLVES = {
     "reference default": Setting("reference", "reference", "default", {}),
     "exudyn default": Setting("exudyn", "exudyn", "default", {}),
     "exudyn rigid_body (forced)": Setting("exudyn", "exudyn", "rigid_body", {"solver.exudyn.model": "rigid_body"}),
-    "baseline: reference scipy DOP853 rtol 1e-9 (0.1 default)": Setting(
-        "reference", "reference", "scipy", {"solver.reference.method": "DOP853", "solver.reference.rtol": 1e-9,
-                                            "solver.reference.atol": 1e-12}),
-    "baseline: exudyn rigid_body h 2e-6 s (0.1 default)": Setting(
-        "exudyn", "exudyn", "rigid h2e-6", {"solver.exudyn.model": "rigid_body", "solver.exudyn.step_control": "fixed",
-                                            "solver.exudyn.step_size_s": 2e-6}),
+    "baseline: reference scipy DOP853 rtol 1e-9 (0.1 default)": _ref("DOP853", 1e-9),
+    "baseline: exudyn rigid_body h 2e-6 s (0.1 default)": _rigid(2e-6),
 }
 MAP_VARY = ["clearance_mm=0.01,0.05,0.1,0.15,0.2,0.25,0.3,0.35,0.4,0.45,0.5", "speed_rpm=300:800:11"]
 
