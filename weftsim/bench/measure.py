@@ -5,7 +5,7 @@ hard scenes, each engine setting of :func:`settings` and measures
 
 - wall and CPU time of ``solve`` (median of ``repeats`` runs; runs too long to repeat whole
   are timed on ``timing_revolutions`` instead, and the table says so);
-- the error of the reproducible quantities (SPEC.md section 6) against the converged
+- the error of the reproducible quantities (docs/physics.md section 6) against the converged
   solution of the same scene (:func:`converged_solution`): the first revolution's maxima of
   driving torque, rapier acceleration and contact force, and the RMS and mean over
   revolutions 2..N (N = 10 by default; means are compared relative to the RMS, since the
@@ -33,7 +33,7 @@ CASES = {
     "c0.50mm-800rpm": {"joint_e.clearance_mm": 0.50, "drive.speed_rpm": 800.0},
 }
 # The converged solution: compiled DOP853 at the tightest tolerances; the spread of the ensemble is
-# the floor below which errors are not meaningful (SPEC.md 6: statistics reproduce to 1-2 %).
+# the floor below which errors are not meaningful (docs/physics.md section 6: statistics reproduce to 1-2 %).
 CONVERGED = (("numba_DOP853", 1e-12), ("numba_DOP853", 1e-11), ("numba_DOP853", 1e-10), ("numba_RK45", 1e-10))
 TARGETS = {"peak": 0.01, "stats": 0.02}  # issue 6: < 1 % first-revolution peaks, < 2 % statistics
 
@@ -71,7 +71,7 @@ def _rigid(step: float, route: str = "auto") -> Setting:
                     "solver.exudyn.step_size_s": step, "solver.exudyn.callback": route})  # fmt: skip
 
 
-def _rigid_adaptive(local_error: float, route: str = "symbolic") -> Setting:
+def _rigid_adaptive(local_error: float, route: str = "auto") -> Setting:
     return Setting("exudyn", f"exudyn rigid_body adaptive {route}", f"tol {local_error:.0e} m",
                    {"solver.exudyn.model": "rigid_body", "solver.exudyn.step_control": "adaptive",
                     "solver.exudyn.local_error_m": local_error, "solver.exudyn.callback": route})  # fmt: skip
@@ -159,7 +159,7 @@ def converged_solution(case: str, models, revolutions: float, log=print) -> dict
     """Quantities of the converged ensemble (:data:`CONVERGED`) and its spread (the error floor).
 
     Peaks come from the tightest run; RMS and mean are the median over the ensemble (they
-    scatter by ~1 % from impact-sequence chaos, SPEC.md 6).
+    scatter by ~1 % from impact-sequence chaos, docs/physics.md section 6).
     """
     members = []
     for method, rtol in CONVERGED:
