@@ -346,12 +346,13 @@ def output_rows(scene) -> float:
 
 
 def write_run(result: RunResult, outdir: str | Path, figure: bool = True, force: bool = False) -> dict[str, Path]:
-    """Write ``channels.csv``, ``summary.json`` and ``channels.png`` for one run, atomically each.
+    """Write ``channels.csv``, ``summary.json``, ``channels.png`` and (clearance joint) ``orbit.png``
+    for one run, atomically each.
 
     Raises :class:`WriteFailed` (after writing what it can) when a file cannot be written.
     """
     from weftsim.analysis import summary
-    from weftsim.plots import plot_channels
+    from weftsim.plots import plot_channels, plot_orbit
 
     outdir = prepare_directory(outdir, force)
     what = {"kind": "run", "engine": result.engine, "scene": result.scene.name, "status": result.status}
@@ -361,4 +362,6 @@ def write_run(result: RunResult, outdir: str | Path, figure: bool = True, force:
     }
     if figure and result.steps["time_s"].size:
         files["figure"] = ("channels.png", lambda target: write_figure(target, plot_channels([result])))
+        if result.scene.joint.clearance > 0.0:
+            files["orbit"] = ("orbit.png", lambda target: write_figure(target, plot_orbit(result)))
     return write_files(outdir, what, files)

@@ -100,3 +100,72 @@ def plot_kinematics(angle_deg, s, v, a, title=""):
     fig.suptitle(title)
     fig.tight_layout()
     return fig
+
+
+def contact_onsets(steps) -> np.ndarray:
+    """Rows of the per-step channels that start a contact at E (an impact).
+
+    A contact segment is where the engine holds an impact velocity (docs/physics.md section 2):
+    :func:`weftsim.plausibility.contact_mode`; an onset is its first row after free flight.
+    """
+    from weftsim.plausibility import contact_mode, onset_rows
+
+    return onset_rows(contact_mode(steps))
+
+
+def plot_orbit(result, title=None):
+    """Orbit of the journal centre inside the clearance circle at E, with the impacts marked.
+
+    The eccentricity e = P_j - P_b (journal centre minus bearing centre, docs/physics.md
+    section 2) is drawn at every accepted solver step in the four-bar plane (model y, z),
+    inside the circle |e| = c of the radial clearance: on the circle the journal touches the
+    bearing wall, outside it the two penetrate by δ = |e| - c.  Each contact onset (an impact)
+    is a dot coloured by its impact velocity δ̇⁻; the first is ringed.  The orbit of the journal
+    centre is the standard picture of a clearance joint (as in Flores and Ambrósio 2004).
+
+    Parameters
+    ----------
+    result : RunResult
+        A run with a clearance joint (``scene.joint.clearance > 0``).
+    title : str, optional
+        Defaults to the scene, engine, clearance and crank speed.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    clearance = result.scene.joint.clearance
+    if not clearance > 0.0:
+        raise ValueError(f"the orbit needs a clearance joint: joint_e.clearance_mm must be > 0, got "
+                         f"{clearance * 1e3:g}")
+    steps = result.steps
+    y_mm, z_mm = steps["eccentricity_y_m"] * 1e3, steps["eccentricity_z_m"] * 1e3
+    onsets = contact_onsets(steps)
+    fig = figure(figsize=(6.4, 6.8))
+    ax = fig.subplots()
+    circle = np.linspace(0.0, 2.0 * math.pi, 361)
+    c_mm = clearance * 1e3
+    ax.plot(c_mm * np.cos(circle), c_mm * np.sin(circle), color="0.3", lw=1.2,
+            label=f"clearance circle, c = {c_mm:g} mm")
+    ax.plot(y_mm, z_mm, lw=0.6, color="tab:blue", label="journal centre (every solver step)",
+            rasterized=len(y_mm) > 20000)
+    if onsets.size:
+        speed = steps["impact_velocity_m_s"][onsets]
+        dots = ax.scatter(y_mm[onsets], z_mm[onsets], c=speed, s=18, cmap="plasma", zorder=3,
+                          label=f"impacts ({onsets.size}), colour = impact velocity")
+        ax.scatter(y_mm[onsets[:1]], z_mm[onsets[:1]], s=90, facecolors="none", edgecolors="k", zorder=4,
+                   label="first impact")
+        fig.colorbar(dots, ax=ax, shrink=0.8, label="impact velocity δ̇⁻ [m/s]")
+    ax.set_aspect("equal")
+    reach = 1.15 * max(c_mm, float(np.max(np.hypot(y_mm, z_mm), initial=0.0)))
+    ax.set_xlim(-reach, reach)
+    ax.set_ylim(-reach, reach)
+    ax.set_xlabel("eccentricity y [mm]")
+    ax.set_ylabel("eccentricity z [mm]")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2)
+    rpm = result.scene.drive.speed * 30 / math.pi
+    ax.set_title(title or f"scene {result.scene.name}, engine {result.engine}: journal orbit at E "
+                          f"(c = {c_mm:g} mm, {rpm:g} rpm)", fontsize=10)
+    fig.tight_layout()
+    return fig
