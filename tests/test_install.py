@@ -30,9 +30,11 @@ def lock() -> dict[str, Version]:
 
 
 def declared() -> list[Requirement]:
-    """The run-time dependencies and those of the [test] extra, as pyproject.toml states them."""
+    """The run-time dependencies and those of the [test] and [docs] extras (what CI installs), as
+    pyproject.toml states them."""
     project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
-    return [Requirement(text) for text in project["dependencies"] + project["optional-dependencies"]["test"]]
+    extras = project["optional-dependencies"]
+    return [Requirement(text) for text in project["dependencies"] + extras["test"] + extras["docs"]]
 
 
 def test_lock_pins_public_releases_and_not_weftsim_itself():
