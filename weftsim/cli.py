@@ -1,4 +1,4 @@
-"""Command line: ``weftsim kinematics | run | compare | sweep | study``.  Thin: parse, call, report.
+"""Command line: ``weftsim kinematics | run | animate | compare | sweep | study``.  Thin: parse, call, report.
 
 Every expected failure (bad scene, bad flag, unwritable output, failed solve) is one
 line on stderr and a non-zero exit status; tracebacks only for real bugs.
@@ -78,9 +78,10 @@ def _non_negative(text: str) -> float:
     return value
 
 
-def _add_scene_flags(p: argparse.ArgumentParser, full: bool = True) -> None:
+def _add_scene_flags(p: argparse.ArgumentParser, full: bool = True,
+                     output_help: str = "output directory (default: out/<scene name>)") -> None:
     p.add_argument("scene", help="scene file (TOML), e.g. models/reference.toml")
-    p.add_argument("-o", "--output", default=None, help="output directory (default: out/<scene name>)")
+    p.add_argument("-o", "--output", default=None, help=output_help)
     p.add_argument("--force", action="store_true",
                    help="write into an output directory that holds files weftsim did not write")
     p.add_argument("--speed-rpm", type=_positive(float), help="override drive.speed_rpm")
@@ -109,6 +110,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--engine", default="exudyn", choices=("exudyn", "reference"),
                    help="exudyn (multibody model, default) or reference (closed-form Lagrange cross-check)")
     p.add_argument("--no-plot", action="store_true", help="skip the figure")
+
+    p = sub.add_parser("animate", help="animation of the linkage, the journal and the rapier over a revolution (GIF)",
+                       description="Simulate a scene and draw its last complete revolution: the linkage projected "
+                       "on the four-bar plane, the journal in its clearance (magnified, labelled) and the rapier.")
+    _add_scene_flags(p, output_help="animation file, .gif (or .mp4 with ffmpeg) (default: out/<scene name>-animation.gif)")
+    p.add_argument("--engine", default="exudyn", choices=("exudyn", "reference"), help="as for run")
+    p.add_argument("--frames", type=_positive(int), default=72, help="frames over the revolution (default 72)")
 
     p = sub.add_parser("compare", help="run both engines on one scene and compare them")
     _add_scene_flags(p)
@@ -398,6 +406,35 @@ def cmd_run(args) -> int:
     return 0
 
 
+def cmd_animate(args) -> int:
+    from weftsim.animate import check_format, write_animation
+
+    scene = _load(args)
+    target = _outdir(args, scene, "-animation.gif")
+    try:
+        check_format(target)
+        if args.frames < 2:
+            raise ValueError(f"--frames must be >= 2, got {args.frames}")
+    except ValueError as exc:
+        raise CliError(str(exc)) from None
+    _check_fits(scene, target.parent)
+    _announce_run_time(scene, (args.engine,), "animate")
+    with _stop_on_interrupt("animate"):
+        result = _solve(scene, args.engine, announce=True)
+    if not result.ok:
+        raise CliError(f"simulation failed: {result.message}; nothing animated", EXIT_FAILED)
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        frames = write_animation(result, target, frames=args.frames)
+    except OSError as exc:
+        raise CliError(f"cannot write {target}: {exc.strerror or exc}") from None
+    closure = float(abs(frames.rod_length - scene.geometry.l_ef).max())
+    print(f"wrote {target}: {args.frames} frames over crank angles {frames.crank_angle_deg[0]:.1f}.."
+          f"{frames.crank_angle_deg[-1]:.1f} deg; "
+          f"drawn rod EF within {closure:.1e} m of L_EF = {scene.geometry.l_ef:g} m")
+    return 0
+
+
 def cmd_compare(args) -> int:
     from weftsim.compare import format_report, run_compare
     from weftsim.output import prepare_directory, to_json
@@ -490,7 +527,7 @@ def cmd_bench(args) -> int:
     return 0
 
 
-COMMANDS = {"kinematics": cmd_kinematics, "run": cmd_run, "compare": cmd_compare, "sweep": cmd_sweep,
+COMMANDS = {"kinematics": cmd_kinematics, "run": cmd_run, "animate": cmd_animate, "compare": cmd_compare, "sweep": cmd_sweep,
             "study": cmd_study, "bench": cmd_bench}
 
 

@@ -1,0 +1,406 @@
+"""Animation of a run: the linkage, the journal in its clearance and the rapier over one revolution.
+
+Projection
+----------
+The picture is the orthographic projection onto the plane x = 0 of the model frame
+(docs/physics.md section 1), seen along axis D (+x) with y to the right and z up. That plane is the
+plane of the four-bar O-E-F-G, so rocker arm OE, rod EF and sector arm FG appear at their true
+lengths. The spherical 4R (members 0-3) turns about axes that meet at O; it is drawn as the
+projections of the unit vectors of crank axis B, b(theta), and rocker axis C, c(phi), scaled to a
+display length. Axis A (+z) lies in the plane; c(phi) = (0, cos phi, sin phi) lies in it too and keeps
+its length, while b(theta) traces an ellipse. The rapier rack moves along y; it is drawn in a strip
+below, at its displacement s::
+
+        z ^          E (bearing on rocker 3, journal on rod 4: clearance drawn magnified)
+          |        /  \\
+          |  OE  /      \\  rod EF
+          |    /          F
+          |  /  C       /  sector arm FG
+          O ---------- G ----> y        rapier:  |====[]=========|  s, positive into the shed
+
+Where the points come from
+--------------------------
+Everything is read from the run's accepted solver steps (``result.steps``, the engine's own states;
+the output samples of an engine may be interpolated between steps), so the picture shows what the
+engine computed:
+the crank angle theta = omega t gives the rocker angle phi(theta) (:func:`weftsim.spherical.rocker_angle`)
+and so the bearing centre P_b = L_OE u(theta_OE0 + phi); the eccentricity channels give the journal
+centre P_j = P_b + e; the rapier displacement gives the sector angle
+theta_FG = theta_FG(0) + s / (d5 d7 / d6) and so F = G + L_FG u(theta_FG). The rod length ``|F - P_j|``
+is then a check of the engine's closure, not an input (``weftsim animate`` reports it).
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from weftsim.kinematics import fourbar, rocker_angle
+from weftsim.results import RunResult
+from weftsim.spherical import crank_axis, rocker_axis
+
+FORMATS = (".gif", ".mp4")
+DEFAULT_FRAMES = 72  # one frame per 5 deg of crank: smooth enough, ~1 MB as a GIF
+DEFAULT_FPS = 18  # a revolution in 4 s: the loom's motion slowed about 27x at 400 rpm
+AXIS_DISPLAY_LENGTH = 0.5  # crank and rocker axes drawn at this fraction of L_OE
+
+
+@dataclass(frozen=True)
+class MechanismFrames:
+    """Points of the mechanism at each frame, in the four-bar plane (model y, z), m.
+
+    Attributes
+    ----------
+    time_s, crank_angle_deg : ndarray, shape (n,)
+        Time of each frame and its crank angle within the revolution (0..360 deg).
+    crank_axis_tip, rocker_axis_tip : ndarray, shape (n, 2)
+        Projections of the crank axis b(theta) and the rocker axis c(phi), scaled to the display
+        length ``axis_length``.
+    bearing, journal : ndarray, shape (n, 2)
+        Bearing centre P_b (point E of rocker 3) and journal centre P_j = P_b + e (point E of rod 4).
+    point_f : ndarray, shape (n, 2)
+        Joint F between rod 4 and sector 5.
+    point_g : ndarray, shape (2,)
+        Sector pivot G = (L_OG, 0).
+    eccentricity : ndarray, shape (n, 2)
+        e = P_j - P_b.
+    in_contact : ndarray of bool, shape (n,)
+        Whether the journal touches the bearing (the engine's contact flag).
+    rapier_displacement : ndarray, shape (n,)
+        s, m, positive into the shed.
+    clearance, axis_length : float
+        Radial clearance c and the display length of the axes, m.
+    """
+
+    time_s: np.ndarray
+    crank_angle_deg: np.ndarray
+    crank_axis_tip: np.ndarray
+    rocker_axis_tip: np.ndarray
+    bearing: np.ndarray
+    journal: np.ndarray
+    point_f: np.ndarray
+    point_g: np.ndarray
+    eccentricity: np.ndarray
+    in_contact: np.ndarray
+    rapier_displacement: np.ndarray
+    clearance: float
+    axis_length: float
+
+    @property
+    def rod_length(self) -> np.ndarray:
+        """``|F - P_j|`` at each frame, m: the closure check (L_EF for a consistent run)."""
+        return np.hypot(*(self.point_f - self.journal).T)
+
+
+def _unit(angle) -> np.ndarray:
+    return np.stack([np.cos(angle), np.sin(angle)], axis=-1)
+
+
+def animated_window(result: RunResult) -> tuple[float, float]:
+    """Times (s) of the revolution to animate: the last complete one, or the whole run if shorter."""
+    from weftsim.analysis import complete_revolutions
+
+    n = complete_revolutions(result)
+    period = result.scene.drive.period
+    if n >= 1:
+        return (n - 1) * period, n * period
+    return 0.0, float(result.steps["time_s"][-1])
+
+
+def mechanism_frames(result: RunResult, frames: int = DEFAULT_FRAMES) -> MechanismFrames:
+    """Positions of the mechanism's points at ``frames`` instants evenly spread over a revolution.
+
+    The instants are accepted solver steps of the run (the nearest to an even spread over
+    :func:`animated_window`; the last instant of the window is left out, as it repeats the first),
+    so every point is an engine's state, not an interpolation (the output samples of the Exudyn
+    engine's kinematic tree are interpolated between its steps: the rod length drawn from them is
+    off by 3e-7 of L_EF, from the steps by round-off only).
+
+    Parameters
+    ----------
+    result : RunResult
+        A run with at least two accepted steps.
+    frames : int
+        Number of frames, >= 2.
+
+    Returns
+    -------
+    MechanismFrames
+    """
+    if frames < 2:
+        raise ValueError(f"frames must be >= 2, got {frames}")
+    steps = result.steps
+    t = steps["time_s"]
+    if t.size < 2:
+        raise ValueError(f"the run has {t.size} solver steps; an animation needs at least 2")
+    scene = result.scene
+    g = scene.geometry
+    t0, t1 = animated_window(result)
+    wanted = t0 + (t1 - t0) * np.arange(frames) / frames
+    rows = np.clip(np.searchsorted(t, wanted), 1, t.size - 1)
+    rows = np.where(np.abs(t[rows - 1] - wanted) <= np.abs(t[rows] - wanted), rows - 1, rows)
+    time = t[rows]
+    theta = scene.drive.speed * time
+    phi = rocker_angle(theta, g.crank_inclination)[0]
+    bearing = g.l_oe * _unit(g.rocker_arm_angle + phi)
+    ecc = np.column_stack([steps["eccentricity_y_m"][rows], steps["eccentricity_z_m"][rows]])
+    phi0 = rocker_angle(0.0, g.crank_inclination)[0]
+    theta_fg0 = float(fourbar(g.rocker_arm_angle + phi0, g).theta_fg)  # s = 0 here (docs/physics.md section 1)
+    theta_fg = theta_fg0 + steps["rapier_displacement_m"][rows] / g.rapier_ratio
+    point_g = np.array([g.l_og, 0.0])
+    length = AXIS_DISPLAY_LENGTH * g.l_oe
+    return MechanismFrames(
+        time_s=time,
+        crank_angle_deg=np.degrees(theta) % 360.0,
+        crank_axis_tip=length * crank_axis(theta, g.crank_inclination)[:, 1:],
+        rocker_axis_tip=length * rocker_axis(phi)[:, 1:],
+        bearing=bearing,
+        journal=bearing + ecc,
+        point_f=point_g + g.l_fg * _unit(theta_fg),
+        point_g=point_g,
+        eccentricity=ecc,
+        in_contact=steps["in_contact"][rows] > 0.5,
+        rapier_displacement=steps["rapier_displacement_m"][rows],
+        clearance=scene.joint.clearance,
+        axis_length=length,
+    )
+
+
+def clearance_magnification(clearance: float, rod_length: float) -> float:
+    """A round factor (1, 2 or 5 times a power of ten) that draws the clearance circle at about 8 %
+    of the rod length: large enough to see the journal move, small enough to keep the linkage legible."""
+    if clearance <= 0.0:
+        return 1.0
+    raw = 0.08 * rod_length / clearance
+    decade = 10.0 ** math.floor(math.log10(raw))
+    return max(1.0, max(m * decade for m in (1.0, 2.0, 5.0) if m * decade <= raw))
+
+
+def _linkage_artists(ax, frames: MechanismFrames, magnification: float):
+    """Draw the static parts and return a function that moves the rest to frame k."""
+    from matplotlib.patches import Circle
+
+    ax.plot([0.0, frames.point_g[0]], [0.0, 0.0], color="0.55", lw=3, solid_capstyle="round", zorder=1)
+    ax.plot([0.0, 0.0], [0.0, frames.axis_length], color="0.55", lw=1, ls=":", zorder=1)
+    ax.annotate("A (+z)", (0.0, frames.axis_length), fontsize=7, color="0.4", ha="center", va="bottom")
+    for point, name in ((np.zeros(2), "O"), (frames.point_g, "G")):
+        ax.plot(*point, marker="^", color="0.3", ms=9, zorder=4)
+        ax.annotate(name, point, xytext=(0, -14), textcoords="offset points", ha="center", fontsize=9)
+    crank, = ax.plot([], [], color="tab:purple", lw=1.2, ls="--", label="crank axis B (projected)")
+    rocker, = ax.plot([], [], color="tab:green", lw=1.2, ls="--", label="rocker axis C")
+    arm, = ax.plot([], [], color="tab:green", lw=4, solid_capstyle="round", label="rocker arm OE (3)")
+    rod, = ax.plot([], [], color="tab:blue", lw=4, solid_capstyle="round", label="rod EF (4)")
+    sector, = ax.plot([], [], color="tab:orange", lw=4, solid_capstyle="round", label="sector arm FG (5)")
+    magnified = frames.clearance > 0.0
+    ring = Circle((0.0, 0.0), magnification * frames.clearance, fill=False, color="k", lw=1.0, zorder=5)
+    journal, = ax.plot([], [], marker="o", ms=6, color="tab:blue", ls="none", zorder=6,
+                       label="journal centre (red: in contact)")
+    trail, = ax.plot([], [], color="tab:red", lw=0.7, alpha=0.6, zorder=5)
+    if magnified:
+        ax.add_patch(ring)
+        label = ax.text(0.0, 0.0, f"clearance x{magnification:g}", fontsize=8, ha="left", va="bottom")
+    else:
+        label = ax.text(0.0, 0.0, "ideal joint", fontsize=8, ha="left", va="bottom")
+    moving = (crank, rocker, arm, rod, sector, journal, trail, ring, label)
+
+    def move(k: int):
+        e, j, f = frames.bearing[k], frames.journal[k], frames.point_f[k]
+        crank.set_data([0.0, frames.crank_axis_tip[k, 0]], [0.0, frames.crank_axis_tip[k, 1]])
+        rocker.set_data([0.0, frames.rocker_axis_tip[k, 0]], [0.0, frames.rocker_axis_tip[k, 1]])
+        arm.set_data([0.0, e[0]], [0.0, e[1]])
+        rod.set_data([j[0], f[0]], [j[1], f[1]])
+        sector.set_data([f[0], frames.point_g[0]], [f[1], frames.point_g[1]])
+        drawn = e + magnification * frames.eccentricity[: k + 1]
+        journal.set_data([drawn[-1, 0]], [drawn[-1, 1]])
+        journal.set_color("tab:red" if frames.in_contact[k] else "tab:blue")
+        trail.set_data(drawn[-12:, 0], drawn[-12:, 1])
+        ring.center = tuple(e)
+        label.set_position((e[0] + 1.2 * magnification * frames.clearance + 0.004, e[1]))
+
+    return move, moving
+
+
+def _rapier_artists(ax, frames: MechanismFrames, stroke: float):
+    ax.plot([0.0, stroke * 1e3], [0.0, 0.0], color="0.6", lw=6, solid_capstyle="butt")
+    head, = ax.plot([], [], marker="s", ms=10, color="tab:red")
+    rack, = ax.plot([], [], color="tab:red", lw=3)
+    text = ax.text(0.99, 0.9, "", transform=ax.transAxes, ha="right", va="top", fontsize=8)
+    ax.set_xlim(-0.05 * stroke * 1e3, 1.05 * stroke * 1e3)
+    ax.set_ylim(-1.0, 1.0)
+    ax.set_yticks([])
+    ax.set_xlabel("rapier displacement s [mm] (along y, positive into the shed)")
+
+    def move(k: int):
+        s = frames.rapier_displacement[k] * 1e3
+        head.set_data([s], [0.0])
+        rack.set_data([min(0.0, s), s], [0.0, 0.0])
+        text.set_text(f"s = {s:7.1f} mm")
+
+    return move, (head, rack, text)
+
+
+def animation_figure(result: RunResult, frames: MechanismFrames, magnification: float | None = None):
+    """The figure of the animation and a function ``draw(k)`` that puts it at frame k.
+
+    Parameters
+    ----------
+    result : RunResult
+        The run (scene, engine and clearance for the labels).
+    frames : MechanismFrames
+        From :func:`mechanism_frames`.
+    magnification : float, optional
+        Scale of the clearance drawing; default :func:`clearance_magnification`.
+
+    Returns
+    -------
+    figure : matplotlib.figure.Figure
+    draw : callable
+        ``draw(k)`` moves every artist to frame k.
+    moving : tuple of matplotlib artists
+        The artists ``draw`` changes (marked animated: a full draw of the figure leaves them out, so
+        the static rest is drawn once and each frame redraws only these).
+    """
+    from weftsim.kinematics import linkage_state
+    from weftsim.plots import figure
+
+    scene = result.scene
+    if magnification is None:
+        magnification = clearance_magnification(frames.clearance, scene.geometry.l_ef)
+    fig = figure(figsize=(7.0, 6.0))
+    grid = fig.add_gridspec(2, 1, height_ratios=(5, 1))
+    ax, strip = fig.add_subplot(grid[0]), fig.add_subplot(grid[1])
+    points = np.concatenate([frames.bearing, frames.point_f, frames.crank_axis_tip, frames.rocker_axis_tip,
+                             [frames.point_g, np.zeros(2), (0.0, frames.axis_length)]])
+    low, high = points.min(axis=0), points.max(axis=0)
+    margin = 0.12 * (high - low).max()
+    ax.set_xlim(low[0] - margin, high[0] + margin)
+    ax.set_ylim(low[1] - margin, high[1] + margin)
+    ax.set_aspect("equal")
+    ax.grid(alpha=0.25)
+    ax.set_xlabel("y [m]")
+    ax.set_ylabel("z [m]")
+    move_linkage, linkage = _linkage_artists(ax, frames, magnification)
+    ax.legend(fontsize=7, loc="lower left", ncol=2)
+    stroke = float(np.ptp(linkage_state(np.linspace(0.0, 2.0 * math.pi, 721), scene.geometry).rapier_displacement))
+    move_rapier, rapier = _rapier_artists(strip, frames, stroke)
+    rpm = scene.drive.speed * 30.0 / math.pi
+    joint = (f"c = {frames.clearance * 1e3:g} mm at E, drawn x{magnification:g}" if frames.clearance > 0.0
+             else "ideal joint at E")
+    title = fig.suptitle("", fontsize=9)
+    caption = (f"scene {scene.name}, engine {result.engine}, {rpm:g} rpm, {joint}\n"
+               "projection on the four-bar plane x = 0 (view along axis D)")
+
+    def draw(k: int):
+        move_linkage(k)
+        move_rapier(k)
+        state = "in contact" if frames.in_contact[k] else "free flight"
+        title.set_text(f"{caption}\ncrank angle {frames.crank_angle_deg[k]:5.1f} deg, journal {state}")
+
+    fig.tight_layout()
+    draw(0)
+    moving = linkage + rapier + (title,)
+    for artist in moving:
+        artist.set_animated(True)
+    return fig, draw, moving
+
+
+def render_frames(fig, draw, moving, count: int):
+    """Yield frame k = 0..count-1 as an RGB array (height, width, 3) of uint8.
+
+    Blitting: the static figure is drawn once; each frame restores it and draws only the moving
+    artists (a full redraw, dominated by the tick labels, took 6-8x longer per frame).
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    background = canvas.copy_from_bbox(fig.bbox)
+    for k in range(count):
+        canvas.restore_region(background)
+        draw(k)
+        for artist in moving:
+            fig.draw_artist(artist)
+        yield np.asarray(canvas.buffer_rgba())[..., :3].copy()
+
+
+def _gif(frames, fps: float, target: Path) -> None:
+    """Save RGB frames as one looping GIF (Pillow ships with matplotlib)."""
+    from PIL import Image
+
+    images = [Image.fromarray(rgb).quantize(colors=128, method=Image.Quantize.FASTOCTREE) for rgb in frames]
+    images[0].save(target, format="GIF", save_all=True, append_images=images[1:],
+                   duration=int(round(1000.0 / fps)), loop=0, disposal=1)
+
+
+def _mp4(frames, fps: float, target: Path) -> None:
+    """Pipe RGB frames to ffmpeg as H.264 in an MP4 container."""
+    import subprocess
+
+    frames = iter(frames)
+    first = next(frames)
+    height, width = first.shape[:2]
+    # libx264 with yuv420p needs even sizes: crop a pixel row or column if needed.
+    height, width = height - height % 2, width - width % 2
+    command = ["ffmpeg", "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", f"{width}x{height}",
+               "-r", f"{fps:g}", "-i", "pipe:", "-vcodec", "libx264", "-pix_fmt", "yuv420p", "-f", "mp4", str(target)]
+    with subprocess.Popen(command, stdin=subprocess.PIPE, stderr=subprocess.PIPE) as ffmpeg:
+        for rgb in (first, *frames):
+            ffmpeg.stdin.write(np.ascontiguousarray(rgb[:height, :width]).tobytes())
+        ffmpeg.stdin.close()
+        error = ffmpeg.stderr.read().decode(errors="replace").strip()
+    if ffmpeg.returncode:
+        raise OSError(f"ffmpeg failed (exit {ffmpeg.returncode}): {error.splitlines()[-1] if error else 'no message'}")
+
+
+def check_format(path: str | Path) -> str:
+    """The animation format of ``path`` from its suffix: ``.gif`` always, ``.mp4`` where ffmpeg is found.
+
+    Raises ValueError with one line naming the suffix and what is allowed.
+    """
+    suffix = Path(path).suffix.lower()
+    if suffix not in FORMATS:
+        raise ValueError(f"the animation file must end in .gif or .mp4, got {str(path)!r}")
+    if suffix == ".mp4" and shutil.which("ffmpeg") is None:
+        raise ValueError(f"cannot write {str(path)!r}: MP4 needs ffmpeg, which is not on PATH; use a .gif file")
+    return suffix
+
+
+def write_animation(result: RunResult, path: str | Path, frames: int = DEFAULT_FRAMES, fps: float = DEFAULT_FPS,
+                    magnification: float | None = None) -> MechanismFrames:
+    """Write the animation of ``result`` over a revolution to ``path`` (.gif, or .mp4 with ffmpeg).
+
+    The file is written atomically (:func:`weftsim.output.write_atomic`): a failed or interrupted
+    write leaves no partial file.
+
+    Parameters
+    ----------
+    result : RunResult
+        The run to animate (its last complete revolution, or all of it if shorter).
+    path : str or Path
+        Output file; its suffix chooses the format.
+    frames : int
+        Frames over the revolution.
+    fps : float
+        Frames per second of the file.
+    magnification : float, optional
+        Scale of the clearance drawing; default :func:`clearance_magnification`.
+
+    Returns
+    -------
+    MechanismFrames
+        The drawn points (for checks such as the rod length).
+    """
+    from weftsim.output import write_atomic
+
+    suffix = check_format(path)
+    if not fps > 0:
+        raise ValueError(f"fps must be > 0, got {fps}")
+    points = mechanism_frames(result, frames)
+    fig, draw, moving = animation_figure(result, points, magnification)
+    save = _gif if suffix == ".gif" else _mp4
+    write_atomic(Path(path), lambda tmp: save(render_frames(fig, draw, moving, frames), fps, tmp))
+    return points
