@@ -23,12 +23,12 @@ one scalar definition is :mod:`weftsim.kernel.joint`, which the engines call)::
   law keeps its restitution; in a driven lasting contact the approach rate can grow far beyond
   the onset value, and the onset-only rule (``"onset"``, kept for comparison with published
   results) then inflates the damping force without bound.
-- Friction (modified Coulomb, Ambrosio 2003): on the journal, F_T = -mu c_d(|v_T|) F_N sign(v_T) t,
+- Friction (modified Coulomb, Ambrosio 2003): on the journal, ``F_T = -mu c_d(|v_T|) F_N sign(v_T) t``,
   with v_T = (velocity of the journal's material point at Q - that of the bearing's) . t.
 - Force on the journal f_j = -F_N n + F_T (pulls it back towards the bearing centre); on the
-  bearing f_b = -f_j; both act at Q.  The normal part passes through P_b and P_j (Q - P_j =
-  (R_b - |e|) n), so only friction has a moment about the centres:
-  M_j = (R_b - |e|) F_T.t about P_j and M_b = -R_b F_T.t about P_b (N m, about +z).
+  bearing f_b = -f_j; both act at Q.  The normal part passes through P_b and P_j (``Q - P_j =
+  (R_b - |e|) n``), so only friction has a moment about the centres:
+  ``M_j = (R_b - |e|) F_T.t`` about P_j and ``M_b = -R_b F_T.t`` about P_b (N m, about +z).
 - e = 0 (journal centred, the initial state) is free flight: zero force, n = 0, delta_dot = 0.
 
 Sources: Flores & Ambrosio, Comput. Struct. 82 (2004); Li et al. (2020) Eqs. 1-13.
@@ -106,9 +106,10 @@ def tangential_velocity(ecc, bearing_velocity, bearing_angular_velocity,
                         journal_velocity, journal_angular_velocity, bearing_radius: float):
     """Relative tangential velocity v_T of the contact points (journal relative to bearing), m/s.
 
-    Both material points sit at Q = P_b + R_b n:
-    v_Q,b = v_Pb + w_b R_b t,  v_Q,j = v_Pj + w_j (R_b - |e|) t, and
-    v_T = (v_Q,j - v_Q,b) . t = (v_Pj - v_Pb) . t + w_j (R_b - |e|) - w_b R_b.
+    Both material points sit at Q = P_b + R_b n::
+
+        v_Q,b = v_Pb + w_b R_b t,  v_Q,j = v_Pj + w_j (R_b - |e|) t, and
+        v_T = (v_Q,j - v_Q,b) . t = (v_Pj - v_Pb) . t + w_j (R_b - |e|) - w_b R_b.
 
     Parameters
     ----------

@@ -468,8 +468,9 @@ _FRICTION_FACTOR = np.vectorize(_friction_factor, otypes=[float])
 def friction_factor(tangential_speed, v0: float, v1: float):
     """Dynamic correction factor c_d of the modified Coulomb law (Ambrosio 2003), in [0, 1].
 
-    Piecewise linear in |v_T| as in Ambrosio's law:
-    c_d = 0 for |v_T| <= v0, (|v_T| - v0) / (v1 - v0) for v0 < |v_T| < v1, 1 for |v_T| >= v1.
+    Piecewise linear in ``|v_T|`` as in Ambrosio's law::
+
+        c_d = 0 for |v_T| <= v0,  (|v_T| - v0) / (v1 - v0) for v0 < |v_T| < v1,  1 for |v_T| >= v1.
 
     Parameters
     ----------

@@ -161,7 +161,7 @@ class Plausibility:
 
 
 def roundoff_penetration(scene) -> float:
-    """Round-off of delta = |e| - c, m: :data:`ROUNDOFF_ULPS` ulps of the summed link lengths."""
+    """Round-off of ``delta = |e| - c``, m: :data:`ROUNDOFF_ULPS` ulps of the summed link lengths."""
     g = scene.geometry
     return ROUNDOFF_ULPS * float(np.finfo(float).eps) * (g.l_oe + g.l_ef + g.l_fg + g.l_og)
 

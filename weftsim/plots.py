@@ -118,8 +118,8 @@ def plot_orbit(result, title=None):
 
     The eccentricity e = P_j - P_b (journal centre minus bearing centre, docs/physics.md
     section 2) is drawn at every accepted solver step in the four-bar plane (model y, z),
-    inside the circle |e| = c of the radial clearance: on the circle the journal touches the
-    bearing wall, outside it the two penetrate by δ = |e| - c.  Each contact onset (an impact)
+    inside the circle ``|e| = c`` of the radial clearance: on the circle the journal touches the
+    bearing wall, outside it the two penetrate by ``δ = |e| - c``.  Each contact onset (an impact)
     is a dot coloured by its impact velocity δ̇⁻; the first is ringed.  The orbit of the journal
     centre is the standard picture of a clearance joint (as in Flores and Ambrósio 2004).
 

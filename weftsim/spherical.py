@@ -187,7 +187,7 @@ def coupler_frame(theta, beta):
     -------
     ndarray, shape (..., 3, 3)
         R with R[..., :, 0] = b(theta), R[..., :, 1] = c(phi(theta)),
-        R[..., :, 2] = b x c.  Orthonormal since |b| = |c| = 1 and b . c = 0.
+        R[..., :, 2] = b x c.  Orthonormal since ``|b| = |c| = 1`` and b . c = 0.
     """
     phi, _, _ = rocker_angle(theta, beta)
     b = crank_axis(theta, beta)

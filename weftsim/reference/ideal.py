@@ -9,7 +9,7 @@ and the driving torque (paper Eq. 48, docs/physics.md section 4) at constant ome
 
     T(theta) = d/dt dL/dtheta_dot - dL/dtheta = 1/2 J_eq'(theta) omega^2 + U'(theta).
 
-Generalized inertias (primes are d/dtheta; docs/physics.md section 1 frames):
+Generalized inertias (primes are d/dtheta; docs/physics.md section 1 frames)::
 
     crank 1        J1
     coupler 2      w^T I_O w,  I_O = R diag(I_b, I_c, I_n) R^T,  R = [b, c, b x c],
@@ -99,8 +99,10 @@ def sector_chain_inertia(scene: Scene) -> float:
 def equivalent_inertia(theta, scene: Scene):
     """J_eq(theta) of the whole ideal-joint linkage (members 1-8) and dJ_eq/dtheta.
 
-    J_eq = J13 + m4 |r4'|^2 + J4 theta_EF'^2 + J_FG theta_FG'^2, with
-    J_eq' = J13' + 2 m4 r4'.r4'' + 2 J4 theta_EF' theta_EF'' + 2 J_FG theta_FG' theta_FG''.
+    ::
+
+        J_eq  = J13 + m4 |r4'|^2 + J4 theta_EF'^2 + J_FG theta_FG'^2
+        J_eq' = J13' + 2 m4 r4'.r4'' + 2 J4 theta_EF' theta_EF'' + 2 J_FG theta_FG' theta_FG''
     """
     theta = np.asarray(theta, dtype=float)
     inert = scene.inertia

@@ -1,13 +1,13 @@
 """The paper's studies, one command each: ``weftsim study NAME`` (see docs/paper-comparison.md).
 
-==============  ===================================================================  ========
-name            what                                                                 paper
-==============  ===================================================================  ========
-``contact-law`` K(delta) of the law; K and D along a revolution, c = 0.01 mm, 500 rpm  Fig. 7-9
-``clearance``   c = 0.01, 0.25, 0.50 mm at 400 rpm, with the ideal joint              Fig. 12
-``speed``       300, 500, 800 rpm at c = 0.25 mm; amplitude ratios; spectrum          Fig. 13
-``engines``     reference vs exudyn, c = 0.50 mm at 400 rpm                          Fig. 16
-==============  ===================================================================  ========
+===============  =====================================================================  ========
+name             what                                                                   paper
+===============  =====================================================================  ========
+``contact-law``  K(delta) of the law; K and D along a revolution, c = 0.01 mm, 500 rpm  Fig. 7-9
+``clearance``    c = 0.01, 0.25, 0.50 mm at 400 rpm, with the ideal joint               Fig. 12
+``speed``        300, 500, 800 rpm at c = 0.25 mm; amplitude ratios; spectrum           Fig. 13
+``engines``      reference vs exudyn, c = 0.50 mm at 400 rpm                            Fig. 16
+===============  =====================================================================  ========
 
 Each writes into its output directory PNG figures named ``study-*.png``, CSV files of
 the plotted curves and a JSON file of every number it prints (``<name>.json``).
