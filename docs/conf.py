@@ -1,0 +1,70 @@
+"""Sphinx configuration of the weftsim documentation site (``scripts/build_docs.sh``).
+
+The Markdown pages of ``docs/`` are read as they are (myst-parser), the API reference comes from the
+numpydoc docstrings (autodoc + napoleon), and the gallery runs every ``examples/plot_*.py`` at build
+time (sphinx-gallery), offering each as a Python script and a Jupyter notebook.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))  # the checkout's weftsim, also when it is not installed
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # _gallery.py, the gallery's figure scraper
+# Exudyn must never open a window while the gallery runs (docs/clearance-joint.md).
+os.environ.setdefault("EXUDYN_SUPPRESS_UI_WINDOW_OPEN", "1")
+
+import weftsim  # noqa: E402
+
+project = "weftsim"
+author = "the weftsim authors"
+copyright = "the weftsim authors, MIT licence"
+release = weftsim.__version__
+version = release
+
+extensions = [
+    "sphinx.ext.autodoc",
+    "sphinx.ext.napoleon",
+    "sphinx.ext.mathjax",
+    "sphinx.ext.viewcode",
+    "myst_parser",
+    "sphinx_gallery.gen_gallery",
+]
+
+source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
+root_doc = "index"
+exclude_patterns = ["_build", "data"]
+
+# Markdown: headings get anchors so that pages can link to sections (physics.md#3-contact-force-laws).
+myst_heading_anchors = 3
+myst_enable_extensions = ["dollarmath"]
+
+# The docstrings are numpydoc; napoleon reads them without demanding numpydoc's full section set.
+napoleon_google_docstring = False
+napoleon_numpy_docstring = True
+napoleon_use_rtype = False
+napoleon_use_ivar = True  # "Attributes" as fields: dataclass fields are not described twice
+autodoc_default_options = {"members": True, "undoc-members": False, "show-inheritance": False}
+autodoc_member_order = "bysource"
+autodoc_typehints = "description"
+
+sphinx_gallery_conf = {
+    "examples_dirs": str(ROOT / "examples"),
+    "gallery_dirs": "auto_examples",
+    "filename_pattern": r"/plot_",  # every plot_*.py runs at build time
+    "abort_on_example_error": True,
+    "download_all_examples": True,
+    "remove_config_comments": True,
+    "within_subsection_order": "FileNameSortKey",
+    "show_memory": False,
+    "matplotlib_animations": True,
+    "image_scrapers": ("matplotlib", "_gallery.weftsim_figures"),
+    "capture_repr": ("_repr_html_",),  # no "<Figure size ...>" lines under the code
+}
+
+html_theme = "furo"
+html_title = f"weftsim {release}"
+html_static_path: list[str] = []
