@@ -42,8 +42,9 @@ for name, value in peaks(result, 0).items():
 # The channels
 # ------------
 # Rapier displacement, velocity and acceleration, driving torque, contact force and penetration
-# against the crank angle, like the paper's Fig. 12. The rapier's motion stays close to the ideal
-# one; the clearance shows in the acceleration, the torque and the contact force.
+# against the crank angle, like the paper's Fig. 12. The rapier's displacement and velocity stay close
+# to the ideal mechanism's (stroke 1.052 m, +-21.75 m/s at 400 rpm); the clearance shows in the
+# acceleration (peaks several times the ideal +1142 m/s^2), the driving torque and the contact force.
 from weftsim.plots import plot_channels, plot_orbit
 
 channels = plot_channels([result])
