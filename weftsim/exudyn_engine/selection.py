@@ -33,10 +33,13 @@ def rigid_body_needs(scene: Scene) -> list[str]:
     """Reasons why ``scene`` needs the rigid-body model (empty: the kinematic tree carries it)."""
     joint = scene.joint
     needs = []
-    if joint.is_ideal:
+    if not scene.joint_f.is_ideal:
+        needs.append("clearance at F (the kinematic tree carries the clearance at E only; the rigid-body "
+                     "model adds the reusable clearance joint at F)")  # fmt: skip
+    if scene.is_ideal:
         needs.append("ideal joint at E (c = 0): no free coordinate, one generalized-alpha step per "
                      "0.25 deg of crank")  # fmt: skip
-    if joint.friction_coefficient > 0.0:
+    if joint.friction_coefficient > 0.0 and not joint.is_ideal:
         needs.append("friction in the clearance joint (the kinematic tree carries no friction moment)")
     return needs
 
