@@ -433,8 +433,8 @@ def _missing_joint_f(flat: dict[str, Any]) -> list[str]:
         return []
     if "joint_f.clearance_mm" not in flat:
         return ["joint_f.clearance_mm"]
-    if isinstance(clearance, (int, float)) and not isinstance(clearance, bool) and clearance == 0:
-        return []
+    if isinstance(clearance, bool) or not isinstance(clearance, (int, float)) or not clearance > 0:
+        return []  # the ideal joint, or a bad value that the key's own check reports
     return [key for key in JOINT_F_REQUIRED if key not in flat]
 
 
@@ -467,7 +467,13 @@ def load_scene(path: str | Path, overrides: dict[str, Any] | None = None) -> par
     for dotted in flat:  # a misspelt key is reported as such, not as the missing one it stands for
         if dotted not in TOP_LEVEL:
             _known(dotted, str(origin.get(dotted, path)))
-    missing = [key for key in REQUIRED if key not in flat] + _missing_joint_f(flat)
+    missing_f = _missing_joint_f(flat)
+    if missing_f:
+        raise SceneError(
+            f"{path}: missing required keys {', '.join(missing_f)}; a [joint_f] table that gives F a clearance "
+            "must give every key [joint_e] gives (clearance_mm alone, or 0, is the ideal joint at F)"
+        )
+    missing = [key for key in REQUIRED if key not in flat]
     if missing:
         raise SceneError(
             f"{path}: missing required keys {', '.join(missing)}; a scene must give every key of "
