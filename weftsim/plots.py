@@ -59,7 +59,7 @@ def last_revolution(result):
     return {k: v[keep] for k, v in steps.items()}, n - 1
 
 
-def channel_panels(curves, title: str):
+def channel_panels(curves, title: str, panels=None):
     """Six panels like the paper's Fig. 12/13/16 against crank angle over one revolution (eight when
     every curve has joint F's channels: its contact force and penetration below).
 
@@ -68,18 +68,24 @@ def channel_panels(curves, title: str):
     curves : list of (label, data, style)
         ``data`` holds per-step channels with ``crank_angle_deg`` folded to 0..360;
         ``style`` is a dict of matplotlib line options (may be empty).
+    panels : tuple of (channel, axis label, scale), optional
+        An even number of panels; default :data:`PANELS` (and :data:`PANELS_F`).  A curve without a
+        panel's channel is left out of that panel.
     """
-    panels = PANELS + (PANELS_F if curves and all(PANELS_F[0][0] in data for _, data, _ in curves) else ())
+    if panels is None:
+        panels = PANELS + (PANELS_F if curves and all(PANELS_F[0][0] in data for _, data, _ in curves) else ())
     rows = len(panels) // 2
     fig = figure(figsize=(11, 3 * rows))
     axes = fig.subplots(rows, 2, sharex=True)
     for label, data, style in curves:
         angle = data["crank_angle_deg"]
         for ax, (name, ylabel, scale) in zip(axes.flat, panels):
-            ax.plot(angle, data[name] * scale, label=label, rasterized=len(angle) > 20000,
-                    **({"lw": 0.8} | style))
             ax.set_ylabel(ylabel)
             ax.grid(alpha=0.3)
+            if name not in data:
+                continue
+            ax.plot(angle, data[name] * scale, label=label, rasterized=len(angle) > 20000,
+                    **({"lw": 0.8} | style))
     for ax in axes[-1]:
         ax.set_xlabel("crank angle [deg]")
         ax.set_xlim(0, 360)
