@@ -67,7 +67,8 @@ def select_path(scene: Scene) -> dict:
     from weftsim.exudyn_engine.solver import adaptive, step_plan
 
     if adaptive(scene):
-        method = f"generalized-alpha, adaptive step (local error {s.local_error:g} m at E)"
+        where = " and ".join(name.upper() for name in scene.loose_joints)  # the rod's pins with a clearance
+        method = f"generalized-alpha, adaptive step (local error {s.local_error:g} m at {where})"
     else:
         method = f"generalized-alpha, fixed step h {step_plan(scene)[0]:.3g} s"
     return {"model": model, "method": method, "reason": reason}
