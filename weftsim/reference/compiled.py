@@ -3,7 +3,8 @@
 
 scipy's ``DOP853`` and ``RK45`` are re-implemented step for step in :mod:`.compiled_rk` (same
 tableaux, taken from scipy; same initial step, error norm, step-size control and dense output), with the
-right-hand side and the contact law of :mod:`weftsim.kernel.chain`.  What
+right-hand side and the contact law of :mod:`weftsim.kernel.chain` (:mod:`weftsim.kernel.chain_f` with a
+clearance at F: one contact mode and held impact velocity per joint, events searched per joint).  What
 the scipy path pays per step in Python (stage combinations, error norm, dense-output
 objects, event location; ~50 us per step attempt, docs/reference-solver.md section 4)
 becomes a few microseconds.  The event search is that of :mod:`weftsim.kernel.roots` (compiled here,
@@ -30,7 +31,7 @@ from numba import njit
 from weftsim.kernel.chain import TRACK_MAX, V_MIN
 from weftsim.kernel.chain_f import BLOCKS, N_JOINTS, joint_is_loose, penetration_at
 from weftsim.reference.compiled_rk import (
-    _MAX_FACTOR, _MIN_FACTOR, _SAFETY, DOP853, RK45, N, _dense, _dense_coefficients, _error_norm, _f,
+    _MAX_FACTOR, _MIN_FACTOR, _SAFETY, DOP853, RK45, _dense, _dense_coefficients, _error_norm, _f,
     _initial_step, _stages,
 )  # fmt: skip
 from weftsim.reference.compiled_rk import DENSE as _RK_DENSE

@@ -2,7 +2,8 @@
 
 Re-implemented step for step from scipy (same tableaux, copied from scipy in :mod:`.rk_tableaux`; same initial step, error
 norm, step-size control and dense output), with the right-hand side of
-:mod:`weftsim.kernel.chain`.  :mod:`weftsim.reference.compiled` drives these in its
+:mod:`weftsim.kernel.chain_f` (which is :mod:`weftsim.kernel.chain`'s with clearance at E alone); the
+state has 6 entries (2 coordinates) or 10 (clearance at E and F).  :mod:`weftsim.reference.compiled` drives these in its
 event-driven loop.  Every function is module-level ``@njit(cache=True, error_model="numpy")``.
 """
 
@@ -28,7 +29,6 @@ _C853X = _T.DOP853_C[_S + 1:].copy()
 _A45, _B45, _C45 = _T.RK45_A.copy(), _T.RK45_B.copy(), _T.RK45_C.copy()
 _E45, _P45 = _T.RK45_E.copy(), np.ascontiguousarray(_T.RK45_P)
 _SAFETY, _MIN_FACTOR, _MAX_FACTOR = 0.9, 0.2, 10.0  # scipy's step-size control
-N = 6  # state size with clearance at E alone or at F alone (E and F: 10; weftsim.kernel.chain_f.state_size)
 
 
 @njit(cache=True, error_model="numpy")
