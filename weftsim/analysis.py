@@ -11,7 +11,12 @@ import math
 
 import numpy as np
 
-from weftsim.results import PEAK_CHANNELS, RunResult
+from weftsim.results import PEAK_CHANNELS, PEAK_CHANNELS_F, RunResult
+
+
+def peak_channels(result: RunResult) -> tuple[str, ...]:
+    """The channels summarised by peaks and statistics: :data:`PEAK_CHANNELS`, and joint F's when it has a clearance."""
+    return PEAK_CHANNELS + (PEAK_CHANNELS_F if result.has_joint_f else ())
 
 
 def revolution_index(time: np.ndarray, period: float) -> np.ndarray:
@@ -80,7 +85,8 @@ def peaks(result: RunResult, revolution: int) -> dict[str, dict[str, float]]:
     window = _window(result, revolution * period, (revolution + 1) * period)
     if window["time_s"].size == 0:
         raise ValueError(f"revolution {revolution + 1} has no solver steps")
-    return {name: {"min": float(window[name].min()), "max": float(window[name].max())} for name in PEAK_CHANNELS}
+    return {name: {"min": float(window[name].min()), "max": float(window[name].max())}
+            for name in peak_channels(result)}
 
 
 def statistics(result: RunResult, skip_revolutions: int = 1) -> dict[str, dict[str, float]] | None:
@@ -90,7 +96,7 @@ def statistics(result: RunResult, skip_revolutions: int = 1) -> dict[str, dict[s
         return None
     period = result.scene.drive.period
     window = _window(result, skip_revolutions * period, n * period)
-    return {name: channel_statistics(window["time_s"], window[name]) for name in PEAK_CHANNELS}
+    return {name: channel_statistics(window["time_s"], window[name]) for name in peak_channels(result)}
 
 
 def energy_balance(result: RunResult) -> dict[str, float]:

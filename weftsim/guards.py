@@ -228,12 +228,15 @@ def result_breach(result) -> tuple[int, Breach] | None:
     i = _first(~finite)
     if i is not None:
         return i, non_finite_breach("non-finite values (NaN or inf) in the results")
+    from weftsim.plausibility import joint_view
+
     scene = result.scene
-    if not scene.joint.is_ideal:
-        guard = RunGuard(scene)
-        i = _first(st["penetration_m"] > guard.max_penetration)
+    for joint in scene.loose_joints:  # each joint against its own journal radius
+        joint_scene, joint_steps = joint_view(result, joint)
+        guard = RunGuard(joint_scene)
+        i = _first(joint_steps["penetration_m"] > guard.max_penetration)
         if i is not None:
-            return i, guard.check(penetration=float(st["penetration_m"][i]), steps=0)
+            return i, guard.check(penetration=float(joint_steps["penetration_m"][i]), steps=0)
     residual = energy_residual(st)
     scale = float(np.max(np.abs(st["kinetic_energy_J"]))) or 1.0
     limit = scene.limits.max_energy_error

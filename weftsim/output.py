@@ -27,7 +27,7 @@ from typing import Callable
 
 import numpy as np
 
-from weftsim.results import CHANNELS, RunResult
+from weftsim.results import RunResult
 
 
 class OutputError(OSError):
@@ -357,7 +357,7 @@ def write_run(result: RunResult, outdir: str | Path, figure: bool = True, force:
     outdir = prepare_directory(outdir, force)
     what = {"kind": "run", "engine": result.engine, "scene": result.scene.name, "status": result.status}
     files = {
-        "channels": ("channels.csv", lambda target: write_csv(target, {n: result.samples[n] for n in CHANNELS})),
+        "channels": ("channels.csv", lambda target: write_csv(target, {n: result.samples[n] for n in result.channel_names})),
         "summary": ("summary.json", lambda target: write_json(target, summary(result))),
     }
     if figure and result.steps["time_s"].size:

@@ -111,7 +111,7 @@ class Material:
 
 @dataclass(frozen=True)
 class ClearanceJoint:
-    """The revolute joint at E with radial clearance (docs/physics.md sections 2 and 3).
+    """A revolute joint with radial clearance: E, or F (docs/physics.md sections 2 and 3).
 
     Attributes
     ----------
@@ -297,7 +297,9 @@ class Scene:
     name: str = "reference"
     geometry: Geometry = field(default_factory=Geometry)
     inertia: Inertia = field(default_factory=Inertia)
-    joint: ClearanceJoint = field(default_factory=ClearanceJoint)
+    joint: ClearanceJoint = field(default_factory=ClearanceJoint)  # joint E (rocker 3 - rod 4)
+    # Joint F (rod 4 - sector 5): ideal unless a scene gives it a clearance (docs/clearance-f.md).
+    joint_f: ClearanceJoint = field(default_factory=lambda: ClearanceJoint(clearance=0.0))
     drive: Drive = field(default_factory=Drive)
     reference_solver: ReferenceSolver = field(default_factory=ReferenceSolver)
     exudyn_solver: ExudynSolver = field(default_factory=ExudynSolver)
@@ -305,3 +307,13 @@ class Scene:
     compare: CompareTolerance = field(default_factory=CompareTolerance)
     limits: Limits = field(default_factory=Limits)
     source: str = ""
+
+    @property
+    def loose_joints(self) -> tuple[str, ...]:
+        """Names of the joints with a clearance, in the order E, F: ``()`` is the ideal mechanism."""
+        return tuple(name for name, joint in (("e", self.joint), ("f", self.joint_f)) if not joint.is_ideal)
+
+    @property
+    def is_ideal(self) -> bool:
+        """True when every joint is ideal (no free coordinate: the closed form of docs/physics.md section 4)."""
+        return not self.loose_joints

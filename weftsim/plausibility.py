@@ -224,39 +224,87 @@ def _engine_count(result) -> int | None:
 
 
 def validity_warnings(scene, law, max_penetration_ratio: float, peak_pressure: float,
-                      yield_pressure: float | None, damping_steps: int = 0, max_damping: float = 0.0) -> list[str]:
-    """The law-range warnings of a clearance run (module docstring); ``damping_steps`` count under "onset"."""
+                      yield_pressure: float | None, damping_steps: int = 0, max_damping: float = 0.0,
+                      table: str = "joint_e") -> list[str]:
+    """The law-range warnings of a clearance run (module docstring); ``damping_steps`` count under "onset".
+
+    ``scene.joint`` is the joint judged, ``table`` its scene table (joint F's warnings name [joint_f]).
+    """
     joint = scene.joint
     out = []
     if damping_steps and joint.impact_velocity_rule != "max_approach":
         out.append(f"{damping_steps} contact steps have a damping force above {scene.limits.max_damping_ratio:g} x xi "
                    f"x the elastic force (largest {max_damping:.3g}), beyond any isolated impact the law was derived "
                    "for: the \"onset\" rule in a lasting contact; joint_e.impact_velocity_rule = \"max_approach\" "
-                   "bounds it")
+                   "bounds it".replace("joint_e", table))
     lo, hi = law.valid_restitution
     if not lo <= joint.restitution <= hi:
-        out.append(f"joint_e.restitution = {joint.restitution:g} is outside {lo:g}..{hi:g}, the range the "
+        out.append(f"{table}.restitution = {joint.restitution:g} is outside {lo:g}..{hi:g}, the range the "
                    f"'{law.name}' law's damping was derived for: its restitution is not what the scene asks; "
                    "choose a law valid there (e.g. 'flores' for any ce)")
+    at = "" if table == "joint_e" else " at F"
     if max_penetration_ratio > PENETRATION_WARNING_RATIO:
-        out.append(f"the largest penetration is {max_penetration_ratio:.3g} of the clearance (above "
+        out.append(f"the largest penetration{at} is {max_penetration_ratio:.3g} of the clearance (above "
                    f"{PENETRATION_WARNING_RATIO:g}): the contact is no longer narrow against the radii that the "
                    "Hertz-based laws assume; read peak forces as estimates")
     if yield_pressure is not None and peak_pressure > yield_pressure:
-        out.append(f"the peak Hertz contact pressure {peak_pressure / 1e6:.4g} MPa exceeds first yield "
+        out.append(f"the peak Hertz contact pressure{at} {peak_pressure / 1e6:.4g} MPa exceeds first yield "
                    f"{yield_pressure / 1e6:.4g} MPa (1.67 x the smaller yield_strength_mpa): the joint would "
                    "deform plastically, which no law here models")
     return out
 
 
+def joint_view(result, joint: str):
+    """(scene, steps) of one clearance joint in E's place: ``scene.joint`` is the joint, the steps hold its
+    channels under joint E's names (joint F's ``_f`` channels renamed), so every check reads one joint."""
+    import dataclasses
+
+    from weftsim.results import JOINT_E_NAME
+
+    if joint == "e":
+        return result.scene, result.steps
+    steps = dict(result.steps)
+    steps.update({e_name: result.steps[f_name] for f_name, e_name in JOINT_E_NAME.items()})
+    return dataclasses.replace(result.scene, joint=result.scene.joint_f), steps
+
+
 def assess(result) -> Plausibility | None:
-    """Counts and warnings of a run with a clearance joint; None for the ideal joint or no steps."""
+    """Counts and warnings of a run with clearance joints; None for the ideal mechanism or no steps.
+
+    Each joint with a clearance is judged on its own channels (:func:`joint_view`); with two, the
+    counts add up, the extremes are the larger and the warnings of both are kept.
+    """
+    if result.scene.is_ideal or result.steps["time_s"].size == 0:
+        return None
+    reports = [_assess_joint(result, *joint_view(result, joint), f"joint_{joint}")
+               for joint in result.scene.loose_joints]
+    if len(reports) == 1:
+        return reports[0]
+    e, f = reports
+    present = [v for v in (e.min_penetration_in_contact_m, f.min_penetration_in_contact_m) if v is not None]
+    return Plausibility(
+        onsets=e.onsets + f.onsets,
+        nonpositive_onsets=e.nonpositive_onsets + f.nonpositive_onsets,
+        engine_nonpositive_onsets=e.engine_nonpositive_onsets,  # the engine's count covers both joints
+        damping_steps=e.damping_steps + f.damping_steps,
+        max_damping_ratio=max(e.max_damping_ratio, f.max_damping_ratio),
+        damping_limit=e.damping_limit,
+        damping_is_defect=e.damping_is_defect or f.damping_is_defect,
+        negative_penetration_steps=e.negative_penetration_steps + f.negative_penetration_steps,
+        min_penetration_in_contact_m=min(present) if present else None,
+        roundoff_m=max(e.roundoff_m, f.roundoff_m),
+        max_penetration_ratio=max(e.max_penetration_ratio, f.max_penetration_ratio),
+        peak_pressure_pa=max(e.peak_pressure_pa, f.peak_pressure_pa),
+        yield_pressure_pa=e.yield_pressure_pa if f.yield_pressure_pa is None else (
+            f.yield_pressure_pa if e.yield_pressure_pa is None else min(e.yield_pressure_pa, f.yield_pressure_pa)),
+        warnings=e.warnings + f.warnings,
+    )
+
+
+def _assess_joint(result, scene, steps, table: str) -> Plausibility:
+    """:func:`assess` of one joint: ``scene.joint`` and the E-named channels of ``steps`` are that joint's."""
     from weftsim.contact import make_law
 
-    scene = result.scene
-    steps = result.steps
-    if scene.joint.is_ideal or steps["time_s"].size == 0:
-        return None
     law = make_law(scene.joint)
     mode = contact_mode(steps)
     delta = np.asarray(steps["penetration_m"])
@@ -286,7 +334,7 @@ def assess(result) -> Plausibility | None:
         peak_pressure_pa=peak_pressure,
         yield_pressure_pa=yield_pressure,
         warnings=tuple(validity_warnings(scene, law, max_penetration_ratio, peak_pressure, yield_pressure,
-                                         damping_steps, float(ratio.max()))),
+                                         damping_steps, float(ratio.max()), table)),
     )
 
 
@@ -297,20 +345,21 @@ HINT = ("the contact history is broken, so its forces are not to be trusted: for
 
 
 def first_defect_row(result, report: Plausibility) -> int:
-    """Index of the first step showing one of the defects (for the failure message's time)."""
-    steps = result.steps
-    rows = []
-    mode = contact_mode(steps)
-    starts = onset_rows(mode)
-    bad_onsets = starts[np.asarray(steps["penetration_rate_m_s"])[starts] <= 0.0]
-    rows.extend(bad_onsets[:1].tolist())
-    if report.damping_steps and report.damping_is_defect:
-        from weftsim.contact import make_law
+    """Index of the first step showing one of the defects (for the failure message's time), at any joint."""
+    from weftsim.contact import make_law
 
-        ratio = damping_ratio(steps, make_law(result.scene.joint))
-        rows.append(int(np.flatnonzero(damping_excess(ratio, report.damping_limit))[0]))
-    negative = np.flatnonzero(mode & (np.asarray(steps["penetration_m"]) < -report.roundoff_m))
-    rows.extend(negative[:1].tolist())
+    rows = []
+    for joint in result.scene.loose_joints:
+        scene, steps = joint_view(result, joint)
+        mode = contact_mode(steps)
+        starts = onset_rows(mode)
+        bad_onsets = starts[np.asarray(steps["penetration_rate_m_s"])[starts] <= 0.0]
+        rows.extend(bad_onsets[:1].tolist())
+        if report.damping_steps and report.damping_is_defect:
+            excess = np.flatnonzero(damping_excess(damping_ratio(steps, make_law(scene.joint)), report.damping_limit))
+            rows.extend(excess[:1].tolist())
+        negative = np.flatnonzero(mode & (np.asarray(steps["penetration_m"]) < -report.roundoff_m))
+        rows.extend(negative[:1].tolist())
     return min(rows) if rows else 0
 
 

@@ -14,6 +14,18 @@ PANELS = (
     ("contact_force_N", "contact force at E [N]", 1.0),
     ("penetration_m", "penetration at E [mm]", 1e3),
 )
+# Added below PANELS when every curve has a clearance at F (weftsim.results.JOINT_F_CHANNELS).
+PANELS_F = (
+    ("contact_force_f_N", "contact force at F [N]", 1.0),
+    ("penetration_f_m", "penetration at F [mm]", 1e3),
+)
+
+
+def clearance_label(scene) -> str:
+    """``c = 0.25 mm`` (clearance at E alone, as before), or the clearance of each joint: ``c_E = 0.25, c_F = 0.25 mm``."""
+    if scene.joint_f.is_ideal:
+        return f"c = {scene.joint.clearance * 1e3:g} mm"
+    return f"c_E = {scene.joint.clearance * 1e3:g}, c_F = {scene.joint_f.clearance * 1e3:g} mm"
 
 
 def figure(**options):
@@ -47,24 +59,33 @@ def last_revolution(result):
     return {k: v[keep] for k, v in steps.items()}, n - 1
 
 
-def channel_panels(curves, title: str):
-    """Six panels like the paper's Fig. 12/13/16 against crank angle over one revolution.
+def channel_panels(curves, title: str, panels=None):
+    """Six panels like the paper's Fig. 12/13/16 against crank angle over one revolution (eight when
+    every curve has joint F's channels: its contact force and penetration below).
 
     Parameters
     ----------
     curves : list of (label, data, style)
         ``data`` holds per-step channels with ``crank_angle_deg`` folded to 0..360;
         ``style`` is a dict of matplotlib line options (may be empty).
+    panels : tuple of (channel, axis label, scale), optional
+        An even number of panels; default :data:`PANELS` (and :data:`PANELS_F`).  A curve without a
+        panel's channel is left out of that panel.
     """
-    fig = figure(figsize=(11, 9))
-    axes = fig.subplots(3, 2, sharex=True)
+    if panels is None:
+        panels = PANELS + (PANELS_F if curves and all(PANELS_F[0][0] in data for _, data, _ in curves) else ())
+    rows = len(panels) // 2
+    fig = figure(figsize=(11, 3 * rows))
+    axes = fig.subplots(rows, 2, sharex=True)
     for label, data, style in curves:
         angle = data["crank_angle_deg"]
-        for ax, (name, ylabel, scale) in zip(axes.flat, PANELS):
-            ax.plot(angle, data[name] * scale, label=label, rasterized=len(angle) > 20000,
-                    **({"lw": 0.8} | style))
+        for ax, (name, ylabel, scale) in zip(axes.flat, panels):
             ax.set_ylabel(ylabel)
             ax.grid(alpha=0.3)
+            if name not in data:
+                continue
+            ax.plot(angle, data[name] * scale, label=label, rasterized=len(angle) > 20000,
+                    **({"lw": 0.8} | style))
     for ax in axes[-1]:
         ax.set_xlabel("crank angle [deg]")
         ax.set_xlim(0, 360)
@@ -77,7 +98,7 @@ def channel_panels(curves, title: str):
 
 def plot_channels(results, labels=None, title=None):
     """Six panels over the last complete revolution of each result."""
-    labels = labels or [f"{r.engine}, c = {r.scene.joint.clearance * 1e3:g} mm, "
+    labels = labels or [f"{r.engine}, {clearance_label(r.scene)}, "
                         f"{r.scene.drive.speed * 30 / math.pi:g} rpm" for r in results]
     curves = []
     for result, label in zip(results, labels):

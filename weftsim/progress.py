@@ -79,7 +79,7 @@ def estimate_run_time(scene, engine: str) -> float:
     :data:`SECONDS_PER_REVOLUTION`); 0 for the closed-form ideal joint of the reference engine."""
     revolutions = scene.drive.revolutions
     if engine == "reference":
-        if scene.joint.is_ideal:
+        if scene.is_ideal:
             return 0.0
         from weftsim.reference import select_path
 

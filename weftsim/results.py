@@ -36,6 +36,24 @@ CHANNELS: tuple[str, ...] = (
     "penetration_rate_m_s",
 )
 
+# Channels of joint F (rod 4 - sector 5), present exactly when the scene gives F a clearance
+# (docs/clearance-f.md); the unsuffixed contact channels above are joint E's (their names predate F).
+# The energy channels are the mechanism's: contact_energy_J and dissipated_energy_J hold both joints.
+JOINT_F_CHANNELS: tuple[str, ...] = (
+    "contact_force_f_N",
+    "penetration_f_m",
+    "eccentricity_f_y_m",
+    "eccentricity_f_z_m",
+    "impact_velocity_f_m_s",
+    "in_contact_f",
+    "penetration_rate_f_m_s",
+)
+
+# Joint E's channel of each joint-F channel (same quantity at the other joint).
+JOINT_E_NAME = dict(zip(JOINT_F_CHANNELS, ("contact_force_N", "penetration_m", "eccentricity_y_m",
+                                           "eccentricity_z_m", "impact_velocity_m_s", "in_contact",
+                                           "penetration_rate_m_s")))
+
 # Channels that describe the contact at E; identically zero for the ideal joint.
 CONTACT_CHANNELS: tuple[str, ...] = (
     "contact_force_N",
@@ -58,6 +76,8 @@ PEAK_CHANNELS: tuple[str, ...] = (
     "contact_force_N",
     "penetration_m",
 )
+# Joint F's peak channels (summaries of a scene with clearance at F).
+PEAK_CHANNELS_F: tuple[str, ...] = ("contact_force_f_N", "penetration_f_m")
 
 STATUSES = ("success", "failed")
 ENGINES = ("reference", "exudyn")
@@ -67,13 +87,19 @@ def _as_channels(data: dict[str, np.ndarray], what: str) -> dict[str, np.ndarray
     missing = [name for name in CHANNELS if name not in data]
     if missing:
         raise ValueError(f"{what} lacks channels {missing}; every engine must provide all of {list(CHANNELS)}")
-    lengths = {name: np.shape(data[name]) for name in CHANNELS}
+    names = CHANNELS
+    given_f = [name for name in JOINT_F_CHANNELS if name in data]
+    if given_f:
+        if len(given_f) != len(JOINT_F_CHANNELS):
+            raise ValueError(f"{what} has joint F channels {given_f} but not all of {list(JOINT_F_CHANNELS)}")
+        names = CHANNELS + JOINT_F_CHANNELS
+    lengths = {name: np.shape(data[name]) for name in names}
     n = len(np.asarray(data["time_s"]))
     bad = {name: shape for name, shape in lengths.items() if shape != (n,)}
     if bad:
         raise ValueError(f"{what}: channels must be 1-D of length {n} like time_s, got {bad}")
     out = {}
-    for name in CHANNELS:
+    for name in names:
         arr = np.array(data[name], dtype=float)
         arr.setflags(write=False)
         out[name] = arr
@@ -95,7 +121,8 @@ class RunResult:
     message : str
         Empty on success; otherwise what failed, at which time and crank angle, and what to try.
     samples, steps : dict of str to ndarray
-        All :data:`CHANNELS`, on the uniform output grid and at every accepted solver step.
+        All :data:`CHANNELS`, on the uniform output grid and at every accepted solver step, and
+        :data:`JOINT_F_CHANNELS` when the scene has a clearance at F.
     solver_stats : dict
         Steps, rejected steps, function evaluations, contact events, ``wall_time_s``, ...
     events : dict
@@ -150,13 +177,23 @@ class RunResult:
         return f"{what} ({reason})" if reason else what
 
     @property
+    def channel_names(self) -> tuple[str, ...]:
+        """The channels this result holds: :data:`CHANNELS`, then joint F's when F has a clearance."""
+        return tuple(self.samples)
+
+    @property
+    def has_joint_f(self) -> bool:
+        """True when the result holds joint F's channels (the scene has a clearance at F)."""
+        return JOINT_F_CHANNELS[0] in self.samples
+
+    @property
     def wall_time_s(self) -> float:
         return float(self.solver_stats.get("wall_time_s", float("nan")))
 
 
-def empty_channels() -> dict[str, np.ndarray]:
-    """All channels with no rows, for a run that failed before its first step."""
-    return {name: np.zeros(0) for name in CHANNELS}
+def empty_channels(joint_f: bool = False) -> dict[str, np.ndarray]:
+    """All channels with no rows (``joint_f``: with joint F's), for a run that failed before its first step."""
+    return {name: np.zeros(0) for name in CHANNELS + (JOINT_F_CHANNELS if joint_f else ())}
 
 
 def angle_grid(end_time: float, omega: float, step_angle: float) -> np.ndarray:

@@ -168,6 +168,19 @@ SCHEMA: tuple[Key, ...] = (
         doc="damping force bound, multiple of xi x the elastic force (delta_dot / v_imp): <= 1 in an isolated "
             "impact and under max_approach (beyond it the run fails); the onset rule exceeds it (a warning)"),
 )
+
+def _joint_f_keys() -> tuple[Key, ...]:
+    """The keys of [joint_f] (joint F, rod 4 - sector 5): those of [joint_e], for the scene's ``joint_f``."""
+    out = []
+    for key in SCHEMA:
+        if key.path.startswith("joint_e."):
+            doc = "joint F: " + (key.doc or key.path.partition(".")[2])
+            out.append(replace(key, path="joint_f." + key.path.partition(".")[2],
+                               target="joint_f." + key.target.partition(".")[2], doc=doc))
+    return tuple(out)
+
+
+SCHEMA = SCHEMA + _joint_f_keys()
 _BY_PATH = {key.path: key for key in SCHEMA}
 TOP_LEVEL = ("name", "description", "extends")
 # Sections that describe the machine: a scene must give all their keys, itself or through
@@ -177,6 +190,10 @@ REQUIRED_SECTIONS = ("mechanism", "inertia", "joint_e", "drive")
 # Model options inside those sections that are not part of the machine: they default.
 OPTIONAL = ("joint_e.impact_velocity_rule", "joint_e.journal_material.yield_strength_mpa",
             "joint_e.bearing_material.yield_strength_mpa")
+# [joint_f] is optional as a whole (absent: the ideal revolute joint at F).  Given with a clearance > 0
+# it must give every key [joint_e] must give (a loose joint is part of the machine).
+JOINT_F_REQUIRED = tuple("joint_f." + key.path.partition(".")[2] for key in SCHEMA
+                         if key.path.startswith("joint_e.") and key.path not in OPTIONAL)
 REQUIRED = tuple(key.path for key in SCHEMA
                  if key.path.partition(".")[0] in REQUIRED_SECTIONS and key.path not in OPTIONAL)
 
@@ -346,17 +363,20 @@ def _check_scene(scene: params.Scene, where: str, origin: dict[str, Path]) -> No
     def at(key: str) -> str:
         return str(origin.get(key, where))
 
-    joint = scene.joint
-    if joint.law not in LAWS:
-        raise SceneError(f"{at('joint_e.law')}: key 'joint_e.law' must be one of {', '.join(sorted(LAWS))}, got {joint.law!r}")
-    v0, v1 = joint.friction_velocities
-    if not v0 < v1:
-        raise SceneError(f"{at('joint_e.friction_velocities_m_s')}: key 'joint_e.friction_velocities_m_s' must have v0 < v1, got [{v0:g}, {v1:g}]")
-    if joint.clearance >= joint.journal_radius:
-        raise SceneError(
-            f"{at('joint_e.clearance_mm')}: key 'joint_e.clearance_mm' must be smaller than the journal radius "
-            f"{joint.journal_radius / MM:g} mm, got {joint.clearance / MM:g}"
-        )
+    for table, joint in (("joint_e", scene.joint), ("joint_f", scene.joint_f)):
+        if table == "joint_f" and joint.is_ideal:
+            continue  # the ideal joint at F: its other keys describe nothing
+        law, ramp, clearance = f"{table}.law", f"{table}.friction_velocities_m_s", f"{table}.clearance_mm"
+        if joint.law not in LAWS:
+            raise SceneError(f"{at(law)}: key '{law}' must be one of {', '.join(sorted(LAWS))}, got {joint.law!r}")
+        v0, v1 = joint.friction_velocities
+        if not v0 < v1:
+            raise SceneError(f"{at(ramp)}: key '{ramp}' must have v0 < v1, got [{v0:g}, {v1:g}]")
+        if joint.clearance >= joint.journal_radius:
+            raise SceneError(
+                f"{at(clearance)}: key '{clearance}' must be smaller than the journal radius "
+                f"{joint.journal_radius / MM:g} mm, got {joint.clearance / MM:g}"
+            )
     if scene.output.sample_angle / scene.drive.speed > scene.drive.end_time:
         raise SceneError(f"{at('drive.revolutions')}: key 'drive.revolutions' is shorter than one output sample")
     from weftsim.kinematics import assembly_failure_angle
@@ -405,6 +425,19 @@ def scene_from_keys(flat: dict[str, Any], where: str = "scene", origin: dict[str
     return scene
 
 
+def _missing_joint_f(flat: dict[str, Any]) -> list[str]:
+    """Keys of [joint_f] a scene must still give: all of them once it gives F a clearance > 0."""
+    clearance = flat.get("joint_f.clearance_mm", 0.0)
+    given = [key for key in flat if key.startswith("joint_f.")]
+    if not given:
+        return []
+    if "joint_f.clearance_mm" not in flat:
+        return ["joint_f.clearance_mm"]
+    if isinstance(clearance, bool) or not isinstance(clearance, (int, float)) or not clearance > 0:
+        return []  # the ideal joint, or a bad value that the key's own check reports
+    return [key for key in JOINT_F_REQUIRED if key not in flat]
+
+
 def load_scene(path: str | Path, overrides: dict[str, Any] | None = None) -> params.Scene:
     """Read, merge (``extends``), override and validate a scene file.
 
@@ -434,6 +467,12 @@ def load_scene(path: str | Path, overrides: dict[str, Any] | None = None) -> par
     for dotted in flat:  # a misspelt key is reported as such, not as the missing one it stands for
         if dotted not in TOP_LEVEL:
             _known(dotted, str(origin.get(dotted, path)))
+    missing_f = _missing_joint_f(flat)
+    if missing_f:
+        raise SceneError(
+            f"{path}: missing required keys {', '.join(missing_f)}; a [joint_f] table that gives F a clearance "
+            "must give every key [joint_e] gives (clearance_mm alone, or 0, is the ideal joint at F)"
+        )
     missing = [key for key in REQUIRED if key not in flat]
     if missing:
         raise SceneError(

@@ -7,7 +7,7 @@ live there and are 4-5x cheaper than 3-D ones)::
     Exudyn Y = model z (crank axis A, up; gravity along -Y)
     Exudyn Z = model x (rocker axis D, normal of the four-bar plane)
 
-Members and joints (all joints ideal except E when the scene has a clearance)::
+Members and joints (all joints ideal except E and F when the scene gives them a clearance)::
 
     1 crank    3-D  revolute A (ground, axis Y through O); driven: d(rz)/dt = omega
     2 coupler  3-D  revolute B (crank, axis b(0) through O)
@@ -15,7 +15,7 @@ Members and joints (all joints ideal except E when the scene has a clearance)::
                     + generic joint D (ground) constraining only the rotations about X, Y:
                     the fourth revolute of the spherical 4R without redundant constraints
     4 rod      2-D  E: ideal revolute or clearance joint (bearing on 3, journal on 4)
-    5 sector   2-D  revolute F (rod), revolute G (ground)
+    5 sector   2-D  F: ideal revolute or clearance joint (bearing on 5, journal on 4); revolute G (ground)
     6/7, 8          reflected onto the sector: J5_eff = J5 + J67 (d5/d6)^2 + m8 (d5 d7/d6)^2
                     (ideal gear meshes; ``reflect_gears=False`` builds them as bodies with
                     coordinate constraints instead, for checking)
@@ -91,6 +91,12 @@ class MechanismModel:
     clearance: ClearanceJointModel | None
     sector_reference_angle: float  # theta_FG(0), rad
     reflect_gears: bool
+    clearance_f: ClearanceJointModel | None = None  # the clearance joint at F (bearing on 5, journal on 4)
+
+    @property
+    def clearances(self) -> dict:
+        """The clearance joints of the model by name ("e", "f"): those the scene gives a clearance."""
+        return {name: c for name, c in (("e", self.clearance), ("f", self.clearance_f)) if c is not None}
 
 
 def _rigid_3d(mbs, inertia, rotation, angular_velocity, gravity):
@@ -171,7 +177,14 @@ def build_mechanism(mbs, scene: Scene, callback: str | None = None, reflect_gear
     sector = _rigid_2d(mbs, UNSPECIFIED_MASS, sector_inertia, [g.l_og, 0.0, 0.0], float(st.theta_fg),
                        (0.0, 0.0), omega * float(st.d_theta_fg), gravity)  # fmt: skip
     half = 0.5 * math.hypot(f[0] - e[0], f[1] - e[1])
-    _pin(mbs, rod["bodyNumber"], [half, 0.0, 0.0], sector["bodyNumber"], [g.l_fg, 0.0, 0.0])  # F
+    route = scene.exudyn_solver.callback if callback is None else callback
+    clearance_f = None
+    if scene.joint_f.is_ideal:
+        _pin(mbs, rod["bodyNumber"], [half, 0.0, 0.0], sector["bodyNumber"], [g.l_fg, 0.0, 0.0])  # F
+    else:  # F with a clearance: the sector's eye is the bearing, the rod's pin the journal
+        bearing_f = mbs.AddMarker(MarkerBodyPosition(bodyNumber=sector["bodyNumber"], localPosition=[g.l_fg, 0.0, 0.0]))
+        journal_f = mbs.AddMarker(MarkerBodyPosition(bodyNumber=rod["bodyNumber"], localPosition=[half, 0.0, 0.0]))
+        clearance_f = add_clearance_joint(mbs, bearing_f, journal_f, scene.joint_f, callback=route)
     _pin(mbs, ground, [g.l_og, 0.0, 0.0], sector["bodyNumber"], [0.0, 0.0, 0.0])  # G
     bodies = {"crank": crank, "coupler": coupler, "rocker": rocker, "rod": rod, "sector": sector}
     if not reflect_gears:
@@ -185,7 +198,6 @@ def build_mechanism(mbs, scene: Scene, callback: str | None = None, reflect_gear
     if scene.joint.is_ideal:
         mbs.AddObject(ObjectJointRevolute2D(markerNumbers=[marker_bearing, marker_journal]))
     else:
-        route = scene.exudyn_solver.callback if callback is None else callback
         clearance = add_clearance_joint(mbs, marker_bearing, marker_journal, scene.joint,
                                         callback=route, call_counter=call_counter)  # fmt: skip
 
@@ -198,6 +210,7 @@ def build_mechanism(mbs, scene: Scene, callback: str | None = None, reflect_gear
         nodes={k: v["nodeNumber"] for k, v in bodies.items()},
         drive=drive, marker_bearing=marker_bearing, marker_journal=marker_journal,
         clearance=clearance, sector_reference_angle=float(st.theta_fg), reflect_gears=reflect_gears,
+        clearance_f=clearance_f,
     )  # fmt: skip
 
 

@@ -33,10 +33,13 @@ def rigid_body_needs(scene: Scene) -> list[str]:
     """Reasons why ``scene`` needs the rigid-body model (empty: the kinematic tree carries it)."""
     joint = scene.joint
     needs = []
-    if joint.is_ideal:
+    if not scene.joint_f.is_ideal:
+        needs.append("clearance at F (the kinematic tree carries the clearance at E only; the rigid-body "
+                     "model adds the reusable clearance joint at F)")  # fmt: skip
+    if scene.is_ideal:
         needs.append("ideal joint at E (c = 0): no free coordinate, one generalized-alpha step per "
                      "0.25 deg of crank")  # fmt: skip
-    if joint.friction_coefficient > 0.0:
+    if joint.friction_coefficient > 0.0 and not joint.is_ideal:
         needs.append("friction in the clearance joint (the kinematic tree carries no friction moment)")
     return needs
 
@@ -64,7 +67,8 @@ def select_path(scene: Scene) -> dict:
     from weftsim.exudyn_engine.solver import adaptive, step_plan
 
     if adaptive(scene):
-        method = f"generalized-alpha, adaptive step (local error {s.local_error:g} m at E)"
+        where = " and ".join(name.upper() for name in scene.loose_joints)  # the rod's pins with a clearance
+        method = f"generalized-alpha, adaptive step (local error {s.local_error:g} m at {where})"
     else:
         method = f"generalized-alpha, fixed step h {step_plan(scene)[0]:.3g} s"
     return {"model": model, "method": method, "reason": reason}

@@ -6,15 +6,16 @@ Every sensor stores internally at every accepted step (``storeInternal=True``,
     crank angle       theta = rz of the crank node
     rapier s, v, a    (d5 d7/d6) x (angle, rate, acceleration of the sector node)
     driving torque    T = -lambda_drive (the motor's torque on the crank about +z)
-    contact           e = connector Displacement (X, Y) = model (y, z); F_N = |connector Force|;
+    contact           per clearance joint (E: the unsuffixed channels, F: the ``_f`` channels)
+                      e = connector Displacement (X, Y) = model (y, z); F_N = |connector Force|;
                       delta = |e| - c, delta_dot = e_dot . e/|e|; held impact velocity and
                       contact flag from the tracker
     kinetic energy    sum of the bodies' KineticEnergy outputs
     potential energy  sum of m g Y_com (gravity along -Y)
-    contact energy    law.elastic_energy(delta)
+    contact energy    law.elastic_energy(delta), summed over the clearance joints
     driving work      integral T dtheta (trapezoid over accepted steps; theta_dot = omega)
     dissipated        integral (F_N - F_el(delta)) delta_dot dt (trapezoid over accepted steps),
-                      the energy the contact damping takes out
+                      the energy the contact damping takes out (all clearance joints)
 
 The trapezoid rules have errors O(h^2) per step; the integrator's own numerical
 dissipation (generalized-alpha, spectral radius < 1) is not in any channel, so the
@@ -28,7 +29,7 @@ import numpy as np
 from exudyn.itemInterface import SensorBody, SensorNode, SensorObject
 
 from weftsim.exudyn_engine.mechanism import CRANK_COORDINATE, ROTATION_2D, MechanismModel
-from weftsim.results import CHANNELS, CONTACT_CHANNELS
+from weftsim.results import CHANNELS, CONTACT_CHANNELS, JOINT_E_NAME, JOINT_F_CHANNELS
 
 OVT = exu.OutputVariableType
 
@@ -58,11 +59,10 @@ def add_sensors(mbs, model: MechanismModel) -> dict:
         heights.append((float(mass), _sensor(mbs, sensor)))
     s["kinetic"] = kinetic
     s["heights"] = heights
-    if model.clearance is not None:
-        conn = model.clearance.connector
-        s["ecc"] = _sensor(mbs, SensorObject(objectNumber=conn, outputVariableType=OVT.Displacement, **store))
-        s["ecc_rate"] = _sensor(mbs, SensorObject(objectNumber=conn, outputVariableType=OVT.Velocity, **store))
-        s["force"] = _sensor(mbs, SensorObject(objectNumber=conn, outputVariableType=OVT.Force, **store))
+    for name, joint in model.clearances.items():
+        conn = joint.connector
+        for key, output in (("ecc", OVT.Displacement), ("ecc_rate", OVT.Velocity), ("force", OVT.Force)):
+            s[f"{key}_{name}"] = _sensor(mbs, SensorObject(objectNumber=conn, outputVariableType=output, **store))
     return s
 
 
@@ -99,37 +99,47 @@ def step_channels(mbs, model: MechanismModel, sensors: dict) -> dict[str, np.nda
         "driving_work_J": _cumtrapz(torque, theta),
     }
     zeros = np.zeros(n)
-    if model.clearance is None:
-        for name in CONTACT_CHANNELS:
+    for name in CONTACT_CHANNELS:
+        ch[name] = zeros
+    if model.clearance_f is not None:
+        for name in JOINT_F_CHANNELS:
             ch[name] = zeros
-        return ch
-    cl = model.clearance
-    ecc = data["ecc"][:n, 1:3]
-    rate_vec = data["ecc_rate"][:n, 1:3]
+    for joint, cl in model.clearances.items():
+        contact = _joint_channels(cl, data, joint, t, n)
+        ch["contact_energy_J"] = ch["contact_energy_J"] + contact.pop("contact_energy_J")
+        ch["dissipated_energy_J"] = ch["dissipated_energy_J"] + contact.pop("dissipated_energy_J")
+        if joint == "f":  # joint F's channels carry its suffix; E's keep their names
+            contact = {f_name: contact[e_name] for f_name, e_name in JOINT_E_NAME.items()}
+        ch.update(contact)
+    return ch
+
+
+def _joint_channels(cl, data: dict, joint: str, t: np.ndarray, n: int) -> dict[str, np.ndarray]:
+    """Contact channels of one clearance joint (E's names) from its sensors ``*_<joint>`` and tracker."""
+    ecc = data[f"ecc_{joint}"][:n, 1:3]
+    rate_vec = data[f"ecc_rate_{joint}"][:n, 1:3]
     length = np.hypot(ecc[:, 0], ecc[:, 1])
-    delta = length - scene.joint.clearance
+    delta = length - cl.joint.clearance
     safe = np.where(length > 0.0, length, 1.0)
     rate = np.where(length > 0.0, np.sum(ecc * rate_vec, axis=1) / safe, 0.0)
-    f_n = np.hypot(data["force"][:n, 1], data["force"][:n, 2])
+    force = data[f"force_{joint}"]
+    f_n = np.hypot(force[:n, 1], force[:n, 2])
     f_el = np.where(delta > 0.0, cl.law.elastic_force(np.maximum(delta, 0.0)), 0.0)
     hist = cl.tracker.history()
     # The tracker records every post-step call (Exudyn also calls it once at t = 0): take,
     # for each stored step, the tracker's last record at that time.
     row = np.clip(np.searchsorted(hist["time"], t * (1.0 + 1e-12), side="right") - 1, 0, len(hist["time"]) - 1)
-    impact = hist["impact_velocity"][row]
-    contact = hist["in_contact"][row]
-    ch.update({
+    return {
         "contact_force_N": f_n,
         "penetration_m": delta,
         "eccentricity_y_m": ecc[:, 0],
         "eccentricity_z_m": ecc[:, 1],
-        "impact_velocity_m_s": impact,
-        "in_contact": contact,
+        "impact_velocity_m_s": hist["impact_velocity"][row],
+        "in_contact": hist["in_contact"][row],
         "contact_energy_J": np.where(delta > 0.0, cl.law.elastic_energy(np.maximum(delta, 0.0)), 0.0),
         "dissipated_energy_J": _cumtrapz((f_n - f_el) * rate, t),
         "penetration_rate_m_s": rate,
-    })  # fmt: skip
-    return ch
+    }
 
 
 def sample_channels(steps: dict[str, np.ndarray], times: np.ndarray) -> dict[str, np.ndarray]:
@@ -140,16 +150,19 @@ def sample_channels(steps: dict[str, np.ndarray], times: np.ndarray) -> dict[str
     (a failed run) are dropped.
     """
     t = steps["time_s"]
+    names = [k for k in CHANNELS + JOINT_F_CHANNELS if k in steps]
     if len(t) == 0:
-        return {k: np.zeros(0) for k in CHANNELS}
+        return {k: np.zeros(0) for k in names}
     # Exudyn accumulates t += h: the last step may fall short of the end time by round-off.
     last_step = t[-1] - t[-2] if len(t) > 1 else 0.0
     times = times[times <= t[-1] + 0.5 * last_step]
-    out = {k: np.interp(times, t, steps[k]) for k in CHANNELS}
+    out = {k: np.interp(times, t, steps[k]) for k in names}
     nearest = np.clip(np.searchsorted(t, times), 0, len(t) - 1)
     prev = np.clip(nearest - 1, 0, len(t) - 1)
     nearest = np.where(np.abs(t[prev] - times) < np.abs(t[nearest] - times), prev, nearest)
-    out["in_contact"] = steps["in_contact"][nearest]
+    for flag in ("in_contact", "in_contact_f"):
+        if flag in steps:
+            out[flag] = steps[flag][nearest]
     out["time_s"] = times
     return out
 

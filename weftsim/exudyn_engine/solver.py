@@ -74,19 +74,22 @@ def check_settings(scene: Scene) -> str | None:
         return f"`exudyn_solver.local_error` must be > 0 (m), got {s.local_error}"
     if route_error(s.callback):
         return f"`exudyn_solver.{route_error(s.callback)[1:]}"
-    if s.callback == "numba" and not scene.joint.is_ideal:
+    if s.callback == "numba" and not scene.is_ideal:
         try:
             import numba  # noqa: F401 - optional dependency of this route only
         except ImportError:
             return "`exudyn_solver.callback` = 'numba' needs numba installed; use 'auto' or 'python'"
     if not scene.output.sample_angle > 0.0:
         return f"`output.sample_angle` must be > 0, got {scene.output.sample_angle}"
-    if scene.joint.impact_velocity_rule not in IMPACT_VELOCITY_RULES:
-        return (f"`joint.impact_velocity_rule` must be one of {IMPACT_VELOCITY_RULES}, "
-                f"got {scene.joint.impact_velocity_rule!r}")  # fmt: skip
-    if scene.joint.friction_coefficient > 0.0 and not scene.joint.is_ideal:
-        return ("the Exudyn engine has no friction in the clearance joint (docs/clearance-joint.md); "
-                "set `friction_coefficient` = 0 or use the reference engine")  # fmt: skip
+    for table, joint in (("joint_e", scene.joint), ("joint_f", scene.joint_f)):
+        if joint.is_ideal:
+            continue
+        if joint.impact_velocity_rule not in IMPACT_VELOCITY_RULES:
+            return (f"`{table}.impact_velocity_rule` must be one of {IMPACT_VELOCITY_RULES}, "
+                    f"got {joint.impact_velocity_rule!r}")  # fmt: skip
+        if joint.friction_coefficient > 0.0:
+            return (f"the Exudyn engine has no friction in the clearance joint (docs/clearance-joint.md); "
+                    f"set `{table}.friction_coefficient` = 0 or use the reference engine")  # fmt: skip
     return None
 
 
@@ -99,7 +102,7 @@ def requested_step(scene: Scene) -> float:
     Under ``step_control = "fixed"`` the scene's step is taken as it is, ideal joint or not.
     """
     step = scene.exudyn_solver.step_size
-    if scene.joint.is_ideal and scene.exudyn_solver.step_control == "adaptive":
+    if scene.is_ideal and scene.exudyn_solver.step_control == "adaptive":
         step = max(step, IDEAL_JOINT_STEP_ANGLE / scene.drive.speed)
     return step
 
@@ -143,11 +146,12 @@ def adaptive(scene: Scene) -> bool:
     """True when the step is error-controlled (:mod:`.step_control`): a clearance joint under
     ``step_control = "adaptive"``.  The ideal joint always takes the fixed step of :func:`step_plan`
     (nothing but the prescribed kinematics to follow; :data:`IDEAL_JOINT_STEP_ANGLE`)."""
-    return scene.exudyn_solver.step_control == "adaptive" and not scene.joint.is_ideal
+    return scene.exudyn_solver.step_control == "adaptive" and not scene.is_ideal
 
 
 def _failed(scene: Scene, message: str, wall: float) -> RunResult:
-    return RunResult(scene, "exudyn", "failed", message, empty_channels(), empty_channels(),
+    empty = empty_channels(not scene.joint_f.is_ideal)
+    return RunResult(scene, "exudyn", "failed", message, empty, empty,
                      {"wall_time_s": wall}, {"first_contact_time_s": None})  # fmt: skip
 
 
@@ -224,6 +228,7 @@ def _solve_model(scene: Scene, model: str, progress, callback: str | None, wall0
     # The adaptive step takes about 1/3 of the fixed plan's steps (docs/performance.md).
     report_every = max(1, (n_steps // 3 if adaptive(scene) else n_steps) // _PROGRESS_CALLS)
     guard = RunGuard(scene)
+    guard_f = None if scene.joint_f.is_ideal else RunGuard(dataclasses.replace(scene, joint=scene.joint_f))
     breach = []
 
     def count(mbs, t):
@@ -235,6 +240,8 @@ def _solve_model(scene: Scene, model: str, progress, callback: str | None, wall0
         # joint's own post-step hook, so the tracker holds this step's penetration.
         found = guard.check(penetration=model.clearance.tracker.delta if model.clearance else None,
                             steps=1 if t > 0.0 else 0)  # fmt: skip
+        if found is None and guard_f is not None:  # joint F's penetration against its own journal radius
+            found = guard_f.check(penetration=model.clearance_f.tracker.delta, steps=0)
         if found is not None:
             breach.append(found)
             return False  # Exudyn stops after this step
@@ -247,8 +254,8 @@ def _solve_model(scene: Scene, model: str, progress, callback: str | None, wall0
         control = StepController.for_mechanism(mbs, solver, model, scene)
         control.install()
     mbs.Assemble()
-    if model.clearance is not None:
-        model.clearance.reset(mbs)
+    for joint in model.clearances.values():
+        joint.reset(mbs)
     if progress is not None:
         progress(0.0)
     status, message, kind = "success", "", None
@@ -298,8 +305,8 @@ def _solve_model(scene: Scene, model: str, progress, callback: str | None, wall0
         "newton_iterations": int(it.newtonStepsCount),
         "jacobian_evaluations": int(it.newtonJacobiCount),
         "function_evaluations": int(it.newtonStepsCount),
-        **(model.clearance.tracker.counters() if model.clearance else {"contact_events": 0}),
-        "callback": model.clearance.route if model.clearance else None,
+        **_contact_counters(model),
+        "callback": next((c.route for c in model.clearances.values()), None),
         **({k: v for k, v in control.counters().items() if k != "smallest_step_s"} if control else {}),
         "solve_time_s": wall_solve,
         "wall_time_s": _time.perf_counter() - wall0,
@@ -307,10 +314,21 @@ def _solve_model(scene: Scene, model: str, progress, callback: str | None, wall0
     if kind is not None:
         stats["failure"] = kind
     stats["time_per_step_us"] = 1e6 * wall_solve / max(n_done, 1)
-    first = model.clearance.tracker.first_contact_time if model.clearance else None
-    counts = model.clearance.tracker.counters() if model.clearance else {}
+    first = {name: c.tracker.first_contact_time for name, c in model.clearances.items()}
+    counts = _contact_counters(model) if model.clearances else {}
+    events = {"first_contact_time_s": min((v for v in first.values() if v is not None), default=None), **counts}
+    if model.clearance_f is not None:
+        events.update({f"first_contact_time_{name}_s": first.get(name) for name in ("e", "f")})
     if progress is not None:
         progress(1.0)
     # Post-run criteria (energy balance, ...) that no single step shows; see weftsim.guards.
-    return vet_result(RunResult(scene, "exudyn", status, message, samples, steps, stats,
-                                {"first_contact_time_s": first, **counts}))  # fmt: skip
+    return vet_result(RunResult(scene, "exudyn", status, message, samples, steps, stats, events))
+
+
+def _contact_counters(model) -> dict:
+    """Contact-history counts of the clearance joints, summed (E's alone keep their values as before)."""
+    total = {"contact_events": 0}
+    for joint in model.clearances.values():
+        for key, value in joint.tracker.counters().items():
+            total[key] = total.get(key, 0) + value
+    return total

@@ -56,6 +56,9 @@ END_OF_STEP_ACCELERATIONS = False
 def check_tree_settings(scene: Scene) -> str | None:
     """Message naming the first setting the kinematic-tree model cannot run with, or None."""
     s = scene.exudyn_solver
+    if not scene.joint_f.is_ideal:
+        return ("the 'kinematic_tree' Exudyn model carries the clearance at E only, and this scene has one at F "
+                "(joint_f); use `exudyn_solver.model` = 'auto' or 'rigid_body' (it adds the clearance joint at F)")
     if scene.joint.is_ideal:
         return ("the 'kinematic_tree' Exudyn model needs a clearance joint (with an ideal joint nothing moves "
                 "freely); use `exudyn_solver.model` = 'rigid_body' or the reference engine")  # fmt: skip

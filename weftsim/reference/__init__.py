@@ -10,6 +10,9 @@ The cross-check engine that plays ADAMS's role for the Exudyn model.  Public ent
 - Clearance joint: members 1-3 prescribed by theta = omega t, members 4-8 a 2-DOF chain
   (theta_FG, theta_EF) forced through the contact at E (:mod:`.dynamics`), integrated
   in segments between contact events (:mod:`.integrate`).
+- Clearance at F (``scene.joint_f``): alone, again 2 DOF (the rod turns about E of the rocker, the
+  sector is driven through the contact at F); with E, the rod is free (4 DOF)
+  (:mod:`weftsim.kernel.chain_f`).  These run on the compiled path only.
 
 The derivation is in docs/reference-solver.md.
 """
@@ -46,6 +49,9 @@ def _check(scene: Scene) -> str | None:
             import numba  # noqa: F401 - a dependency; checked for installs that lost it
         except ImportError:
             return f"`reference_solver.method` = {settings.method!r} needs numba installed; use 'DOP853' (scipy)"
+    if not scene.joint_f.is_ideal and compiled_method(scene) is None:
+        return (f"`reference_solver.method` = {settings.method!r} cannot run a clearance at F (joint_f): the scipy "
+                f"path carries the clearance at E only; use 'auto' or one of {list(COMPILED_METHODS)}")
     for name in ("rtol", "atol", "max_step"):
         value = getattr(settings, name)
         if not (value > 0.0 and math.isfinite(value)):
@@ -91,14 +97,16 @@ def compiled_method(scene: Scene) -> str | None:
 
 def select_path(scene: Scene) -> dict:
     """``{"model", "method", "reason"}`` of the run :func:`solve` makes of ``scene``."""
-    if scene.joint.is_ideal:
+    if scene.is_ideal:
         return {"model": "ideal joint", "method": "closed form",
                 "reason": "clearance 0: no free coordinate, nothing to integrate"}
     s = scene.reference_solver
     method = compiled_method(scene) or s.method
     why = ("solver.reference.method = 'auto': the fastest path meeting the accuracy targets" if s.method == AUTO
            else f"set by solver.reference.method = {s.method!r}")
-    return {"model": "clearance chain (2 DOF)", "method": f"{method} rtol {s.rtol:g} atol {s.atol:g}", "reason": why}
+    model = {("e",): "clearance chain (2 DOF)", ("f",): "clearance at F: chain about E (2 DOF)",
+             ("e", "f"): "clearance at E and F: free rod (4 DOF)"}[scene.loose_joints]
+    return {"model": model, "method": f"{method} rtol {s.rtol:g} atol {s.atol:g}", "reason": why}
 
 
 def _solve_clearance(scene: Scene, progress, step_states) -> RunResult:
@@ -135,7 +143,7 @@ def solve(scene: Scene, progress=None, step_states=None) -> RunResult:
     Parameters
     ----------
     scene : Scene
-        ``scene.joint.clearance == 0`` selects the ideal joint (closed form); otherwise the
+        Every joint ideal (``scene.is_ideal``) selects the closed form; otherwise the
         clearance mode is integrated with ``scene.reference_solver`` (method by name from
         :data:`METHODS` or :data:`COMPILED_METHODS`, or ``"auto"``: the compiled DOP853;
         rtol, atol, max_step as crank angle).  :func:`select_path` says which.
@@ -157,9 +165,10 @@ def solve(scene: Scene, progress=None, step_states=None) -> RunResult:
     """
     problem = _check(scene)
     if problem is not None:
-        return RunResult(scene, "reference", "failed", problem, empty_channels(), empty_channels(),
+        empty = empty_channels(not scene.joint_f.is_ideal)
+        return RunResult(scene, "reference", "failed", problem, empty, empty,
                          {"wall_time_s": 0.0}, {"first_contact_time_s": None})  # fmt: skip
-    if scene.joint.is_ideal:
+    if scene.is_ideal:
         result = _solve_ideal(scene, progress)
     else:
         result = _solve_clearance(scene, progress, step_states)

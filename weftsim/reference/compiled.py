@@ -3,7 +3,8 @@
 
 scipy's ``DOP853`` and ``RK45`` are re-implemented step for step in :mod:`.compiled_rk` (same
 tableaux, taken from scipy; same initial step, error norm, step-size control and dense output), with the
-right-hand side and the contact law of :mod:`weftsim.kernel.chain`.  What
+right-hand side and the contact law of :mod:`weftsim.kernel.chain` (:mod:`weftsim.kernel.chain_f` with a
+clearance at F: one contact mode and held impact velocity per joint, events searched per joint).  What
 the scipy path pays per step in Python (stage combinations, error norm, dense-output
 objects, event location; ~50 us per step attempt, docs/reference-solver.md section 4)
 becomes a few microseconds.  The event search is that of :mod:`weftsim.kernel.roots` (compiled here,
@@ -27,9 +28,10 @@ import math
 import numpy as np
 from numba import njit
 
-from weftsim.kernel.chain import CLEARANCE, TRACK_MAX, V_MIN, penetration
+from weftsim.kernel.chain import TRACK_MAX, V_MIN
+from weftsim.kernel.chain_f import BLOCKS, N_JOINTS, joint_is_loose, penetration_at
 from weftsim.reference.compiled_rk import (
-    _MAX_FACTOR, _MIN_FACTOR, _SAFETY, DOP853, RK45, N, _dense, _dense_coefficients, _error_norm, _f,
+    _MAX_FACTOR, _MIN_FACTOR, _SAFETY, DOP853, RK45, _dense, _dense_coefficients, _error_norm, _f,
     _initial_step, _stages,
 )  # fmt: skip
 from weftsim.reference.compiled_rk import DENSE as _RK_DENSE
@@ -49,12 +51,17 @@ _STEP_BUFFER = 1 << 15
 _SUBSTEPS = np.arange(1, _CONTACT_SUBSTEPS + 1) / (_CONTACT_SUBSTEPS + 1.0)
 _GRID = np.linspace(0.0, 1.0, SAMPLES + 1)  # the event search grid of a step (integrate._GRID)
 
-# Float state: t, h_abs, held impact velocity, max penetration rate, first contact time (-1: none),
-# last accepted step, its penetration and length (for the guards of weftsim.guards).
-T, H_ABS, IMPACT, MAX_RATE, FIRST_CONTACT, LAST_PENETRATION, LAST_STEP = range(7)
-# Guard limits: penetration bound (m), shortest accepted step (s), step budget (0: none).
-PENETRATION_LIMIT, MIN_STEP_LIMIT, STEP_BUDGET = range(3)
-# Int state: mode, segment to start, counters, next output sample.
+# Float state: t, h_abs, held impact velocity at E, max penetration rate, first contact time (-1: none),
+# penetration at E of the last accepted step and its length (for the guards of weftsim.guards); then the
+# held impact velocity, penetration and first contact time at F.  IMPACT + joint, LAST_PENETRATION + joint
+# and FIRST_CONTACT + joint are read through JOINT_SLOTS.
+T, H_ABS, IMPACT, MAX_RATE, FIRST_CONTACT, LAST_PENETRATION, LAST_STEP, IMPACT_F, LAST_PENETRATION_F, \
+    FIRST_CONTACT_F = range(10)
+N_FLOAT_STATE = 10
+JOINT_SLOTS = np.array([[IMPACT, LAST_PENETRATION, FIRST_CONTACT], [IMPACT_F, LAST_PENETRATION_F, FIRST_CONTACT_F]])
+# Guard limits: penetration bound at E (m), shortest accepted step (s), step budget (0: none), bound at F.
+PENETRATION_LIMIT, MIN_STEP_LIMIT, STEP_BUDGET, PENETRATION_LIMIT_F = range(4)
+# Int state: mode (mask of the joints in contact: bit 0 E, bit 1 F), segment to start, counters, next sample.
 CONTACT, START, STEPS, REJECTED, NFEV, DENSE, SEGMENTS, EVENTS, IMPACTS, NEXT_SAMPLE, PEAKS, NONPOSITIVE = range(12)
 N_INT_STATE = 12
 assert (NFEV, DENSE) == (_RK_NFEV, _RK_DENSE)  # compiled_rk counts evaluations into the same int state
@@ -63,14 +70,14 @@ NO_EVENT, ONSET, SEPARATION, PEAK = 0, 1, 2, 3
 
 
 @njit(cache=True, error_model="numpy")
-def _state(t, prm, method, F, t_old, h, y_old, tmp):
-    """(delta, delta_dot) on the dense output of the last step at time t."""
+def _state(t, prm, method, F, t_old, h, y_old, tmp, joint):
+    """(delta, delta_dot) of ``joint`` on the dense output of the last step at time t."""
     _dense(method, F, t_old, h, y_old, t, tmp)
-    return penetration(prm, t, tmp)
+    return penetration_at(prm, t, tmp, joint)
 
 
 # The event search of weftsim.kernel.roots on the dense output of the last step, compiled; its
-# ``args`` are (prm, method, F, t_old, h, y_old, tmp).
+# ``args`` are (prm, method, F, t_old, h, y_old, tmp, joint).
 _first_crossing = specialize(roots.first_crossing, state=_state)
 _rate_peak = specialize(roots.rate_peak, state=_state)
 
@@ -79,9 +86,55 @@ _rate_peak = specialize(roots.rate_peak, state=_state)
 def _record(buf_t, buf_y, buf_c, buf_i, n, t, y, contact, impact):
     buf_t[n] = t
     buf_y[n, :] = y
-    buf_c[n] = 1 if contact else 0
-    buf_i[n] = impact
+    buf_c[n] = contact
+    buf_i[n, :] = impact
     return n + 1
+
+
+@njit(cache=True, error_model="numpy")
+def _events_of_joint(prm, method, F, t, h, y, tmp, joint, in_contact, held, g_old, r_old, g_new, r_new, t_new,
+                     grid_t, grid_d, grid_r, peak_t, peak_r):
+    """The first event of one joint inside the step: (kind, time, value) (:mod:`weftsim.reference.events`).
+
+    Onset or separation (the first rising crossing of sign * delta), then under "max_approach" a
+    maximum of the approach rate above ``held`` before it.  ``grid_t`` holds the step's sample times.
+    """
+    args = (prm, method, F, t, h, y, tmp, joint)
+    sign = -1.0 if in_contact else 1.0
+    possible = sign * g_new > 0.0 or sign * r_old > 0.0 > sign * r_new
+    t_stop = t_new
+    kind = NO_EVENT
+    value = 0.0
+    grid_d[0], grid_r[0] = g_old, r_old
+    grid_d[SAMPLES], grid_r[SAMPLES] = g_new, r_new
+    for i in range(1, SAMPLES):
+        d, r = _state(grid_t[i], prm, method, F, t, h, y, tmp, joint)
+        grid_d[i], grid_r[i] = d, r
+    if possible:
+        found, t_root, rate = _first_crossing(args, grid_t, grid_d, grid_r, sign)
+        if found:
+            t_stop = t_root
+            kind = SEPARATION if in_contact else ONSET
+            value = sign * rate
+    if in_contact and prm[BLOCKS[joint] + TRACK_MAX] != 0.0:
+        n = SAMPLES + 1
+        if kind != NO_EVENT:  # the approach rate counts up to the separation only
+            n = 0
+            for i in range(SAMPLES + 1):
+                if grid_t[i] < t_stop:
+                    peak_t[n], peak_r[n] = grid_t[i], grid_r[i]
+                    n += 1
+            peak_t[n], peak_r[n] = t_stop, value
+            n += 1
+        else:
+            peak_t[:n] = grid_t
+            peak_r[:n] = grid_r
+        found, t_peak, r_peak = _rate_peak(args, peak_t, peak_r, n, held)
+        if found:
+            t_stop = t_peak
+            kind = PEAK
+            value = r_peak
+    return kind, t_stop, value
 
 
 @njit(cache=True, error_model="numpy")
@@ -92,23 +145,29 @@ def advance(prm, method, rtol, atol, max_step, t_end, t_pause, limits, y, f, fst
     Steps, events and contact substeps go to ``stp_*`` from row 0 (count returned),
     samples to ``smp_*`` at rows ist[NEXT_SAMPLE]...  Returns (code, rows written).
     After every accepted step (as :mod:`weftsim.reference.integrate` with ``RunGuard``): the
-    penetration bound, the shortest step (not the step cut to land on t_end) and the step
-    budget of ``limits``; a crossing records the step and returns GUARD.
+    penetration bound of each joint, the shortest step (not the step cut to land on t_end) and the
+    step budget of ``limits``; a crossing records the step and returns GUARD.  Each joint with a
+    clearance has its own contact mode and held impact velocity (bit ``joint`` of ist[CONTACT],
+    fst[JOINT_SLOTS[joint, 0]]); the earliest event of any joint ends the step.
     """
-    K = np.zeros((16, N))
-    F = np.zeros((7, N))
-    y_new = np.empty(N)
-    tmp = np.empty(N)
-    scale = np.empty(N)
+    n_y = y.size
+    K = np.zeros((16, n_y))
+    F = np.zeros((7, n_y))
+    y_new = np.empty(n_y)
+    tmp = np.empty(n_y)
+    scale = np.empty(n_y)
     order = 7 if method == DOP853 else 4
     f_row = 12 if method == DOP853 else 6
     exponent = -1.0 / (order + 1)
     n_rows = 0
     capacity = stp_t.size
     n_samples = sample_times.size
-    v_min = prm[V_MIN]
-    track = prm[TRACK_MAX] != 0.0
-    ideal = 1 if prm[CLEARANCE] <= 0.0 else 0
+    loose = np.zeros(N_JOINTS, dtype=np.bool_)
+    for j in range(N_JOINTS):
+        loose[j] = joint_is_loose(prm, j)
+    impact = np.zeros(N_JOINTS)
+    g_old = np.empty(N_JOINTS)
+    r_old = np.empty(N_JOINTS)
     grid_t = np.empty(SAMPLES + 1)
     grid_d = np.empty(SAMPLES + 1)
     grid_r = np.empty(SAMPLES + 1)
@@ -116,8 +175,9 @@ def advance(prm, method, rtol, atol, max_step, t_end, t_pause, limits, y, f, fst
     peak_r = np.empty(SAMPLES + 2)
     t = fst[T]
     while t < t_end:
-        contact = ist[CONTACT] == 1
-        impact = fst[IMPACT]
+        contact = ist[CONTACT]
+        for j in range(N_JOINTS):
+            impact[j] = fst[JOINT_SLOTS[j, 0]]
         if ist[START] == 1:
             _f(prm, t, y, contact, impact, f, ist)
             fst[H_ABS] = _initial_step(prm, t, y, f, t_end, max_step, order, rtol, atol, contact, impact, ist, tmp)
@@ -142,8 +202,8 @@ def advance(prm, method, rtol, atol, max_step, t_end, t_pause, limits, y, f, fst
             h = t_new - t
             h_abs = abs(h)
             K[0, :] = f
-            g_new = _stages(prm, method, t, y, h, K, contact, impact, ist, y_new, tmp)
-            for j in range(N):
+            _stages(prm, method, t, y, h, K, contact, impact, ist, y_new, tmp)
+            for j in range(n_y):
                 scale[j] = atol + max(abs(y[j]), abs(y_new[j])) * rtol
             err = _error_norm(method, K, h, scale)
             if not err == err:  # NaN from a non-finite stage: reject and shrink
@@ -158,63 +218,54 @@ def advance(prm, method, rtol, atol, max_step, t_end, t_pause, limits, y, f, fst
             rejected = True
             ist[REJECTED] += 1
         fst[H_ABS] = h_abs
-        for j in range(N):
+        for j in range(n_y):
             if not math.isfinite(y_new[j]):
                 return NON_FINITE, n_rows
         ist[STEPS] += 1
         f_new = K[f_row]
-        g_new, r_new = penetration(prm, t_new, y_new)
-        fst[LAST_PENETRATION] = g_new if contact else -math.inf  # only contact steps are model states
         fst[LAST_STEP] = h if t_new < t_end else math.inf
-        if (fst[LAST_PENETRATION] > limits[PENETRATION_LIMIT] or fst[LAST_STEP] < limits[MIN_STEP_LIMIT]
-                or (limits[STEP_BUDGET] > 0.0 and ist[STEPS] > limits[STEP_BUDGET])):
+        breach = limits[STEP_BUDGET] > 0.0 and ist[STEPS] > limits[STEP_BUDGET]
+        breach = breach or fst[LAST_STEP] < limits[MIN_STEP_LIMIT]
+        for j in range(N_JOINTS):
+            slot = JOINT_SLOTS[j, 1]
+            fst[slot] = -math.inf
+            if loose[j]:
+                g_old[j], r_old[j] = penetration_at(prm, t, y, j)
+                if (contact >> j) & 1:  # only contact steps are model states
+                    fst[slot] = penetration_at(prm, t_new, y_new, j)[0]
+        breach = (breach or fst[LAST_PENETRATION] > limits[PENETRATION_LIMIT]
+                  or fst[LAST_PENETRATION_F] > limits[PENETRATION_LIMIT_F])
+        if breach:
             fst[T] = t_new
             y[:] = y_new
             n_rows = _record(stp_t, stp_y, stp_c, stp_i, n_rows, t_new, y_new, contact, impact)
             return GUARD, n_rows
-        # Events inside the step (weftsim.reference.events): first rising crossing, rate peak.
-        g_old, r_old = penetration(prm, t, y)
-        sign = -1.0 if contact else 1.0
-        possible = (sign * g_new > 0.0 or sign * r_old > 0.0 > sign * r_new) and ideal == 0
+        # Events inside the step (weftsim.reference.events), per joint; the earliest ends the step.
         t_stop = t_new
         kind = NO_EVENT
         value = 0.0
+        event_joint = -1
         dense = False
-        if contact or possible:
-            _dense_coefficients(prm, method, t, y, y_new, f_new, h, K, contact, impact, ist, F, tmp)
-            dense = True
-            grid_d[0], grid_r[0] = g_old, r_old
-            grid_d[SAMPLES], grid_r[SAMPLES] = g_new, r_new
-            for i in range(SAMPLES + 1):
-                grid_t[i] = t + h * _GRID[i]
-            grid_t[SAMPLES] = t_new
-            for i in range(1, SAMPLES):
-                d, r = _state(grid_t[i], prm, method, F, t, h, y, tmp)
-                grid_d[i], grid_r[i] = d, r
-            if possible:
-                found, t_root, rate = _first_crossing((prm, method, F, t, h, y, tmp), grid_t, grid_d, grid_r, sign)
-                if found:
-                    t_stop = t_root
-                    kind = SEPARATION if contact else ONSET
-                    value = sign * rate
-            if contact and track:
-                n = SAMPLES + 1
-                if kind != NO_EVENT:  # the approach rate counts up to the separation only
-                    n = 0
-                    for i in range(SAMPLES + 1):
-                        if grid_t[i] < t_stop:
-                            peak_t[n], peak_r[n] = grid_t[i], grid_r[i]
-                            n += 1
-                    peak_t[n], peak_r[n] = t_stop, value
-                    n += 1
-                else:
-                    peak_t[:n] = grid_t
-                    peak_r[:n] = grid_r
-                found, t_peak, r_peak = _rate_peak((prm, method, F, t, h, y, tmp), peak_t, peak_r, n, impact)
-                if found:
-                    t_stop = t_peak
-                    kind = PEAK
-                    value = r_peak
+        for i in range(SAMPLES + 1):
+            grid_t[i] = t + h * _GRID[i]
+        grid_t[SAMPLES] = t_new
+        for j in range(N_JOINTS):
+            if not loose[j]:
+                continue
+            in_contact = ((contact >> j) & 1) == 1
+            g_new, r_new = penetration_at(prm, t_new, y_new, j)
+            sign = -1.0 if in_contact else 1.0
+            possible = sign * g_new > 0.0 or sign * r_old[j] > 0.0 > sign * r_new
+            if not (in_contact or possible):
+                continue
+            if not dense:
+                _dense_coefficients(prm, method, t, y, y_new, f_new, h, K, contact, impact, ist, F, tmp)
+                dense = True
+            j_kind, j_stop, j_value = _events_of_joint(prm, method, F, t, h, y, tmp, j, in_contact, impact[j],
+                                                       g_old[j], r_old[j], g_new, r_new, t_new, grid_t, grid_d,
+                                                       grid_r, peak_t, peak_r)  # fmt: skip
+            if j_kind != NO_EVENT and (kind == NO_EVENT or j_stop < t_stop):
+                kind, t_stop, value, event_joint = j_kind, j_stop, j_value, j
         k = ist[NEXT_SAMPLE]
         while k < n_samples and sample_times[k] <= t_stop:
             if not dense:
@@ -224,7 +275,7 @@ def advance(prm, method, rtol, atol, max_step, t_end, t_pause, limits, y, f, fst
             _record(smp_t, smp_y, smp_c, smp_i, k, sample_times[k], tmp, contact, impact)
             k += 1
         ist[NEXT_SAMPLE] = k
-        if contact and _CONTACT_SUBSTEPS > 0:
+        if contact != 0 and _CONTACT_SUBSTEPS > 0:
             for i in range(_CONTACT_SUBSTEPS):
                 t_sub = t + (t_stop - t) * _SUBSTEPS[i]
                 _dense(method, F, t, h, y, t_sub, tmp)
@@ -234,23 +285,27 @@ def advance(prm, method, rtol, atol, max_step, t_end, t_pause, limits, y, f, fst
             t = t_stop
             y[:] = tmp
             ist[EVENTS] += 1
+            held = JOINT_SLOTS[event_joint, 0]
             if kind == SEPARATION:
-                ist[CONTACT] = 0
-                fst[IMPACT] = 0.0
+                ist[CONTACT] = contact & ~(1 << event_joint)
+                fst[held] = 0.0
             elif kind == PEAK:
-                fst[IMPACT] = value
+                fst[held] = value
                 ist[PEAKS] += 1
             else:
                 if not value > 0.0:
                     ist[NONPOSITIVE] += 1  # no rising root found: counted, judged by weftsim.guards
                 fst[MAX_RATE] = max(fst[MAX_RATE], value)
-                ist[CONTACT] = 1
-                fst[IMPACT] = max(value, v_min)
+                ist[CONTACT] = contact | (1 << event_joint)
+                fst[held] = max(value, prm[BLOCKS[event_joint] + V_MIN])
                 ist[IMPACTS] += 1
-                if fst[FIRST_CONTACT] < 0.0:
-                    fst[FIRST_CONTACT] = t
+                first = JOINT_SLOTS[event_joint, 2]
+                if fst[first] < 0.0:
+                    fst[first] = t
             ist[START] = 1
-            n_rows = _record(stp_t, stp_y, stp_c, stp_i, n_rows, t, y, ist[CONTACT] == 1, fst[IMPACT])
+            for j in range(N_JOINTS):
+                impact[j] = fst[JOINT_SLOTS[j, 0]]
+            n_rows = _record(stp_t, stp_y, stp_c, stp_i, n_rows, t, y, ist[CONTACT], impact)
         else:
             t = t_new
             y[:] = y_new

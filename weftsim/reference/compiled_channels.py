@@ -25,9 +25,10 @@ from weftsim.params import Geometry, Inertia, Scene
 from weftsim.kernel.chain import (
     CLEARANCE, COEF, COUPLING, GRAVITY, KIND, L_EF, L_FG, M11, M22, OMEGA, ROD_MASS, chain, penetration,
 )  # fmt: skip
+from weftsim.kernel import chain_f as kf
 from weftsim.kernel.laws import elastic_energy
 from weftsim.reference.dynamics import initial_state, pack_parameters
-from weftsim.results import CHANNELS
+from weftsim.results import CHANNELS, JOINT_F_CHANNELS
 
 TABLE_POINTS = 4096  # spline knots per revolution: interpolation error ~ 5/384 h^4 |f''''| ~ 1e-12 relative
 
@@ -126,11 +127,79 @@ def _fill(prm, table, a0, ratio, time, states, contact, impact, out):
         out[i, 17] = penetration(prm, t, y)[1]
 
 
+@njit(cache=True, error_model="numpy")
+def _fill_f(prm, table, a0, ratio, time, states, contact, impact, out):
+    """Rows of :data:`CHANNELS` then :data:`JOINT_F_CHANNELS` into out (n, 25), clearance at F.
+
+    ``contact``: mask (bit 0 E, bit 1 F); ``impact`` (n, 2).  The energy channels hold both joints.
+    """
+    omega = prm[OMEGA]
+    n_dof = kf.degrees_of_freedom(prm)
+    d = np.empty(2 * n_dof + 2)
+    start = np.empty(4)
+    crank = np.empty(4)
+    crank_side_eval(table, 0.0, start)
+    work0 = 0.5 * start[0] * omega * omega + start[2]
+    loose_e = kf.joint_is_loose(prm, kf.JOINT_E_INDEX)
+    jf = kf.JOINT_F
+    n_base = len(CHANNELS)
+    for i in range(time.size):
+        t = time[i]
+        y = states[i]
+        mask = contact[i]
+        q3, fe_n, delta_e, e_y, e_z, ff_n, delta_f, ef_y, ef_z, dda = kf.chain_f(prm, t, y, mask, impact[i], d)
+        crank_side_eval(table, omega * t, crank)
+        kin48, pot48 = kf.rod_energy(prm, t, y)
+        kin13 = 0.5 * crank[0] * omega * omega
+        out[i, 0] = t
+        out[i, 1] = omega * t * (180.0 / math.pi)
+        out[i, 2] = ratio * (y[0] - a0)
+        out[i, 3] = ratio * y[n_dof]
+        out[i, 4] = ratio * dda
+        out[i, 5] = 0.5 * crank[1] * omega * omega + crank[3] - q3
+        out[i, 6] = fe_n
+        out[i, 7] = delta_e if loose_e else 0.0
+        out[i, 8] = e_y
+        out[i, 9] = e_z
+        out[i, 10] = impact[i, 0] if mask & 1 else 0.0
+        out[i, 11] = 1.0 if (mask & 1 and delta_e > 0.0) else 0.0
+        out[i, 12] = kin13 + kin48
+        out[i, 13] = crank[2] + pot48
+        out[i, 14] = elastic_energy(prm[jf + KIND], prm[jf + COEF], prm[jf + CLEARANCE], delta_f)
+        if loose_e:
+            out[i, 14] += elastic_energy(prm[KIND], prm[COEF], prm[CLEARANCE], delta_e)
+        out[i, 15] = kin13 + crank[2] - work0 + y[2 * n_dof]
+        out[i, 16] = y[2 * n_dof + 1]
+        out[i, 17] = kf.penetration_at(prm, t, y, kf.JOINT_E_INDEX)[1] if loose_e else 0.0
+        out[i, n_base] = ff_n
+        out[i, n_base + 1] = delta_f
+        out[i, n_base + 2] = ef_y
+        out[i, n_base + 3] = ef_z
+        out[i, n_base + 4] = impact[i, 1] if mask & 2 else 0.0
+        out[i, n_base + 5] = 1.0 if (mask & 2 and delta_f > 0.0) else 0.0
+        out[i, n_base + 6] = kf.penetration_at(prm, t, y, kf.JOINT_F_INDEX)[1]
+
+
 def compiled_channels(scene: Scene, time, states, contact, impact) -> dict[str, np.ndarray]:
-    """All :data:`~weftsim.results.CHANNELS` at the given rows (arguments as ``clearance_channels``)."""
+    """All :data:`~weftsim.results.CHANNELS` at the given rows (arguments as ``clearance_channels``).
+
+    With clearance at F (``scene.joint_f``) also :data:`~weftsim.results.JOINT_F_CHANNELS`; then
+    ``contact`` is the mask of the joints in contact (bit 0 E, bit 1 F) and ``impact`` (n, 2) their
+    held impact velocities (:func:`weftsim.reference.compiled_run.integrate_compiled`).
+    """
     time = np.ascontiguousarray(time, dtype=float)
-    out = np.empty((time.size, len(CHANNELS)))
-    _fill(pack_parameters(scene), crank_side_table(scene), float(initial_state(scene)[0]),
-          scene.geometry.rapier_ratio, time, np.ascontiguousarray(states, dtype=float).reshape(time.size, 6),
-          np.asarray(contact, dtype=np.bool_), np.asarray(impact, dtype=float), out)  # fmt: skip
-    return dict(zip(CHANNELS, np.ascontiguousarray(out.T)))
+    prm = pack_parameters(scene)
+    table = crank_side_table(scene)
+    a0 = float(initial_state(scene)[0])
+    size = initial_state(scene).size
+    states = np.ascontiguousarray(states, dtype=float).reshape(time.size, size)
+    if scene.joint_f.is_ideal:
+        out = np.empty((time.size, len(CHANNELS)))
+        _fill(prm, table, a0, scene.geometry.rapier_ratio, time, states, np.asarray(contact, dtype=np.bool_),
+              np.asarray(impact, dtype=float), out)  # fmt: skip
+        return dict(zip(CHANNELS, np.ascontiguousarray(out.T)))
+    names = CHANNELS + JOINT_F_CHANNELS
+    out = np.empty((time.size, len(names)))
+    _fill_f(prm, table, a0, scene.geometry.rapier_ratio, time, states, np.asarray(contact, dtype=np.int64),
+            np.ascontiguousarray(impact, dtype=float).reshape(time.size, 2), out)  # fmt: skip
+    return dict(zip(names, np.ascontiguousarray(out.T)))

@@ -9,17 +9,19 @@ from __future__ import annotations
 
 import math
 import time as _time
+from dataclasses import replace
 
 import numpy as np
 
 from weftsim.guards import RunGuard, failure_message, non_finite_breach
 from weftsim.params import Scene
 from weftsim.reference.compiled import (
-    DENSE, DONE, EVENTS, FIRST_CONTACT, GUARD, IMPACTS, LAST_PENETRATION, LAST_STEP, MAX_RATE, METHODS,
-    N, N_INT_STATE, NEXT_SAMPLE, NFEV, NON_FINITE, NONPOSITIVE, PAUSED, PEAKS, REJECTED, SEGMENTS, START,
-    STEP_TOO_SMALL, STEPS, T, _STEP_BUFFER,
+    DENSE, DONE, EVENTS, FIRST_CONTACT, FIRST_CONTACT_F, GUARD, IMPACTS, LAST_PENETRATION, LAST_PENETRATION_F,
+    LAST_STEP, MAX_RATE, METHODS, N_FLOAT_STATE, N_INT_STATE, NEXT_SAMPLE, NFEV, NON_FINITE, NONPOSITIVE, PAUSED,
+    PEAKS, REJECTED, SEGMENTS, START, STEP_TOO_SMALL, STEPS, T, _STEP_BUFFER,
     advance,
 )  # fmt: skip
+from weftsim.kernel.chain_f import N_JOINTS
 from weftsim.reference.dynamics import initial_state, pack_parameters
 from weftsim.reference.integrate import _PROGRESS_EVERY
 from weftsim.results import RunResult
@@ -27,15 +29,37 @@ from weftsim.results import RunResult
 __all__ = ["integrate_compiled", "solve_compiled", "METHODS"]
 
 
-def _empty_buffers(n: int):
-    return np.zeros(n), np.zeros((n, N)), np.zeros(n, dtype=np.uint8), np.zeros(n)
+def _empty_buffers(n: int, size: int):
+    """Rows of (t, state (n, size), contact mask, held impact velocities (n, 2) at E and F)."""
+    return np.zeros(n), np.zeros((n, size)), np.zeros(n, dtype=np.uint8), np.zeros((n, N_JOINTS))
+
+
+def _penetration_breach(scene: Scene, guard: RunGuard, fst) -> tuple[float | None, RunGuard]:
+    """The penetration to report to the guard and the guard that judges it (joint E's, or F's)."""
+    if scene.joint_f.is_ideal or not fst[LAST_PENETRATION_F] > guard_f(scene).max_penetration:
+        return (None if scene.joint.is_ideal else fst[LAST_PENETRATION]), guard
+    return fst[LAST_PENETRATION_F], guard_f(scene)
+
+
+def guard_f(scene: Scene) -> RunGuard:
+    """The penetration guard of joint F: the run guard of the scene with F's joint in E's place."""
+    return RunGuard(replace(scene, joint=scene.joint_f))
+
+
+def _rows(scene: Scene, rows):
+    """Rows as the callers take them: with clearance at E alone the contact flag (bool) and E's held
+    impact velocity (n,), as the scipy path gives them; with clearance at F the mask and both columns."""
+    t, y, mask, impact = rows
+    if scene.joint_f.is_ideal:
+        return t, y, (mask & 1).astype(bool), impact[:, 0].copy()
+    return t, y, mask, impact
 
 
 def integrate_compiled(scene: Scene, progress=None, method: str = "numba_DOP853"):
     """Run the compiled integrator; returns (steps, samples, stats, events, status, message).
 
-    ``steps`` and ``samples`` are tuples (t, y (n, 6), contact (bool), impact) as
-    :func:`weftsim.reference.channels.clearance_channels` takes them.
+    ``steps`` and ``samples`` are tuples (t, y (n, 6 or 10), contact mask (bit 0 E, bit 1 F), held
+    impact velocities (n, 2)) as :func:`weftsim.reference.compiled_channels.compiled_channels` takes them.
     """
     settings = scene.reference_solver
     omega, t_end = scene.drive.speed, scene.drive.end_time
@@ -48,16 +72,20 @@ def integrate_compiled(scene: Scene, progress=None, method: str = "numba_DOP853"
     if t_end - sample_times[-1] > 1e-9 * sample_dt:
         sample_times = np.append(sample_times, t_end)
     y = initial_state(scene).astype(float)
-    f = np.zeros(N)
-    fst = np.array([0.0, 0.0, 0.0, 0.0, -1.0, -math.inf, math.inf])
+    f = np.zeros(y.size)
+    fst = np.zeros(N_FLOAT_STATE)
+    fst[FIRST_CONTACT] = fst[FIRST_CONTACT_F] = -1.0
+    fst[LAST_PENETRATION] = fst[LAST_PENETRATION_F] = -math.inf
+    fst[LAST_STEP] = math.inf
     ist = np.zeros(N_INT_STATE, dtype=np.int64)
     ist[START] = 1
     guard = RunGuard(scene)
     limits = np.array([math.inf if scene.joint.is_ideal else guard.max_penetration, guard.min_step,
-                       float(guard.max_steps or 0)])  # fmt: skip
-    smp = _empty_buffers(sample_times.size)
-    stp = _empty_buffers(_STEP_BUFFER)
-    chunks = [(np.zeros(1), y[None, :].copy(), np.zeros(1, dtype=np.uint8), np.zeros(1))]
+                       float(guard.max_steps or 0),
+                       math.inf if scene.joint_f.is_ideal else guard_f(scene).max_penetration])  # fmt: skip
+    smp = _empty_buffers(sample_times.size, y.size)
+    stp = _empty_buffers(_STEP_BUFFER, y.size)
+    chunks = [(np.zeros(1), y[None, :].copy(), np.zeros(1, dtype=np.uint8), np.zeros((1, N_JOINTS)))]
     if progress is not None:
         progress(0.0)
     # Pause every 1 % of the run for progress reports and the wall-time budget only if needed.
@@ -75,8 +103,8 @@ def integrate_compiled(scene: Scene, progress=None, method: str = "numba_DOP853"
         t = fst[T]
         breach = None
         if code == GUARD:
-            breach = guard.check(penetration=None if scene.joint.is_ideal else fst[LAST_PENETRATION],
-                                 step_size=fst[LAST_STEP], steps=int(ist[STEPS]) - steps_seen)  # fmt: skip
+            penetration, judge = _penetration_breach(scene, guard, fst)
+            breach = judge.check(penetration=penetration, step_size=fst[LAST_STEP], steps=int(ist[STEPS]) - steps_seen)
         elif code == STEP_TOO_SMALL:
             breach = guard.check(step_size=10.0 * np.spacing(t), steps=0)
         elif code == NON_FINITE:
@@ -98,8 +126,7 @@ def integrate_compiled(scene: Scene, progress=None, method: str = "numba_DOP853"
     steps = tuple(np.concatenate([c[i] for c in chunks]) for i in range(4))
     n_done = int(ist[NEXT_SAMPLE])
     samples = tuple(b[:n_done] for b in smp)
-    steps = (steps[0], steps[1], steps[2].astype(bool), steps[3])
-    samples = (samples[0], samples[1], samples[2].astype(bool), samples[3])
+    steps, samples = _rows(scene, steps), _rows(scene, samples)
     stats = {
         "method": method,
         "rtol": settings.rtol,
@@ -118,10 +145,15 @@ def integrate_compiled(scene: Scene, progress=None, method: str = "numba_DOP853"
         "nonpositive_onsets": int(ist[NONPOSITIVE]),
         "wall_time_s": wall,
     }
+    first = {joint: None if fst[slot] < 0.0 else float(fst[slot])
+             for joint, slot in (("e", FIRST_CONTACT), ("f", FIRST_CONTACT_F))}
     events = {
-        "first_contact_time_s": None if fst[FIRST_CONTACT] < 0.0 else float(fst[FIRST_CONTACT]),
+        # The first onset at any joint (E's alone in an E-only scene, as before).
+        "first_contact_time_s": min((v for v in first.values() if v is not None), default=None),
         "max_impact_velocity_m_s": float(fst[MAX_RATE]),
     }
+    if not scene.joint_f.is_ideal:
+        events.update({f"first_contact_time_{joint}_s": value for joint, value in first.items()})
     if failure is not None:
         stats["failure"] = failure
     if progress is not None and status == "success":
@@ -146,7 +178,7 @@ def solve_compiled(scene: Scene, progress=None, method: str | None = None, step_
     wall0 = _time.perf_counter()
 
     def channels(arrays):
-        return compiled_channels(scene, *arrays) if arrays[0].size else empty_channels()
+        return compiled_channels(scene, *arrays) if arrays[0].size else empty_channels(not scene.joint_f.is_ideal)
 
     step_channels, sample_channels = channels(steps), channels(samples)
     stats["postprocess_time_s"] = _time.perf_counter() - wall0

@@ -22,6 +22,7 @@ from numba import njit
 from weftsim import kinematics as kin
 from weftsim.contact import make_law
 from weftsim.kernel import chain as kc
+from weftsim.kernel import chain_f as kf
 from weftsim.kernel.joint import N_JOINT, joint_parameters
 from weftsim.params import Scene
 from weftsim.reference.ideal import sector_chain_inertia
@@ -88,10 +89,25 @@ def _chain_block(p: ChainConstants) -> np.ndarray:
     return out
 
 
+def topology(scene: Scene) -> int:
+    """The kernel's topology (:mod:`weftsim.kernel.chain_f`): E_ONLY (also the ideal mechanism), F_ONLY, E_AND_F."""
+    if scene.joint_f.is_ideal:
+        return kf.E_ONLY
+    return kf.F_ONLY if scene.joint.is_ideal else kf.E_AND_F
+
+
 def pack_parameters(scene: Scene) -> np.ndarray:
-    """Every number the kernel needs for this scene: the joint block, then the chain's constants."""
-    out = _chain_block(ChainConstants.from_scene(scene))
-    out[:N_JOINT] = joint_parameters(scene.joint, make_law(scene.joint))
+    """Every number the kernel needs for this scene: the joint block at E, the chain's constants,
+    the joint block at F (zeros while F is ideal), the topology, J_FG and J4."""
+    out = np.zeros(kf.N_PARAMETERS)
+    out[:kc.N_PARAMETERS] = _chain_block(ChainConstants.from_scene(scene))
+    if not scene.joint.is_ideal or scene.joint_f.is_ideal:
+        out[:N_JOINT] = joint_parameters(scene.joint, make_law(scene.joint))
+    if not scene.joint_f.is_ideal:
+        out[kf.JOINT_F:kf.JOINT_F + N_JOINT] = joint_parameters(scene.joint_f, make_law(scene.joint_f))
+    out[kf.TOPOLOGY] = topology(scene)
+    out[kf.SECTOR_CHAIN] = sector_chain_inertia(scene)
+    out[kf.ROD_INERTIA] = scene.inertia.rod_inertia
     return out
 
 
@@ -146,10 +162,20 @@ def initial_state(scene: Scene) -> np.ndarray:
 
     Returns [a, psi, a', psi', W3, D] with a = theta_FG(0), psi = theta_EF(0) (angle of
     F - E, so P_j = F - L_EF u(psi) = E), rates omega * d/dtheta of the ideal kinematics,
-    and the two integrated energy terms 0.
+    and the two integrated energy terms 0 (the same with clearance at F alone: psi is then the
+    rod's angle about E of the rocker).
+    With clearance at E and F (4 coordinates) the state is [a, Y, Z, psi, a', Y', Z', psi', W3, D],
+    (Y, Z) the rod's centre of mass (:mod:`weftsim.kernel.chain_f`).
     """
     omega = scene.drive.speed
     st = kin.linkage_state(0.0, scene.geometry, scene.inertia.rocker_com)
+    if topology(scene) == kf.E_AND_F:
+        com, d_com = np.asarray(st.rod_com, dtype=float), np.asarray(st.d_rod_com, dtype=float)
+        return np.array([
+            float(st.theta_fg), com[0], com[1], float(st.theta_ef),
+            omega * float(st.d_theta_fg), omega * d_com[0], omega * d_com[1], omega * float(st.d_theta_ef),
+            0.0, 0.0,
+        ])  # fmt: skip
     return np.array([
         float(st.theta_fg), float(st.theta_ef),
         omega * float(st.d_theta_fg), omega * float(st.d_theta_ef),

@@ -37,9 +37,14 @@ class SweepError(ValueError):
 
 
 def _short_names() -> dict[str, Key]:
-    """Short name (last dotted part) -> key, for the parts that occur once in the schema."""
+    """Short name (last dotted part) -> key, for the parts that occur once in the schema.
+
+    Joint F's keys repeat joint E's: they go by their full path, and E's keep the short names.
+    """
     by_last: dict[str, list[Key]] = {}
     for key in SCHEMA:
+        if key.path.startswith("joint_f."):
+            continue
         by_last.setdefault(key.path.rpartition(".")[2], []).append(key)
     return {name: keys[0] for name, keys in by_last.items() if len(keys) == 1}
 
@@ -66,7 +71,8 @@ def resolve_key(name: str) -> Key:
         return _BY_PATH[name]
     if name in SHORT_NAMES:
         return SHORT_NAMES[name]
-    ambiguous = [key.path for key in SCHEMA if key.path.rpartition(".")[2] == name]
+    ambiguous = [key.path for key in SCHEMA if key.path.rpartition(".")[2] == name and key.path in _BY_PATH
+                 and not key.path.startswith("joint_f.")]
     if ambiguous:
         raise SweepError(f"sweep key '{name}' is ambiguous; use the full scene key: {', '.join(ambiguous)}")
     near = difflib.get_close_matches(name, list(SHORT_NAMES) + list(_BY_PATH), n=3)

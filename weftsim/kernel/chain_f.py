@@ -1,0 +1,267 @@
+"""The chains with clearance at F (rod 4 - sector 5), alone or with clearance at E (the one definition).
+
+Members 1-3 are prescribed by theta = omega t as in :mod:`.chain`; the bearing of E is the point E
+of the rocker, P_E(t) (:func:`weftsim.kernel.chain.crank_side`).  At F the **journal is the rod's
+pin** (centre P_jF on member 4) and the **bearing the sector's eye** (centre P_bF = F of the sector,
+G + L_FG u(a)), so that member 4 carries the journal at both joints.  Four-bar plane coordinates
+(Y, Z), u(x) = (cos x, sin x), n(x) = (-sin x, cos x), g = (0, -g)::
+
+    topology F_ONLY (E ideal, F loose): 2 DOF, y = [a, psi, a', psi', W3, D]
+        rod pinned at E:  P_jF = P_E(t) + L_EF u(psi),  centre of mass P_E + (L_EF/2) u(psi)
+        J_FG a''   = -L_FG n(a).f_F + M_bF
+        M22 psi''  = L_EF n(psi).f_F + M_jF - m4 (L_EF/2) (n(psi).(a_E - g))
+        force on the rocker at E: -(m4 a_c - f_F - m4 g)                 (Newton on the rod)
+
+    topology E_AND_F (both loose): 4 DOF, y = [a, Y, Z, psi, a', Y', Z', psi', W3, D]
+        rod free, centre of mass C = (Y, Z):  P_jE = C - (L_EF/2) u(psi),  P_jF = C + (L_EF/2) u(psi)
+        J_FG a''   = -L_FG n(a).f_F + M_bF
+        m4 C''     = f_E + f_F + m4 g
+        J4 psi''   = -(L_EF/2) n(psi).f_E + (L_EF/2) n(psi).f_F + M_jE + M_jF
+
+with J_FG = J5 + J67 (d5/d6)^2 + m8 (d5 d7/d6)^2 (sector, gears and rapier reflected onto theta_FG;
+the sector and gears are balanced, so gravity acts on the rod alone), M22 = m4 L_EF^2/4 + J4, a_E
+= omega^2 d^2P_E/dtheta^2, f_k and M_jk, M_bk the force on the journal and the friction moments of
+joint k (:func:`weftsim.kernel.joint.clearance_force`).  The generalized force of the rod on the
+crank side is Q3 = (force on the rocker at E) . dP_E/dtheta (+ the friction moment at E); W3' =
+-Q3 omega and D' = the power both contacts dissipate, so the energy balance closes as with E alone
+(docs/reference-solver.md, "Clearance at F").
+
+The parameter array is that of :mod:`.chain` followed by joint F's block (same layout as joint E's,
+:func:`weftsim.kernel.joint.joint_parameters`) and the constants below.  Topology E_ONLY is the chain
+of :mod:`.chain` itself: :func:`rhs_any` and :func:`penetration_at` call it unchanged there, so a
+scene with clearance at E alone integrates bit for bit as before.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from weftsim.kernel import chain as kc
+from weftsim.kernel.joint import BEARING_RADIUS, CLEARANCE, KIND, COEF, MU, N_JOINT, clearance_force
+from weftsim.kernel.laws import elastic_force
+
+# Indices after the chain's constants: joint F's block, the topology, J_FG and J4.
+JOINT_F = kc.N_PARAMETERS
+TOPOLOGY, SECTOR_CHAIN, ROD_INERTIA = range(JOINT_F + N_JOINT, JOINT_F + N_JOINT + 3)
+N_PARAMETERS = JOINT_F + N_JOINT + 3
+# Topologies: which joints have a clearance.
+E_ONLY, F_ONLY, E_AND_F = 0, 1, 2
+# Joint numbers (bits of the contact mask, rows of the held impact velocities).
+JOINT_E_INDEX, JOINT_F_INDEX = 0, 1
+N_JOINTS = 2
+# Offsets of each joint's block in the parameter array.
+BLOCKS = (0, JOINT_F)
+
+
+@njit(cache=True, error_model="numpy")
+def degrees_of_freedom(prm):
+    """Coordinates of the chain: 2 (E only, F only) or 4 (E and F)."""
+    return 4 if prm[TOPOLOGY] == E_AND_F else 2
+
+
+@njit(cache=True, error_model="numpy")
+def state_size(prm):
+    """Length of the state y: coordinates, their rates, W3 and D."""
+    return 2 * degrees_of_freedom(prm) + 2
+
+
+@njit(cache=True, error_model="numpy")
+def joint_is_loose(prm, joint):
+    """True when ``joint`` (:data:`JOINT_E_INDEX` or :data:`JOINT_F_INDEX`) has a clearance."""
+    topology = prm[TOPOLOGY]
+    if joint == JOINT_E_INDEX:
+        return topology != F_ONLY and prm[CLEARANCE] > 0.0
+    return topology != E_ONLY
+
+
+@njit(cache=True, error_model="numpy")
+def crank_side_acceleration(prm, t):
+    """P_E, dP_E/dtheta and d^2P_E/dtheta^2 (m, m/rad, m/rad^2) and phi' at time t.
+
+    phi' = tan(beta) sin(theta) / w and phi'' = tan(beta) cos(theta) / w + 2 tan^3(beta) cos(theta)
+    sin^2(theta) / w^2 with w = 1 + tan^2(beta) cos^2(theta) (docs/physics.md section 1);
+    d^2P_E/dtheta^2 = L_OE (n phi'' - u phi'^2) = n(P_E) phi'' - P_E phi'^2 with n(P) = (-P_Z, P_Y).
+    """
+    b_y, b_z, db_y, db_z, dphi = kc.crank_side(prm, t)
+    theta = prm[kc.OMEGA] * t
+    st, ct = math.sin(theta), math.cos(theta)
+    tb = prm[kc.TAN_BETA]
+    w = 1.0 + tb * tb * ct * ct
+    ddphi = tb * ct / w + 2.0 * tb * tb * tb * ct * st * st / (w * w)
+    dd_y = -b_z * ddphi - b_y * dphi * dphi
+    dd_z = b_y * ddphi - b_z * dphi * dphi
+    return b_y, b_z, db_y, db_z, dd_y, dd_z, dphi
+
+
+@njit(cache=True, error_model="numpy")
+def contact_terms(jp, ecc_y, ecc_z, v_y, v_z, w_j, w_b, impact_velocity):
+    """Force of one joint in contact (block ``jp``) on its journal, and the power it dissipates.
+
+    ``w_j``, ``w_b``: angular velocities of the journal's and the bearing's bodies (rad/s).
+    v_T = e_dot.t + w_j (R_b - |e|) - w_b R_b (:func:`weftsim.clearance.tangential_velocity`);
+    dissipated power = -(f.e_dot + M_j w_j + M_b w_b) - F_el delta_dot (the contact's power less
+    the rate of its elastic energy).
+
+    Returns (f_Y, f_Z, F_N, delta, M_j, M_b, dissipated): N, N, N, m, N m, N m, W.
+    """
+    length = math.sqrt(ecc_y * ecc_y + ecc_z * ecc_z)
+    delta = length - jp[CLEARANCE]
+    if length <= 0.0:
+        return 0.0, 0.0, 0.0, delta, 0.0, 0.0, 0.0
+    v_t = 0.0
+    if jp[MU] > 0.0:
+        r_b = jp[BEARING_RADIUS]
+        v_t = (ecc_y * v_z - ecc_z * v_y) / length + w_j * (r_b - length) - w_b * r_b
+    f_y, f_z, f_n, _, delta, delta_dot, m_j, m_b = clearance_force(jp, ecc_y, ecc_z, v_y, v_z, v_t, impact_velocity)
+    f_el = elastic_force(jp[KIND], jp[COEF], jp[CLEARANCE], delta)
+    dissipated = -(f_y * v_y + f_z * v_z + m_j * w_j + m_b * w_b) - f_el * delta_dot
+    return f_y, f_z, f_n, delta, m_j, m_b, dissipated
+
+
+@njit(cache=True, error_model="numpy")
+def eccentricities(prm, t, y):
+    """Eccentricity and its rate at E and at F of state y (topologies F_ONLY, E_AND_F).
+
+    Returns (e_E, e_dot_E, e_F, e_dot_F) as eight floats (m, m/s; zeros at an ideal E), then the
+    angular velocities of the rocker, the rod and the sector (rad/s).
+    """
+    omega, l_fg, l_ef = prm[kc.OMEGA], prm[kc.L_FG], prm[kc.L_EF]
+    b_y, b_z, db_y, db_z, dphi = kc.crank_side(prm, t)
+    a = y[0]
+    if prm[TOPOLOGY] == E_AND_F:
+        c_y, c_z, psi = y[1], y[2], y[3]
+        da, dc_y, dc_z, dpsi = y[4], y[5], y[6], y[7]
+        half = 0.5 * l_ef
+        sp, cp = math.sin(psi), math.cos(psi)
+        e_y = c_y - half * cp - b_y
+        e_z = c_z - half * sp - b_z
+        ve_y = dc_y + half * sp * dpsi - omega * db_y
+        ve_z = dc_z - half * cp * dpsi - omega * db_z
+        j_y, j_z = c_y + half * cp, c_z + half * sp
+        vj_y, vj_z = dc_y - half * sp * dpsi, dc_z + half * cp * dpsi
+    else:
+        psi, da, dpsi = y[1], y[2], y[3]
+        sp, cp = math.sin(psi), math.cos(psi)
+        e_y = e_z = ve_y = ve_z = 0.0
+        j_y, j_z = b_y + l_ef * cp, b_z + l_ef * sp
+        vj_y, vj_z = omega * db_y - l_ef * sp * dpsi, omega * db_z + l_ef * cp * dpsi
+    sa, ca = math.sin(a), math.cos(a)
+    f_y = j_y - (prm[kc.L_OG] + l_fg * ca)
+    f_z = j_z - l_fg * sa
+    vf_y = vj_y + l_fg * sa * da
+    vf_z = vj_z - l_fg * ca * da
+    return e_y, e_z, ve_y, ve_z, f_y, f_z, vf_y, vf_z, omega * dphi, dpsi, da
+
+
+@njit(cache=True, error_model="numpy")
+def _rate(e_y, e_z, v_y, v_z):
+    length = math.sqrt(e_y * e_y + e_z * e_z)
+    return length, ((v_y * e_y + v_z * e_z) / length if length > 0.0 else 0.0)
+
+
+@njit(cache=True, error_model="numpy")
+def penetration_at(prm, t, y, joint):
+    """(delta, delta_dot) of ``joint`` (0 = E, 1 = F) of state y at time t (m, m/s)."""
+    if prm[TOPOLOGY] == E_ONLY:
+        return kc.penetration(prm, t, y)
+    q = eccentricities(prm, t, y)
+    if joint == JOINT_E_INDEX:
+        length, rate = _rate(q[0], q[1], q[2], q[3])
+        return length - prm[CLEARANCE], rate
+    length, rate = _rate(q[4], q[5], q[6], q[7])
+    return length - prm[JOINT_F + CLEARANCE], rate
+
+
+@njit(cache=True, error_model="numpy")
+def chain_f(prm, t, y, contact, impact, out):
+    """y' of topologies F_ONLY and E_AND_F into ``out`` (module docstring).
+
+    ``contact``: bit 0 (E) and bit 1 (F) set for the joints in a contact segment; ``impact`` (2,):
+    their held impact velocities (m/s).
+
+    Returns
+    -------
+    q3 (N m), then for E and for F: F_N (N), delta (m), e_Y, e_Z (m); the rapier side's a'' (rad/s^2).
+    """
+    e_y, e_z, ve_y, ve_z, ef_y, ef_z, vf_y, vf_z, w_rocker, dpsi, da = eccentricities(prm, t, y)
+    b_y, b_z, db_y, db_z, dd_y, dd_z, dphi = crank_side_acceleration(prm, t)
+    fe_y = fe_z = fe_n = m_je = m_be = diss_e = 0.0
+    ff_y = ff_z = ff_n = m_jf = m_bf = diss_f = 0.0
+    both = prm[TOPOLOGY] == E_AND_F
+    delta_e = -prm[CLEARANCE]
+    if both:
+        delta_e = math.sqrt(e_y * e_y + e_z * e_z) - prm[CLEARANCE]
+        if contact & 1:
+            fe_y, fe_z, fe_n, delta_e, m_je, m_be, diss_e = contact_terms(prm, e_y, e_z, ve_y, ve_z, dpsi, w_rocker,
+                                                                          impact[0])  # fmt: skip
+    jf = prm[JOINT_F:JOINT_F + N_JOINT]
+    delta_f = math.sqrt(ef_y * ef_y + ef_z * ef_z) - jf[CLEARANCE]
+    if contact & 2:
+        ff_y, ff_z, ff_n, delta_f, m_jf, m_bf, diss_f = contact_terms(jf, ef_y, ef_z, vf_y, vf_z, dpsi, da, impact[1])
+    a = y[0]
+    sa, ca = math.sin(a), math.cos(a)
+    l_fg, l_ef, omega = prm[kc.L_FG], prm[kc.L_EF], prm[kc.OMEGA]
+    m4, g = prm[kc.ROD_MASS], prm[kc.GRAVITY]
+    dda = (-l_fg * (ca * ff_z - sa * ff_y) + m_bf) / prm[SECTOR_CHAIN]
+    if both:
+        psi = y[3]
+        sp, cp = math.sin(psi), math.cos(psi)
+        half = 0.5 * l_ef
+        out[0], out[1], out[2], out[3] = y[4], y[5], y[6], y[7]
+        out[4] = dda
+        out[5] = (fe_y + ff_y) / m4
+        out[6] = (fe_z + ff_z) / m4 - g
+        out[7] = (half * (cp * ff_z - sp * ff_y) - half * (cp * fe_z - sp * fe_y) + m_je + m_jf) / prm[ROD_INERTIA]
+        q3 = -(fe_y * db_y + fe_z * db_z) + m_be * dphi
+        n = 8
+    else:
+        psi = y[1]
+        sp, cp = math.sin(psi), math.cos(psi)
+        half = 0.5 * l_ef
+        w2 = omega * omega
+        ae_y, ae_z = w2 * dd_y, w2 * dd_z
+        ddpsi = (l_ef * (cp * ff_z - sp * ff_y) + m_jf - m4 * half * (cp * (ae_z + g) - sp * ae_y)) / prm[kc.M22]
+        out[0], out[1] = da, dpsi
+        out[2], out[3] = dda, ddpsi
+        # Newton on the rod: the force it takes at E, and the opposite on the rocker.
+        ac_y = ae_y + half * (-sp * ddpsi - cp * dpsi * dpsi)
+        ac_z = ae_z + half * (cp * ddpsi - sp * dpsi * dpsi)
+        pin_y = m4 * ac_y - ff_y
+        pin_z = m4 * (ac_z + g) - ff_z
+        q3 = -(pin_y * db_y + pin_z * db_z)
+        n = 4
+    out[n] = -q3 * omega
+    out[n + 1] = diss_e + diss_f
+    return q3, fe_n, delta_e, e_y, e_z, ff_n, delta_f, ef_y, ef_z, dda
+
+
+@njit(cache=True, error_model="numpy")
+def rhs_any(prm, t, y, contact, impact, out):
+    """y' of any topology into ``out``; returns delta of the first loose joint (the E-only chain's value).
+
+    E_ONLY: :func:`weftsim.kernel.chain.chain` with contact bit 0 and impact[0], unchanged.
+    """
+    if prm[TOPOLOGY] == E_ONLY:
+        return kc.chain(prm, t, y, (contact & 1) != 0, impact[0], out)[2]
+    r = chain_f(prm, t, y, contact, impact, out)
+    return r[2] if prm[TOPOLOGY] == E_AND_F else r[6]
+
+
+@njit(cache=True, error_model="numpy")
+def rod_energy(prm, t, y):
+    """Kinetic and potential energy (J) of members 4-8 in topologies F_ONLY and E_AND_F."""
+    l_ef, m4, g = prm[kc.L_EF], prm[kc.ROD_MASS], prm[kc.GRAVITY]
+    if prm[TOPOLOGY] == E_AND_F:
+        da, dc_y, dc_z, dpsi = y[4], y[5], y[6], y[7]
+        kinetic = 0.5 * (prm[SECTOR_CHAIN] * da * da + m4 * (dc_y * dc_y + dc_z * dc_z) + prm[ROD_INERTIA] * dpsi * dpsi)
+        return kinetic, m4 * g * y[2]
+    b_y, b_z, db_y, db_z, _ = kc.crank_side(prm, t)
+    omega, psi, da, dpsi = prm[kc.OMEGA], y[1], y[2], y[3]
+    half = 0.5 * l_ef
+    sp, cp = math.sin(psi), math.cos(psi)
+    vc_y = omega * db_y - half * sp * dpsi
+    vc_z = omega * db_z + half * cp * dpsi
+    kinetic = 0.5 * (prm[SECTOR_CHAIN] * da * da + m4 * (vc_y * vc_y + vc_z * vc_z) + prm[ROD_INERTIA] * dpsi * dpsi)
+    return kinetic, m4 * g * (b_z + half * sp)
