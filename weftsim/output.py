@@ -27,16 +27,8 @@ from typing import Callable
 
 import numpy as np
 
+from weftsim.errors import OutputError, WriteFailed
 from weftsim.results import CHANNELS, RunResult
-
-
-class OutputError(OSError):
-    """The output directory or a file in it cannot be written."""
-
-
-class WriteFailed(OutputError):
-    """The results were computed but some files could not be written; the message says where
-    each one is (written, rescued, or lost with the reason)."""
 
 
 MANIFEST = ".weftsim-output.json"

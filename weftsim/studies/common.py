@@ -19,17 +19,11 @@ from pathlib import Path
 
 import numpy as np
 
+from weftsim.errors import SimulationFailed, StudyError  # noqa: F401 (re-exported: weftsim.studies)
+
 log = logging.getLogger(__name__)
 
 RPM = 60.0 / (2.0 * math.pi)  # rad/s -> rpm
-
-
-class StudyError(ValueError):
-    """A study cannot run: unknown name, missing scene file or bad setting."""
-
-
-class SimulationFailed(StudyError):
-    """A simulation of a study ended with ``status = "failed"``."""
 
 
 def scene_path(models: str | Path, name: str) -> Path:
