@@ -267,7 +267,7 @@ def test_rerun_replaces_the_previous_run_and_drops_its_stale_files(tmp_path):
     # exactly this run's files.
     assert not (out / "channels.png").exists()
     manifest = json.loads((out / ".weftsim-output.json").read_text())
-    assert manifest["files"] == ["channels.csv", "summary.json"]
+    assert manifest["files"] == ["channels.csv", "result.npz", "summary.json"]
     summary = json.loads((out / "summary.json").read_text())
     assert summary["scene"]["drive.revolutions"] == 0.02
 

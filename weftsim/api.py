@@ -26,11 +26,10 @@ from typing import TYPE_CHECKING, Any, Callable
 
 from weftsim.errors import EngineError, RunFailed, SceneError
 from weftsim.params import Scene
+from weftsim.results import RunResult
 
 if TYPE_CHECKING:
     import xarray
-
-    from weftsim.results import RunResult
 
 # Engine names :func:`simulate` accepts.  "auto" is the default engine, the Exudyn multibody
 # model (the project's primary engine; the reference engine is its independent cross-check).
@@ -65,7 +64,7 @@ def scene_overrides(overrides: Mapping[str, Any] | None = None, where: str = "ov
         if value is None:
             continue
         if merged.get(key) is not None:
-            raise SceneError(f"{where}: key '{key}' is given twice, as {flag} = {value!r} and as "
+            raise SceneError(f"{where}: key '{key}' is given twice, by the flag {flag} = {value!r} and as "
                              f"{key} = {merged[key]!r}; give it once")
         merged[key] = value
     return merged
@@ -194,7 +193,7 @@ def save_result(result: RunResult, path: str | os.PathLike) -> Path:
 
     Both tables (output samples and every solver step) are kept bit for bit, with the scene, the
     status, the solver statistics, the plausibility counts and the path; :func:`load_result`
-    rebuilds an equal :class:`RunResult`.  Returns the path written (``.npz`` appended if missing).
+    rebuilds an equal :class:`RunResult`.  Returns the path, written as given.
     """
     from weftsim.results import save_npz
 

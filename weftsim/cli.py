@@ -1,33 +1,53 @@
-"""Command line: ``weftsim kinematics | run | compare | sweep | study``.  Thin: parse, call, report.
+"""Command line: ``weftsim scenes | kinematics | run | compare | sweep | study | bench``.  Thin: parse,
+call the Python interface (:mod:`weftsim.api`), report.
 
-Every expected failure (bad scene, bad flag, unwritable output, failed solve) is one
-line on stderr and a non-zero exit status; tracebacks only for real bugs.
+One grammar for the scene of every command: ``SCENE`` is a file or the name of a bundled scene,
+``--set KEY=VALUE`` (repeatable) overrides any scene key, and ``--revolutions``, ``--speed-rpm``,
+``--clearance-mm`` and ``--law`` are its shorthands (:func:`add_scene_flags`, :func:`scene_from_args`;
+a new subcommand calls both).  A run's results go to ``out/<scene>/<engine>/``, so runs of the two
+engines do not overwrite each other.  A mistyped flag, command or key gets the closest spelling.
+
+Every expected failure (bad scene, bad flag, unwritable output, failed solve) is a
+:class:`weftsim.errors.WeftsimError`, printed as one line on stderr with its exit status;
+tracebacks only for real bugs.
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
+import difflib
 import logging
 import math
 import os
 import signal
 import sys
 import threading
+import re
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
+from weftsim.api import ENGINE_NAMES as ENGINE_CHOICES
+from weftsim.errors import WeftsimError
 from weftsim.exitcodes import EXIT_DISAGREE, EXIT_FAILED, EXIT_USAGE  # noqa: F401 (re-exported)
+
+if TYPE_CHECKING:
+    from weftsim.params import Scene
 
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a command stopped by Ctrl-C
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE: the reader of stdout went away (`| head`), as for any Unix tool
 
 
-class CliError(Exception):
-    """An error to print as one line, with an exit status."""
+class CliError(WeftsimError):
+    """An error of the command line itself, to print as one line, with an exit status."""
 
-    def __init__(self, message: str, status: int = EXIT_USAGE):
+    def __init__(self, message: str, status: int = EXIT_USAGE) -> None:
         super().__init__(message)
-        self.status = status
+        self.exit_status = status
+
+    @property
+    def status(self) -> int:
+        return self.exit_status
 
 
 class _Version(argparse.Action):
@@ -44,15 +64,50 @@ class _Version(argparse.Action):
 
 
 class _Parser(argparse.ArgumentParser):
-    """argparse with one-line errors (the usage stays behind --help) and no abbreviated flags
-    (``--speed 400`` must not silently mean ``--speed-rpm``)."""
+    """argparse with one-line errors (the usage stays behind --help), no abbreviated flags
+    (``--speed 400`` must not silently mean ``--speed-rpm``) and the closest spelling of a
+    mistyped flag or command (``did you mean --clearance-mm?``)."""
 
     def __init__(self, *args, **kwargs):
         kwargs.setdefault("allow_abbrev", False)
         super().__init__(*args, **kwargs)
+        self._argv: list[str] = []
+
+    def parse_args(self, args=None, namespace=None):
+        self._argv = list(sys.argv[1:] if args is None else args)  # for the suggestion of error()
+        return super().parse_args(args, namespace)
 
     def error(self, message: str):
-        self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {message}{self._suggestion(message)} "
+                              f"(see '{self.prog} --help')\n")
+
+    def _command_parser(self) -> argparse.ArgumentParser:
+        """The subcommand's parser when the arguments name one (its flags are the ones to suggest)."""
+        for action in self._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                for word in self._argv:
+                    if word in action.choices:
+                        return action.choices[word]
+        return self
+
+    def _suggestion(self, message: str) -> str:
+        """``; did you mean --clearance-mm?`` for an unknown flag or an invalid choice, else ''."""
+        choice = re.search(r"invalid choice: '(.*?)' \(choose from (.*)\)", message)
+        if choice:
+            options = re.findall(r"'([^']*)'", choice.group(2))
+            near = difflib.get_close_matches(choice.group(1), options, n=1)
+            return f"; did you mean {near[0]}?" if near else ""
+        unknown = re.search(r"unrecognized arguments: (.*)", message)
+        if not unknown:
+            return ""
+        flags = [action_flag for action in self._command_parser()._actions for action_flag in action.option_strings]
+        hints = []
+        for word in unknown.group(1).split():
+            if word.startswith("--"):
+                near = difflib.get_close_matches(word.partition("=")[0], flags, n=1, cutoff=0.6)
+                if near:
+                    hints.append(f"did you mean {near[0]} for {word.partition('=')[0]}?")
+        return "; " + "; ".join(hints) if hints else ""
 
 
 def _positive(kind):
@@ -78,16 +133,76 @@ def _non_negative(text: str) -> float:
     return value
 
 
-def _add_scene_flags(p: argparse.ArgumentParser, full: bool = True) -> None:
-    p.add_argument("scene", help="scene file (TOML), e.g. models/reference.toml")
-    p.add_argument("-o", "--output", default=None, help="output directory (default: out/<scene name>)")
-    p.add_argument("--force", action="store_true",
-                   help="write into an output directory that holds files weftsim did not write")
-    p.add_argument("--speed-rpm", type=_positive(float), help="override drive.speed_rpm")
-    if full:
-        p.add_argument("--clearance-mm", type=_non_negative, help="override joint_e.clearance_mm (0 = ideal joint)")
-        p.add_argument("--law", help="override joint_e.law (contact force law)")
-        p.add_argument("--revolutions", type=_positive(float), help="override drive.revolutions")
+SCENE_HELP = "scene file (TOML) or the name of a bundled scene ('weftsim scenes' lists them), e.g. reference"
+# The shorthand flags, by the load_scene flag (weftsim.api.SCENE_FLAGS) each sets: (type, help).
+SHORTHANDS: dict[str, tuple[Any, str]] = {
+    "revolutions": (_positive(float), "crank revolutions to simulate (drive.revolutions)"),
+    "speed_rpm": (_positive(float), "crank speed, rpm (drive.speed_rpm)"),
+    "clearance_mm": (_non_negative, "radial clearance at E, mm; 0 = ideal joint (joint_e.clearance_mm)"),
+    "law": (str, "contact force law (joint_e.law)"),
+}
+
+
+def add_scene_flags(parser: argparse.ArgumentParser, shorthands: tuple[str, ...] = tuple(SHORTHANDS),
+                    positional: bool = True) -> None:
+    """Add the scene grammar every command shares: ``SCENE``, ``--set KEY=VALUE`` and the shorthands.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        A subcommand's parser (``weftsim wear``, ``weftsim animate``, ...).
+    shorthands : tuple of str
+        Which of ``revolutions``, ``speed_rpm``, ``clearance_mm``, ``law`` the command takes (all by
+        default; a command where one means nothing leaves it out rather than ignore it).
+    positional : bool
+        Add the ``scene`` argument (a command with its own positional, as ``sweep``, adds it itself).
+
+    :func:`scene_from_args` turns the parsed arguments into the validated scene.
+    """
+    if positional:
+        parser.add_argument("scene", help=SCENE_HELP)
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="set",
+                        help="override any scene key in file units, e.g. --set joint_e.restitution=0.8 "
+                        "(a dotted key, or its last part where unique: restitution); repeatable")
+    for flag in shorthands:
+        kind, text = SHORTHANDS[flag]
+        parser.add_argument("--" + flag.replace("_", "-"), type=kind, help=text)
+
+
+def _set_overrides(args: argparse.Namespace) -> dict[str, Any]:
+    """The ``--set`` overrides as dotted scene keys (file units)."""
+    from weftsim.sweep.grid import parse_set
+
+    overrides: dict[str, Any] = {}
+    for text in getattr(args, "set", None) or []:
+        key, value = parse_set(text)
+        if key in overrides:
+            raise CliError(f"--set: key '{key}' is given twice; give it once")
+        overrides[key] = value
+    return overrides
+
+
+def _shorthands(args: argparse.Namespace) -> dict[str, Any]:
+    return {flag: getattr(args, flag) for flag in SHORTHANDS if getattr(args, flag, None) is not None}
+
+
+def scene_from_args(args: argparse.Namespace) -> Scene:
+    """The validated scene of ``args.scene`` with the ``--set`` overrides and the shorthand flags.
+
+    Raises :class:`weftsim.errors.SceneError` (or SweepError for a malformed ``--set``) with the
+    line to print; a key set both by ``--set`` and by its shorthand flag is refused.
+    """
+    from weftsim.api import scene_overrides
+    from weftsim.scene import load_scene
+
+    overrides = scene_overrides(_set_overrides(args), where="command line", **_shorthands(args))
+    return load_scene(args.scene, overrides)
+
+
+def _add_output_flags(parser: argparse.ArgumentParser, default: str) -> None:
+    parser.add_argument("-o", "--output", default=None, help=f"output directory (default: {default})")
+    parser.add_argument("--force", action="store_true",
+                        help="write into an output directory that holds files weftsim did not write")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -101,31 +216,38 @@ def build_parser() -> argparse.ArgumentParser:
                         help="the versions of weftsim and the packages it runs on, and exit")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    p = sub.add_parser("kinematics", help="ideal rapier motion over one revolution (CSV + plot)")
-    _add_scene_flags(p, full=False)
+    sub.add_parser("scenes", help="list the bundled scenes (name and description)")
 
-    p = sub.add_parser("run", help="simulate a scene with one engine (CSV, summary.json, figure)")
-    _add_scene_flags(p)
-    p.add_argument("--engine", default="exudyn", choices=("exudyn", "reference"),
-                   help="exudyn (multibody model, default) or reference (closed-form Lagrange cross-check)")
+    p = sub.add_parser("kinematics", help="ideal rapier motion over one revolution (CSV + plot)")
+    add_scene_flags(p, shorthands=("speed_rpm",))  # ideal joints, one revolution: the others mean nothing here
+    _add_output_flags(p, "out/<scene name>/kinematics")
+
+    p = sub.add_parser("run", help="simulate a scene with one engine (CSV, NPZ, summary.json, figure)")
+    add_scene_flags(p)
+    _add_output_flags(p, "out/<scene name>/<engine>")
+    p.add_argument("--engine", default="auto", choices=ENGINE_CHOICES,
+                   help="exudyn (multibody model), reference (closed-form Lagrange cross-check) or auto "
+                   "(the default engine, exudyn)")
     p.add_argument("--no-plot", action="store_true", help="skip the figure")
 
     p = sub.add_parser("compare", help="run both engines on one scene and compare them")
-    _add_scene_flags(p)
+    add_scene_flags(p)
+    _add_output_flags(p, "out/<scene name>/compare")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
 
     p = sub.add_parser("sweep", help="run a grid of scene variants in parallel (table of peaks, plots)",
                        description="Run every combination of the --vary values on a pool of worker processes "
                        "(or a Dask cluster) into OUTPUT/<cell>/; rerunning skips finished cells.  See docs/sweeps.md.")
-    p.add_argument("scene", help="base scene file (TOML), e.g. models/reference.toml")
+    p.add_argument("scene", help="base " + SCENE_HELP)
     p.add_argument("--vary", action="append", required=True, metavar="KEY=VALUES",
                    help="a scene key (clearance_mm, speed_rpm, law, ... or a dotted key) and its values: "
                    "a list 0.01,0.25,0.5 or an inclusive range start:stop:count; repeat for more axes")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="fixed override for every cell")
-    p.add_argument("-o", "--output", default=None, help="sweep directory (default: out/<scene name>-sweep)")
-    p.add_argument("--engine", default="exudyn",
-                   help="exudyn (default), reference, or module:function of your own engine: a plug-in, "
-                   "imported and run like any code (docs/sweeps.md)")
+    add_scene_flags(p, positional=False)
+    p.add_argument("-o", "--output", default=None,
+                   help="sweep directory (default: out/<scene name>/sweep-<engine>)")
+    p.add_argument("--engine", default="auto",
+                   help="auto (the default engine, exudyn), exudyn, reference, or module:function of your own "
+                   "engine: a plug-in, imported and run like any code (docs/sweeps.md)")
     p.add_argument("--allow-cwd-engine", action="store_true",
                    help="allow a --engine module:function found in the current directory (refused by default)")
     p.add_argument("--jobs", type=_positive(int), help="local worker processes (default: number of CPUs)")
@@ -135,18 +257,21 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("study", help="one of the paper's studies: figures, CSV and JSON (docs/paper-comparison.md)",
                        description="Run a study of the paper: contact-law (Fig. 7-9), clearance (Fig. 12), "
-                       "speed (Fig. 13, with the acceleration spectrum), engines (Fig. 16), or all of them.")
+                       "speed (Fig. 13, with the acceleration spectrum), engines (Fig. 16), or all of them.  "
+                       "Each study sets its own scenes; --revolutions is the one scene flag it takes.")
     p.add_argument("name", help="contact-law, clearance, speed, engines or all")
     p.add_argument("-o", "--output", default=None,
                    help="output directory (default: out/study-NAME; with 'all': parent of one directory per study)")
-    p.add_argument("--models", default="models", help="directory of the scene files (default: models)")
+    p.add_argument("--models", default=None,
+                   help="directory of the scene files (default: the bundled scenes, 'weftsim scenes')")
     p.add_argument("--revolutions", type=_positive(float), help="override the study's crank revolutions per run")
     p.add_argument("--force", action="store_true",
                    help="write into an output directory that holds files weftsim did not write")
 
     p = sub.add_parser("bench", help="work-precision benchmark of every engine setting (docs/performance.md)",
                        description="Time every engine setting on an easy and two hard scenes against a converged "
-                       "solution: tables, log-log figures and JSON.  The full mode takes ~30 min on 2 cores.")
+                       "solution: tables, log-log figures and JSON.  The full mode takes ~30 min on 2 cores.  "
+                       "The cases fix their scenes, so it takes no scene flags.")
     p.add_argument("--quick", action="store_true", help="a few settings, 2 revolutions (a few minutes)")
     p.add_argument("--targets", action="store_true",
                    help="the speed targets of the default paths against the 0.1 defaults (about 10 min)")
@@ -154,30 +279,28 @@ def build_parser() -> argparse.ArgumentParser:
                    help="output directory (default: out/bench, out/bench-quick or out/bench-targets)")
     p.add_argument("--case", action="append", help="only this case (repeatable): c0.25mm-400rpm, c0.01mm-800rpm, "
                    "c0.50mm-800rpm")
-    p.add_argument("--models", default="models", help="directory of the scene files (default: models)")
+    p.add_argument("--models", default=None,
+                   help="directory of the scene files (default: the bundled scenes, 'weftsim scenes')")
     p.add_argument("--repeats", type=_positive(int), default=5, help="timed runs per setting (median; default 5)")
     p.add_argument("--force", action="store_true",
                    help="write into an output directory that holds files weftsim did not write")
     return parser
 
 
-def _overrides(args) -> dict:
-    return {
-        "drive.speed_rpm": getattr(args, "speed_rpm", None),
-        "joint_e.clearance_mm": getattr(args, "clearance_mm", None),
-        "joint_e.law": getattr(args, "law", None),
-        "drive.revolutions": getattr(args, "revolutions", None),
-    }
+def _models(args: argparse.Namespace) -> Path:
+    """``--models``, or the directory of the bundled scenes."""
+    from weftsim.scene import bundled_directory
+
+    if args.models is not None:
+        return Path(args.models)
+    directory = bundled_directory()
+    if directory is None:
+        raise CliError("this installation has no bundled scenes; pass the directory of the scene files with --models")
+    return directory
 
 
-def _load(args):
-    from weftsim.scene import load_scene
-
-    return load_scene(args.scene, _overrides(args))
-
-
-def _outdir(args, scene, suffix: str = "") -> Path:
-    """``-o``, or ``out/<scene name><suffix>``: a name that would leave ``out/`` is refused."""
+def _outdir(args, scene, *parts: str) -> Path:
+    """``-o``, or ``out/<scene name>/<parts>``: a name that would leave ``out/`` is refused."""
     if args.output:
         return Path(args.output)
     name = scene.name
@@ -185,7 +308,7 @@ def _outdir(args, scene, suffix: str = "") -> Path:
         raise CliError(f"the scene's key 'name' = {name!r} cannot name the default output directory "
                        "out/<name>: it must be one plain file name (no '/' or '\\', not '.' or '..'); "
                        "change it or choose the output directory with -o")
-    return Path("out") / (name + suffix)
+    return Path("out", name, *parts)
 
 
 def _check_fits(scene, outdir: Path, runs: int = 1) -> None:
@@ -284,10 +407,10 @@ def cmd_kinematics(args) -> int:
     from weftsim.output import check_output_fits, prepare_directory, write_csv, write_figure, write_files
     from weftsim.plots import plot_kinematics
 
-    scene = _load(args)
+    scene = scene_from_args(args)
     step = scene.output.sample_angle
     rows = int(round(2.0 * math.pi / step)) + 1
-    outdir = _outdir(args, scene, "-kinematics")
+    outdir = _outdir(args, scene, "kinematics")
     check_output_fits(rows, len(KINEMATICS_COLUMNS), outdir,
                       f"output.sample_deg = {math.degrees(step):g} over one revolution",
                       fix="a coarser output.sample_deg (any value up to 0.5 deg)")
@@ -326,27 +449,18 @@ def cmd_kinematics(args) -> int:
     return 0
 
 
-def _engine(engine: str):
-    """The engine package (``solve``, ``select_path``) named by ``--engine``."""
-    if engine == "reference":
-        import weftsim.reference as module
-    elif engine == "exudyn":
-        import weftsim.exudyn_engine as module
-    else:
-        raise CliError(f"--engine must be 'reference' or 'exudyn', got {engine!r}")
-    return module
-
-
 def _solve(scene, engine: str, label: str | None = None, announce: bool = False):
+    """:func:`weftsim.api.simulate` with progress on stderr; ``announce``: first the path it takes."""
+    from weftsim.api import resolve_engine, select_path, simulate
     from weftsim.progress import Progress
 
-    module = _engine(engine)
+    engine = resolve_engine(engine)
     if announce:  # `run`: its first line is the model and method it takes, and why
-        path = module.select_path(scene)
+        path = select_path(scene, engine)
         print(f"scene {scene.name}, engine {engine}: {path['model']}, {path['method']} ({path['reason']})", flush=True)
     progress = Progress(label or f"{engine} {scene.name}")
     try:
-        return module.solve(scene, progress=progress)
+        return simulate(scene, engine, progress=progress)
     finally:
         progress.close()
 
@@ -377,17 +491,19 @@ def _interrupted_line(result, outdir: Path, signum: int) -> str:
 
 
 def cmd_run(args) -> int:
+    from weftsim.api import resolve_engine
     from weftsim.output import prepare_directory, write_run
     from weftsim.plausibility import report_lines
 
-    scene = _load(args)
-    outdir = _outdir(args, scene)
+    scene = scene_from_args(args)
+    engine = resolve_engine(args.engine)
+    outdir = _outdir(args, scene, engine)
     _check_fits(scene, outdir)
     outdir = prepare_directory(outdir, args.force)
-    _announce_run_time(scene, (args.engine,), "run")
+    _announce_run_time(scene, (engine,), "run")
     with _stop_on_interrupt("run") as stop:
-        result = _solve(scene, args.engine, announce=True)
-    written = write_run(result, outdir, figure=not args.no_plot, force=args.force)
+        result = _solve(scene, engine, announce=True)
+    written = write_run(result, outdir, figure=not args.no_plot, force=args.force, npz=True)
     _report_run(result, written)
     report_lines(result, "run")
     if stop["signal"] is not None and not result.ok:
@@ -402,8 +518,8 @@ def cmd_compare(args) -> int:
     from weftsim.compare import format_report, run_compare
     from weftsim.output import prepare_directory, to_json
 
-    scene = _load(args)
-    outdir = _outdir(args, scene, "-compare")
+    scene = scene_from_args(args)
+    outdir = _outdir(args, scene, "compare")
     _check_fits(scene, outdir, runs=2)
     prepare_directory(outdir, args.force)  # refused before the estimate is shown
     with _stdout_to_stderr() if args.json else contextlib.nullcontext():  # the estimate imports Exudyn
@@ -429,18 +545,22 @@ def _raise_terminated(signum, frame):
 
 
 def cmd_sweep(args) -> int:
-    from weftsim.sweep import SweepError, format_report, plan_sweep, run_sweep
+    from weftsim.api import SCENE_FLAGS, resolve_engine, scene_overrides
+    from weftsim.sweep import format_report, plan_sweep, run_sweep
 
+    engine = resolve_engine(args.engine) if args.engine in ENGINE_CHOICES else args.engine
+    scene_overrides(_set_overrides(args), where="command line", **_shorthands(args))  # a key given twice
+    # The shorthand flags are fixed overrides of every cell, as --set is.
+    fixed = list(args.set) + [f"{SCENE_FLAGS[flag]}={value!r}" if isinstance(value, float) else
+                              f"{SCENE_FLAGS[flag]}={value}" for flag, value in _shorthands(args).items()]
     handled = (signal.SIGTERM, signal.SIGHUP)
     previous = {sig: signal.signal(sig, _raise_terminated) for sig in handled}
     try:
-        plan = plan_sweep(args.scene, args.vary, args.set, args.engine, allow_large=args.yes,
+        plan = plan_sweep(args.scene, args.vary, fixed, engine, allow_large=args.yes,
                           allow_cwd_engine=args.allow_cwd_engine,
                           announce=lambda line: print(line, file=sys.stderr, flush=True))
-        outdir = Path(args.output) if args.output else Path("out") / (Path(args.scene).stem + "-sweep")
+        outdir = _outdir(args, plan.base, "sweep-" + engine.replace(":", "."))
         report = run_sweep(plan, outdir, jobs=args.jobs, scheduler=args.scheduler, cell_figures=args.cell_figures)
-    except SweepError as exc:
-        raise CliError(str(exc)) from None
     except _SweepTerminated as exc:
         name = signal.Signals(exc.signum).name
         raise CliError(f"terminated by {name}; finished cells are kept, run the same command again to resume",
@@ -456,17 +576,13 @@ def cmd_sweep(args) -> int:
 
 
 def cmd_study(args) -> int:
-    from weftsim.studies import STUDIES, SimulationFailed, StudyError, format_study, run_study
+    from weftsim.studies import STUDIES, format_study, run_study
 
     names = list(STUDIES) if args.name == "all" else [args.name]
+    models = _models(args)
     for name in names:
         outdir = Path(args.output) / name if args.output and args.name == "all" else args.output
-        try:
-            report = run_study(name, outdir, args.models, args.revolutions, args.force)
-        except SimulationFailed as exc:
-            raise CliError(str(exc), EXIT_FAILED) from None
-        except StudyError as exc:
-            raise CliError(str(exc)) from None
+        report = run_study(name, outdir, models, args.revolutions, args.force)
         print(format_study(name, report))
     return 0
 
@@ -480,18 +596,32 @@ def cmd_bench(args) -> int:
     if args.targets:
         from weftsim.bench.targets import run_targets, write_targets
 
-        report = run_targets(args.models, repeats=args.repeats, log=lambda text: print(text, file=sys.stderr))
+        report = run_targets(_models(args), repeats=args.repeats, log=lambda text: print(text, file=sys.stderr))
         files = write_targets(report, args.output or "out/bench-targets", args.force)
         print(f"targets measured in {report['total_time_s']:.0f} s; wrote " + ", ".join(map(str, files)))
         return 0
     outdir = args.output or ("out/bench-quick" if args.quick else "out/bench")
-    report = run_benchmark(outdir, args.models, args.quick, args.case, repeats=args.repeats, force=args.force)
+    report = run_benchmark(outdir, _models(args), args.quick, args.case, repeats=args.repeats, force=args.force)
     print(f"benchmark done in {report['total_time_s']:.0f} s; wrote " + ", ".join(map(str, report["files"])))
     return 0
 
 
-COMMANDS = {"kinematics": cmd_kinematics, "run": cmd_run, "compare": cmd_compare, "sweep": cmd_sweep,
-            "study": cmd_study, "bench": cmd_bench}
+def cmd_scenes(args) -> int:
+    """``weftsim scenes``: each bundled scene's name and description, one a line."""
+    from weftsim.scene import bundled_directory, bundled_scene_path, bundled_scenes, scene_description
+
+    names = bundled_scenes()
+    if not names:
+        raise CliError("this installation has no bundled scenes")
+    width = max(map(len, names))
+    print(f"bundled scenes in {bundled_directory()} (weftsim run NAME; a scene file may extends = \"NAME\"):")
+    for name in names:
+        print(f"  {name:{width}s}  {scene_description(bundled_scene_path(name))}")
+    return 0
+
+
+COMMANDS = {"scenes": cmd_scenes, "kinematics": cmd_kinematics, "run": cmd_run, "compare": cmd_compare,
+            "sweep": cmd_sweep, "study": cmd_study, "bench": cmd_bench}
 
 
 def _one_line(text: str) -> str:
@@ -506,20 +636,11 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(name)s: %(message)s")
-    from weftsim.output import OutputError, WriteFailed
-    from weftsim.scene import SceneError
-
     try:
         return COMMANDS[args.command](args)
-    except WriteFailed as exc:  # the results were computed: where each file went is in the message
+    except WeftsimError as exc:  # its message is the line to print, its class the exit status
         print(f"weftsim {args.command}: error: {_one_line(exc)}", file=sys.stderr)
-        return EXIT_FAILED
-    except (SceneError, OutputError) as exc:
-        print(f"weftsim {args.command}: error: {_one_line(exc)}", file=sys.stderr)
-        return EXIT_USAGE
-    except CliError as exc:
-        print(f"weftsim {args.command}: error: {_one_line(exc)}", file=sys.stderr)
-        return exc.status
+        return exc.exit_status
     except MemoryError:
         print(f"weftsim {args.command}: error: out of memory; use a coarser output.sample_deg or fewer "
               "drive.revolutions", file=sys.stderr)

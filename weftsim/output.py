@@ -337,13 +337,19 @@ def output_rows(scene) -> float:
     return math.floor(scene.drive.end_time * scene.drive.speed / scene.output.sample_angle) + 2
 
 
-def write_run(result: RunResult, outdir: str | Path, figure: bool = True, force: bool = False) -> dict[str, Path]:
+def write_run(result: RunResult, outdir: str | Path, figure: bool = True, force: bool = False,
+              npz: bool = False) -> dict[str, Path]:
     """Write ``channels.csv``, ``summary.json`` and ``channels.png`` for one run, atomically each.
+
+    With ``npz`` also ``result.npz``: the whole result, per-step data included, losslessly
+    (:func:`weftsim.results.save_npz`; ``weftsim.load_result`` reads it).  ``weftsim run`` asks for
+    it; a sweep's cells do not (a 10-revolution result is a few MB, times every cell).
 
     Raises :class:`WriteFailed` (after writing what it can) when a file cannot be written.
     """
     from weftsim.analysis import summary
     from weftsim.plots import plot_channels
+    from weftsim.results import save_npz
 
     outdir = prepare_directory(outdir, force)
     what = {"kind": "run", "engine": result.engine, "scene": result.scene.name, "status": result.status}
@@ -351,6 +357,8 @@ def write_run(result: RunResult, outdir: str | Path, figure: bool = True, force:
         "channels": ("channels.csv", lambda target: write_csv(target, {n: result.samples[n] for n in CHANNELS})),
         "summary": ("summary.json", lambda target: write_json(target, summary(result))),
     }
+    if npz:
+        files["npz"] = ("result.npz", lambda target: write_atomic(target, lambda tmp: save_npz(result, tmp)))
     if figure and result.steps["time_s"].size:
         files["figure"] = ("channels.png", lambda target: write_figure(target, plot_channels([result])))
     return write_files(outdir, what, files)

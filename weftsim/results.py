@@ -281,11 +281,9 @@ def save_npz(result: RunResult, path: str | os.PathLike) -> Path:
     Returns
     -------
     Path
-        ``path`` (``numpy`` appends ``.npz`` to a name without it; the path returned is the real one).
+        ``path``, written as given (no suffix is added; ``.npz`` is the customary one).
     """
     path = Path(path)
-    if path.suffix != ".npz":
-        path = path.with_name(path.name + ".npz")
     meta = {"format": NPZ_FORMAT, "scene": _plain(result.scene), "engine": result.engine, "status": result.status,
             "message": result.message, "solver_stats": _plain(result.solver_stats), "events": _plain(result.events),
             "plausibility": _plain(result.plausibility), "path": _plain(result.path)}

@@ -22,7 +22,7 @@ import stat
 import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 from weftsim import params
 from weftsim.errors import SceneError

@@ -69,7 +69,7 @@ def resolve_key(name: str) -> Key:
     near = difflib.get_close_matches(name, list(SHORT_NAMES) + list(_BY_PATH), n=3)
     hint = f"did you mean {', '.join(near)}? " if near else ""
     raise SweepError(
-        f"unknown sweep key '{name}'; {hint}use a dotted scene key (any key of the README's scene reference, "
+        f"unknown scene key '{name}'; {hint}use a dotted scene key (any key of the README's scene reference, "
         f"e.g. joint_e.clearance_mm) or its last part where that is unique ({', '.join(COMMON_KEYS)}, ...)"
     )
 
