@@ -167,11 +167,11 @@ def test_every_scene_command_takes_the_same_flags():
 
 
 def test_study_and_bench_find_the_bundled_scenes_without_models():
-    from weftsim.cli import _models, build_parser
+    from weftsim.cli import build_parser, models_directory
     from weftsim.scene import bundled_directory
 
     for argv in (["study", "clearance"], ["bench", "--quick"]):
         args = build_parser().parse_args(argv)
-        assert _models(args) == bundled_directory()
-        assert (_models(args) / "paper" / "clearance_0p50mm_400rpm.toml").is_file()
-    assert _models(build_parser().parse_args(["study", "speed", "--models", "elsewhere"])) == Path("elsewhere")
+        assert models_directory(args) == bundled_directory()
+        assert (models_directory(args) / "paper" / "clearance_0p50mm_400rpm.toml").is_file()
+    assert models_directory(build_parser().parse_args(["study", "speed", "--models", "elsewhere"])) == Path("elsewhere")

@@ -4,8 +4,9 @@ call the Python interface (:mod:`weftsim.api`), report.
 One grammar for the scene of every command: ``SCENE`` is a file or the name of a bundled scene,
 ``--set KEY=VALUE`` (repeatable) overrides any scene key, and ``--revolutions``, ``--speed-rpm``,
 ``--clearance-mm`` and ``--law`` are its shorthands (:func:`add_scene_flags`, :func:`scene_from_args`;
-a new subcommand calls both).  A run's results go to ``out/<scene>/<engine>/``, so runs of the two
-engines do not overwrite each other.  A mistyped flag, command or key gets the closest spelling.
+a new subcommand calls both, and :func:`add_output_flags` / :func:`output_directory` for ``-o``).  A
+run's results go to ``out/<scene>/<engine>/``, so runs of the two engines do not overwrite each other.
+A mistyped flag, command or key gets the closest spelling.
 
 Every expected failure (bad scene, bad flag, unwritable output, failed solve) is a
 :class:`weftsim.errors.WeftsimError`, printed as one line on stderr with its exit status;
@@ -16,203 +17,44 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import difflib
 import logging
 import math
 import os
 import signal
 import sys
 import threading
-import re
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
 
 from weftsim.api import ENGINE_NAMES as ENGINE_CHOICES
+from weftsim.cli_grammar import (  # noqa: F401 (CliError, add_scene_flags, scene_from_args: for subcommands)
+    SCENE_HELP,
+    CliError,
+    Parser,
+    VersionAction,
+    add_output_flags,
+    add_scene_flags,
+    models_directory,
+    output_directory,
+    positive,
+    scene_from_args,
+    set_overrides,
+    shorthand_values,
+)
 from weftsim.errors import WeftsimError
 from weftsim.exitcodes import EXIT_DISAGREE, EXIT_FAILED, EXIT_USAGE  # noqa: F401 (re-exported)
-
-if TYPE_CHECKING:
-    from weftsim.params import Scene
 
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a command stopped by Ctrl-C
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE: the reader of stdout went away (`| head`), as for any Unix tool
 
 
-class CliError(WeftsimError):
-    """An error of the command line itself, to print as one line, with an exit status."""
-
-    def __init__(self, message: str, status: int = EXIT_USAGE) -> None:
-        super().__init__(message)
-        self.exit_status = status
-
-    @property
-    def status(self) -> int:
-        return self.exit_status
-
-
-class _Version(argparse.Action):
-    """``--version``: the versions line (read from package metadata only when asked), then exit 0."""
-
-    def __init__(self, option_strings, dest, **kwargs):
-        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, **kwargs)
-
-    def __call__(self, parser, namespace, values, option_string=None):
-        from weftsim.provenance import version_line
-
-        print(version_line())
-        parser.exit()
-
-
-class _Parser(argparse.ArgumentParser):
-    """argparse with one-line errors (the usage stays behind --help), no abbreviated flags
-    (``--speed 400`` must not silently mean ``--speed-rpm``) and the closest spelling of a
-    mistyped flag or command (``did you mean --clearance-mm?``)."""
-
-    def __init__(self, *args, **kwargs):
-        kwargs.setdefault("allow_abbrev", False)
-        super().__init__(*args, **kwargs)
-        self._argv: list[str] = []
-
-    def parse_args(self, args=None, namespace=None):
-        self._argv = list(sys.argv[1:] if args is None else args)  # for the suggestion of error()
-        return super().parse_args(args, namespace)
-
-    def error(self, message: str):
-        self.exit(EXIT_USAGE, f"{self.prog}: error: {message}{self._suggestion(message)} "
-                              f"(see '{self.prog} --help')\n")
-
-    def _command_parser(self) -> argparse.ArgumentParser:
-        """The subcommand's parser when the arguments name one (its flags are the ones to suggest)."""
-        for action in self._actions:
-            if isinstance(action, argparse._SubParsersAction):
-                for word in self._argv:
-                    if word in action.choices:
-                        return action.choices[word]
-        return self
-
-    def _suggestion(self, message: str) -> str:
-        """``; did you mean --clearance-mm?`` for an unknown flag or an invalid choice, else ''."""
-        choice = re.search(r"invalid choice: '(.*?)' \(choose from (.*)\)", message)
-        if choice:
-            options = re.findall(r"'([^']*)'", choice.group(2))
-            near = difflib.get_close_matches(choice.group(1), options, n=1)
-            return f"; did you mean {near[0]}?" if near else ""
-        unknown = re.search(r"unrecognized arguments: (.*)", message)
-        if not unknown:
-            return ""
-        flags = [action_flag for action in self._command_parser()._actions for action_flag in action.option_strings]
-        hints = []
-        for word in unknown.group(1).split():
-            if word.startswith("--"):
-                near = difflib.get_close_matches(word.partition("=")[0], flags, n=1, cutoff=0.6)
-                if near:
-                    hints.append(f"did you mean {near[0]} for {word.partition('=')[0]}?")
-        return "; " + "; ".join(hints) if hints else ""
-
-
-def _positive(kind):
-    def parse(text: str):
-        try:
-            value = kind(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
-        if not math.isfinite(value) or value <= 0:
-            raise argparse.ArgumentTypeError(f"must be a finite number > 0, got {text!r}")
-        return value
-
-    return parse
-
-
-def _non_negative(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
-    if not math.isfinite(value) or value < 0:
-        raise argparse.ArgumentTypeError(f"must be a finite number >= 0, got {text!r}")
-    return value
-
-
-SCENE_HELP = "scene file (TOML) or the name of a bundled scene ('weftsim scenes' lists them), e.g. reference"
-# The shorthand flags, by the load_scene flag (weftsim.api.SCENE_FLAGS) each sets: (type, help).
-SHORTHANDS: dict[str, tuple[Any, str]] = {
-    "revolutions": (_positive(float), "crank revolutions to simulate (drive.revolutions)"),
-    "speed_rpm": (_positive(float), "crank speed, rpm (drive.speed_rpm)"),
-    "clearance_mm": (_non_negative, "radial clearance at E, mm; 0 = ideal joint (joint_e.clearance_mm)"),
-    "law": (str, "contact force law (joint_e.law)"),
-}
-
-
-def add_scene_flags(parser: argparse.ArgumentParser, shorthands: tuple[str, ...] = tuple(SHORTHANDS),
-                    positional: bool = True) -> None:
-    """Add the scene grammar every command shares: ``SCENE``, ``--set KEY=VALUE`` and the shorthands.
-
-    Parameters
-    ----------
-    parser : argparse.ArgumentParser
-        A subcommand's parser (``weftsim wear``, ``weftsim animate``, ...).
-    shorthands : tuple of str
-        Which of ``revolutions``, ``speed_rpm``, ``clearance_mm``, ``law`` the command takes (all by
-        default; a command where one means nothing leaves it out rather than ignore it).
-    positional : bool
-        Add the ``scene`` argument (a command with its own positional, as ``sweep``, adds it itself).
-
-    :func:`scene_from_args` turns the parsed arguments into the validated scene.
-    """
-    if positional:
-        parser.add_argument("scene", help=SCENE_HELP)
-    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="set",
-                        help="override any scene key in file units, e.g. --set joint_e.restitution=0.8 "
-                        "(a dotted key, or its last part where unique: restitution); repeatable")
-    for flag in shorthands:
-        kind, text = SHORTHANDS[flag]
-        parser.add_argument("--" + flag.replace("_", "-"), type=kind, help=text)
-
-
-def _set_overrides(args: argparse.Namespace) -> dict[str, Any]:
-    """The ``--set`` overrides as dotted scene keys (file units)."""
-    from weftsim.sweep.grid import parse_set
-
-    overrides: dict[str, Any] = {}
-    for text in getattr(args, "set", None) or []:
-        key, value = parse_set(text)
-        if key in overrides:
-            raise CliError(f"--set: key '{key}' is given twice; give it once")
-        overrides[key] = value
-    return overrides
-
-
-def _shorthands(args: argparse.Namespace) -> dict[str, Any]:
-    return {flag: getattr(args, flag) for flag in SHORTHANDS if getattr(args, flag, None) is not None}
-
-
-def scene_from_args(args: argparse.Namespace) -> Scene:
-    """The validated scene of ``args.scene`` with the ``--set`` overrides and the shorthand flags.
-
-    Raises :class:`weftsim.errors.SceneError` (or SweepError for a malformed ``--set``) with the
-    line to print; a key set both by ``--set`` and by its shorthand flag is refused.
-    """
-    from weftsim.api import scene_overrides
-    from weftsim.scene import load_scene
-
-    overrides = scene_overrides(_set_overrides(args), where="command line", **_shorthands(args))
-    return load_scene(args.scene, overrides)
-
-
-def _add_output_flags(parser: argparse.ArgumentParser, default: str) -> None:
-    parser.add_argument("-o", "--output", default=None, help=f"output directory (default: {default})")
-    parser.add_argument("--force", action="store_true",
-                        help="write into an output directory that holds files weftsim did not write")
-
-
 def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(
+    parser = Parser(
         prog="weftsim",
         description="Weft insertion mechanism of a rapier loom with a clearance joint at E: "
         "Exudyn multibody model and closed-form Lagrange cross-check.",
     )
     parser.add_argument("-v", "--verbose", action="store_true", help="log what happens")
-    parser.add_argument("--version", action=_Version,
+    parser.add_argument("--version", action=VersionAction,
                         help="the versions of weftsim and the packages it runs on, and exit")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
@@ -220,11 +62,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("kinematics", help="ideal rapier motion over one revolution (CSV + plot)")
     add_scene_flags(p, shorthands=("speed_rpm",))  # ideal joints, one revolution: the others mean nothing here
-    _add_output_flags(p, "out/<scene name>/kinematics")
+    add_output_flags(p, "out/<scene name>/kinematics")
 
     p = sub.add_parser("run", help="simulate a scene with one engine (CSV, NPZ, summary.json, figure)")
     add_scene_flags(p)
-    _add_output_flags(p, "out/<scene name>/<engine>")
+    add_output_flags(p, "out/<scene name>/<engine>")
     p.add_argument("--engine", default="auto", choices=ENGINE_CHOICES,
                    help="exudyn (multibody model), reference (closed-form Lagrange cross-check) or auto "
                    "(the default engine, exudyn)")
@@ -232,7 +74,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("compare", help="run both engines on one scene and compare them")
     add_scene_flags(p)
-    _add_output_flags(p, "out/<scene name>/compare")
+    add_output_flags(p, "out/<scene name>/compare")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
 
     p = sub.add_parser("sweep", help="run a grid of scene variants in parallel (table of peaks, plots)",
@@ -250,7 +92,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "engine: a plug-in, imported and run like any code (docs/sweeps.md)")
     p.add_argument("--allow-cwd-engine", action="store_true",
                    help="allow a --engine module:function found in the current directory (refused by default)")
-    p.add_argument("--jobs", type=_positive(int), help="local worker processes (default: number of CPUs)")
+    p.add_argument("--jobs", type=positive(int), help="local worker processes (default: number of CPUs)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="run on an existing Dask cluster, e.g. tcp://host:8786")
     p.add_argument("--cell-figures", action="store_true", help="also draw each cell's channels.png")
     p.add_argument("--yes", action="store_true", help="run a grid of more than 2000 cells (refused without it)")
@@ -264,7 +106,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="output directory (default: out/study-NAME; with 'all': parent of one directory per study)")
     p.add_argument("--models", default=None,
                    help="directory of the scene files (default: the bundled scenes, 'weftsim scenes')")
-    p.add_argument("--revolutions", type=_positive(float), help="override the study's crank revolutions per run")
+    p.add_argument("--revolutions", type=positive(float), help="override the study's crank revolutions per run")
     p.add_argument("--force", action="store_true",
                    help="write into an output directory that holds files weftsim did not write")
 
@@ -281,34 +123,10 @@ def build_parser() -> argparse.ArgumentParser:
                    "c0.50mm-800rpm")
     p.add_argument("--models", default=None,
                    help="directory of the scene files (default: the bundled scenes, 'weftsim scenes')")
-    p.add_argument("--repeats", type=_positive(int), default=5, help="timed runs per setting (median; default 5)")
+    p.add_argument("--repeats", type=positive(int), default=5, help="timed runs per setting (median; default 5)")
     p.add_argument("--force", action="store_true",
                    help="write into an output directory that holds files weftsim did not write")
     return parser
-
-
-def _models(args: argparse.Namespace) -> Path:
-    """``--models``, or the directory of the bundled scenes."""
-    from weftsim.scene import bundled_directory
-
-    if args.models is not None:
-        return Path(args.models)
-    directory = bundled_directory()
-    if directory is None:
-        raise CliError("this installation has no bundled scenes; pass the directory of the scene files with --models")
-    return directory
-
-
-def _outdir(args, scene, *parts: str) -> Path:
-    """``-o``, or ``out/<scene name>/<parts>``: a name that would leave ``out/`` is refused."""
-    if args.output:
-        return Path(args.output)
-    name = scene.name
-    if name in (".", "..") or "/" in name or "\\" in name or (os.altsep and os.altsep in name):
-        raise CliError(f"the scene's key 'name' = {name!r} cannot name the default output directory "
-                       "out/<name>: it must be one plain file name (no '/' or '\\', not '.' or '..'); "
-                       "change it or choose the output directory with -o")
-    return Path("out", name, *parts)
 
 
 def _check_fits(scene, outdir: Path, runs: int = 1) -> None:
@@ -410,7 +228,7 @@ def cmd_kinematics(args) -> int:
     scene = scene_from_args(args)
     step = scene.output.sample_angle
     rows = int(round(2.0 * math.pi / step)) + 1
-    outdir = _outdir(args, scene, "kinematics")
+    outdir = output_directory(args, scene, "kinematics")
     check_output_fits(rows, len(KINEMATICS_COLUMNS), outdir,
                       f"output.sample_deg = {math.degrees(step):g} over one revolution",
                       fix="a coarser output.sample_deg (any value up to 0.5 deg)")
@@ -497,7 +315,7 @@ def cmd_run(args) -> int:
 
     scene = scene_from_args(args)
     engine = resolve_engine(args.engine)
-    outdir = _outdir(args, scene, engine)
+    outdir = output_directory(args, scene, engine)
     _check_fits(scene, outdir)
     outdir = prepare_directory(outdir, args.force)
     _announce_run_time(scene, (engine,), "run")
@@ -519,7 +337,7 @@ def cmd_compare(args) -> int:
     from weftsim.output import prepare_directory, to_json
 
     scene = scene_from_args(args)
-    outdir = _outdir(args, scene, "compare")
+    outdir = output_directory(args, scene, "compare")
     _check_fits(scene, outdir, runs=2)
     prepare_directory(outdir, args.force)  # refused before the estimate is shown
     with _stdout_to_stderr() if args.json else contextlib.nullcontext():  # the estimate imports Exudyn
@@ -549,17 +367,17 @@ def cmd_sweep(args) -> int:
     from weftsim.sweep import format_report, plan_sweep, run_sweep
 
     engine = resolve_engine(args.engine) if args.engine in ENGINE_CHOICES else args.engine
-    scene_overrides(_set_overrides(args), where="command line", **_shorthands(args))  # a key given twice
+    scene_overrides(set_overrides(args), where="command line", **shorthand_values(args))  # a key given twice
     # The shorthand flags are fixed overrides of every cell, as --set is.
     fixed = list(args.set) + [f"{SCENE_FLAGS[flag]}={value!r}" if isinstance(value, float) else
-                              f"{SCENE_FLAGS[flag]}={value}" for flag, value in _shorthands(args).items()]
+                              f"{SCENE_FLAGS[flag]}={value}" for flag, value in shorthand_values(args).items()]
     handled = (signal.SIGTERM, signal.SIGHUP)
     previous = {sig: signal.signal(sig, _raise_terminated) for sig in handled}
     try:
         plan = plan_sweep(args.scene, args.vary, fixed, engine, allow_large=args.yes,
                           allow_cwd_engine=args.allow_cwd_engine,
                           announce=lambda line: print(line, file=sys.stderr, flush=True))
-        outdir = _outdir(args, plan.base, "sweep-" + engine.replace(":", "."))
+        outdir = output_directory(args, plan.base, "sweep-" + engine.replace(":", "."))
         report = run_sweep(plan, outdir, jobs=args.jobs, scheduler=args.scheduler, cell_figures=args.cell_figures)
     except _SweepTerminated as exc:
         name = signal.Signals(exc.signum).name
@@ -579,7 +397,7 @@ def cmd_study(args) -> int:
     from weftsim.studies import STUDIES, format_study, run_study
 
     names = list(STUDIES) if args.name == "all" else [args.name]
-    models = _models(args)
+    models = models_directory(args)
     for name in names:
         outdir = Path(args.output) / name if args.output and args.name == "all" else args.output
         report = run_study(name, outdir, models, args.revolutions, args.force)
@@ -596,12 +414,12 @@ def cmd_bench(args) -> int:
     if args.targets:
         from weftsim.bench.targets import run_targets, write_targets
 
-        report = run_targets(_models(args), repeats=args.repeats, log=lambda text: print(text, file=sys.stderr))
+        report = run_targets(models_directory(args), repeats=args.repeats, log=lambda text: print(text, file=sys.stderr))
         files = write_targets(report, args.output or "out/bench-targets", args.force)
         print(f"targets measured in {report['total_time_s']:.0f} s; wrote " + ", ".join(map(str, files)))
         return 0
     outdir = args.output or ("out/bench-quick" if args.quick else "out/bench")
-    report = run_benchmark(outdir, _models(args), args.quick, args.case, repeats=args.repeats, force=args.force)
+    report = run_benchmark(outdir, models_directory(args), args.quick, args.case, repeats=args.repeats, force=args.force)
     print(f"benchmark done in {report['total_time_s']:.0f} s; wrote " + ", ".join(map(str, report["files"])))
     return 0
 
