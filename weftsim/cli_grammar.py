@@ -17,7 +17,7 @@ import os
 import re
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Callable, NoReturn
 
 from weftsim.errors import WeftsimError
 from weftsim.exitcodes import EXIT_USAGE
@@ -61,11 +61,12 @@ class Parser(argparse.ArgumentParser):
         super().__init__(*args, **kwargs)
         self._argv: list[str] = []
 
-    def parse_args(self, args=None, namespace=None):
+    def parse_args(self, args: list[str] | None = None,  # type: ignore[override]
+                   namespace: argparse.Namespace | None = None) -> argparse.Namespace:
         self._argv = list(sys.argv[1:] if args is None else args)  # for the suggestion of error()
         return super().parse_args(args, namespace)
 
-    def error(self, message: str):
+    def error(self, message: str) -> NoReturn:
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message}{self._suggestion(message)} "
                               f"(see '{self.prog} --help')\n")
 
@@ -98,8 +99,10 @@ class Parser(argparse.ArgumentParser):
         return "; " + "; ".join(hints) if hints else ""
 
 
-def positive(kind):
-    def parse(text: str):
+def positive(kind: Callable[[str], float]) -> Callable[[str], float]:
+    """An argparse type: ``kind(text)``, finite and > 0, or an error naming what was given."""
+
+    def parse(text: str) -> float:
         try:
             value = kind(text)
         except ValueError:
