@@ -38,7 +38,8 @@ def test_every_scene_file_of_models_is_bundled_under_its_path_name():
 def test_overrides_and_flags_are_in_file_units():
     scene = weftsim.load_scene("reference", {"joint_e.restitution": 0.8, "solver.reference.rtol": 1e-7},
                                clearance_mm=0.5, speed_rpm=600, revolutions=3, law="flores")
-    # File units in, SI out: 0.5 mm -> 5e-4 m, 600 rpm -> 20 pi rad/s.
+    # File units in, SI out: 0.5 mm -> 5e-4 m, 600 rpm -> 20 pi rad/s; one multiplication each, so the only
+    # difference is its rounding (<= 1 ulp, 1.1e-16 relative): 1e-15 leaves a margin of ten.
     assert scene.joint.clearance == pytest.approx(5e-4, rel=1e-15)
     assert scene.drive.speed == pytest.approx(600 * 2 * math.pi / 60, rel=1e-15)
     assert (scene.drive.revolutions, scene.joint.law, scene.joint.restitution) == (3, "flores", 0.8)
@@ -83,6 +84,7 @@ def test_a_file_of_the_same_name_as_a_bundled_scene_wins(tmp_path, monkeypatch):
     (tmp_path / "reference").write_text(text.replace("speed_rpm = 400.0", "speed_rpm = 300.0"))
     monkeypatch.chdir(tmp_path)
     scene = weftsim.load_scene("reference")
+    # rpm -> rad/s is one multiplication: 1e-15 sits ten times above its rounding, as in the test above.
     assert scene.name == "local" and scene.drive.speed == pytest.approx(300 * math.pi / 30, rel=1e-15)
 
 
@@ -102,7 +104,8 @@ def test_simulate_a_bundled_name_reproduces_the_check_values():
     result = weftsim.simulate(weftsim.load_scene("ideal", revolutions=1), engine="reference")
     assert result.ok and result.engine == "reference"
     s, v = result.steps["rapier_displacement_m"], result.steps["rapier_velocity_m_s"]
-    # Steps every 0.1 deg of the closed form: the flat extrema are sampled to far below these 6 digits.
+    # The check values have 6-7 digits; the tolerances are half a unit of their last digit.  The steps are
+    # 0.1 deg of the closed form, which samples these flat extrema to ~1e-8 relative, far below that.
     assert s.max() - s.min() == pytest.approx(1.052348, abs=5e-7)
     assert v.max() == pytest.approx(21.754, abs=5e-4)
 
@@ -211,7 +214,8 @@ def test_a_sweep_loads_as_a_labelled_grid(tmp_path):
                 continue
             expected = fake_peaks(c, rpm)
             assert str(cell["status"].values) == "success"
-            # cell.json keeps full double precision: only round-off of the peak search remains.
+            # cell.json keeps full double precision and fake_peaks evaluates the same closed form on the same
+            # grid: only round-off in a different order of operations (~1e-15) remains, 1e-12 is far above it.
             assert float(cell["contact_force_N_rev1_peak"]) == pytest.approx(expected["contact"], rel=1e-12)
             assert float(cell["rapier_acceleration_m_s2_rev1_peak"]) == pytest.approx(expected["acceleration"],
                                                                                      rel=1e-12)
