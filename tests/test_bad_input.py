@@ -92,7 +92,7 @@ SCENES = [
     ("unknown-method", EXTENDS + '[solver.reference]\nmethod = "Euler"\n', ["solver.reference.method", "'Euler'"]),
     ("unknown-callback", EXTENDS + '[solver.exudyn]\ncallback = "fortran"\n', ["solver.exudyn.callback", "'fortran'"]),
     ("extends-missing-file", 'extends = "nowhere.toml"\n', ["nowhere.toml", "not found"]),
-    ("extends-not-a-path", "extends = 3\n", ["'extends' must be a path string"]),
+    ("extends-not-a-path", "extends = 3\n", ["'extends' must be a path or the name of a bundled scene"]),
     ("extends-itself", 'extends = "scene.toml"\n', ["loops back"]),
     ("not-toml", "this is = = not toml\n", ["not valid TOML"]),
     ("duplicate-key", EXTENDS + "[drive]\nspeed_rpm = 400\nspeed_rpm = 500\n", ["not valid TOML"]),
@@ -270,7 +270,7 @@ def test_rerun_replaces_the_previous_run_and_drops_its_stale_files(tmp_path):
     # exactly this run's files.
     assert not (out / "channels.png").exists()
     manifest = json.loads((out / ".weftsim-output.json").read_text())
-    assert manifest["files"] == ["channels.csv", "summary.json"]
+    assert manifest["files"] == ["channels.csv", "result.npz", "summary.json"]
     summary = json.loads((out / "summary.json").read_text())
     assert summary["scene"]["drive.revolutions"] == 0.02
 

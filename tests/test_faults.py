@@ -128,7 +128,8 @@ def _can_mount_tmpfs() -> str | None:
 
 
 # Bytes of the small tmpfs: the reference scene's channels.csv over 0.3 revolutions at 0.5 deg
-# (217 rows, ~50 kB) and its summary.json (~6 kB) fit, its channels.png (~150 kB) and orbit.png do not.
+# (217 rows, ~50 kB) and its summary.json (~6 kB) fit, its result.npz (~150 kB: 1058 solver steps),
+# channels.png (~150 kB) and orbit.png do not.
 TMPFS_BYTES = 96 * 1024
 
 
@@ -149,16 +150,22 @@ def test_disk_full_on_a_real_tmpfs_keeps_what_was_computed(tmp_path):
     assert done.returncode == 0, done.stderr
     assert int((tmp_path / "rc.txt").read_text()) == EXIT_FAILED
     last = error_line((tmp_path / "stderr.txt").read_text())
-    assert "cannot write channels.png" in last and "No space left on device" in last, last
+    assert "cannot write channels.png, result.npz" in last and "No space left on device" in last, last
     assert "channels.csv, summary.json written there" in last and "kept in" in last, last
     manifest = json.loads((copy / MANIFEST).read_text())
     assert manifest["state"] == "incomplete" and manifest["files"] == ["channels.csv", "summary.json"]
-    assert manifest["missing"] == {"channels.png": "No space left on device", "orbit.png": "No space left on device"}
+    assert manifest["missing"] == {"channels.png": "No space left on device", "orbit.png": "No space left on device",
+                                   "result.npz": "No space left on device"}
     (kept,) = rescue.glob("weftsim-rescue-*/channels.png")
     assert (kept.parent / "orbit.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert kept.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"  # a complete figure, where the line says
     assert str(kept.parent) in last and manifest["rescued_to"] == str(kept.parent)
     assert json.loads((copy / "summary.json").read_text())["complete"] is True  # the run itself succeeded
+    # The rescued result is the whole run: its output samples are the rows of the channels.csv that fitted.
+    import weftsim
+
+    rescued = weftsim.load_result(kept.parent / "result.npz")
+    assert rescued.samples["time_s"].size == np.loadtxt(copy / "channels.csv", delimiter=",", skiprows=1).shape[0]
 
 
 class FullDisk:
@@ -178,7 +185,7 @@ class FullDisk:
 
 
 @pytest.mark.parametrize("command, files", [
-    ("run", ["channels.csv", "channels.png", "orbit.png", "summary.json"]),
+    ("run", ["channels.csv", "channels.png", "orbit.png", "result.npz", "summary.json"]),
     ("kinematics", ["kinematics.csv", "kinematics.png"]),
 ])  # fmt: skip
 def test_disk_full_rescues_every_file_and_marks_the_manifest(tmp_path, monkeypatch, capsys, command, files):

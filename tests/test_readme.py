@@ -2,6 +2,8 @@
 
 from pathlib import Path
 
+import pytest
+
 from weftsim.scene import SCHEMA
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -27,3 +29,35 @@ def test_every_install_command_of_the_readme_and_ci_uses_the_lock():
         assert installs, f"{name} has no install command"
         unlocked = [line for line in installs if "-c requirements.lock" not in line]
         assert not unlocked, f"{name} installs without the lock: {unlocked}"
+
+
+def _block(readme: str, language: str, after: str) -> str:
+    """The first fenced ``language`` block after the line ``after``."""
+    start = readme.index(after)
+    fence = f"```{language}\n"
+    begin = readme.index(fence, start) + len(fence)
+    return readme[begin:readme.index("```", begin)]
+
+
+def test_the_quick_start_runs_a_bundled_scene():
+    readme = (ROOT / "README.md").read_text()
+    command = _block(readme, "bash", "## Quick start")
+    assert command.strip().endswith(".venv/bin/weftsim run reference")
+
+
+def test_the_readme_script_simulates_both_engines_into_pandas_tables(capsys):
+    """The README's ten-line script, run as written: both engines, a table each, printed results."""
+    pandas = pytest.importorskip("pandas")
+    script = _block((ROOT / "README.md").read_text(), "python", "## Python")
+    assert len(script.strip().splitlines()) <= 10
+    namespace: dict = {}
+    exec(compile(script, "README.md", "exec"), namespace)
+    tables = namespace["tables"]
+    assert set(tables) == {"reference", "exudyn"}
+    for table in tables.values():
+        assert isinstance(table, pandas.DataFrame) and "contact_force_N" in table.columns
+        # One revolution on the 0.5 deg output grid: 720 intervals, 721 samples.
+        assert len(table) == 721
+        assert table["contact_force_N"].max() > 0  # c = 0.5 mm: the journal hits the bearing
+    printed = capsys.readouterr().out
+    assert "reference success" in printed and "exudyn success" in printed

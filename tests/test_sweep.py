@@ -115,7 +115,7 @@ def test_lists_and_inclusive_ranges_parse_in_file_units():
 
 
 @pytest.mark.parametrize("text, words", [
-    ("clearnce_mm=0.1", ["unknown sweep key 'clearnce_mm'", "did you mean clearance_mm"]),
+    ("clearnce_mm=0.1", ["unknown scene key 'clearnce_mm'", "did you mean clearance_mm"]),
     ("youngs_modulus_gpa=200", ["ambiguous", "joint_e.journal_material.youngs_modulus_gpa"]),
     ("speed_rpm=300:800", ["start:stop:count"]),
     ("speed_rpm=300:800:1", ["at least 2"]),

@@ -1,3 +1,80 @@
-"""weftsim: weft insertion mechanism of a rapier loom with a clearance joint."""
+"""weftsim: the weft insertion mechanism of a rapier loom with a clearance joint at E.
+
+A spatial linkage (spherical 4R, planar four-bar, sector gear, pinion and rapier rack) whose
+revolute joint E between the cross rocker and the connecting rod has a radial clearance,
+after Li Bo et al. (2020); the physics is written down in docs/physics.md.  Two independent
+engines solve the same scene: ``"exudyn"`` (Exudyn multibody model) and ``"reference"``
+(closed-form Lagrange equations).
+
+Python interface
+----------------
+load_scene(scene, overrides=None, **flags)
+    A scene file or bundled scene name, with overrides in file units.
+simulate(scene, engine="auto")
+    Run one engine; returns a :class:`RunResult` (``to_pandas()``, ``samples``, ``steps``).
+save_result(result, path), load_result(path)
+    Lossless NPZ (``weftsim run`` writes ``result.npz``).
+load_sweep(directory)
+    A ``weftsim sweep`` directory as an xarray Dataset over its varied keys.
+bundled_scenes()
+    Names of the scenes installed with weftsim.
+WeftsimError
+    Base class of every error raised on purpose (SceneError, OutputError, EngineError, ...).
+
+Example::
+
+    import weftsim
+
+    scene = weftsim.load_scene("reference", clearance_mm=0.5, revolutions=1)
+    for engine in ("reference", "exudyn"):
+        table = weftsim.simulate(scene, engine).to_pandas()
+"""
 
 __version__ = "0.1.0"
+
+from weftsim.api import (  # noqa: E402 (after __version__, which submodules read)
+    DEFAULT_ENGINE,
+    ENGINE_NAMES,
+    bundled_scenes,
+    load_result,
+    load_scene,
+    load_sweep,
+    save_result,
+    select_path,
+    simulate,
+)
+from weftsim.errors import (  # noqa: E402
+    EngineError,
+    MissingExtra,
+    OutputError,
+    RunFailed,
+    SceneError,
+    SweepError,
+    WeftsimError,
+    WriteFailed,
+)
+from weftsim.params import Scene  # noqa: E402
+from weftsim.results import CHANNELS, RunResult  # noqa: E402
+
+__all__ = [
+    "CHANNELS",
+    "DEFAULT_ENGINE",
+    "ENGINE_NAMES",
+    "EngineError",
+    "MissingExtra",
+    "OutputError",
+    "RunFailed",
+    "RunResult",
+    "Scene",
+    "SceneError",
+    "SweepError",
+    "WeftsimError",
+    "WriteFailed",
+    "bundled_scenes",
+    "load_result",
+    "load_scene",
+    "load_sweep",
+    "save_result",
+    "select_path",
+    "simulate",
+]

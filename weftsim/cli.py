@@ -1,7 +1,16 @@
-"""Command line: ``weftsim kinematics | run | animate | compare | sweep | study``.  Thin: parse, call, report.
+"""Command line: ``weftsim scenes | kinematics | run | animate | compare | sweep | study | bench``.  Thin: parse,
+call the Python interface (:mod:`weftsim.api`), report.
 
-Every expected failure (bad scene, bad flag, unwritable output, failed solve) is one
-line on stderr and a non-zero exit status; tracebacks only for real bugs.
+One grammar for the scene of every command: ``SCENE`` is a file or the name of a bundled scene,
+``--set KEY=VALUE`` (repeatable) overrides any scene key, and ``--revolutions``, ``--speed-rpm``,
+``--clearance-mm`` and ``--law`` are its shorthands (:func:`add_scene_flags`, :func:`scene_from_args`;
+a new subcommand calls both, and :func:`add_output_flags` / :func:`output_directory` for ``-o``).  A
+run's results go to ``out/<scene>/<engine>/``, so runs of the two engines do not overwrite each other.
+A mistyped flag, command or key gets the closest spelling.
+
+Every expected failure (bad scene, bad flag, unwritable output, failed solve) is a
+:class:`weftsim.errors.WeftsimError`, printed as one line on stderr with its exit status;
+tracebacks only for real bugs.
 """
 
 from __future__ import annotations
@@ -16,145 +25,104 @@ import sys
 import threading
 from pathlib import Path
 
+from weftsim.api import ENGINE_NAMES as ENGINE_CHOICES
+from weftsim.cli_grammar import (  # noqa: F401 (CliError, add_scene_flags, scene_from_args: for subcommands)
+    SCENE_HELP,
+    CliError,
+    Parser,
+    VersionAction,
+    add_output_flags,
+    add_scene_flags,
+    models_directory,
+    output_directory,
+    positive,
+    scene_from_args,
+    set_overrides,
+    shorthand_values,
+)
+from weftsim.errors import WeftsimError
 from weftsim.exitcodes import EXIT_DISAGREE, EXIT_FAILED, EXIT_USAGE  # noqa: F401 (re-exported)
 
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a command stopped by Ctrl-C
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE: the reader of stdout went away (`| head`), as for any Unix tool
 
 
-class CliError(Exception):
-    """An error to print as one line, with an exit status."""
-
-    def __init__(self, message: str, status: int = EXIT_USAGE):
-        super().__init__(message)
-        self.status = status
-
-
-class _Version(argparse.Action):
-    """``--version``: the versions line (read from package metadata only when asked), then exit 0."""
-
-    def __init__(self, option_strings, dest, **kwargs):
-        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, **kwargs)
-
-    def __call__(self, parser, namespace, values, option_string=None):
-        from weftsim.provenance import version_line
-
-        print(version_line())
-        parser.exit()
-
-
-class _Parser(argparse.ArgumentParser):
-    """argparse with one-line errors (the usage stays behind --help) and no abbreviated flags
-    (``--speed 400`` must not silently mean ``--speed-rpm``)."""
-
-    def __init__(self, *args, **kwargs):
-        kwargs.setdefault("allow_abbrev", False)
-        super().__init__(*args, **kwargs)
-
-    def error(self, message: str):
-        self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
-
-
-def _positive(kind):
-    def parse(text: str):
-        try:
-            value = kind(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
-        if not math.isfinite(value) or value <= 0:
-            raise argparse.ArgumentTypeError(f"must be a finite number > 0, got {text!r}")
-        return value
-
-    return parse
-
-
-def _non_negative(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
-    if not math.isfinite(value) or value < 0:
-        raise argparse.ArgumentTypeError(f"must be a finite number >= 0, got {text!r}")
-    return value
-
-
-def _add_scene_flags(p: argparse.ArgumentParser, full: bool = True,
-                     output_help: str = "output directory (default: out/<scene name>)") -> None:
-    p.add_argument("scene", help="scene file (TOML), e.g. models/reference.toml")
-    p.add_argument("-o", "--output", default=None, help=output_help)
-    p.add_argument("--force", action="store_true",
-                   help="write into an output directory that holds files weftsim did not write")
-    p.add_argument("--speed-rpm", type=_positive(float), help="override drive.speed_rpm")
-    if full:
-        p.add_argument("--clearance-mm", type=_non_negative, help="override joint_e.clearance_mm (0 = ideal joint)")
-        p.add_argument("--law", help="override joint_e.law (contact force law)")
-        p.add_argument("--revolutions", type=_positive(float), help="override drive.revolutions")
-
-
 def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(
+    parser = Parser(
         prog="weftsim",
         description="Weft insertion mechanism of a rapier loom with a clearance joint at E: "
         "Exudyn multibody model and closed-form Lagrange cross-check.",
     )
     parser.add_argument("-v", "--verbose", action="store_true", help="log what happens")
-    parser.add_argument("--version", action=_Version,
+    parser.add_argument("--version", action=VersionAction,
                         help="the versions of weftsim and the packages it runs on, and exit")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    p = sub.add_parser("kinematics", help="ideal rapier motion over one revolution (CSV + plot)")
-    _add_scene_flags(p, full=False)
+    sub.add_parser("scenes", help="list the bundled scenes (name and description)")
 
-    p = sub.add_parser("run", help="simulate a scene with one engine (CSV, summary.json, figure)")
-    _add_scene_flags(p)
-    p.add_argument("--engine", default="exudyn", choices=("exudyn", "reference"),
-                   help="exudyn (multibody model, default) or reference (closed-form Lagrange cross-check)")
+    p = sub.add_parser("kinematics", help="ideal rapier motion over one revolution (CSV + plot)")
+    add_scene_flags(p, shorthands=("speed_rpm",))  # ideal joints, one revolution: the others mean nothing here
+    add_output_flags(p, "out/<scene name>/kinematics")
+
+    p = sub.add_parser("run", help="simulate a scene with one engine (CSV, NPZ, summary.json, figure)")
+    add_scene_flags(p)
+    add_output_flags(p, "out/<scene name>/<engine>")
+    p.add_argument("--engine", default="auto", choices=ENGINE_CHOICES,
+                   help="exudyn (multibody model), reference (closed-form Lagrange cross-check) or auto "
+                   "(the default engine, exudyn)")
     p.add_argument("--no-plot", action="store_true", help="skip the figure")
 
     p = sub.add_parser("animate", help="animation of the linkage, the journal and the rapier over a revolution (GIF)",
                        description="Simulate a scene and draw its last complete revolution: the linkage projected "
                        "on the four-bar plane, the journal in its clearance (magnified, labelled) and the rapier.")
-    _add_scene_flags(p, output_help="animation file, .gif (or .mp4 with ffmpeg) (default: out/<scene name>-animation.gif)")
-    p.add_argument("--engine", default="exudyn", choices=("exudyn", "reference"), help="as for run")
-    p.add_argument("--frames", type=_positive(int), default=72, help="frames over the revolution (default 72)")
+    add_scene_flags(p)
+    p.add_argument("-o", "--output", default=None,
+                   help="animation file, .gif (or .mp4 with ffmpeg) (default: out/<scene name>/<engine>/animation.gif)")
+    p.add_argument("--engine", default="auto", choices=ENGINE_CHOICES, help="as for run")
+    p.add_argument("--frames", type=positive(int), default=72, help="frames over the revolution (default 72)")
 
     p = sub.add_parser("compare", help="run both engines on one scene and compare them")
-    _add_scene_flags(p)
+    add_scene_flags(p)
+    add_output_flags(p, "out/<scene name>/compare")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
 
     p = sub.add_parser("sweep", help="run a grid of scene variants in parallel (table of peaks, plots)",
                        description="Run every combination of the --vary values on a pool of worker processes "
                        "(or a Dask cluster) into OUTPUT/<cell>/; rerunning skips finished cells.  See docs/sweeps.md.")
-    p.add_argument("scene", help="base scene file (TOML), e.g. models/reference.toml")
+    p.add_argument("scene", help="base " + SCENE_HELP)
     p.add_argument("--vary", action="append", required=True, metavar="KEY=VALUES",
                    help="a scene key (clearance_mm, speed_rpm, law, ... or a dotted key) and its values: "
                    "a list 0.01,0.25,0.5 or an inclusive range start:stop:count; repeat for more axes")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="fixed override for every cell")
-    p.add_argument("-o", "--output", default=None, help="sweep directory (default: out/<scene name>-sweep)")
-    p.add_argument("--engine", default="exudyn",
-                   help="exudyn (default), reference, or module:function of your own engine: a plug-in, "
-                   "imported and run like any code (docs/sweeps.md)")
+    add_scene_flags(p, positional=False)
+    p.add_argument("-o", "--output", default=None,
+                   help="sweep directory (default: out/<scene name>/sweep-<engine>)")
+    p.add_argument("--engine", default="auto",
+                   help="auto (the default engine, exudyn), exudyn, reference, or module:function of your own "
+                   "engine: a plug-in, imported and run like any code (docs/sweeps.md)")
     p.add_argument("--allow-cwd-engine", action="store_true",
                    help="allow a --engine module:function found in the current directory (refused by default)")
-    p.add_argument("--jobs", type=_positive(int), help="local worker processes (default: number of CPUs)")
+    p.add_argument("--jobs", type=positive(int), help="local worker processes (default: number of CPUs)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="run on an existing Dask cluster, e.g. tcp://host:8786")
     p.add_argument("--cell-figures", action="store_true", help="also draw each cell's channels.png")
     p.add_argument("--yes", action="store_true", help="run a grid of more than 2000 cells (refused without it)")
 
     p = sub.add_parser("study", help="one of the paper's studies: figures, CSV and JSON (docs/paper-comparison.md)",
                        description="Run a study of the paper: contact-law (Fig. 7-9), clearance (Fig. 12), "
-                       "speed (Fig. 13, with the acceleration spectrum), engines (Fig. 16), or all of them.")
+                       "speed (Fig. 13, with the acceleration spectrum), engines (Fig. 16), or all of them.  "
+                       "Each study sets its own scenes; --revolutions is the one scene flag it takes.")
     p.add_argument("name", help="contact-law, clearance, speed, engines or all")
     p.add_argument("-o", "--output", default=None,
                    help="output directory (default: out/study-NAME; with 'all': parent of one directory per study)")
-    p.add_argument("--models", default="models", help="directory of the scene files (default: models)")
-    p.add_argument("--revolutions", type=_positive(float), help="override the study's crank revolutions per run")
+    p.add_argument("--models", default=None,
+                   help="directory of the scene files (default: the bundled scenes, 'weftsim scenes')")
+    p.add_argument("--revolutions", type=positive(float), help="override the study's crank revolutions per run")
     p.add_argument("--force", action="store_true",
                    help="write into an output directory that holds files weftsim did not write")
 
     p = sub.add_parser("bench", help="work-precision benchmark of every engine setting (docs/performance.md)",
                        description="Time every engine setting on an easy and two hard scenes against a converged "
-                       "solution: tables, log-log figures and JSON.  The full mode takes ~30 min on 2 cores.")
+                       "solution: tables, log-log figures and JSON.  The full mode takes ~30 min on 2 cores.  "
+                       "The cases fix their scenes, so it takes no scene flags.")
     p.add_argument("--quick", action="store_true", help="a few settings, 2 revolutions (a few minutes)")
     p.add_argument("--targets", action="store_true",
                    help="the speed targets of the default paths against the 0.1 defaults (about 10 min)")
@@ -162,38 +130,12 @@ def build_parser() -> argparse.ArgumentParser:
                    help="output directory (default: out/bench, out/bench-quick or out/bench-targets)")
     p.add_argument("--case", action="append", help="only this case (repeatable): c0.25mm-400rpm, c0.01mm-800rpm, "
                    "c0.50mm-800rpm")
-    p.add_argument("--models", default="models", help="directory of the scene files (default: models)")
-    p.add_argument("--repeats", type=_positive(int), default=5, help="timed runs per setting (median; default 5)")
+    p.add_argument("--models", default=None,
+                   help="directory of the scene files (default: the bundled scenes, 'weftsim scenes')")
+    p.add_argument("--repeats", type=positive(int), default=5, help="timed runs per setting (median; default 5)")
     p.add_argument("--force", action="store_true",
                    help="write into an output directory that holds files weftsim did not write")
     return parser
-
-
-def _overrides(args) -> dict:
-    return {
-        "drive.speed_rpm": getattr(args, "speed_rpm", None),
-        "joint_e.clearance_mm": getattr(args, "clearance_mm", None),
-        "joint_e.law": getattr(args, "law", None),
-        "drive.revolutions": getattr(args, "revolutions", None),
-    }
-
-
-def _load(args):
-    from weftsim.scene import load_scene
-
-    return load_scene(args.scene, _overrides(args))
-
-
-def _outdir(args, scene, suffix: str = "") -> Path:
-    """``-o``, or ``out/<scene name><suffix>``: a name that would leave ``out/`` is refused."""
-    if args.output:
-        return Path(args.output)
-    name = scene.name
-    if name in (".", "..") or "/" in name or "\\" in name or (os.altsep and os.altsep in name):
-        raise CliError(f"the scene's key 'name' = {name!r} cannot name the default output directory "
-                       "out/<name>: it must be one plain file name (no '/' or '\\', not '.' or '..'); "
-                       "change it or choose the output directory with -o")
-    return Path("out") / (name + suffix)
 
 
 def _check_fits(scene, outdir: Path, runs: int = 1) -> None:
@@ -292,10 +234,10 @@ def cmd_kinematics(args) -> int:
     from weftsim.output import check_output_fits, prepare_directory, write_csv, write_figure, write_files
     from weftsim.plots import plot_kinematics
 
-    scene = _load(args)
+    scene = scene_from_args(args)
     step = scene.output.sample_angle
     rows = int(round(2.0 * math.pi / step)) + 1
-    outdir = _outdir(args, scene, "-kinematics")
+    outdir = output_directory(args, scene, "kinematics")
     check_output_fits(rows, len(KINEMATICS_COLUMNS), outdir,
                       f"output.sample_deg = {math.degrees(step):g} over one revolution",
                       fix="a coarser output.sample_deg (any value up to 0.5 deg)")
@@ -334,27 +276,18 @@ def cmd_kinematics(args) -> int:
     return 0
 
 
-def _engine(engine: str):
-    """The engine package (``solve``, ``select_path``) named by ``--engine``."""
-    if engine == "reference":
-        import weftsim.reference as module
-    elif engine == "exudyn":
-        import weftsim.exudyn_engine as module
-    else:
-        raise CliError(f"--engine must be 'reference' or 'exudyn', got {engine!r}")
-    return module
-
-
 def _solve(scene, engine: str, label: str | None = None, announce: bool = False):
+    """:func:`weftsim.api.simulate` with progress on stderr; ``announce``: first the path it takes."""
+    from weftsim.api import resolve_engine, select_path, simulate
     from weftsim.progress import Progress
 
-    module = _engine(engine)
+    engine = resolve_engine(engine)
     if announce:  # `run`: its first line is the model and method it takes, and why
-        path = module.select_path(scene)
+        path = select_path(scene, engine)
         print(f"scene {scene.name}, engine {engine}: {path['model']}, {path['method']} ({path['reason']})", flush=True)
     progress = Progress(label or f"{engine} {scene.name}")
     try:
-        return module.solve(scene, progress=progress)
+        return simulate(scene, engine, progress=progress)
     finally:
         progress.close()
 
@@ -385,17 +318,19 @@ def _interrupted_line(result, outdir: Path, signum: int) -> str:
 
 
 def cmd_run(args) -> int:
+    from weftsim.api import resolve_engine
     from weftsim.output import prepare_directory, write_run
     from weftsim.plausibility import report_lines
 
-    scene = _load(args)
-    outdir = _outdir(args, scene)
+    scene = scene_from_args(args)
+    engine = resolve_engine(args.engine)
+    outdir = output_directory(args, scene, engine)
     _check_fits(scene, outdir)
     outdir = prepare_directory(outdir, args.force)
-    _announce_run_time(scene, (args.engine,), "run")
+    _announce_run_time(scene, (engine,), "run")
     with _stop_on_interrupt("run") as stop:
-        result = _solve(scene, args.engine, announce=True)
-    written = write_run(result, outdir, figure=not args.no_plot, force=args.force)
+        result = _solve(scene, engine, announce=True)
+    written = write_run(result, outdir, figure=not args.no_plot, force=args.force, npz=True)
     _report_run(result, written)
     report_lines(result, "run")
     if stop["signal"] is not None and not result.ok:
@@ -408,9 +343,11 @@ def cmd_run(args) -> int:
 
 def cmd_animate(args) -> int:
     from weftsim.animate import check_format, write_animation
+    from weftsim.api import resolve_engine
 
-    scene = _load(args)
-    target = _outdir(args, scene, "-animation.gif")
+    scene = scene_from_args(args)
+    engine = resolve_engine(args.engine)
+    target = Path(args.output) if args.output else output_directory(args, scene, engine) / "animation.gif"
     try:
         check_format(target)
         if args.frames < 2:
@@ -418,9 +355,9 @@ def cmd_animate(args) -> int:
     except ValueError as exc:
         raise CliError(str(exc)) from None
     _check_fits(scene, target.parent)
-    _announce_run_time(scene, (args.engine,), "animate")
+    _announce_run_time(scene, (engine,), "animate")
     with _stop_on_interrupt("animate"):
-        result = _solve(scene, args.engine, announce=True)
+        result = _solve(scene, engine, announce=True)
     if not result.ok:
         raise CliError(f"simulation failed: {result.message}; nothing animated", EXIT_FAILED)
     try:
@@ -439,8 +376,8 @@ def cmd_compare(args) -> int:
     from weftsim.compare import format_report, run_compare
     from weftsim.output import prepare_directory, to_json
 
-    scene = _load(args)
-    outdir = _outdir(args, scene, "-compare")
+    scene = scene_from_args(args)
+    outdir = output_directory(args, scene, "compare")
     _check_fits(scene, outdir, runs=2)
     prepare_directory(outdir, args.force)  # refused before the estimate is shown
     with _stdout_to_stderr() if args.json else contextlib.nullcontext():  # the estimate imports Exudyn
@@ -466,18 +403,22 @@ def _raise_terminated(signum, frame):
 
 
 def cmd_sweep(args) -> int:
-    from weftsim.sweep import SweepError, format_report, plan_sweep, run_sweep
+    from weftsim.api import SCENE_FLAGS, resolve_engine, scene_overrides
+    from weftsim.sweep import format_report, plan_sweep, run_sweep
 
+    engine = resolve_engine(args.engine) if args.engine in ENGINE_CHOICES else args.engine
+    scene_overrides(set_overrides(args), where="command line", **shorthand_values(args))  # a key given twice
+    # The shorthand flags are fixed overrides of every cell, as --set is.
+    fixed = list(args.set) + [f"{SCENE_FLAGS[flag]}={value!r}" if isinstance(value, float) else
+                              f"{SCENE_FLAGS[flag]}={value}" for flag, value in shorthand_values(args).items()]
     handled = (signal.SIGTERM, signal.SIGHUP)
     previous = {sig: signal.signal(sig, _raise_terminated) for sig in handled}
     try:
-        plan = plan_sweep(args.scene, args.vary, args.set, args.engine, allow_large=args.yes,
+        plan = plan_sweep(args.scene, args.vary, fixed, engine, allow_large=args.yes,
                           allow_cwd_engine=args.allow_cwd_engine,
                           announce=lambda line: print(line, file=sys.stderr, flush=True))
-        outdir = Path(args.output) if args.output else Path("out") / (Path(args.scene).stem + "-sweep")
+        outdir = output_directory(args, plan.base, "sweep-" + engine.replace(":", "."))
         report = run_sweep(plan, outdir, jobs=args.jobs, scheduler=args.scheduler, cell_figures=args.cell_figures)
-    except SweepError as exc:
-        raise CliError(str(exc)) from None
     except _SweepTerminated as exc:
         name = signal.Signals(exc.signum).name
         raise CliError(f"terminated by {name}; finished cells are kept, run the same command again to resume",
@@ -493,17 +434,13 @@ def cmd_sweep(args) -> int:
 
 
 def cmd_study(args) -> int:
-    from weftsim.studies import STUDIES, SimulationFailed, StudyError, format_study, run_study
+    from weftsim.studies import STUDIES, format_study, run_study
 
     names = list(STUDIES) if args.name == "all" else [args.name]
+    models = models_directory(args)
     for name in names:
         outdir = Path(args.output) / name if args.output and args.name == "all" else args.output
-        try:
-            report = run_study(name, outdir, args.models, args.revolutions, args.force)
-        except SimulationFailed as exc:
-            raise CliError(str(exc), EXIT_FAILED) from None
-        except StudyError as exc:
-            raise CliError(str(exc)) from None
+        report = run_study(name, outdir, models, args.revolutions, args.force)
         print(format_study(name, report))
     return 0
 
@@ -517,18 +454,33 @@ def cmd_bench(args) -> int:
     if args.targets:
         from weftsim.bench.targets import run_targets, write_targets
 
-        report = run_targets(args.models, repeats=args.repeats, log=lambda text: print(text, file=sys.stderr))
+        report = run_targets(models_directory(args), repeats=args.repeats, log=lambda text: print(text, file=sys.stderr))
         files = write_targets(report, args.output or "out/bench-targets", args.force)
         print(f"targets measured in {report['total_time_s']:.0f} s; wrote " + ", ".join(map(str, files)))
         return 0
     outdir = args.output or ("out/bench-quick" if args.quick else "out/bench")
-    report = run_benchmark(outdir, args.models, args.quick, args.case, repeats=args.repeats, force=args.force)
+    report = run_benchmark(outdir, models_directory(args), args.quick, args.case, repeats=args.repeats, force=args.force)
     print(f"benchmark done in {report['total_time_s']:.0f} s; wrote " + ", ".join(map(str, report["files"])))
     return 0
 
 
-COMMANDS = {"kinematics": cmd_kinematics, "run": cmd_run, "animate": cmd_animate, "compare": cmd_compare, "sweep": cmd_sweep,
-            "study": cmd_study, "bench": cmd_bench}
+def cmd_scenes(args) -> int:
+    """``weftsim scenes``: each bundled scene's name and description, one a line."""
+    from weftsim.scene import bundled_directory, bundled_scene_path, bundled_scenes, scene_description
+
+    names = bundled_scenes()
+    if not names:
+        raise CliError("this installation has no bundled scenes")
+    width = max(map(len, names))
+    print(f"bundled scenes in {bundled_directory()} (weftsim run NAME; a scene file may extends = \"NAME\"):")
+    for name in names:
+        print(f"  {name:{width}s}  {scene_description(bundled_scene_path(name))}")
+    return 0
+
+
+COMMANDS = {"scenes": cmd_scenes, "kinematics": cmd_kinematics, "run": cmd_run, "animate": cmd_animate,
+            "compare": cmd_compare,
+            "sweep": cmd_sweep, "study": cmd_study, "bench": cmd_bench}
 
 
 def _one_line(text: str) -> str:
@@ -543,20 +495,11 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(name)s: %(message)s")
-    from weftsim.output import OutputError, WriteFailed
-    from weftsim.scene import SceneError
-
     try:
         return COMMANDS[args.command](args)
-    except WriteFailed as exc:  # the results were computed: where each file went is in the message
+    except WeftsimError as exc:  # its message is the line to print, its class the exit status
         print(f"weftsim {args.command}: error: {_one_line(exc)}", file=sys.stderr)
-        return EXIT_FAILED
-    except (SceneError, OutputError) as exc:
-        print(f"weftsim {args.command}: error: {_one_line(exc)}", file=sys.stderr)
-        return EXIT_USAGE
-    except CliError as exc:
-        print(f"weftsim {args.command}: error: {_one_line(exc)}", file=sys.stderr)
-        return exc.status
+        return exc.exit_status
     except MemoryError:
         print(f"weftsim {args.command}: error: out of memory; use a coarser output.sample_deg or fewer "
               "drive.revolutions", file=sys.stderr)

@@ -37,11 +37,14 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, replace
-from typing import Callable
+from typing import Callable, TYPE_CHECKING
 
 import numpy as np
 
 from weftsim.params import Scene
+
+if TYPE_CHECKING:
+    from weftsim.results import RunResult
 
 KINDS = ("non_finite", "penetration", "step_size", "steps", "wall_time", "energy", "plausibility", "interrupted")
 
@@ -199,7 +202,7 @@ def _first(mask) -> int | None:
     return int(idx[0]) if idx.size else None
 
 
-def energy_residual(steps: dict):
+def energy_residual(steps: dict) -> np.ndarray:
     """W - dKE - dPE - dE_contact - dE_dissipated at every step, J (zero for exact conservation)."""
     return (
         steps["driving_work_J"] - steps["driving_work_J"][0]
@@ -262,7 +265,7 @@ def plausibility_breach(result, report) -> tuple[int, Breach] | None:
     return first_defect_row(result, report), Breach("plausibility", "; ".join(defects), HINT)
 
 
-def vet_result(result):
+def vet_result(result) -> RunResult:
     """``result`` with its plausibility report attached, failed if a criterion is crossed.
 
     Applied by both engines to every run, so a criterion crossed without the step-by-step

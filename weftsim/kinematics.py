@@ -79,7 +79,7 @@ def _point_on_arm(length, angle, d_angle, dd_angle):
     return length * u, length * d1 * n, length * (d2 * n - d1 * d1 * u)
 
 
-def fourbar_assembly_argument(theta_oe, geometry: Geometry):
+def fourbar_assembly_argument(theta_oe, geometry: Geometry) -> np.ndarray:
     """Argument of the acos in the assembly formula; the four-bar closes iff it is in [-1, 1].
 
     With a = L_OG - E_Y, b' = -E_Z, D = hypot(a, b'):
@@ -209,7 +209,7 @@ class LinkageState:
     transmission_angle: np.ndarray
 
 
-def linkage_state(theta, geometry: Geometry, rocker_com_distance: float | None = None):
+def linkage_state(theta, geometry: Geometry, rocker_com_distance: float | None = None) -> LinkageState:
     """Positions, velocities and accelerations (per unit crank speed) of members 3-8.
 
     Chain rule through the rocker: theta_OE = theta_OE0 + phi(theta), so for any
@@ -271,7 +271,7 @@ def linkage_state(theta, geometry: Geometry, rocker_com_distance: float | None =
     )  # fmt: skip
 
 
-def rapier_motion(theta, omega, geometry: Geometry):
+def rapier_motion(theta, omega, geometry: Geometry) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Rapier displacement, velocity and acceleration at constant crank speed.
 
     s = (d5 d7/d6)(theta_FG - theta_FG(0)),  v = omega s',  a = omega^2 s''.

@@ -27,16 +27,8 @@ from typing import Callable
 
 import numpy as np
 
+from weftsim.errors import OutputError, WriteFailed
 from weftsim.results import RunResult
-
-
-class OutputError(OSError):
-    """The output directory or a file in it cannot be written."""
-
-
-class WriteFailed(OutputError):
-    """The results were computed but some files could not be written; the message says where
-    each one is (written, rescued, or lost with the reason)."""
 
 
 MANIFEST = ".weftsim-output.json"
@@ -345,14 +337,20 @@ def output_rows(scene) -> float:
     return math.floor(scene.drive.end_time * scene.drive.speed / scene.output.sample_angle) + 2
 
 
-def write_run(result: RunResult, outdir: str | Path, figure: bool = True, force: bool = False) -> dict[str, Path]:
+def write_run(result: RunResult, outdir: str | Path, figure: bool = True, force: bool = False,
+              npz: bool = False) -> dict[str, Path]:
     """Write ``channels.csv``, ``summary.json``, ``channels.png`` and (clearance joint) ``orbit.png``
     for one run, atomically each.
+
+    With ``npz`` also ``result.npz``: the whole result, per-step data included, losslessly
+    (:func:`weftsim.results.save_npz`; ``weftsim.load_result`` reads it).  ``weftsim run`` asks for
+    it; a sweep's cells do not (a 10-revolution result is a few MB, times every cell).
 
     Raises :class:`WriteFailed` (after writing what it can) when a file cannot be written.
     """
     from weftsim.analysis import summary
     from weftsim.plots import plot_channels, plot_orbit
+    from weftsim.results import save_npz
 
     outdir = prepare_directory(outdir, force)
     what = {"kind": "run", "engine": result.engine, "scene": result.scene.name, "status": result.status}
@@ -360,6 +358,8 @@ def write_run(result: RunResult, outdir: str | Path, figure: bool = True, force:
         "channels": ("channels.csv", lambda target: write_csv(target, {n: result.samples[n] for n in result.channel_names})),
         "summary": ("summary.json", lambda target: write_json(target, summary(result))),
     }
+    if npz:
+        files["npz"] = ("result.npz", lambda target: write_atomic(target, lambda tmp: save_npz(result, tmp)))
     if figure and result.steps["time_s"].size:
         files["figure"] = ("channels.png", lambda target: write_figure(target, plot_channels([result])))
         if result.scene.joint.clearance > 0.0:

@@ -3,8 +3,14 @@
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from types import ModuleType
+
+    from matplotlib.figure import Figure
 
 PANELS = (
     ("rapier_displacement_m", "rapier displacement [mm]", 1e3),
@@ -28,7 +34,7 @@ def clearance_label(scene) -> str:
     return f"c_E = {scene.joint.clearance * 1e3:g}, c_F = {scene.joint_f.clearance * 1e3:g} mm"
 
 
-def figure(**options):
+def figure(**options) -> Figure:
     """A matplotlib Figure drawn by the Agg backend, without pyplot (whose import costs ~0.2 s of a
     ``weftsim run``); save it with :func:`weftsim.output.write_figure`."""
     from matplotlib.figure import Figure
@@ -36,7 +42,7 @@ def figure(**options):
     return Figure(**options)
 
 
-def pyplot():
+def pyplot() -> ModuleType:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -45,7 +51,7 @@ def pyplot():
     return plt
 
 
-def last_revolution(result):
+def last_revolution(result) -> tuple[dict[str, np.ndarray], int]:
     """Per-step channels of the last complete revolution (all steps if the run is shorter)."""
     from weftsim.analysis import complete_revolutions
 
@@ -59,7 +65,7 @@ def last_revolution(result):
     return {k: v[keep] for k, v in steps.items()}, n - 1
 
 
-def channel_panels(curves, title: str, panels=None):
+def channel_panels(curves, title: str, panels=None) -> Figure:
     """Six panels like the paper's Fig. 12/13/16 against crank angle over one revolution (eight when
     every curve has joint F's channels: its contact force and penetration below).
 
@@ -96,7 +102,7 @@ def channel_panels(curves, title: str, panels=None):
     return fig
 
 
-def plot_channels(results, labels=None, title=None):
+def plot_channels(results, labels=None, title=None) -> Figure:
     """Six panels over the last complete revolution of each result."""
     labels = labels or [f"{r.engine}, {clearance_label(r.scene)}, "
                         f"{r.scene.drive.speed * 30 / math.pi:g} rpm" for r in results]
@@ -107,7 +113,7 @@ def plot_channels(results, labels=None, title=None):
     return channel_panels(curves, title or (results[0].scene.name + " (last revolution)"))
 
 
-def plot_kinematics(angle_deg, s, v, a, title=""):
+def plot_kinematics(angle_deg, s, v, a, title="") -> Figure:
     """Ideal rapier displacement, velocity and acceleration over one revolution."""
     fig = figure(figsize=(8, 8))
     axes = fig.subplots(3, 1, sharex=True)

@@ -4,16 +4,35 @@ A :class:`RunResult` holds named channels (units in their names) twice: on the
 uniform crank-angle output grid (``samples``) and at every accepted solver step
 (``steps``).  Peaks and statistics are taken from ``steps`` because an impact
 lasts about 0.1 ms, a fraction of a degree, and falls between output samples.
+
+:func:`save_npz` / :func:`load_npz` keep a result losslessly (both tables bit for bit,
+the scene in SI units, the solver statistics, events, plausibility and path), so
+the per-step data behind the peaks can be studied after the run; ``weftsim run``
+writes it as ``result.npz`` beside ``channels.csv``.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import json
 import math
+import os
+import types
+import typing
+import zipfile
 from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
+from weftsim import params
+
+from weftsim.errors import OutputError, require
 from weftsim.params import Scene
+
+if TYPE_CHECKING:
+    import pandas
 
 CHANNELS: tuple[str, ...] = (
     "time_s",
@@ -188,7 +207,37 @@ class RunResult:
 
     @property
     def wall_time_s(self) -> float:
+        """Wall-clock time of the solve, s (NaN when the engine did not record it)."""
         return float(self.solver_stats.get("wall_time_s", float("nan")))
+
+    def to_pandas(self, which: Literal["samples", "steps"] = "samples") -> pandas.DataFrame:
+        """One table of the run as a :class:`pandas.DataFrame`, one column per channel.
+
+        Parameters
+        ----------
+        which : {"samples", "steps"}
+            ``"samples"``: the uniform crank-angle output grid (the rows of ``channels.csv``);
+            ``"steps"``: every accepted solver step, where the peaks are taken (an impact of
+            ~0.1 ms falls between output samples).
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns :data:`CHANNELS` (SI units, named in the column names) as float64, a
+            ``RangeIndex``; ``attrs`` hold the scene name, engine, status and ``which``.
+
+        Raises
+        ------
+        weftsim.errors.MissingExtra
+            pandas is not installed (it comes with the optional extra ``weftsim[data]``).
+        """
+        if which not in ("samples", "steps"):
+            raise ValueError(f"which must be 'samples' or 'steps', got {which!r}")
+        pd = require("pandas", "data", "RunResult.to_pandas")
+        table = self.samples if which == "samples" else self.steps
+        frame = pd.DataFrame({name: np.array(table[name]) for name in CHANNELS})
+        frame.attrs.update({"scene": self.scene.name, "engine": self.engine, "status": self.status, "table": which})
+        return frame
 
 
 def empty_channels(joint_f: bool = False) -> dict[str, np.ndarray]:
@@ -207,3 +256,106 @@ def angle_grid(end_time: float, omega: float, step_angle: float) -> np.ndarray:
     if end_time - t[-1] > 1e-9 * dt:
         t = np.append(t, end_time)
     return t
+
+
+# Format tag of a saved result; :func:`load_npz` refuses others (a later layout gets a new number).
+NPZ_FORMAT = "weftsim-result/1"
+
+
+def _plain(value: Any) -> Any:
+    """A dataclass, numpy scalar or array, tuple or Path as JSON-ready Python values (floats exact)."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return {f.name: _plain(getattr(value, f.name)) for f in dataclasses.fields(value)}
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _plain(value.tolist())
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, Path):
+        return str(value)
+    return value
+
+
+def _dataclass_type(hint: Any) -> type | None:
+    """The dataclass named by a field's type hint (also inside ``X | None``), else None."""
+    if dataclasses.is_dataclass(hint):
+        return hint
+    if typing.get_origin(hint) in (typing.Union, types.UnionType):
+        found = [arg for arg in typing.get_args(hint) if dataclasses.is_dataclass(arg)]
+        return found[0] if found else None
+    return None
+
+
+def _rebuild(cls: type, data: dict) -> Any:
+    """The dataclass ``cls`` from :func:`_plain`'s dict: nested dataclasses and tuples restored by the
+    field types, so a scene comes back equal to the one saved (JSON keeps every float exactly)."""
+    hints = typing.get_type_hints(cls, vars(params))
+    values = {}
+    for f in dataclasses.fields(cls):
+        if f.name not in data:  # a field added after the file was written keeps its default
+            continue
+        value, hint = data[f.name], hints.get(f.name)
+        nested = _dataclass_type(hint)
+        if nested is not None and isinstance(value, dict):
+            value = _rebuild(nested, value)
+        elif isinstance(value, list) and (hint is tuple or typing.get_origin(hint) is tuple):
+            value = tuple(value)
+        values[f.name] = value
+    return cls(**values)
+
+
+def save_npz(result: RunResult, path: str | os.PathLike) -> Path:
+    """Write ``result`` to one NPZ file from which :func:`load_npz` rebuilds it exactly.
+
+    The file holds ``samples/<channel>`` and ``steps/<channel>`` (float64 arrays, bit for bit)
+    and ``meta``: one JSON text with the format tag, the scene (SI values of
+    :class:`weftsim.params.Scene`), engine, status, message, solver statistics, events,
+    plausibility and path.  No pickled objects, so reading a file runs no code.
+
+    Returns
+    -------
+    Path
+        ``path``, written as given (no suffix is added; ``.npz`` is the customary one).
+    """
+    path = Path(path)
+    meta = {"format": NPZ_FORMAT, "scene": _plain(result.scene), "engine": result.engine, "status": result.status,
+            "message": result.message, "solver_stats": _plain(result.solver_stats), "events": _plain(result.events),
+            "plausibility": _plain(result.plausibility), "path": _plain(result.path)}
+    arrays = {f"{table}/{name}": getattr(result, table)[name] for table in ("samples", "steps") for name in CHANNELS}
+    # allow_nan: NaN and inf statistics come back as they were (Python's JSON reads its own NaN back).
+    arrays["meta"] = np.array(json.dumps(meta, allow_nan=True))
+    with path.open("wb") as file:
+        np.savez_compressed(file, **arrays)
+    return path
+
+
+def load_npz(path: str | os.PathLike) -> RunResult:
+    """The :class:`RunResult` saved by :func:`save_npz`.
+
+    Raises
+    ------
+    weftsim.errors.OutputError
+        The file cannot be read, is not a weftsim result, or lacks a channel.
+    """
+    path = Path(path)
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            meta = json.loads(str(data["meta"][()]))
+            if not isinstance(meta, dict) or meta.get("format") != NPZ_FORMAT:
+                raise OutputError(f"{path}: not a weftsim result of format {NPZ_FORMAT} "
+                                  f"(found {meta.get('format') if isinstance(meta, dict) else meta!r})")
+            tables = {table: {name: data[f"{table}/{name}"] for name in CHANNELS} for table in ("samples", "steps")}
+    except OutputError:
+        raise
+    except FileNotFoundError:
+        raise OutputError(f"{path}: result file not found") from None
+    except KeyError as exc:
+        raise OutputError(f"{path}: not a complete weftsim result (no {exc.args[0]!r} in it)") from None
+    except (OSError, ValueError, zipfile.BadZipFile) as exc:
+        raise OutputError(f"{path}: cannot be read as a weftsim result ({exc})") from None
+    scene = _rebuild(Scene, meta["scene"])
+    return RunResult(scene, meta["engine"], meta["status"], meta["message"], tables["samples"], tables["steps"],
+                     meta["solver_stats"], meta["events"], meta["plausibility"], meta["path"])

@@ -1,7 +1,10 @@
 """Scene files: TOML in, validated :class:`weftsim.params.Scene` out.
 
-A scene file may ``extends = "other.toml"`` (path relative to the file) and then
-holds only what differs; tables merge key by key.  Units live in the key names
+A scene file may ``extends = "other.toml"`` (path relative to the file) or
+``extends = "reference"`` (a bundled scene, :func:`bundled_scenes`) and then holds only
+what differs; tables merge key by key.  A scene is named by a path or by the name of a
+bundled scene (:func:`scene_source`): a regular file at the path wins, so a user's file
+is never shadowed by a bundled scene of the same name.  Units live in the key names
 (``_mm``, ``_deg``, ``_rpm``, ``_gpa``, ...) and are converted to SI here.  A scene
 must give every key of the sections that describe the machine (:data:`REQUIRED_SECTIONS`),
 itself or through ``extends``; settings (solver, output, compare, limits) default.  Every
@@ -12,14 +15,17 @@ scene reference is written from it.
 
 from __future__ import annotations
 
+import difflib
 import math
+import os
 import stat
 import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 from weftsim import params
+from weftsim.errors import SceneError
 
 INTEGRATORS = ("auto", "DOP853", "RK45", "RK23", "Radau", "LSODA", "BDF", "numba_DOP853", "numba_RK45")
 EXUDYN_MODELS = ("auto", "rigid_body", "kinematic_tree")
@@ -28,10 +34,6 @@ STEP_CONTROLS = ("adaptive", "fixed")
 CALLBACK_ROUTES = ("auto", "python", "symbolic", "numba")
 BRANCHES = {"+": 1, "-": -1}
 IMPACT_VELOCITY_RULES = ("max_approach", "onset")
-
-
-class SceneError(ValueError):
-    """A scene file or a command-line override is not acceptable."""
 
 
 @dataclass(frozen=True)
@@ -274,6 +276,92 @@ def _read_toml(path: Path) -> dict:
         raise SceneError(f"{path}: not valid TOML ({exc})") from None
 
 
+def bundled_directory() -> Path | None:
+    """The directory of the bundled scene files, or None if this installation has none.
+
+    An installed weftsim carries them as the package data ``weftsim/scenes`` (the build maps
+    the repository's ``models/`` there, see ``setup.py``); a source checkout, run from the tree
+    or installed in editable mode, reads ``models/`` beside the package itself.
+    """
+    package = Path(__file__).resolve().parent
+    installed, checkout = package / "scenes", package.parent / "models"
+    if (installed / "reference.toml").is_file():
+        return installed
+    if (checkout / "reference.toml").is_file() and (package.parent / "pyproject.toml").is_file():
+        return checkout
+    return None
+
+
+def bundled_scenes() -> list[str]:
+    """Names of the bundled scenes, sorted: the file's path below the scene directory without ``.toml``
+    (``"reference"``, ``"paper/clearance_0p50mm_400rpm"``)."""
+    root = bundled_directory()
+    if root is None:
+        return []
+    return sorted(p.relative_to(root).with_suffix("").as_posix() for p in root.rglob("*.toml") if p.is_file())
+
+
+def bundled_scene_path(name: str) -> Path:
+    """The file of the bundled scene ``name``.
+
+    Raises
+    ------
+    SceneError
+        If no bundled scene has that name (the message lists them, closest first).
+    """
+    names = bundled_scenes()
+    if name not in names:
+        raise SceneError(f"no bundled scene named {shown(name)!r}; {_bundled_hint(name, names)}")
+    root = bundled_directory()
+    assert root is not None  # names is not empty
+    return root / (name + ".toml")
+
+
+def _bundled_hint(name: str, names: list[str]) -> str:
+    """'did you mean ...? bundled scenes: ...' for an unknown scene name."""
+    if not names:
+        return "this installation has no bundled scenes"
+    near = difflib.get_close_matches(name.removesuffix(".toml"), names, n=2, cutoff=0.6)
+    mean = f"did you mean {' or '.join(near)}? " if near else ""
+    return f"{mean}bundled scenes: {', '.join(names)} ('weftsim scenes' lists them)"
+
+
+def scene_source(scene: str | os.PathLike, base: Path | None = None) -> Path:
+    """The file a scene argument names: a path, or the name of a bundled scene.
+
+    A string names a regular file if one exists at that path (relative to ``base``, default the
+    current directory); otherwise a bundled scene of that name (``"reference"``,
+    ``"paper/clearance_0p50mm_400rpm"``).  A :class:`os.PathLike` is always a path.  Anything else
+    is returned as a path, so reading it reports what is wrong (not found, a directory, a pipe).
+
+    Raises
+    ------
+    SceneError
+        If nothing exists at the path and no bundled scene has that name.
+    """
+    if not isinstance(scene, (str, os.PathLike)):
+        raise SceneError(f"a scene is a path or the name of a bundled scene, got {type(scene).__name__} "
+                         f"{shown(repr(scene))[:80]}")
+    path = Path(scene) if base is None else base / scene
+    if isinstance(scene, os.PathLike) or path.is_file():
+        return path
+    if scene in bundled_scenes():
+        return bundled_scene_path(scene)
+    if os.path.lexists(path):  # a directory, pipe or device: reading it says so
+        return path
+    raise SceneError(f"{shown(str(path))}: scene file not found, and no bundled scene has that name; "
+                     f"{_bundled_hint(scene, bundled_scenes())}")
+
+
+def scene_description(path: Path) -> str:
+    """The ``description`` of a scene file (empty if it gives none or cannot be read)."""
+    try:
+        description = _read_toml(path).get("description", "")
+    except SceneError:
+        return ""
+    return description if isinstance(description, str) else ""
+
+
 def _read_merged(path: Path) -> tuple[dict[str, Any], dict[str, Path]]:
     """Flattened keys of a scene and its ``extends`` chain, and the file each key came from.
 
@@ -293,8 +381,11 @@ def _read_merged(path: Path) -> tuple[dict[str, Any], dict[str, Path]]:
             break
         parent = flat.pop("extends")
         if not isinstance(parent, str):
-            raise SceneError(f"{path}: key 'extends' must be a path string, got {parent!r}")
-        path = (path.parent / parent).resolve()
+            raise SceneError(f"{path}: key 'extends' must be a path or the name of a bundled scene, got {parent!r}")
+        try:
+            path = scene_source(parent, path.parent).resolve()
+        except SceneError as exc:
+            raise SceneError(f"{path}: key 'extends' = {shown(repr(parent))}: {exc}") from None
     merged, origin = {}, {}
     for index, (path, flat) in enumerate(reversed(chain)):
         if index:  # a base file's name and description do not describe the scene extending it
@@ -398,7 +489,9 @@ def _known(path: str, where: str) -> Key:
         near = [k.path for k in SCHEMA if k.path.rpartition(".")[0] == section] or sorted(
             {k.path.partition(".")[0] for k in SCHEMA}
         )
-        raise SceneError(f"{where}: unknown key '{shown(path)}'; allowed here: {', '.join(near)}")
+        close = difflib.get_close_matches(path, list(_BY_PATH), n=1, cutoff=0.75)
+        mean = f"did you mean '{close[0]}'? " if close else ""
+        raise SceneError(f"{where}: unknown key '{shown(path)}'; {mean}allowed here: {', '.join(near)}")
     return key
 
 
@@ -438,16 +531,19 @@ def _missing_joint_f(flat: dict[str, Any]) -> list[str]:
     return [key for key in JOINT_F_REQUIRED if key not in flat]
 
 
-def load_scene(path: str | Path, overrides: dict[str, Any] | None = None) -> params.Scene:
+def load_scene(path: str | os.PathLike, overrides: dict[str, Any] | None = None,
+               overrides_from: str = "command line") -> params.Scene:
     """Read, merge (``extends``), override and validate a scene file.
 
     Parameters
     ----------
-    path : str or Path
-        The TOML scene file.
+    path : str or path-like
+        The TOML scene file, or the name of a bundled scene (:func:`scene_source`).
     overrides : dict, optional
         Dotted file keys with file-unit values, e.g. ``{"drive.speed_rpm": 500}``,
         applied after the file (the command-line flags use this).
+    overrides_from : str
+        Where the overrides came from, as error messages name it.
 
     Raises
     ------
@@ -456,14 +552,14 @@ def load_scene(path: str | Path, overrides: dict[str, Any] | None = None) -> par
         or the required keys (sections :data:`REQUIRED_SECTIONS`) that neither the file
         nor the files it extends give.
     """
-    path = Path(path)
+    path = scene_source(path)
     flat, origin = _read_merged(path)
     flat.setdefault("name", path.stem)
     for dotted, value in (overrides or {}).items():
         if value is None:
             continue
         flat[dotted] = value
-        origin[dotted] = Path("command line")
+        origin[dotted] = Path(overrides_from)
     for dotted in flat:  # a misspelt key is reported as such, not as the missing one it stands for
         if dotted not in TOP_LEVEL:
             _known(dotted, str(origin.get(dotted, path)))

@@ -35,7 +35,7 @@ __all__ = [
 ]
 
 
-def rocker_angle(theta, beta):
+def rocker_angle(theta, beta) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Rocker angle of the loom's spherical 4R and its derivatives.
 
     With arcs B-C = C-D = A-D = 90 deg the closure b . c = 0 gives
@@ -86,7 +86,7 @@ def _spherical_4r_coefficients(theta_in, alpha1, alpha2, alpha3, alpha4):
     return (a, da, dda), (b, db, ddb), (c, dc, ddc)
 
 
-def spherical_4r_assembles(theta_in, alpha1, alpha2, alpha3, alpha4):
+def spherical_4r_assembles(theta_in, alpha1, alpha2, alpha3, alpha4) -> np.ndarray:
     """True where the general spherical 4R can be assembled, C^2 <= A^2 + B^2.
 
     Same arguments as :func:`spherical_4r`; returns a boolean array of the shape of
@@ -98,7 +98,7 @@ def spherical_4r_assembles(theta_in, alpha1, alpha2, alpha3, alpha4):
     return c * c <= a * a + b * b
 
 
-def spherical_4r(theta_in, alpha1, alpha2, alpha3, alpha4, branch):
+def spherical_4r(theta_in, alpha1, alpha2, alpha3, alpha4, branch) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """General spherical 4R input-output law (docs/physics.md section 1) with derivatives.
 
     In the mechanism's own frame (a = z, d = R_y(alpha1) z,
@@ -158,7 +158,7 @@ def spherical_4r(theta_in, alpha1, alpha2, alpha3, alpha4, branch):
     return phi, dphi, ddphi
 
 
-def crank_axis(theta, beta):
+def crank_axis(theta, beta) -> np.ndarray:
     """Crank axis b(theta) = (-sin beta sin theta, sin beta cos theta, cos beta), shape (..., 3)."""
     theta = np.asarray(theta, dtype=float)
     sb = np.sin(beta)
@@ -167,13 +167,13 @@ def crank_axis(theta, beta):
     )
 
 
-def rocker_axis(phi):
+def rocker_axis(phi) -> np.ndarray:
     """Rocker axis c(phi) = (0, cos phi, sin phi), shape (..., 3)."""
     phi = np.asarray(phi, dtype=float)
     return np.stack([np.zeros_like(phi), np.cos(phi), np.sin(phi)], axis=-1)
 
 
-def coupler_frame(theta, beta):
+def coupler_frame(theta, beta) -> np.ndarray:
     """Rotation matrix of the coupler (member 2): columns [b, c, b x c].
 
     Parameters
@@ -195,7 +195,7 @@ def coupler_frame(theta, beta):
     return np.stack([b, c, np.cross(b, c)], axis=-1)
 
 
-def coupler_angular_velocity(theta, beta):
+def coupler_angular_velocity(theta, beta) -> tuple[np.ndarray, np.ndarray]:
     """Angular velocity of the coupler per unit crank speed, in the fixed frame.
 
     The coupler turns relative to the crank about b and relative to the rocker

@@ -23,8 +23,13 @@ import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from weftsim.analysis import complete_revolutions, peaks, statistics
+
+if TYPE_CHECKING:
+    from weftsim.params import Scene
+    from weftsim.results import RunResult
 
 QUANTITY_CHANNELS = ("driving_torque_Nm", "rapier_acceleration_m_s2", "contact_force_N")
 CASES = {
@@ -98,7 +103,7 @@ def settings(case: str, quick: bool = False) -> list[Setting]:
     return out
 
 
-def load_case(case: str, models: str | Path, revolutions: float, overrides: dict | None = None):
+def load_case(case: str, models: str | Path, revolutions: float, overrides: dict | None = None) -> Scene:
     from weftsim.scene import load_scene
 
     keys = {**CASES[case], "drive.revolutions": revolutions, **(overrides or {})}
@@ -114,7 +119,7 @@ def _solver(engine: str):
     return solve
 
 
-def timed_solve(scene, engine: str):
+def timed_solve(scene, engine: str) -> tuple[RunResult, float, float]:
     """(result, wall s, CPU s) of one ``solve``."""
     solve = _solver(engine)
     wall0, cpu0 = time.perf_counter(), time.process_time()

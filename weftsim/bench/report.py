@@ -13,6 +13,10 @@ import os
 import platform
 import subprocess
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 FAILED_Y = 1.0  # where failed runs are drawn (relative error 100 %)
 
@@ -117,7 +121,7 @@ def markdown(report: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def figure(report: dict, case: str):
+def figure(report: dict, case: str) -> Figure:
     """Error against wall time (log-log) for one case: peaks and statistics panels."""
     import matplotlib
 

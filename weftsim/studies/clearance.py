@@ -47,7 +47,7 @@ def ideal_features(geometry, omega: float, points: int = 36001) -> dict[str, lis
     }
 
 
-def acceleration_deviation(result, bin_deg: float = BIN_DEG, skip_revolutions: int = 1):
+def acceleration_deviation(result, bin_deg: float = BIN_DEG, skip_revolutions: int = 1) -> tuple[np.ndarray, np.ndarray]:
     """Time-weighted RMS of a - a_ideal per crank-angle bin over revolutions after ``skip_revolutions``.
 
     Returns

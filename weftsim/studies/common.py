@@ -16,20 +16,19 @@ import logging
 import math
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+from weftsim.errors import SimulationFailed, StudyError  # noqa: F401 (re-exported: weftsim.studies)
+
+if TYPE_CHECKING:
+    from weftsim.params import Scene
+    from weftsim.results import RunResult
 
 log = logging.getLogger(__name__)
 
 RPM = 60.0 / (2.0 * math.pi)  # rad/s -> rpm
-
-
-class StudyError(ValueError):
-    """A study cannot run: unknown name, missing scene file or bad setting."""
-
-
-class SimulationFailed(StudyError):
-    """A simulation of a study ended with ``status = "failed"``."""
 
 
 def scene_path(models: str | Path, name: str) -> Path:
@@ -41,14 +40,14 @@ def scene_path(models: str | Path, name: str) -> Path:
     return path
 
 
-def load(models: str | Path, name: str, overrides: dict | None = None):
+def load(models: str | Path, name: str, overrides: dict | None = None) -> Scene:
     """Load ``models/<name>`` with file-unit overrides (e.g. ``{"drive.revolutions": 10}``)."""
     from weftsim.scene import load_scene
 
     return load_scene(scene_path(models, name), overrides)
 
 
-def solve(scene, engine: str = "reference", label: str | None = None, progress: bool = True):
+def solve(scene, engine: str = "reference", label: str | None = None, progress: bool = True) -> RunResult:
     """Run one engine on a scene (progress on stderr for long runs); a failed run raises SimulationFailed."""
     from weftsim.progress import Progress
 

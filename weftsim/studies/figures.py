@@ -5,12 +5,17 @@ Axes are labelled in the paper's units: mm, deg, m/s², N·m, N, Hz.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from weftsim.plots import pyplot, channel_panels  # noqa: F401 - channel_panels re-exported for the studies
 
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
-def trend_panels(x, x_label: str, panels, title: str, x_ticks=None):
+
+def trend_panels(x, x_label: str, panels, title: str, x_ticks=None) -> Figure:
     """Rows of reproducible quantities against a study parameter.
 
     Parameters
@@ -35,7 +40,7 @@ def trend_panels(x, x_label: str, panels, title: str, x_ticks=None):
     return fig
 
 
-def spectrum_panels(spectra, title: str, low_band_hz: float = 100.0):
+def spectrum_panels(spectra, title: str, low_band_hz: float = 100.0) -> Figure:
     """Amplitude spectra: 0..low_band_hz on a linear scale, the whole band on a log scale.
 
     Parameters
@@ -64,7 +69,7 @@ def spectrum_panels(spectra, title: str, low_band_hz: float = 100.0):
     return fig
 
 
-def contact_law_panels(curve, revolution, law_lines, title: str):
+def contact_law_panels(curve, revolution, law_lines, title: str) -> Figure:
     """Paper Fig. 7-9: K against penetration, K along a revolution, D against penetration.
 
     Parameters
@@ -114,7 +119,7 @@ def contact_law_panels(curve, revolution, law_lines, title: str):
     return fig
 
 
-def deviation_panel(bin_centres, deviations, markers, title: str):
+def deviation_panel(bin_centres, deviations, markers, title: str) -> Figure:
     """RMS deviation of the rapier acceleration from the ideal one per crank-angle bin.
 
     Parameters

@@ -28,10 +28,14 @@ import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from weftsim.studies.common import StudyError
+
+if TYPE_CHECKING:
+    from weftsim.params import Scene
 
 # The frequency study of the outliers: every paper scene at these tolerances (72 runs).
 STUDY_RTOLS = {
@@ -90,7 +94,7 @@ class Cell:
         """Identity of the cell in a CSV (for resuming): scene, method, rtol, overrides."""
         return (self.scene_name, self.method, f"{self.rtol:.0e}", self.overrides_text)
 
-    def scene(self):
+    def scene(self) -> Scene:
         from weftsim.scene import load_scene
 
         if self.method == EXUDYN:

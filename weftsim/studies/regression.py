@@ -27,8 +27,12 @@ import math
 import platform
 import time
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from weftsim.results import RunResult
 
 # kind -> floor on the relative tolerance, and the factor on the largest measured shift.
 FLOOR = {
@@ -134,7 +138,7 @@ def _resolve(overrides: dict, base_scene) -> dict:
     return out
 
 
-def run_case(case: Case, root, extra: dict | None = None):
+def run_case(case: Case, root, extra: dict | None = None) -> RunResult:
     """Load and solve a case (``root`` = repository root); a failed run raises RuntimeError."""
     from weftsim.scene import load_scene
     from weftsim.studies.common import solve

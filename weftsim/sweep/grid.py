@@ -24,16 +24,13 @@ from typing import Any
 
 import numpy as np
 
+from weftsim.errors import SweepError
 from weftsim.scene import SCHEMA, Key
 
 SWEEPABLE_KINDS = ("float", "int", "str", "bool")
 RANGE_DIGITS = 12  # range values are rounded to 12 significant digits: 0.08, not 0.08000000000000002
 COMMON_KEYS = ("clearance_mm", "speed_rpm", "law", "revolutions", "restitution", "friction_coefficient")
 SAFE_TEXT = re.compile(r"^[A-Za-z0-9_.+-]+$")  # string values must be usable in a directory name
-
-
-class SweepError(ValueError):
-    """A sweep cannot be set up: bad --vary text, unknown key, invalid cell, incompatible directory."""
 
 
 def _short_names() -> dict[str, Key]:
@@ -78,7 +75,7 @@ def resolve_key(name: str) -> Key:
     near = difflib.get_close_matches(name, list(SHORT_NAMES) + list(_BY_PATH), n=3)
     hint = f"did you mean {', '.join(near)}? " if near else ""
     raise SweepError(
-        f"unknown sweep key '{name}'; {hint}use a dotted scene key (any key of the README's scene reference, "
+        f"unknown scene key '{name}'; {hint}use a dotted scene key (any key of the README's scene reference, "
         f"e.g. joint_e.clearance_mm) or its last part where that is unique ({', '.join(COMMON_KEYS)}, ...)"
     )
 

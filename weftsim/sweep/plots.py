@@ -7,10 +7,14 @@ cells are left blank (grey in a heat map, a gap in a line).
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from weftsim.sweep.cell import METRIC_CHANNELS
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 PANEL_LABELS = {
     "driving_torque_Nm": "peak |driving torque| [N·m]",
@@ -86,7 +90,7 @@ def _grid_panel(fig, ax, grid, xc, yc, channel, annotate):
                             color="white" if grid[i, j] < 0.6 * top else "black")
 
 
-def plot_sweep_1d(rows: list[dict], name: str, title: str = ""):
+def plot_sweep_1d(rows: list[dict], name: str, title: str = "") -> Figure:
     """Three panels: peak torque, acceleration and contact force against the varied parameter."""
     from weftsim.plots import pyplot
 
@@ -110,7 +114,7 @@ def plot_sweep_1d(rows: list[dict], name: str, title: str = ""):
     return fig
 
 
-def plot_sweep_2d(rows: list[dict], x_name: str, y_name: str, title: str = ""):
+def plot_sweep_2d(rows: list[dict], x_name: str, y_name: str, title: str = "") -> Figure:
     """Heat maps of peak torque, acceleration and contact force over the (x, y) grid.
 
     One row for the first revolution and, when the runs are longer, one for the last
@@ -146,7 +150,7 @@ def plot_sweep_2d(rows: list[dict], x_name: str, y_name: str, title: str = ""):
     return fig
 
 
-def plot_sweep(rows: list[dict], axis_names: list[str], title: str = ""):
+def plot_sweep(rows: list[dict], axis_names: list[str], title: str = "") -> Figure | None:
     """The figure for a 1-D or 2-D sweep, or None for more axes (the table still has every cell)."""
     if not any(row.get("status") == "success" for row in rows):
         return None

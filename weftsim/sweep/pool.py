@@ -12,13 +12,14 @@ import concurrent.futures as cf
 import os
 import sys
 import time
+from typing import Callable
 
 from weftsim.sweep.grid import SweepError
 
 CONNECT_TIMEOUT_S = 20.0  # how long to keep trying to reach a Dask scheduler (it may be starting up)
 
 
-def executor(jobs: int | None, scheduler: str | None, n_cells: int, engine: str):
+def executor(jobs: int | None, scheduler: str | None, n_cells: int, engine: str) -> tuple[cf.Executor, int, Callable[..., None]]:
     """(executor, in-flight window, stop): a local process pool, or a Dask client's executor.
 
     ``stop(interrupted)`` cancels what has not started and returns without waiting for running

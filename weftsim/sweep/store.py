@@ -22,12 +22,15 @@ import csv
 import io
 import json
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from weftsim import __version__
 from weftsim.sweep.cell import METRIC_CHANNELS, finite_or_none, read_record
 from weftsim.sweep.grid import Axis, SweepError, format_value
 from weftsim.sweep.lock import LOCK_FILE
+
+if TYPE_CHECKING:
+    import xarray
 
 SWEEP_FILE = "sweep.json"
 TABLE_FILE = "sweep.csv"
@@ -187,3 +190,66 @@ def read_table(path: Path) -> list[dict[str, str]]:
     """Rows of a written ``sweep.csv`` (strings, as in the file)."""
     with open(path, newline="", encoding="utf-8") as f:
         return list(csv.DictReader(f))
+
+
+# Columns of sweep.csv that are numbers, the data variables of the labelled grid.
+GRID_NUMBERS = ("wall_time_s", "complete_revolutions", "first_contact_deg") + METRIC_COLUMNS
+
+
+def _coordinate(values: list) -> list:
+    """An axis's values in order: numbers ascending (a resumed sweep appends values at the end)."""
+    if all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
+        return sorted(values)
+    return list(values)
+
+
+def load_grid(outdir: Path) -> xarray.Dataset:
+    """The sweep in ``outdir`` as an :class:`xarray.Dataset` over its varied keys.
+
+    Dimensions are the axes of ``sweep.json`` (by their cell-name names; attribute ``scene_key``
+    the dotted key), coordinates their values in file units.  Each number of a cell's record
+    (:data:`GRID_NUMBERS`, the columns of ``sweep.csv``) is one float variable, NaN where a cell
+    was not run or lacks it; ``status`` is ``"success"``, ``"failed"`` or ``"not run"``.  The
+    manifest's engine and base scene name are attributes.  Read from the cells' ``cell.json``
+    records, as ``sweep.csv`` is, so a sweep still running or interrupted loads what is finished.
+
+    Raises
+    ------
+    SweepError
+        ``outdir`` holds no sweep or a damaged manifest.
+    weftsim.errors.MissingExtra
+        xarray is not installed (extra ``weftsim[data]``).
+    """
+    import numpy as np
+
+    from weftsim.errors import require
+
+    xr = require("xarray", "data", "load_sweep")
+    outdir = Path(outdir)
+    data = read_manifest(outdir)
+    if data is None:
+        raise SweepError(f"{outdir}: no {SWEEP_FILE} there, so it is not a sweep directory (weftsim sweep writes one)")
+    names = [axis.get("name") or axis["key"] for axis in data["axes"]]
+    values = {name: _coordinate(axis["values"]) for name, axis in zip(names, data["axes"])}
+    index = {name: {format_value(v): i for i, v in enumerate(values[name])} for name in names}
+    shape = tuple(len(values[name]) for name in names)
+    numbers = {column: np.full(shape, np.nan) for column in GRID_NUMBERS}
+    status = np.full(shape, "not run", dtype=object)
+    for row in collect_rows(outdir, names):
+        try:
+            where = tuple(index[name][format_value(row.get(name))] for name in names)
+        except KeyError:  # a cell directory of values the manifest does not list: not part of the grid
+            continue
+        status[where] = row.get("status") or "not run"
+        for column in GRID_NUMBERS:
+            value = finite_or_none(row.get(column))
+            if isinstance(value, (int, float)) and not isinstance(value, bool):
+                numbers[column][where] = float(value)
+    variables = {column: (names, array) for column, array in numbers.items()}
+    variables["status"] = (names, status.astype(str))
+    grid = xr.Dataset(variables, coords={name: values[name] for name in names})
+    for name, axis in zip(names, data["axes"]):
+        grid[name].attrs["scene_key"] = axis["key"]
+    grid.attrs.update({"engine": data["engine"], "scene": str(data["base_scene"].get("name", "")),
+                       "scene_path": str(data.get("scene_path", "")), "sweep_directory": str(outdir)})
+    return grid

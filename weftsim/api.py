@@ -1,0 +1,238 @@
+"""The Python interface of weftsim: load a scene, simulate it, keep and load results.
+
+The functions here are what ``import weftsim`` exports and what the command line calls,
+so a script and ``weftsim run`` take the same path::
+
+    import weftsim
+
+    scene = weftsim.load_scene("reference", clearance_mm=0.5)  # a bundled scene, c = 0.5 mm at E
+    result = weftsim.simulate(scene, engine="reference")     # closed-form Lagrange engine
+    table = result.to_pandas()                                  # needs the extra weftsim[data]
+
+Scenes are given in the units of the scene files (mm, deg, rpm: the unit is part of each
+key's name, docs/physics.md and the README's scene reference); everything inside weftsim,
+results included, is SI.  Errors are :class:`weftsim.errors.WeftsimError` subclasses whose
+message is the line the command line prints.
+"""
+
+from __future__ import annotations
+
+import difflib
+import os
+from collections.abc import Mapping
+from pathlib import Path
+from types import ModuleType
+from typing import TYPE_CHECKING, Any, Callable
+
+from weftsim.errors import EngineError, RunFailed, SceneError
+from weftsim.params import Scene
+from weftsim.results import RunResult
+
+if TYPE_CHECKING:
+    import xarray
+
+# Engine names :func:`simulate` accepts.  "auto" is the default engine, the Exudyn multibody
+# model (the project's primary engine; the reference engine is its independent cross-check).
+ENGINE_NAMES: tuple[str, ...] = ("auto", "exudyn", "reference")
+DEFAULT_ENGINE = "exudyn"
+
+# The shorthands of the command line (--clearance-mm, --speed-rpm, --revolutions, --law) and of
+# load_scene's keyword flags, and the scene keys they set (file units).
+SCENE_FLAGS: dict[str, str] = {
+    "clearance_mm": "joint_e.clearance_mm",
+    "speed_rpm": "drive.speed_rpm",
+    "revolutions": "drive.revolutions",
+    "law": "joint_e.law",
+}
+
+
+def scene_overrides(overrides: Mapping[str, Any] | None = None, where: str = "overrides",
+                    **flags: Any) -> dict[str, Any]:
+    """One dict of dotted scene keys from ``overrides`` and the shorthand ``flags`` (:data:`SCENE_FLAGS`).
+
+    A flag that is None is not given.  Raises :class:`SceneError` for an unknown flag (with the
+    closest one) or a key given both ways.
+    """
+    merged = dict(overrides or {})
+    for flag, value in flags.items():
+        key = SCENE_FLAGS.get(flag)
+        if key is None:
+            near = difflib.get_close_matches(flag, list(SCENE_FLAGS), n=1)
+            mean = f"did you mean {near[0]}? " if near else ""
+            raise SceneError(f"{where}: unknown scene flag {flag!r}; {mean}the flags are {', '.join(SCENE_FLAGS)}; "
+                             "set any other key with overrides={'section.key': value}")
+        if value is None:
+            continue
+        if merged.get(key) is not None:
+            raise SceneError(f"{where}: key '{key}' is given twice, by the flag {flag} = {value!r} and as "
+                             f"{key} = {merged[key]!r}; give it once")
+        merged[key] = value
+    return merged
+
+
+def load_scene(scene: str | os.PathLike, overrides: Mapping[str, Any] | None = None, **flags: Any) -> Scene:
+    """Read, merge, override and validate a scene.
+
+    Parameters
+    ----------
+    scene : str or path-like
+        A scene file (TOML), or the name of a bundled scene (:func:`bundled_scenes`, e.g.
+        ``"reference"`` or ``"paper/clearance_0p50mm_400rpm"``).  A string names a file when a
+        regular file exists at that path, a bundled scene otherwise.
+    overrides : mapping, optional
+        Dotted scene keys and values in the units of the file, applied after it, e.g.
+        ``{"joint_e.clearance_mm": 0.5, "solver.reference.rtol": 1e-8}``.
+    **flags
+        The command line's shorthands: ``clearance_mm`` (radial clearance at E, mm; 0 is the ideal
+        joint), ``speed_rpm`` (crank speed, rpm), ``revolutions`` (crank revolutions), ``law``
+        (contact force law, a name of :data:`weftsim.contact.LAWS`).
+
+    Returns
+    -------
+    Scene
+        The validated scene in SI units (:class:`weftsim.params.Scene`, frozen).
+
+    Raises
+    ------
+    weftsim.errors.SceneError
+        The file or name, a key or a value is not acceptable; the message names the file, the
+        key, the bad value and what is allowed (and the closest key or scene name for a typo).
+    """
+    from weftsim.scene import load_scene as load_file
+
+    return load_file(scene, scene_overrides(overrides, **flags), overrides_from="overrides")
+
+
+def bundled_scenes() -> list[str]:
+    """Names of the scenes installed with weftsim, for :func:`load_scene` and ``weftsim run NAME``.
+
+    ``"reference"`` is the reference mechanism of docs/physics.md section 1 (c = 0.25 mm at E,
+    400 rpm), ``"ideal"`` the same with an ideal joint, ``"paper/..."`` the paper's clearance and
+    speed cases.  ``weftsim scenes`` lists them with their descriptions.
+    """
+    from weftsim.scene import bundled_scenes as names
+
+    return names()
+
+
+def resolve_engine(engine: str) -> str:
+    """The engine ``engine`` names: ``"auto"`` is :data:`DEFAULT_ENGINE`; an unknown name is an EngineError."""
+    if engine == "auto":
+        return DEFAULT_ENGINE
+    if engine not in ENGINE_NAMES:
+        raise EngineError(f"engine must be one of {', '.join(ENGINE_NAMES)}, got {engine!r}")
+    return engine
+
+
+def _engine_module(engine: str) -> ModuleType:
+    """The package of an engine, with ``solve(scene, progress=None)`` and ``select_path(scene)``."""
+    if resolve_engine(engine) == "reference":
+        import weftsim.reference as module
+    else:
+        import weftsim.exudyn_engine as module
+    return module
+
+
+def select_path(scene: Scene, engine: str = "auto") -> dict[str, str]:
+    """The model and method ``engine`` runs ``scene`` on, and why: ``{"model", "method", "reason"}``."""
+    return _engine_module(engine).select_path(scene)
+
+
+def _as_scene(scene: Scene | str | os.PathLike) -> Scene:
+    if isinstance(scene, Scene):
+        return scene
+    if isinstance(scene, (str, os.PathLike)):
+        return load_scene(scene)
+    raise SceneError(f"simulate: scene must be a Scene (weftsim.load_scene), a scene file or the name of a "
+                     f"bundled scene, got {type(scene).__name__}")
+
+
+def simulate(scene: Scene | str | os.PathLike, engine: str = "auto", *,
+             progress: Callable[[float], None] | None = None, raise_on_failure: bool = False) -> RunResult:
+    """Simulate one scene with one engine.
+
+    Parameters
+    ----------
+    scene : Scene, str or path-like
+        A scene from :func:`load_scene`, or what :func:`load_scene` takes (a file or a bundled name).
+    engine : {"auto", "exudyn", "reference"}
+        ``"exudyn"``: the Exudyn multibody model (the kinematic tree, or the rigid-body model where
+        a scene needs it); ``"reference"``: the independent closed-form Lagrange engine (compiled
+        DOP853); ``"auto"``: the default engine, :data:`DEFAULT_ENGINE`.
+    progress : callable, optional
+        Called with the completed fraction in [0, 1] about 100 times per run.
+    raise_on_failure : bool
+        Raise :class:`weftsim.errors.RunFailed` (holding the partial result) when the run fails,
+        instead of returning it with ``status == "failed"``.
+
+    Returns
+    -------
+    RunResult
+        The channels on the output grid (``samples``) and at every accepted step (``steps``), the
+        solver statistics, the status and message, the plausibility counts and the path taken.
+        A failed run keeps what it computed up to the failure (``result.ok`` is False).
+
+    Raises
+    ------
+    weftsim.errors.EngineError
+        ``engine`` is not one of :data:`ENGINE_NAMES`.
+    weftsim.errors.SceneError
+        ``scene`` is a file or name that does not load.
+    weftsim.errors.RunFailed
+        Only with ``raise_on_failure``: the run failed (``exc.result`` holds it).
+    """
+    module = _engine_module(engine)
+    result = module.solve(_as_scene(scene), progress=progress)
+    if raise_on_failure and not result.ok:
+        raise RunFailed(f"simulation failed: {result.message}", result)
+    return result
+
+
+def save_result(result: RunResult, path: str | os.PathLike) -> Path:
+    """Save a result losslessly to one NPZ file (``weftsim run`` writes ``result.npz``).
+
+    Both tables (output samples and every solver step) are kept bit for bit, with the scene, the
+    status, the solver statistics, the plausibility counts and the path; :func:`load_result`
+    rebuilds an equal :class:`RunResult`.  Returns the path, written as given.
+    """
+    from weftsim.results import save_npz
+
+    return save_npz(result, path)
+
+
+def load_result(path: str | os.PathLike) -> RunResult:
+    """The :class:`RunResult` saved by :func:`save_result` (or ``weftsim run``'s ``result.npz``).
+
+    Raises
+    ------
+    weftsim.errors.OutputError
+        The file is missing, unreadable or not a weftsim result.
+    """
+    from weftsim.results import load_npz
+
+    return load_npz(path)
+
+
+def load_sweep(directory: str | os.PathLike) -> xarray.Dataset:
+    """A sweep directory (``weftsim sweep``) as a labelled grid.
+
+    Returns
+    -------
+    xarray.Dataset
+        One dimension per varied key (named as in the cell names, e.g. ``clearance_mm``; its
+        ``scene_key`` attribute is the dotted key), coordinates the values in file units; data
+        variables the table columns of ``sweep.csv`` (peaks of the first and last revolution and
+        99th percentiles of driving torque, rapier acceleration and contact force, wall time,
+        first contact angle) and ``status`` (``"success"``, ``"failed"`` or ``"not run"``).
+        Values of cells not run, or without the number, are NaN.
+
+    Raises
+    ------
+    weftsim.errors.SweepError
+        The directory holds no sweep (no ``sweep.json``) or a damaged one.
+    weftsim.errors.MissingExtra
+        xarray is not installed (it comes with the optional extra ``weftsim[data]``).
+    """
+    from weftsim.sweep.store import load_grid
+
+    return load_grid(Path(directory))

@@ -1,0 +1,94 @@
+"""The exceptions weftsim raises on purpose: one hierarchy under :class:`WeftsimError`.
+
+Every expected failure (a bad scene, an unwritable output directory, an unknown engine, a run
+that failed, a missing optional package) is one of these, and its message is the line the
+command line prints after ``weftsim COMMAND: error:``.  A script catches them all with
+``except weftsim.WeftsimError``; each also derives from the built-in exception a caller would
+expect (``ValueError`` for bad input, ``OSError`` for files, ``ImportError`` for a missing
+package), so code written against those keeps working.
+
+``exit_status`` is the status the ``weftsim`` command ends with (:mod:`weftsim.exitcodes`).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+from weftsim.exitcodes import EXIT_FAILED, EXIT_USAGE
+
+if TYPE_CHECKING:
+    from weftsim.results import RunResult
+
+
+class WeftsimError(Exception):
+    """Base class of every error weftsim raises on purpose; the message is one line for a person."""
+
+    exit_status: int = EXIT_USAGE
+
+
+class SceneError(WeftsimError, ValueError):
+    """A scene file, a bundled scene name or an override is not acceptable (names the file, key and value)."""
+
+
+class EngineError(WeftsimError, ValueError):
+    """An engine name that is not one of :data:`weftsim.api.ENGINE_NAMES`."""
+
+
+class OutputError(WeftsimError, OSError):
+    """The output directory or a file in it cannot be written, or a saved result cannot be read."""
+
+
+class WriteFailed(OutputError):
+    """The results were computed but some files could not be written; the message says where
+    each one is (written, rescued, or lost with the reason)."""
+
+    exit_status = EXIT_FAILED
+
+
+class RunFailed(WeftsimError, RuntimeError):
+    """A simulation ended with ``status = "failed"``; :attr:`result` keeps what it computed."""
+
+    exit_status = EXIT_FAILED
+
+    def __init__(self, message: str, result: RunResult | None = None) -> None:
+        super().__init__(message)
+        self.result = result
+
+
+class SweepError(WeftsimError, ValueError):
+    """A sweep cannot be set up: bad --vary text, unknown key, invalid cell, incompatible directory."""
+
+
+class StudyError(WeftsimError, ValueError):
+    """A study cannot run: unknown name, missing scene file or bad setting."""
+
+
+class SimulationFailed(StudyError):
+    """A simulation of a study ended with ``status = "failed"``."""
+
+    exit_status = EXIT_FAILED
+
+
+class MissingExtra(WeftsimError, ImportError):
+    """An optional package is not installed; the message names the extra that installs it."""
+
+
+def require(module: str, extra: str, purpose: str) -> Any:
+    """Import and return the optional ``module``, or raise :class:`MissingExtra` naming ``extra``.
+
+    Parameters
+    ----------
+    module : str
+        The importable name, e.g. ``"pandas"``.
+    extra : str
+        The optional extra of weftsim that installs it, e.g. ``"data"``.
+    purpose : str
+        What needs it, for the message (``"RunResult.to_pandas"``).
+    """
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ImportError:
+        raise MissingExtra(f"{purpose} needs {module}, which is not installed; install it with "
+                           f"pip install 'weftsim[{extra}]' (or pip install {module})") from None
