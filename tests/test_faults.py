@@ -150,7 +150,7 @@ def test_disk_full_on_a_real_tmpfs_keeps_what_was_computed(tmp_path):
     assert done.returncode == 0, done.stderr
     assert int((tmp_path / "rc.txt").read_text()) == EXIT_FAILED
     last = error_line((tmp_path / "stderr.txt").read_text())
-    assert "cannot write channels.png, result.npz" in last and "No space left on device" in last, last
+    assert "cannot write channels.png, orbit.png, result.npz" in last and "No space left on device" in last, last
     assert "channels.csv, summary.json written there" in last and "kept in" in last, last
     manifest = json.loads((copy / MANIFEST).read_text())
     assert manifest["state"] == "incomplete" and manifest["files"] == ["channels.csv", "summary.json"]
