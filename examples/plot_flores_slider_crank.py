@@ -177,7 +177,7 @@ def simulate(step: float, revolutions: float = 2.0, joint: ClearanceJoint | None
     clearance joint also ``eccentricity`` (n x 2, journal centre minus bearing centre),
     ``normal_force`` (the connector force projected on n = e / |e|: F_N, with or without
     friction), ``force`` (n x 2, the connector force: on the bearing, i.e. the slider), ``in_contact``
-    and ``model`` (the :class:`ClearanceJointModel`).
+    (1.0 / 0.0), ``impact_velocity`` (held v_imp, m/s, 0 out of contact) and ``model`` (the :class:`ClearanceJointModel`).
     """
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
@@ -197,7 +197,12 @@ def simulate(step: float, revolutions: float = 2.0, joint: ClearanceJoint | None
         out["eccentricity"] = e
         out["force"] = data["force"][:, 1:3]
         out["normal_force"] = np.sum(out["force"] * n, axis=1)
-        out["in_contact"] = crank.clearance.tracker.history()["in_contact"]
+        # The tracker records the initial state and every accepted step (t = 0 twice: Exudyn also
+        # calls the post-step function after its initial state): take its last entry at each sample.
+        history = crank.clearance.tracker.history()
+        last = np.searchsorted(history["time"], out["time"], side="right") - 1
+        out["in_contact"] = history["in_contact"][last]
+        out["impact_velocity"] = history["impact_velocity"][last]
         out["model"] = crank.clearance
     return out
 
@@ -233,7 +238,8 @@ def start_up_impact(joint: ClearanceJoint) -> dict:
     Returns
     -------
     dict
-        ``onset_time`` (s), ``impact_velocity`` (m/s), ``peak_force`` (N), ``max_penetration`` (m).
+        ``onset_time`` (s), ``impact_velocity`` (m/s), ``peak_force`` (N), ``max_penetration`` (m),
+        ``duration`` (s, onset to separation).
     """
     from scipy.integrate import solve_ivp
     from scipy.optimize import brentq
@@ -267,7 +273,7 @@ def start_up_impact(joint: ClearanceJoint) -> dict:
     y = sol.sol(t)
     f = np.array([force(d, v, v_imp) for d, v in zip(y[0] - x_b - c, y[1] - v_b)])
     return {"onset_time": onset, "impact_velocity": v_imp, "peak_force": float(f.max()),
-            "max_penetration": float((y[0] - x_b - c).max())}  # fmt: skip
+            "max_penetration": float((y[0] - x_b - c).max()), "duration": float(sol.t[-1] - onset)}  # fmt: skip
 
 
 def first_contact(run: dict) -> slice:
@@ -401,7 +407,7 @@ OPTIONS = options()
 FINE = OPTIONS.fine
 COARSE_STEPS, FINE_STEPS = (2e-6, 1e-6, 5e-7), (2e-6, 1e-6, 5e-7, 2.5e-7, 1.25e-7)
 STEPS = FINE_STEPS if FINE else COARSE_STEPS
-REVOLUTIONS = 21 if FINE else 3  # the first revolution holds the start-up impacts
+REVOLUTIONS = 21 if FINE else 5  # the first revolution holds the start-up impacts
 
 ideal = simulate(STEPS[-1], 1.0)
 ideal_error = np.abs(ideal["slider_acceleration"] - ideal_slider_acceleration(ideal["theta"])).max()
@@ -417,7 +423,8 @@ print(f"ideal joint, h = {STEPS[-1]:.3g} s: peak |a| {np.abs(ideal['slider_accel
 
 impact = start_up_impact(flores_joint())
 print(f"1-DOF start-up impact: onset {impact['onset_time'] * 1e3:.5f} ms, v_imp {impact['impact_velocity']:.4f} m/s, "
-      f"peak F_N {impact['peak_force']:.1f} N, max penetration {impact['max_penetration'] * 1e6:.3f} um")  # fmt: skip
+      f"peak F_N {impact['peak_force']:.1f} N, max penetration {impact['max_penetration'] * 1e6:.3f} um, "
+      f"duration {impact['duration'] * 1e6:.1f} us")  # fmt: skip
 
 # %%
 # Step-size study, without friction
