@@ -27,7 +27,8 @@ discusses the results against the paper.
 # the X axis, all in Exudyn's XY plane, gravity along -Y.  At B the slider carries the bearing
 # (radius R_b = R_j + c) and the rod the journal (radius R_j); the
 # :class:`~weftsim.params.ClearanceJoint` is given every value explicitly.  Parameters of Flores
-# and Ambrosio (2004); assumed here: the crank and rod centres of mass at their midpoints.  The crank angle theta starts at 0 (B at its outer dead centre), the journal centred,
+# and Ambrosio (2004); assumed here: the crank and rod centres of mass at their midpoints.  The
+# crank angle theta starts at 0 (B at its outer dead centre), the journal centred,
 # every velocity that of the ideal mechanism.
 
 from __future__ import annotations
@@ -191,7 +192,8 @@ def simulate(step: float, revolutions: float = 2.0, joint: ClearanceJoint | None
     clearance joint also ``eccentricity`` (n x 2, journal centre minus bearing centre),
     ``normal_force`` (the connector force projected on n = e / |e|: F_N, with or without
     friction), ``force`` (n x 2, the connector force: on the bearing, i.e. the slider), ``in_contact``
-    (1.0 / 0.0), ``impact_velocity`` (held v_imp, m/s, 0 out of contact) and ``model`` (the :class:`ClearanceJointModel`).
+    (1.0 / 0.0), ``impact_velocity`` (held v_imp, m/s, 0 out of contact) and ``model`` (the
+    :class:`ClearanceJointModel`).
     """
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
@@ -245,8 +247,8 @@ def energy_balance(run: dict) -> dict:
     t, theta = run["time"], run["theta"]
     r, omega = CRANK_LENGTH, CRANK_SPEED
     crank_inertia = CRANK_INERTIA + CRANK_MASS * (r / 2.0) ** 2  # about O
-    kinetic = (0.5 * crank_inertia * omega**2 + 0.5 * ROD_MASS * np.sum(run["rod_velocity"] ** 2, axis=1)
-               + 0.5 * ROD_INERTIA * run["rod_rate"] ** 2 + 0.5 * SLIDER_MASS * run["slider_velocity"] ** 2)  # fmt: skip
+    rod = 0.5 * ROD_MASS * np.sum(run["rod_velocity"] ** 2, axis=1) + 0.5 * ROD_INERTIA * run["rod_rate"] ** 2
+    kinetic = 0.5 * crank_inertia * omega**2 + rod + 0.5 * SLIDER_MASS * run["slider_velocity"] ** 2
     potential = GRAVITY * (CRANK_MASS * 0.5 * r * np.sin(theta) + ROD_MASS * run["rod_height"])
     terms = {"work": _cumulative(-run["drive_force"] * omega, t), "kinetic": kinetic - kinetic[0],
              "potential": potential - potential[0]}  # fmt: skip
@@ -378,7 +380,8 @@ def convergence_study(steps, revolutions: int, friction_coefficient: float = 0.0
         energy = energy_balance(run)
         row = {"step": step, "startup_peak": float(run["normal_force"][first_contact(run)].max()),
                "contacts_per_revolution": run["model"].tracker.contact_events / revolutions,
-               "dissipated": float(energy["dissipated"][-1]), "energy_residual": float(np.abs(energy["residual"]).max()),
+               "dissipated": float(energy["dissipated"][-1]),
+               "energy_residual": float(np.abs(energy["residual"]).max()),
                "run": run}  # fmt: skip
         for key, values in stats.items():
             row[key + "_range"] = (float(values.min()), float(values.max()))
@@ -434,7 +437,8 @@ def plot_orbit(run: dict, revolution: int = 1, ax=None):
     ax.plot(e[keep, 0], e[keep, 1], lw=0.8, label="journal centre")
     ax.plot(e[hits, 0], e[hits, 1], "rx", ms=6, label=f"impacts ({len(hits)})")
     ax.set(xlabel="e_x (mm), along the slider's rail", ylabel="e_y (mm)", aspect="equal",
-           xlim=(-1.2 * c, 1.2 * c), ylim=(-1.2 * c, 1.2 * c), title=f"Journal orbit, revolution {revolution + 1}")  # fmt: skip
+           xlim=(-1.2 * c, 1.2 * c), ylim=(-1.2 * c, 1.2 * c),
+           title=f"Journal orbit, revolution {revolution + 1}")  # fmt: skip
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2, fontsize=7)
     return ax.figure
 
