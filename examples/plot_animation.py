@@ -18,15 +18,11 @@ from pathlib import Path
 
 import numpy as np
 
+import weftsim
 from weftsim.animate import write_animation
-from weftsim.reference import solve
-from weftsim.scene import load_scene
 
-# The repository's scene files, from its root or from examples/ (where the site's build runs this).
-MODELS = Path("models") if Path("models").is_dir() else Path("../models")
-
-scene = load_scene(MODELS / "reference.toml", {"joint_e.clearance_mm": 0.5, "drive.revolutions": 2})
-result = solve(scene)
+scene = weftsim.load_scene("reference", clearance_mm=0.5, revolutions=2)
+result = weftsim.simulate(scene, engine="reference")
 animation = Path(tempfile.mkdtemp(prefix="weftsim-animation-")) / "loom.gif"
 frames = write_animation(result, animation, frames=48, fps=12)
 

@@ -13,17 +13,11 @@ trend figures).
 # %%
 # One run per clearance
 # ---------------------
+import weftsim
 from weftsim.analysis import peaks
-from pathlib import Path
-
-from weftsim.reference import solve
-from weftsim.scene import load_scene
-
-# The repository's scene files, from its root or from examples/ (where the site's build runs this).
-MODELS = Path("models") if Path("models").is_dir() else Path("../models")
 
 clearances_mm = (0.0, 0.01, 0.25, 0.5)
-results = [solve(load_scene(MODELS / "reference.toml", {"joint_e.clearance_mm": c, "drive.revolutions": 1}))
+results = [weftsim.simulate(weftsim.load_scene("reference", clearance_mm=c, revolutions=1), engine="reference")
            for c in clearances_mm]
 
 # %%

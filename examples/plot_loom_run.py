@@ -6,24 +6,18 @@ The reference mechanism (a spherical 4R, a planar four-bar, a sector gear and th
 radial clearance c = 0.25 mm in the revolute joint E between rocker 3 and rod 4, driven at 400 rpm.
 One revolution on the reference engine (the closed-form Lagrange equations, compiled), then the
 paper's six channels over that revolution and the orbit of the journal centre inside the clearance
-circle. The same run from the shell is ``weftsim run models/reference.toml --engine reference
---revolutions 1``.
+circle. The same run from the shell is ``weftsim run reference --engine reference --revolutions 1``.
 """
 
 # %%
 # Load the scene and simulate
 # ---------------------------
-# Overrides are keyed and given in the units of the scene file (mm, rpm, revolutions).
-from pathlib import Path
+# ``"reference"`` names a scene bundled with weftsim (``weftsim.bundled_scenes()`` lists them; a path to
+# a scene file works too). Overrides are given in the units of the scene file (mm, rpm, revolutions).
+import weftsim
 
-from weftsim.reference import solve
-from weftsim.scene import load_scene
-
-# The repository's scene files, from its root or from examples/ (where the site's build runs this).
-MODELS = Path("models") if Path("models").is_dir() else Path("../models")
-
-scene = load_scene(MODELS / "reference.toml", {"drive.revolutions": 1})
-result = solve(scene)
+scene = weftsim.load_scene("reference", revolutions=1)
+result = weftsim.simulate(scene, engine="reference")
 print(result.status, "on path:", result.path_text)
 print(f"{result.solver_stats['steps']} accepted steps, {result.solver_stats['impacts']} impacts, "
       f"first contact at crank angle {result.first_contact_angle_deg:.2f} deg")

@@ -6,7 +6,7 @@ A sweep runs every combination of the varied scene keys, in parallel and resumab
 directory per cell, and tabulates the peaks of every cell in ``sweep.csv`` (see the page on design
 sweeps). Here a small one: radial clearance c = 0.05, 0.25, 0.5 mm against crank speed
 300, 500, 700 rpm, half a revolution per cell on the reference engine, 9 cells on 2 worker
-processes. The shell command is ``weftsim sweep models/reference.toml --vary
+processes. The shell command is ``weftsim sweep reference --vary
 clearance_mm=0.05,0.25,0.5 --vary speed_rpm=300:700:3 --set revolutions=0.5 --engine reference``.
 
 The table is then read back as a labelled grid, peak against (clearance, speed), and drawn as a map.
@@ -20,45 +20,27 @@ from pathlib import Path
 
 from weftsim.sweep import plan_sweep, run_sweep
 
-# The repository's scene files, from its root or from examples/ (where the site's build runs this).
-MODELS = Path("models") if Path("models").is_dir() else Path("../models")
-
-plan = plan_sweep(MODELS / "reference.toml", ["clearance_mm=0.05,0.25,0.5", "speed_rpm=300:700:3"],
+plan = plan_sweep("reference", ["clearance_mm=0.05,0.25,0.5", "speed_rpm=300:700:3"],
                   ["revolutions=0.5"], engine="reference")
 outdir = Path(tempfile.mkdtemp(prefix="weftsim-sweep-"))
 report = run_sweep(plan, outdir, jobs=2, progress=False)
 print(f"{report.total} cells, {report.failed} failed; table {report.table.name}")
 
 # %%
-# Load the table as a grid
-# ------------------------
-# One row per cell; the varied keys are columns named by their short names. Reshaped onto the axes
-# of the sweep, each peak column becomes a 2-D array indexed by (clearance, speed).
-import csv
+# Load the sweep as a labelled grid
+# ---------------------------------
+# ``weftsim.load_sweep`` reads the sweep directory as an :class:`xarray.Dataset` (xarray comes with the
+# optional extra ``weftsim[data]``): one dimension per varied key, named as in the cell names, with its
+# values in file units as coordinates; each column of ``sweep.csv`` is a variable on that grid, NaN where
+# a cell failed or was not run.
+import weftsim
 
-import numpy as np
-
-with open(report.table, newline="") as file:
-    rows = list(csv.DictReader(file))
-clearances = sorted({float(r["clearance_mm"]) for r in rows})
-speeds = sorted({float(r["speed_rpm"]) for r in rows})
-
-
-def grid(column: str) -> np.ndarray:
-    """The values of ``column`` on the (clearance, speed) grid; NaN where a cell failed."""
-    values = np.full((len(clearances), len(speeds)), np.nan)
-    for r in rows:
-        if r["status"] == "success" and r[column]:
-            values[clearances.index(float(r["clearance_mm"])), speeds.index(float(r["speed_rpm"]))] = float(r[column])
-    return values
-
-
-force = grid("contact_force_N_rev1_peak")
-torque = grid("driving_torque_Nm_rev1_peak")
+grid = weftsim.load_sweep(outdir)
+print(grid)
+force = grid["contact_force_N_rev1_peak"]
+torque = grid["driving_torque_Nm_rev1_peak"]
 print("peak contact force over the first half revolution [N]; rows: c [mm], columns: speed [rpm]")
-print("         " + "".join(f"{s:>10.0f}" for s in speeds))
-for c, line in zip(clearances, force):
-    print(f"{c:8.2f} " + "".join(f"{v:10.0f}" for v in line))
+print(force.to_pandas().round(0))
 
 # %%
 # The map
@@ -68,9 +50,11 @@ for c, line in zip(clearances, force):
 from matplotlib.figure import Figure
 
 maps = Figure(figsize=(9, 3.8))
+clearances, speeds = grid["clearance_mm"].values, grid["speed_rpm"].values
 for ax, values, label in zip(maps.subplots(1, 2), (force, torque),
                              ("peak contact force [N]", "peak driving torque [N m]")):
-    image = ax.imshow(values, origin="lower", aspect="auto", cmap="viridis")
+    image = ax.imshow(values.transpose("clearance_mm", "speed_rpm").values, origin="lower", aspect="auto",
+                      cmap="viridis")
     ax.set_xticks(range(len(speeds)), [f"{s:g}" for s in speeds])
     ax.set_yticks(range(len(clearances)), [f"{c:g}" for c in clearances])
     ax.set_xlabel("crank speed [rpm]")
