@@ -34,14 +34,17 @@ from numba import njit
 
 from weftsim.kernel.joint import connector_force
 from weftsim.kernel.joint import (  # noqa: F401 - the joint block is part of this array
-    BEARING_RADIUS, CLEARANCE, COEF, KIND, MU, N_JOINT, TRACK_MAX, V_MIN, clearance_force,
+    BEARING_RADIUS, CLEARANCE, COEF, KIND, MU, N_JOINT, TRACK_MAX, V_MIN, clearance_force, clearance_force_at,
 )  # fmt: skip
 from weftsim.kernel.laws import elastic_force
+from weftsim.kernel.wear import sliding_velocity, worn_clearance
 
 # Indices of the chain's constants, after the joint block.
 (OMEGA, TAN_BETA, COS_OE0, SIN_OE0, L_OE, L_EF, L_FG, L_OG, ROD_MASS, GRAVITY, M11, M22,
  COUPLING) = range(N_JOINT, N_JOINT + 13)  # fmt: skip
 N_PARAMETERS = N_JOINT + 13
+# A worn joint E appends its wear block (weftsim.kernel.wear.wear_block) here; a round one nothing.
+WEAR_E = N_PARAMETERS
 
 
 @njit(cache=True, error_model="numpy")
@@ -77,12 +80,26 @@ def eccentricity(prm, t, y):
 
 
 @njit(cache=True, error_model="numpy")
+def local_clearance(prm, t, ecc_y, ecc_z, psi):
+    """Clearance c along the eccentricity at time t: c0 when round, else c0 + h_b + h_j (:mod:`.wear`), m.
+
+    The bearing turns with the rocker (theta_OE = theta_OE0 + phi, :func:`crank_side`), the journal
+    with the rod (its axis E -> F along u(psi)).
+    """
+    if prm.size <= WEAR_E:
+        return prm[CLEARANCE]
+    direction = math.atan2(ecc_z, ecc_y)
+    rocker = math.atan2(prm[SIN_OE0], prm[COS_OE0]) - math.atan(prm[TAN_BETA] * math.cos(prm[OMEGA] * t))
+    return worn_clearance(prm, WEAR_E, prm[CLEARANCE], direction - rocker, direction - psi)
+
+
+@njit(cache=True, error_model="numpy")
 def penetration(prm, t, y):
-    """(delta, delta_dot) = (|e| - c, e_dot . n) of state y at time t (m, m/s)."""
+    """(delta, delta_dot) = (|e| - c, e_dot . n) of state y at time t (m, m/s); c of :func:`local_clearance`."""
     ecc_y, ecc_z, v_y, v_z = eccentricity(prm, t, y)[:4]
     length = math.sqrt(ecc_y * ecc_y + ecc_z * ecc_z)
     rate = (v_y * ecc_y + v_z * ecc_z) / length if length > 0.0 else 0.0
-    return length - prm[CLEARANCE], rate
+    return length - local_clearance(prm, t, ecc_y, ecc_z, y[1]), rate
 
 
 @njit(cache=True, error_model="numpy")
@@ -100,16 +117,15 @@ def chain(prm, t, y, contact, impact_velocity, out):
     da, dpsi, omega = y[2], y[3], prm[OMEGA]
     f_y = f_z = m_j = m_b = dissipated = f_n = 0.0
     length = math.sqrt(ecc_y * ecc_y + ecc_z * ecc_z)
-    delta = length - prm[CLEARANCE]
+    c = local_clearance(prm, t, ecc_y, ecc_z, y[1])
+    delta = length - c
     if contact and length > 0.0:
         v_t = 0.0
         if prm[MU] > 0.0:
-            # v_T = e_dot.t + w_j (R_b - |e|) - w_b R_b (weftsim.clearance.tangential_velocity)
-            r_b = prm[BEARING_RADIUS]
-            v_t = (ecc_y * v_z - ecc_z * v_y) / length + dpsi * (r_b - length) - omega * dphi * r_b
-        f_y, f_z, f_n, _, delta, delta_dot, m_j, m_b = clearance_force(prm, ecc_y, ecc_z, v_y, v_z, v_t,
-                                                                       impact_velocity)  # fmt: skip
-        f_el = elastic_force(prm[KIND], prm[COEF], prm[CLEARANCE], delta)
+            v_t = sliding_velocity(ecc_y, ecc_z, v_y, v_z, length, dpsi, omega * dphi, prm[BEARING_RADIUS])
+        f_y, f_z, f_n, _, delta, delta_dot, m_j, m_b = clearance_force_at(prm, c, ecc_y, ecc_z, v_y, v_z, v_t,
+                                                                          impact_velocity)  # fmt: skip
+        f_el = elastic_force(prm[KIND], prm[COEF], c, delta)
         # Power of the contact on both bodies, f.e_dot + M_j w_j + M_b w_b = -F_N delta_dot + F_T v_T;
         # what the elastic energy (rate F_el delta_dot) does not store is dissipated.
         dissipated = -(f_y * v_y + f_z * v_z + m_j * dpsi + m_b * omega * dphi) - f_el * delta_dot

@@ -23,6 +23,7 @@ from weftsim import kinematics as kin
 from weftsim.contact import make_law
 from weftsim.kernel import chain as kc
 from weftsim.kernel.joint import N_JOINT, joint_parameters
+from weftsim.kernel.wear import wear_block
 from weftsim.params import Scene
 from weftsim.reference.ideal import sector_chain_inertia
 
@@ -92,6 +93,8 @@ def pack_parameters(scene: Scene) -> np.ndarray:
     """Every number the kernel needs for this scene: the joint block, then the chain's constants."""
     out = _chain_block(ChainConstants.from_scene(scene))
     out[:N_JOINT] = joint_parameters(scene.joint, make_law(scene.joint))
+    if scene.joint.is_worn:  # the worn geometry at E (weftsim.kernel.wear), appended at kc.WEAR_E
+        out = np.concatenate([out, wear_block(scene.joint.bearing_wear, scene.joint.journal_wear)])
     return out
 
 
