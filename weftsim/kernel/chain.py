@@ -80,26 +80,38 @@ def eccentricity(prm, t, y):
 
 
 @njit(cache=True, error_model="numpy")
-def local_clearance(prm, t, ecc_y, ecc_z, psi):
-    """Clearance c along the eccentricity at time t: c0 when round, else c0 + h_b + h_j (:mod:`.wear`), m.
+def local_clearance(prm, t, ecc_y, ecc_z, v_y, v_z, y):
+    """(c, dc/dt) along the eccentricity e of state y at time t: (c0, 0) when round, else (:mod:`.wear`)
+    c0 + h_b + h_j with the rate of c as the contact direction turns in each body's frame, m, m/s.
 
-    The bearing turns with the rocker (theta_OE = theta_OE0 + phi, :func:`crank_side`), the journal
-    with the rod (its axis E -> F along u(psi)).
+    The bearing turns with the rocker (theta_OE = theta_OE0 + phi, :func:`rocker_angle`), the journal
+    with the rod (its axis E -> F along u(psi)); the direction of e turns at (e x e_dot) / |e|^2.
     """
     if prm.size <= WEAR_E:
-        return prm[CLEARANCE]
+        return prm[CLEARANCE], 0.0
     direction = math.atan2(ecc_z, ecc_y)
-    rocker = math.atan2(prm[SIN_OE0], prm[COS_OE0]) - math.atan(prm[TAN_BETA] * math.cos(prm[OMEGA] * t))
-    return worn_clearance(prm, WEAR_E, prm[CLEARANCE], direction - rocker, direction - psi)
+    length2 = ecc_y * ecc_y + ecc_z * ecc_z
+    turn = (ecc_y * v_z - ecc_z * v_y) / length2 if length2 > 0.0 else 0.0
+    theta = prm[OMEGA] * t
+    w_b = prm[OMEGA] * prm[TAN_BETA] * math.sin(theta) / (1.0 + (prm[TAN_BETA] * math.cos(theta)) ** 2)
+    return worn_clearance(prm, WEAR_E, prm[CLEARANCE], direction - rocker_angle(prm, t), direction - y[1],
+                          turn - w_b, turn - y[3])  # fmt: skip
+
+
+@njit(cache=True, error_model="numpy")
+def rocker_angle(prm, t):
+    """theta_OE = theta_OE0 + phi, phi = -atan(tan(beta) cos(omega t)): the bearing's frame angle, rad."""
+    return math.atan2(prm[SIN_OE0], prm[COS_OE0]) - math.atan(prm[TAN_BETA] * math.cos(prm[OMEGA] * t))
 
 
 @njit(cache=True, error_model="numpy")
 def penetration(prm, t, y):
-    """(delta, delta_dot) = (|e| - c, e_dot . n) of state y at time t (m, m/s); c of :func:`local_clearance`."""
+    """(delta, delta_dot) = (|e| - c, e_dot . n - dc/dt) of state y at time t (m, m/s); c of :func:`local_clearance`."""
     ecc_y, ecc_z, v_y, v_z = eccentricity(prm, t, y)[:4]
     length = math.sqrt(ecc_y * ecc_y + ecc_z * ecc_z)
-    rate = (v_y * ecc_y + v_z * ecc_z) / length if length > 0.0 else 0.0
-    return length - local_clearance(prm, t, ecc_y, ecc_z, y[1]), rate
+    c, c_rate = local_clearance(prm, t, ecc_y, ecc_z, v_y, v_z, y)
+    rate = (v_y * ecc_y + v_z * ecc_z) / length - c_rate if length > 0.0 else 0.0
+    return length - c, rate
 
 
 @njit(cache=True, error_model="numpy")
@@ -117,14 +129,14 @@ def chain(prm, t, y, contact, impact_velocity, out):
     da, dpsi, omega = y[2], y[3], prm[OMEGA]
     f_y = f_z = m_j = m_b = dissipated = f_n = 0.0
     length = math.sqrt(ecc_y * ecc_y + ecc_z * ecc_z)
-    c = local_clearance(prm, t, ecc_y, ecc_z, y[1])
+    c, c_rate = local_clearance(prm, t, ecc_y, ecc_z, v_y, v_z, y)
     delta = length - c
     if contact and length > 0.0:
         v_t = 0.0
         if prm[MU] > 0.0:
             v_t = sliding_velocity(ecc_y, ecc_z, v_y, v_z, length, dpsi, omega * dphi, prm[BEARING_RADIUS])
-        f_y, f_z, f_n, _, delta, delta_dot, m_j, m_b = clearance_force_at(prm, c, ecc_y, ecc_z, v_y, v_z, v_t,
-                                                                          impact_velocity)  # fmt: skip
+        f_y, f_z, f_n, _, delta, delta_dot, m_j, m_b = clearance_force_at(
+            prm, c, c_rate, ecc_y, ecc_z, v_y, v_z, v_t, impact_velocity)
         f_el = elastic_force(prm[KIND], prm[COEF], c, delta)
         # Power of the contact on both bodies, f.e_dot + M_j w_j + M_b w_b = -F_N delta_dot + F_T v_T;
         # what the elastic energy (rate F_el delta_dot) does not store is dissipated.

@@ -59,13 +59,14 @@ def clearance_force(prm, ex, ey, ex_dot, ey_dot, v_t, v_imp):
 
     The round joint: :func:`clearance_force_at` with the clearance ``prm[CLEARANCE]``.
     """
-    return clearance_force_at(prm, prm[CLEARANCE], ex, ey, ex_dot, ey_dot, v_t, v_imp)
+    return clearance_force_at(prm, prm[CLEARANCE], 0.0, ex, ey, ex_dot, ey_dot, v_t, v_imp)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def clearance_force_at(prm, clearance, ex, ey, ex_dot, ey_dot, v_t, v_imp):
-    """Force of the joint with the clearance ``clearance`` along e (m; a worn joint's local value,
-    :func:`weftsim.kernel.wear.worn_clearance`), at eccentricity e and its rate, held impact velocity v_imp.
+def clearance_force_at(prm, clearance, clearance_rate, ex, ey, ex_dot, ey_dot, v_t, v_imp):
+    """Force of the joint with the clearance ``clearance`` along e (m) changing at ``clearance_rate``
+    (m/s; a worn joint's local values, :func:`weftsim.kernel.wear.worn_clearance`; the round joint
+    passes (c, 0)), at eccentricity e and its rate, held impact velocity v_imp.
 
     ``v_t``: relative tangential velocity of the contact points (journal relative to bearing), m/s,
     read only with friction; ``v_imp`` > 0 in contact, raised by the joint's rule
@@ -83,7 +84,7 @@ def clearance_force_at(prm, clearance, ex, ey, ex_dot, ey_dot, v_t, v_imp):
         return 0.0, 0.0, 0.0, 0.0, delta, 0.0, 0.0, 0.0
     nx = ex / length
     ny = ey / length
-    delta_dot = ex_dot * nx + ey_dot * ny
+    delta_dot = ex_dot * nx + ey_dot * ny - clearance_rate
     v = effective_impact_velocity(v_imp, delta_dot, prm[TRACK_MAX] != 0.0)
     f_n = normal_force(prm[KIND], prm[COEF], clearance, prm[XI], delta, delta_dot, v)
     f_t = 0.0

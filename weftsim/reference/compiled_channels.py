@@ -120,7 +120,8 @@ def _fill(prm, table, a0, ratio, time, states, contact, impact, out):
         out[i, 11] = 1.0 if (contact[i] and delta > 0.0) else 0.0
         out[i, 12] = kin13 + kin48
         out[i, 13] = crank[2] + pot48
-        out[i, 14] = elastic_energy(prm[KIND], prm[COEF], local_clearance(prm, t, ecc_y, ecc_z, y[1]), delta)
+        out[i, 14] = elastic_energy(prm[KIND], prm[COEF], local_clearance(prm, t, ecc_y, ecc_z, 0.0, 0.0, y)[0],
+                                   delta)
         out[i, 15] = kin13 + crank[2] - work0 + y[4]
         out[i, 16] = y[5]
         out[i, 17] = penetration(prm, t, y)[1]
