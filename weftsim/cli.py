@@ -144,6 +144,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--force", action="store_true",
                    help="write into an output directory that holds files weftsim did not write")
 
+    p = sub.add_parser("wear", help="predict the wear of joint E over operating hours (docs/wear.md)")
+    _add_wear_flags(p)
+
     p = sub.add_parser("bench", help="work-precision benchmark of every engine setting (docs/performance.md)",
                        description="Time every engine setting on an easy and two hard scenes against a converged "
                        "solution: tables, log-log figures and JSON.  The full mode takes ~30 min on 2 cores.")
@@ -159,6 +162,20 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--force", action="store_true",
                    help="write into an output directory that holds files weftsim did not write")
     return parser
+
+
+def _add_wear_flags(p: argparse.ArgumentParser) -> None:
+    from weftsim.wear.command import add_flags
+
+    _add_scene_flags(p, full=False)
+    add_flags(p, _positive, _non_negative)
+
+
+def cmd_wear(args) -> int:
+    from weftsim.wear.command import run
+
+    scene = _load(args)
+    return run(args, scene, _outdir(args, scene, "-wear"), _stop_on_interrupt, CliError)
 
 
 def _overrides(args) -> dict:
@@ -491,7 +508,7 @@ def cmd_bench(args) -> int:
 
 
 COMMANDS = {"kinematics": cmd_kinematics, "run": cmd_run, "compare": cmd_compare, "sweep": cmd_sweep,
-            "study": cmd_study, "bench": cmd_bench}
+            "study": cmd_study, "bench": cmd_bench, "wear": cmd_wear}
 
 
 def _one_line(text: str) -> str:
