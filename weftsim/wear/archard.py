@@ -75,16 +75,12 @@ class RunWear:
     sliding_distance: float  # int |v_T| dt in contact, m
 
 
-def run_wear(scene, prm, time, states, contact, impact) -> RunWear:
-    """Archard wear over the given step rows (times (n,) s, states (n, 6), modes, held impact velocities).
+def wear_from_rows(joint, time, rows) -> RunWear:
+    """Archard wear of contact rows (``rows`` (n, 5) as :func:`contact_rows` fills them) at times ``time`` (s).
 
-    ``prm``: the kernel parameter array of ``scene`` (:func:`weftsim.reference.dynamics.pack_parameters`).
+    ``joint``: the :class:`~weftsim.params.ClearanceJoint` (radii, length, ``wear``).
     """
-    joint, wear = scene.joint, scene.joint.wear
-    time = np.ascontiguousarray(time, dtype=float)
-    rows = np.zeros((time.size, 5))
-    contact_rows(prm, time, np.ascontiguousarray(states, dtype=float).reshape(time.size, 6),
-                 np.asarray(contact, dtype=np.bool_), np.asarray(impact, dtype=float), rows)
+    wear = joint.wear
     weights = time_weights(time) if time.size > 1 else np.zeros(time.size)
     work = rows[:, 0] * np.abs(rows[:, 1]) * weights
     n = wear.profile_points
@@ -92,8 +88,21 @@ def run_wear(scene, prm, time, states, contact, impact) -> RunWear:
     k_b = wear.wear_coefficient / wear.bearing_hardness
     k_j = wear.wear_coefficient / wear.journal_hardness
     bearing, journal = np.zeros(n), np.zeros(n)
-    deposit_rows(rows, work, k_b / (joint.bearing_length * joint.bearing_radius * cell),
-                 k_j / (joint.bearing_length * joint.journal_radius * cell), bearing, journal)
+    deposit_rows(np.ascontiguousarray(rows, dtype=float), work,
+                 k_b / (joint.bearing_length * joint.bearing_radius * cell),
+                 k_j / (joint.bearing_length * joint.journal_radius * cell), bearing, journal)  # fmt: skip
     total = float(work.sum())
     sliding = float(np.sum(np.abs(rows[:, 1]) * weights * (rows[:, 0] > 0.0)))
     return RunWear(bearing, journal, k_b * total, k_j * total, total, sliding)
+
+
+def run_wear(scene, prm, time, states, contact, impact) -> RunWear:
+    """Archard wear over the given step rows (times (n,) s, states (n, 6), modes, held impact velocities).
+
+    ``prm``: the kernel parameter array of ``scene`` (:func:`weftsim.reference.dynamics.pack_parameters`).
+    """
+    time = np.ascontiguousarray(time, dtype=float)
+    rows = np.zeros((time.size, 5))
+    contact_rows(prm, time, np.ascontiguousarray(states, dtype=float).reshape(time.size, 6),
+                 np.asarray(contact, dtype=np.bool_), np.asarray(impact, dtype=float), rows)
+    return wear_from_rows(scene.joint, time, rows)
