@@ -23,7 +23,7 @@ import numpy as np
 from weftsim.output import write_figure
 from weftsim.scene import load_scene
 from weftsim.wear.extrapolate import advance, effective_clearance, limit_hours, predict
-from weftsim.wear.figures import growth_figure, profile_figure
+from weftsim.wear.figures import growth_figure, profile_figure, statistic_label
 from weftsim.wear.store import table
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -87,7 +87,7 @@ def main() -> None:
     fig = growth_figure(columns[400.0], "reference loom: 400 rpm (dots), 800 rpm (crosses)")
     for ax, name in zip(fig.axes, ("effective_clearance_mm", "contact_force_p99_N", "rapier_acceleration_p99_m_s2",
                                    "driving_torque_p99_Nm")):
-        ax.plot(columns[800.0]["hours"], columns[800.0][name], "x-", ms=3, label="800 rpm " + name.split("_")[-2])
+        ax.plot(columns[800.0]["hours"], columns[800.0][name], "x-", ms=3, label="800 rpm " + statistic_label(name))
         ax.legend(fontsize=7)
     write_figure(img / "wear_growth.png", fig)
     from weftsim.plots import figure

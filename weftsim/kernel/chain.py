@@ -79,7 +79,7 @@ def eccentricity(prm, t, y):
     return ecc_y, ecc_z, v_y, v_z, db_y, db_z, dphi, sa, ca, sp, cp
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def local_clearance(prm, t, ecc_y, ecc_z, v_y, v_z, y):
     """(c, dc/dt) along the eccentricity e of state y at time t: (c0, 0) when round, else (:mod:`.wear`)
     c0 + h_b + h_j with the rate of c as the contact direction turns in each body's frame, m, m/s.

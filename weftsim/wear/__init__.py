@@ -82,7 +82,7 @@ def predict_to_directory(scene, hours: float, outdir, engine: str = "reference",
 
     def on_update(updates):
         store.save_state(outdir, scene, updates)
-        if progress is not None:
+        if progress is not None and updates[-1].hours > 0.0:  # no time-left estimate from a zero fraction
             progress(min(updates[-1].hours / hours, 1.0))
 
     updates = predict(scene, hours, done, on_update=on_update, stop=stop)

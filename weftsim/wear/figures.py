@@ -34,6 +34,11 @@ def profile_figure(scene, updates, title: str = ""):
     return fig
 
 
+def statistic_label(name: str) -> str:
+    """``mean``, ``rms``, ``p99`` or ``max`` out of a ``wear.csv`` column name."""
+    return next((word for word in ("mean", "rms", "p99", "max") if f"_{word}_" in name), name)
+
+
 def growth_figure(columns: dict, title: str = ""):
     """Effective clearance, contact force and rapier acceleration against operating hours (``wear.csv`` columns)."""
     fig = figure(figsize=(7, 8))
@@ -45,7 +50,7 @@ def growth_figure(columns: dict, title: str = ""):
     for k, (names, label) in enumerate(panels):
         ax = fig.add_subplot(len(panels), 1, k + 1)
         for name in (names if isinstance(names, tuple) else (names,)):
-            ax.plot(hours, columns[name], marker=".", label=name.split("_")[-2] if isinstance(names, tuple) else None)
+            ax.plot(hours, columns[name], marker=".", label=statistic_label(name) if isinstance(names, tuple) else None)
         ax.set_ylabel(label, fontsize=8)
         if isinstance(names, tuple):
             ax.legend(fontsize=7)
