@@ -76,8 +76,15 @@ def main() -> None:
     speeds = np.array(sorted(base))
     exponent = float(np.polyfit(np.log(speeds), np.log([base[s] for s in speeds]), 1)[0])
     print(f"hours to 0.5 mm ~ speed^{exponent:.2f}")
+    response = {}
+    for rpm, (scene, updates) in kept.items():
+        columns = table(scene, updates[:-1])  # the last entry is the extrapolated end state, not simulated
+        response[rpm] = {name: [float(values[0]), float(values[-1])] for name, values in columns.items()}
+        print(f"{rpm:g} rpm, first and last simulated update: " + ", ".join(
+            f"{name} {v[0]:.4g} -> {v[1]:.4g}" for name, v in response[rpm].items() if name.endswith(("_N", "_m_s2", "_Nm", "clearance_mm"))))
     if args.json:
-        Path(args.json).write_text(json.dumps({"rows": rows, "hours_speed_exponent": exponent}, indent=1) + "\n")
+        Path(args.json).write_text(json.dumps({"rows": rows, "hours_speed_exponent": exponent, "response": response},
+                                              indent=1) + "\n")
     if args.no_figures:
         return
     img = ROOT / "docs" / "img"

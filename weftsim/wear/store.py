@@ -18,7 +18,8 @@ from weftsim.wear.extrapolate import Update, effective_clearance, limit_hours
 
 STATE = "wear_state.npz"
 RESPONSE = ("rapier_acceleration_rms_m_s2", "rapier_acceleration_p99_m_s2", "driving_torque_rms_Nm",
-            "driving_torque_p99_Nm", "contact_force_mean_N", "contact_force_p99_N", "contact_force_max_N")
+            "driving_torque_p99_Nm", "contact_force_mean_N", "contact_force_p99_N", "contact_force_max_N",
+            "solver_rtol")
 
 
 class StateMismatch(ValueError):
