@@ -81,7 +81,8 @@ def main() -> None:
         columns = table(scene, updates[:-1])  # the last entry is the extrapolated end state, not simulated
         response[rpm] = {name: [float(values[0]), float(values[-1])] for name, values in columns.items()}
         print(f"{rpm:g} rpm, first and last simulated update: " + ", ".join(
-            f"{name} {v[0]:.4g} -> {v[1]:.4g}" for name, v in response[rpm].items() if name.endswith(("_N", "_m_s2", "_Nm", "clearance_mm"))))
+            f"{name} {v[0]:.4g} -> {v[1]:.4g}" for name, v in response[rpm].items()
+            if name.endswith(("_N", "_m_s2", "_Nm", "clearance_mm"))))
     if args.json:
         Path(args.json).write_text(json.dumps({"rows": rows, "hours_speed_exponent": exponent, "response": response},
                                               indent=1) + "\n")

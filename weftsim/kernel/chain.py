@@ -106,7 +106,8 @@ def rocker_angle(prm, t):
 
 @njit(cache=True, error_model="numpy")
 def penetration(prm, t, y):
-    """(delta, delta_dot) = (|e| - c, e_dot . n - dc/dt) of state y at time t (m, m/s); c of :func:`local_clearance`."""
+    """(delta, delta_dot) = (|e| - c, e_dot . n - dc/dt) of state y at time t (m, m/s), c and dc/dt of
+    :func:`local_clearance` (round: c0 and 0)."""
     ecc_y, ecc_z, v_y, v_z = eccentricity(prm, t, y)[:4]
     length = math.sqrt(ecc_y * ecc_y + ecc_z * ecc_z)
     c, c_rate = local_clearance(prm, t, ecc_y, ecc_z, v_y, v_z, y)
@@ -138,8 +139,10 @@ def chain(prm, t, y, contact, impact_velocity, out):
         f_y, f_z, f_n, _, delta, delta_dot, m_j, m_b = clearance_force_at(
             prm, c, c_rate, ecc_y, ecc_z, v_y, v_z, v_t, impact_velocity)
         f_el = elastic_force(prm[KIND], prm[COEF], c, delta)
-        # Power of the contact on both bodies, f.e_dot + M_j w_j + M_b w_b = -F_N delta_dot + F_T v_T;
-        # what the elastic energy (rate F_el delta_dot) does not store is dissipated.
+        # Power of the contact on both bodies, f.e_dot + M_j w_j + M_b w_b = -F_N e_dot.n + F_T v_T;
+        # what the elastic energy (rate F_el delta_dot) does not store is dissipated.  On a worn wall
+        # delta_dot also holds -dc/dt, so this term also books the work of the radial force as the
+        # wall's profile passes under it (the small-wear normal, docs/wear.md section 2).
         dissipated = -(f_y * v_y + f_z * v_z + m_j * dpsi + m_b * omega * dphi) - f_el * delta_dot
     s = sp * ca - cp * sa  # sin(psi - a)
     c = cp * ca + sp * sa  # cos(psi - a)

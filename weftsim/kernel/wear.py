@@ -9,8 +9,8 @@ Geometry (small wear, docs/wear.md section 2)::
         \\   (rod 4)    /
 
 Both wear profiles are tables of depth (m) at ``n`` equally spaced angles over one turn of their
-body's frame, read by periodic cubic Hermite interpolation (C1: :func:`periodic_value`).  They reach the compiled right-hand side as
-a block appended to the kernel's parameter array (:func:`wear_block`): ``[n_b, n_j, h_b..., h_j...]``
+body's frame, read by periodic cubic Hermite interpolation (C1: :func:`periodic_value`).  They reach
+the compiled right-hand side as a block appended to the kernel's parameter array (:func:`wear_block`): ``[n_b, n_j, h_b..., h_j...]``
 after the ``start`` index the caller owns.  A round joint appends nothing, and
 :func:`worn_clearance` then returns c0 itself (one size test: the round path is unchanged).
 
@@ -85,7 +85,8 @@ def periodic_slope(table, first, n, angle):
     m1 = 0.5 * (p2 - p0)
     m2 = 0.5 * (p3 - p1)
     f2 = f * f
-    d = (6.0 * f2 - 6.0 * f) * p1 + (3.0 * f2 - 4.0 * f + 1.0) * m1 + (-6.0 * f2 + 6.0 * f) * p2 + (3.0 * f2 - 2.0 * f) * m2
+    d = ((6.0 * f2 - 6.0 * f) * p1 + (3.0 * f2 - 4.0 * f + 1.0) * m1 + (-6.0 * f2 + 6.0 * f) * p2
+         + (3.0 * f2 - 2.0 * f) * m2)
     return d * (n / (2.0 * math.pi))
 
 
