@@ -1,4 +1,4 @@
-"""Command line: ``weftsim scenes | kinematics | run | animate | compare | sweep | study | bench``.  Thin: parse,
+"""Command line: ``weftsim scenes | kinematics | run | animate | compare | sweep | study | bench | wear``.  Thin: parse,
 call the Python interface (:mod:`weftsim.api`), report.
 
 One grammar for the scene of every command: ``SCENE`` is a file or the name of a bundled scene,
@@ -119,6 +119,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--force", action="store_true",
                    help="write into an output directory that holds files weftsim did not write")
 
+    p = sub.add_parser("wear", help="predict the wear of joint E over operating hours (docs/wear.md)")
+    _add_wear_flags(p)
+
     p = sub.add_parser("bench", help="work-precision benchmark of every engine setting (docs/performance.md)",
                        description="Time every engine setting on an easy and two hard scenes against a converged "
                        "solution: tables, log-log figures and JSON.  The full mode takes ~30 min on 2 cores.  "
@@ -136,6 +139,21 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--force", action="store_true",
                    help="write into an output directory that holds files weftsim did not write")
     return parser
+
+
+def _add_wear_flags(p: argparse.ArgumentParser) -> None:
+    from weftsim.wear.command import add_flags
+
+    add_scene_flags(p, shorthands=("speed_rpm", "clearance_mm", "law"))  # revolutions: set per update in [joint_e.wear]
+    add_output_flags(p, "out/<scene name>/wear")
+    add_flags(p, positive)
+
+
+def cmd_wear(args) -> int:
+    from weftsim.wear.command import run
+
+    scene = scene_from_args(args)
+    return run(args, scene, output_directory(args, scene, "wear"), _stop_on_interrupt, CliError)
 
 
 def _check_fits(scene, outdir: Path, runs: int = 1) -> None:
@@ -480,7 +498,7 @@ def cmd_scenes(args) -> int:
 
 COMMANDS = {"scenes": cmd_scenes, "kinematics": cmd_kinematics, "run": cmd_run, "animate": cmd_animate,
             "compare": cmd_compare,
-            "sweep": cmd_sweep, "study": cmd_study, "bench": cmd_bench}
+            "sweep": cmd_sweep, "study": cmd_study, "bench": cmd_bench, "wear": cmd_wear}
 
 
 def _one_line(text: str) -> str:

@@ -69,6 +69,10 @@ class SimulationFailed(StudyError):
     exit_status = EXIT_FAILED
 
 
+class WearError(WeftsimError, ValueError):
+    """A wear prediction cannot be made (bad request or a failed simulation): one line."""
+
+
 class MissingExtra(WeftsimError, ImportError):
     """An optional package is not installed; the message names the extra that installs it."""
 

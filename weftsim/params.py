@@ -110,6 +110,42 @@ class Material:
 
 
 @dataclass(frozen=True)
+class WearModel:
+    """Archard wear of a clearance joint and the cycle extrapolation that integrates it (docs/wear.md).
+
+    Archard's law: the volume a surface of hardness H loses is V = k F_N s / H (Archard, J. Appl.
+    Phys. 24, 1953), with the dimensionless wear coefficient k of the pair and the sliding distance s.
+
+    Attributes
+    ----------
+    wear_coefficient : float
+        k, dimensionless.  Default 1e-7: mild, boundary-lubricated wear of a steel pair; k spans
+        1e-2 (severe, dry) to below 1e-6 (mild, lubricated) (Archard 1953; Rabinowicz, Friction and
+        Wear of Materials, 2nd ed. 1995), dry mild steel on mild steel 7e-3 (Archard and Hirst,
+        Proc. R. Soc. A 236, 1956).  Predicted hours scale exactly as H / k (docs/wear.md).
+    bearing_hardness, journal_hardness : float
+        H of each surface, Pa (default 2.0e9: through-hardened steel, ~200 HB).
+    max_clearance_change : float
+        Update criterion: one geometry update may grow the effective clearance by at most this
+        fraction of its current value.
+    revolutions_per_update : int
+        Steady crank revolutions simulated per update (after ``settle_revolutions``).
+    settle_revolutions : int
+        Revolutions simulated first and not counted (the start from the centred journal).
+    profile_points : int
+        Points of the tabulated wear profiles h_b(psi), h_j(psi) over 360 deg.
+    """
+
+    wear_coefficient: float = 1e-7
+    bearing_hardness: float = 2.0e9
+    journal_hardness: float = 2.0e9
+    max_clearance_change: float = 0.02
+    revolutions_per_update: int = 4
+    settle_revolutions: int = 1
+    profile_points: int = 360
+
+
+@dataclass(frozen=True)
 class ClearanceJoint:
     """A revolute joint with radial clearance: E, or F (docs/physics.md sections 2 and 3).
 
@@ -138,6 +174,12 @@ class ClearanceJoint:
         v_min (identical to the onset value in an isolated impact, bounded in a driven lasting
         contact: xi delta_dot / delta_dot^- <= xi); ``"onset"``, the approach rate at the onset
         alone (Lankarani-Nikravesh, Flores), for comparison with published results.
+    wear : WearModel
+        Archard wear parameters (``[joint_e.wear]``), used by ``weftsim wear`` only.
+    bearing_wear, journal_wear : tuple of float
+        Worn depth, m, at equally spaced angles over 360 deg in the bearing's (rocker 3) and the
+        journal's (rod 4) body frame; empty = unworn (round).  The contact sees the clearance
+        c(psi) = c + h_b + h_j along the eccentricity direction (docs/wear.md).
     """
 
     clearance: float = 0.25e-3
@@ -151,6 +193,13 @@ class ClearanceJoint:
     friction_velocities: tuple[float, float] = (1e-4, 2e-4)
     min_impact_velocity: float = 1e-4
     impact_velocity_rule: str = "max_approach"
+    wear: WearModel = field(default_factory=WearModel)
+    bearing_wear: tuple[float, ...] = ()
+    journal_wear: tuple[float, ...] = ()
+
+    @property
+    def is_worn(self) -> bool:
+        return bool(self.bearing_wear or self.journal_wear)
 
     @property
     def is_ideal(self) -> bool:

@@ -64,6 +64,27 @@ class Key:
 
 MM, DEG, GPA, MPA, RPM = 1e-3, math.pi / 180.0, 1e9, 1e6, 2.0 * math.pi / 60.0
 
+
+def WEAR_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 - a constant-like key factory
+    """The ``[<table>.wear]`` keys of a clearance joint (weftsim wear; docs/wear.md), all optional."""
+    return (
+        Key(f"{table}.wear.wear_coefficient", f"{joint}.wear.wear_coefficient", "float", 1, 0, 1, True, False,
+            doc="Archard's dimensionless wear coefficient k (default 1e-7, mild lubricated steel)"),
+        Key(f"{table}.wear.bearing_hardness_mpa", f"{joint}.wear.bearing_hardness", "float", MPA, 0,
+            doc="hardness H of the bearing surface (default 2000 MPa, hardened steel)"),
+        Key(f"{table}.wear.journal_hardness_mpa", f"{joint}.wear.journal_hardness", "float", MPA, 0,
+            doc="hardness H of the journal surface (default 2000 MPa)"),
+        Key(f"{table}.wear.max_clearance_change", f"{joint}.wear.max_clearance_change", "float", 1, 0, 0.5, True,
+            False, doc="update criterion: largest growth of the effective clearance per update, as a fraction"),
+        Key(f"{table}.wear.revolutions_per_update", f"{joint}.wear.revolutions_per_update", "int", 1, 0, 1000,
+            doc="steady crank revolutions simulated per geometry update"),
+        Key(f"{table}.wear.settle_revolutions", f"{joint}.wear.settle_revolutions", "int", 1, 0, 100, False,
+            doc="revolutions simulated first and not counted (start from the centred journal)"),
+        Key(f"{table}.wear.profile_points", f"{joint}.wear.profile_points", "int", 1, 8, 100000, False,
+            doc="points of the tabulated wear profiles over 360 deg"),
+    )
+
+
 SCHEMA: tuple[Key, ...] = (
     Key("mechanism.crank_inclination_deg", "geometry.crank_inclination", "float", DEG, 0, 90, True, True,
         doc="beta, arc A-B of the spherical 4R"),
@@ -114,6 +135,7 @@ SCHEMA: tuple[Key, ...] = (
         doc="optional; peak contact pressure above 1.67 x this (first yield) is warned about"),
     Key("joint_e.bearing_material.yield_strength_mpa", "joint.bearing_material.yield_strength", "float", MPA, 0,
         doc="optional; as for the journal (the smaller of the two counts)"),
+    *WEAR_KEYS("joint_e", "joint"),
     Key("drive.speed_rpm", "drive.speed", "float", RPM, 0, 5000, doc="constant crank speed"),
     Key("drive.revolutions", "drive.revolutions", "float", 1, 0, 1000, doc="crank revolutions to simulate"),
     Key("solver.reference.method", "reference_solver.method", "str", choices=INTEGRATORS,
@@ -191,7 +213,7 @@ TOP_LEVEL = ("name", "description", "extends")
 REQUIRED_SECTIONS = ("mechanism", "inertia", "joint_e", "drive")
 # Model options inside those sections that are not part of the machine: they default.
 OPTIONAL = ("joint_e.impact_velocity_rule", "joint_e.journal_material.yield_strength_mpa",
-            "joint_e.bearing_material.yield_strength_mpa")
+            "joint_e.bearing_material.yield_strength_mpa") + tuple(key.path for key in WEAR_KEYS("joint_e", "joint"))
 # [joint_f] is optional as a whole (absent: the ideal revolute joint at F).  Given with a clearance > 0
 # it must give every key [joint_e] must give (a loose joint is part of the machine).
 JOINT_F_REQUIRED = tuple("joint_f." + key.path.partition(".")[2] for key in SCHEMA

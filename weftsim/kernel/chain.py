@@ -34,14 +34,18 @@ from numba import njit
 
 from weftsim.kernel.joint import connector_force
 from weftsim.kernel.joint import (  # noqa: F401 - the joint block is part of this array
-    BEARING_RADIUS, CLEARANCE, COEF, KIND, MU, N_JOINT, TRACK_MAX, V_MIN, clearance_force,
+    BEARING_RADIUS, CLEARANCE, COEF, KIND, MU, N_JOINT, TRACK_MAX, V_MIN, clearance_force, clearance_force_at,
 )  # fmt: skip
 from weftsim.kernel.laws import elastic_force
+from weftsim.kernel.wear import sliding_velocity, worn_clearance
 
 # Indices of the chain's constants, after the joint block.
 (OMEGA, TAN_BETA, COS_OE0, SIN_OE0, L_OE, L_EF, L_FG, L_OG, ROD_MASS, GRAVITY, M11, M22,
  COUPLING) = range(N_JOINT, N_JOINT + 13)  # fmt: skip
 N_PARAMETERS = N_JOINT + 13
+# A worn joint E appends its wear block (weftsim.kernel.wear.wear_block) here, after the blocks of
+# weftsim.kernel.chain_f (joint F's parameters, the topology, J_FG, J4); a round one appends nothing.
+WEAR_E = N_PARAMETERS + N_JOINT + 3
 
 
 @njit(cache=True, error_model="numpy")
@@ -76,13 +80,40 @@ def eccentricity(prm, t, y):
     return ecc_y, ecc_z, v_y, v_z, db_y, db_z, dphi, sa, ca, sp, cp
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def local_clearance(prm, t, ecc_y, ecc_z, v_y, v_z, y):
+    """(c, dc/dt) along the eccentricity e of state y at time t: (c0, 0) when round, else (:mod:`.wear`)
+    c0 + h_b + h_j with the rate of c as the contact direction turns in each body's frame, m, m/s.
+
+    The bearing turns with the rocker (theta_OE = theta_OE0 + phi, :func:`rocker_angle`), the journal
+    with the rod (its axis E -> F along u(psi)); the direction of e turns at (e x e_dot) / |e|^2.
+    """
+    if prm.size <= WEAR_E:
+        return prm[CLEARANCE], 0.0
+    direction = math.atan2(ecc_z, ecc_y)
+    length2 = ecc_y * ecc_y + ecc_z * ecc_z
+    turn = (ecc_y * v_z - ecc_z * v_y) / length2 if length2 > 0.0 else 0.0
+    theta = prm[OMEGA] * t
+    w_b = prm[OMEGA] * prm[TAN_BETA] * math.sin(theta) / (1.0 + (prm[TAN_BETA] * math.cos(theta)) ** 2)
+    return worn_clearance(prm, WEAR_E, prm[CLEARANCE], direction - rocker_angle(prm, t), direction - y[1],
+                          turn - w_b, turn - y[3])  # fmt: skip
+
+
+@njit(cache=True, error_model="numpy")
+def rocker_angle(prm, t):
+    """theta_OE = theta_OE0 + phi, phi = -atan(tan(beta) cos(omega t)): the bearing's frame angle, rad."""
+    return math.atan2(prm[SIN_OE0], prm[COS_OE0]) - math.atan(prm[TAN_BETA] * math.cos(prm[OMEGA] * t))
+
+
 @njit(cache=True, error_model="numpy")
 def penetration(prm, t, y):
-    """(delta, delta_dot) = (|e| - c, e_dot . n) of state y at time t (m, m/s)."""
+    """(delta, delta_dot) = (|e| - c, e_dot . n - dc/dt) of state y at time t (m, m/s), c and dc/dt of
+    :func:`local_clearance` (round: c0 and 0)."""
     ecc_y, ecc_z, v_y, v_z = eccentricity(prm, t, y)[:4]
     length = math.sqrt(ecc_y * ecc_y + ecc_z * ecc_z)
-    rate = (v_y * ecc_y + v_z * ecc_z) / length if length > 0.0 else 0.0
-    return length - prm[CLEARANCE], rate
+    c, c_rate = local_clearance(prm, t, ecc_y, ecc_z, v_y, v_z, y)
+    rate = (v_y * ecc_y + v_z * ecc_z) / length - c_rate if length > 0.0 else 0.0
+    return length - c, rate
 
 
 @njit(cache=True, error_model="numpy")
@@ -100,18 +131,19 @@ def chain(prm, t, y, contact, impact_velocity, out):
     da, dpsi, omega = y[2], y[3], prm[OMEGA]
     f_y = f_z = m_j = m_b = dissipated = f_n = 0.0
     length = math.sqrt(ecc_y * ecc_y + ecc_z * ecc_z)
-    delta = length - prm[CLEARANCE]
+    c, c_rate = local_clearance(prm, t, ecc_y, ecc_z, v_y, v_z, y)
+    delta = length - c
     if contact and length > 0.0:
         v_t = 0.0
         if prm[MU] > 0.0:
-            # v_T = e_dot.t + w_j (R_b - |e|) - w_b R_b (weftsim.clearance.tangential_velocity)
-            r_b = prm[BEARING_RADIUS]
-            v_t = (ecc_y * v_z - ecc_z * v_y) / length + dpsi * (r_b - length) - omega * dphi * r_b
-        f_y, f_z, f_n, _, delta, delta_dot, m_j, m_b = clearance_force(prm, ecc_y, ecc_z, v_y, v_z, v_t,
-                                                                       impact_velocity)  # fmt: skip
-        f_el = elastic_force(prm[KIND], prm[COEF], prm[CLEARANCE], delta)
-        # Power of the contact on both bodies, f.e_dot + M_j w_j + M_b w_b = -F_N delta_dot + F_T v_T;
-        # what the elastic energy (rate F_el delta_dot) does not store is dissipated.
+            v_t = sliding_velocity(ecc_y, ecc_z, v_y, v_z, length, dpsi, omega * dphi, prm[BEARING_RADIUS])
+        f_y, f_z, f_n, _, delta, delta_dot, m_j, m_b = clearance_force_at(
+            prm, c, c_rate, ecc_y, ecc_z, v_y, v_z, v_t, impact_velocity)
+        f_el = elastic_force(prm[KIND], prm[COEF], c, delta)
+        # Power of the contact on both bodies, f.e_dot + M_j w_j + M_b w_b = -F_N e_dot.n + F_T v_T;
+        # what the elastic energy (rate F_el delta_dot) does not store is dissipated.  On a worn wall
+        # delta_dot also holds -dc/dt, so this term also books the work of the radial force as the
+        # wall's profile passes under it (the small-wear normal, docs/wear.md section 2).
         dissipated = -(f_y * v_y + f_z * v_z + m_j * dpsi + m_b * omega * dphi) - f_el * delta_dot
     s = sp * ca - cp * sa  # sin(psi - a)
     c = cp * ca + sp * sa  # cos(psi - a)

@@ -46,6 +46,7 @@ from weftsim.kernel.laws import elastic_force
 JOINT_F = kc.N_PARAMETERS
 TOPOLOGY, SECTOR_CHAIN, ROD_INERTIA = range(JOINT_F + N_JOINT, JOINT_F + N_JOINT + 3)
 N_PARAMETERS = JOINT_F + N_JOINT + 3
+assert N_PARAMETERS == kc.WEAR_E, "the wear tables of a worn E follow this layout (weftsim.kernel.chain.WEAR_E)"
 # Topologies: which joints have a clearance.
 E_ONLY, F_ONLY, E_AND_F = 0, 1, 2
 # Joint numbers (bits of the contact mask, rows of the held impact velocities).

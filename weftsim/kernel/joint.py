@@ -57,6 +57,17 @@ def joint_parameters(joint, law) -> np.ndarray:
 def clearance_force(prm, ex, ey, ex_dot, ey_dot, v_t, v_imp):
     """Force of the joint at eccentricity e and its rate, with held impact velocity v_imp.
 
+    The round joint: :func:`clearance_force_at` with the clearance ``prm[CLEARANCE]``.
+    """
+    return clearance_force_at(prm, prm[CLEARANCE], 0.0, ex, ey, ex_dot, ey_dot, v_t, v_imp)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def clearance_force_at(prm, clearance, clearance_rate, ex, ey, ex_dot, ey_dot, v_t, v_imp):
+    """Force of the joint with the clearance ``clearance`` along e (m) changing at ``clearance_rate``
+    (m/s; a worn joint's local values, :func:`weftsim.kernel.wear.worn_clearance`; the round joint
+    passes (c, 0)), at eccentricity e and its rate, held impact velocity v_imp.
+
     ``v_t``: relative tangential velocity of the contact points (journal relative to bearing), m/s,
     read only with friction; ``v_imp`` > 0 in contact, raised by the joint's rule
     (:func:`~weftsim.kernel.hold.effective_impact_velocity`).
@@ -68,14 +79,14 @@ def clearance_force(prm, ex, ey, ex_dot, ey_dot, v_t, v_imp):
     P_j and P_b (N m).
     """
     length = math.sqrt(ex * ex + ey * ey)
-    delta = length - prm[CLEARANCE]
+    delta = length - clearance
     if length <= 0.0:
         return 0.0, 0.0, 0.0, 0.0, delta, 0.0, 0.0, 0.0
     nx = ex / length
     ny = ey / length
-    delta_dot = ex_dot * nx + ey_dot * ny
+    delta_dot = ex_dot * nx + ey_dot * ny - clearance_rate
     v = effective_impact_velocity(v_imp, delta_dot, prm[TRACK_MAX] != 0.0)
-    f_n = normal_force(prm[KIND], prm[COEF], prm[CLEARANCE], prm[XI], delta, delta_dot, v)
+    f_n = normal_force(prm[KIND], prm[COEF], clearance, prm[XI], delta, delta_dot, v)
     f_t = 0.0
     mu = prm[MU]
     if mu > 0.0 and f_n > 0.0:

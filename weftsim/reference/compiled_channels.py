@@ -23,7 +23,7 @@ from numba import njit
 
 from weftsim.params import Geometry, Inertia, Scene
 from weftsim.kernel.chain import (
-    CLEARANCE, COEF, COUPLING, GRAVITY, KIND, L_EF, L_FG, M11, M22, OMEGA, ROD_MASS, chain, penetration,
+    COEF, COUPLING, GRAVITY, KIND, L_EF, L_FG, M11, M22, OMEGA, ROD_MASS, chain, local_clearance, penetration,
 )  # fmt: skip
 from weftsim.kernel import chain_f as kf
 from weftsim.kernel.laws import elastic_energy
@@ -121,7 +121,8 @@ def _fill(prm, table, a0, ratio, time, states, contact, impact, out):
         out[i, 11] = 1.0 if (contact[i] and delta > 0.0) else 0.0
         out[i, 12] = kin13 + kin48
         out[i, 13] = crank[2] + pot48
-        out[i, 14] = elastic_energy(prm[KIND], prm[COEF], prm[CLEARANCE], delta)
+        out[i, 14] = elastic_energy(prm[KIND], prm[COEF], local_clearance(prm, t, ecc_y, ecc_z, 0.0, 0.0, y)[0],
+                                   delta)
         out[i, 15] = kin13 + crank[2] - work0 + y[4]
         out[i, 16] = y[5]
         out[i, 17] = penetration(prm, t, y)[1]

@@ -24,6 +24,7 @@ from weftsim.contact import make_law
 from weftsim.kernel import chain as kc
 from weftsim.kernel import chain_f as kf
 from weftsim.kernel.joint import N_JOINT, joint_parameters
+from weftsim.kernel.wear import wear_block
 from weftsim.params import Scene
 from weftsim.reference.ideal import sector_chain_inertia
 
@@ -98,7 +99,8 @@ def topology(scene: Scene) -> int:
 
 def pack_parameters(scene: Scene) -> np.ndarray:
     """Every number the kernel needs for this scene: the joint block at E, the chain's constants,
-    the joint block at F (zeros while F is ideal), the topology, J_FG and J4."""
+    the joint block at F (zeros while F is ideal), the topology, J_FG and J4; then, for a worn
+    joint E, its wear tables (:mod:`weftsim.kernel.wear`, at ``kc.WEAR_E``)."""
     out = np.zeros(kf.N_PARAMETERS)
     out[:kc.N_PARAMETERS] = _chain_block(ChainConstants.from_scene(scene))
     if not scene.joint.is_ideal or scene.joint_f.is_ideal:
@@ -108,6 +110,11 @@ def pack_parameters(scene: Scene) -> np.ndarray:
     out[kf.TOPOLOGY] = topology(scene)
     out[kf.SECTOR_CHAIN] = sector_chain_inertia(scene)
     out[kf.ROD_INERTIA] = scene.inertia.rod_inertia
+    if scene.joint.is_worn:
+        if topology(scene) != kf.E_ONLY:
+            raise ValueError("a worn joint E (weftsim.wear) needs joint F ideal: the worn contact is written for "
+                             "the chain with clearance at E alone")
+        out = np.concatenate([out, wear_block(scene.joint.bearing_wear, scene.joint.journal_wear)])
     return out
 
 

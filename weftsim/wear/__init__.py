@@ -1,0 +1,110 @@
+"""Wear prediction at the clearance joint E: how the clearance grows over operating hours (docs/wear.md).
+
+Public entry::
+
+    predict_to_directory(scene, hours, outdir, ...) -> dict   (the summary written to wear.json)
+
+- :mod:`weftsim.kernel.wear`: the worn clearance c(psi) the contact sees, Archard's deposit on the
+  contact arc (compiled; the reference engine's right-hand side reads the worn geometry);
+- :mod:`.archard`: the wear of one run from its step rows;
+- :mod:`.extrapolate`: the cycle extrapolation with the adaptive update interval;
+- :mod:`.store`: the resumable state and the tables; :mod:`.figures`: the figures.
+
+Joint E only (``[joint_e.wear]``).  A second clearance joint adds its own wear block after E's in
+the kernel parameter array and its own profiles in :class:`~.extrapolate.Update`; the Archard and
+extrapolation code takes the joint's numbers as arguments and is reused as it is.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from weftsim.wear.extrapolate import WearError, predict
+
+__all__ = ["ENGINES", "WearError", "predict", "predict_to_directory"]
+
+ENGINES = ("reference", "exudyn")
+
+
+def check_request(scene, hours: float, engine: str, limit: float | None) -> None:
+    """Refuse what cannot be predicted, with one line naming what is wrong and what is allowed."""
+    import math
+
+    if engine not in ENGINES:
+        raise WearError(f"--engine must be one of {', '.join(ENGINES)}, got {engine!r}")
+    if engine == "exudyn":
+        raise WearError("--engine exudyn: the Exudyn engine has no worn-geometry contact yet; the wear prediction "
+                        "runs on the reference engine (--engine reference, the default)")
+    if not (hours > 0.0 and math.isfinite(hours)):
+        raise WearError(f"--hours must be a finite number > 0, got {hours}")
+    if limit is not None and not (limit > scene.joint.clearance and math.isfinite(limit)):
+        raise WearError(f"--limit-clearance-mm must be larger than the scene's clearance "
+                        f"{scene.joint.clearance * 1e3:g} mm, got {limit * 1e3:g}")
+    if scene.joint.is_ideal:
+        raise WearError("joint_e.clearance_mm is 0 (ideal joint): there is no contact to wear; give a clearance > 0")
+    if not scene.joint_f.is_ideal:
+        raise WearError("the scene gives a clearance at F: the wear prediction covers joint E with F ideal so far "
+                        "(docs/wear.md); set joint_f.clearance_mm = 0 or leave out [joint_f]")
+
+
+def predict_to_directory(scene, hours: float, outdir, engine: str = "reference", limit: float | None = None,
+                         progress=None, stop=None, figures: bool = True) -> dict:
+    """Predict the wear over ``hours`` of operation into ``outdir``, resuming a stored state.
+
+    Parameters
+    ----------
+    scene : Scene
+        With ``scene.joint.wear`` (the ``[joint_e.wear]`` keys).
+    hours : float
+        Operating hours to predict.
+    outdir : path
+        A directory checked by :func:`weftsim.output.prepare_directory`; ``wear_state.npz`` in it is
+        resumed when it belongs to the same scene (:class:`~.store.StateMismatch` otherwise).
+    limit : float, optional
+        Clearance limit, m: ``wear.json`` gives the hours at which the effective clearance reaches it.
+    progress : callable, optional
+        Called with the fraction of the hours done.
+    stop : callable, optional
+        Returns True to end after the current update (Ctrl-C): the state is kept for a resume.
+
+    Returns
+    -------
+    dict
+        The summary (``wear.json``) with ``"files"``: kind -> path written.
+    """
+    from weftsim.output import begin_directory, write_figure, write_files, write_json
+    from weftsim.wear import store
+
+    check_request(scene, hours, engine, limit)
+    outdir = Path(outdir)
+    what = {"kind": "wear", "scene": scene.name}
+    begin_directory(outdir, what)  # ours from the first update on: an interrupted prediction resumes here
+    wall0 = time.perf_counter()
+    done = store.load_state(outdir, scene)
+
+    def on_update(updates):
+        store.save_state(outdir, scene, updates)
+        if progress is not None and updates[-1].hours > 0.0:  # no time-left estimate from a zero fraction
+            progress(min(updates[-1].hours / hours, 1.0))
+
+    updates = predict(scene, hours, done, on_update=on_update, stop=stop)
+    wall = time.perf_counter() - wall0
+    data = store.summary(scene, updates, hours, limit, wall)
+    columns = store.table(scene, updates)
+    files = {
+        "state": (store.STATE, lambda p: p),
+        "table": ("wear.csv", lambda p: store.write_table(p, scene, updates)),
+        "profile": ("wear_profile.csv", lambda p: store.write_profiles(p, updates, "bearing")),
+        "journal_profile": ("wear_profile_journal.csv", lambda p: store.write_profiles(p, updates, "journal")),
+        "summary": ("wear.json", lambda p: write_json(p, data)),
+    }
+    if figures:
+        from weftsim.wear.figures import growth_figure, profile_figure
+
+        title = f"{scene.name}: wear at E"
+        files["profile_figure"] = ("wear_profile.png", lambda p: write_figure(p, profile_figure(scene, updates, title)))
+        files["growth_figure"] = ("wear_growth.png", lambda p: write_figure(p, growth_figure(columns, title)))
+    written = write_files(outdir, what, files)
+    data["files"] = {k: str(v) for k, v in written.items()}
+    return data

@@ -1,0 +1,62 @@
+"""The ``weftsim wear`` subcommand: flags and the run (the CLI module only wires it in)."""
+
+from __future__ import annotations
+
+import sys
+
+from weftsim.exitcodes import EXIT_FAILED
+
+
+def add_flags(p, positive) -> None:
+    """Flags of ``weftsim wear SCENE --hours H [--engine E] [--limit-clearance-mm X]`` beside the shared
+    scene and output flags."""
+    p.add_argument("--hours", type=positive(float), required=True, help="operating hours to predict")
+    p.add_argument("--engine", default="reference", help="reference (default); exudyn is refused (no worn "
+                   "geometry in its contact yet, docs/wear.md)")
+    p.add_argument("--limit-clearance-mm", type=positive(float),
+                   help="clearance limit: wear.json gives the hours at which the effective clearance reaches it")
+    p.add_argument("--no-plot", action="store_true", help="skip the figures")
+
+
+def run(args, scene, outdir, stop_on_interrupt, cli_error) -> int:
+    """Predict, report progress on stderr and the result on stdout; Ctrl-C keeps the state for a resume."""
+    from weftsim.output import prepare_directory
+    from weftsim.progress import Progress
+    from weftsim.wear import WearError, check_request, predict_to_directory
+    from weftsim.wear.store import StateMismatch
+
+    limit = None if args.limit_clearance_mm is None else args.limit_clearance_mm * 1e-3
+    try:
+        check_request(scene, args.hours, args.engine, limit)
+    except WearError as exc:
+        raise cli_error(str(exc)) from None
+    outdir = prepare_directory(outdir, args.force)
+    print(f"scene {scene.name}, wear at E over {args.hours:g} h on the reference engine; each update simulates "
+          f"{scene.joint.wear.settle_revolutions} + {scene.joint.wear.revolutions_per_update} revolutions "
+          f"(~0.1 s), the update interval grows the clearance by at most "
+          f"{100 * scene.joint.wear.max_clearance_change:g} %", file=sys.stderr, flush=True)
+    progress = Progress(f"wear {scene.name}")
+    with stop_on_interrupt("wear") as state:
+        try:
+            data = predict_to_directory(scene, args.hours, outdir, args.engine, limit, progress,
+                                        stop=lambda: state["signal"] is not None, figures=not args.no_plot)
+        except StateMismatch as exc:
+            raise cli_error(str(exc)) from None
+        except WearError as exc:
+            raise cli_error(f"{exc} (the updates before it are kept in {outdir}; rerun to resume)",
+                            EXIT_FAILED) from None
+        finally:
+            progress.close()
+    print(f"scene {scene.name}: {data['hours_reached']:.6g} h in {data['updates']} updates "
+          f"({data['wall_time_s']:.1f} s); effective clearance {data['initial_clearance_mm']:g} -> "
+          f"{data['final_effective_clearance_mm']:.4g} mm, wear volume {data['wear_volume_mm3']:.4g} mm^3")
+    if limit is not None:
+        reached = data.get("hours_to_limit")
+        print(f"  clearance limit {args.limit_clearance_mm:g} mm: " +
+              (f"reached after {reached:.6g} h" if reached is not None else data["note"]))
+    for path in data["files"].values():
+        print(f"  wrote {path}")
+    if not data["complete"]:
+        raise cli_error(f"stopped after {data['hours_reached']:.6g} h; the state is in {outdir}: run the same "
+                        "command again to resume", 130)
+    return 0

@@ -1,0 +1,62 @@
+"""Figures of a wear prediction (no physics): the worn bearing as a polar plot over the hours, and the
+clearance and the response against the hours.  matplotlib is imported only when called."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from weftsim.plots import figure
+
+
+def _chosen(updates, count: int = 6):
+    """About ``count`` updates spread over the run, first and last included."""
+    idx = np.unique(np.linspace(0, len(updates) - 1, min(count, len(updates))).round().astype(int))
+    return [updates[i] for i in idx]
+
+
+def profile_figure(scene, updates, title: str = ""):
+    """Bearing clearance c0 + h_b(psi) (mm) and journal wear, polar, at several updates."""
+    fig = figure(figsize=(10, 5))
+    c0 = scene.joint.clearance * 1e3
+    n = updates[0].bearing.size
+    psi = np.append(np.arange(n), 0) * (2.0 * np.pi / n)
+    for k, which in enumerate(("bearing", "journal")):
+        ax = fig.add_subplot(1, 2, k + 1, projection="polar")
+        for u in _chosen(updates):
+            h = np.append(getattr(u, which), getattr(u, which)[0]) * 1e3
+            ax.plot(psi, (c0 if which == "bearing" else 0.0) + h, label=f"{u.hours:.4g} h")
+        ax.set_title(("bearing: c0 + h_b(psi) [mm], rocker frame" if which == "bearing"
+                      else "journal: h_j(psi) [mm], rod frame"), fontsize=9)
+    fig.axes[0].legend(loc="lower left", bbox_to_anchor=(-0.25, -0.15), fontsize=8)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def statistic_label(name: str) -> str:
+    """``mean``, ``rms``, ``p99`` or ``max`` out of a ``wear.csv`` column name."""
+    return next((word for word in ("mean", "rms", "p99", "max") if f"_{word}_" in name), name)
+
+
+def growth_figure(columns: dict, title: str = ""):
+    """Effective clearance, contact force and rapier acceleration against operating hours (``wear.csv`` columns)."""
+    fig = figure(figsize=(7, 8))
+    hours = columns["hours"]
+    panels = (("effective_clearance_mm", "effective clearance [mm]"),
+              (("contact_force_mean_N", "contact_force_p99_N"), "contact force at E [N]"),
+              (("rapier_acceleration_rms_m_s2", "rapier_acceleration_p99_m_s2"), "rapier acceleration [m/s²]"),
+              (("driving_torque_rms_Nm", "driving_torque_p99_Nm"), "driving torque [N·m]"))
+    for k, (names, label) in enumerate(panels):
+        ax = fig.add_subplot(len(panels), 1, k + 1)
+        for name in (names if isinstance(names, tuple) else (names,)):
+            ax.plot(hours, columns[name], marker=".", label=statistic_label(name) if isinstance(names, tuple) else None)
+        ax.set_ylabel(label, fontsize=8)
+        if isinstance(names, tuple):
+            ax.legend(fontsize=7)
+        ax.grid(True, alpha=0.3)
+    fig.axes[-1].set_xlabel("operating hours")
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return fig

@@ -1,0 +1,138 @@
+"""Files of a wear prediction: the resumable state, ``wear.csv``, ``wear_profile.csv``, ``wear.json``.
+
+The state (``wear_state.npz``) holds every :class:`~weftsim.wear.extrapolate.Update` and the scene
+it belongs to; it is rewritten (atomically) after each update, so an interrupted prediction
+resumes at its last update (docs/wear.md section 4).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from weftsim.output import write_atomic, write_csv
+from weftsim.wear.extrapolate import Update, effective_clearance, limit_hours
+
+STATE = "wear_state.npz"
+RESPONSE = ("rapier_acceleration_rms_m_s2", "rapier_acceleration_p99_m_s2", "driving_torque_rms_Nm",
+            "driving_torque_p99_Nm", "contact_force_mean_N", "contact_force_p99_N", "contact_force_max_N",
+            "solver_rtol")
+
+
+class StateMismatch(ValueError):
+    """The directory's stored state belongs to another scene or other wear settings."""
+
+
+def scene_identity(scene) -> str:
+    """The scene's file keys as canonical JSON: what a stored state must match to be resumed."""
+    from weftsim.scene import to_file_keys
+
+    return json.dumps(to_file_keys(scene), sort_keys=True, default=str)
+
+
+def save_state(outdir: Path, scene, updates: list[Update]) -> Path:
+    arrays = {
+        "scene": np.array(scene_identity(scene)),
+        "hours": np.array([u.hours for u in updates]),
+        "revolutions": np.array([u.revolutions for u in updates]),
+        "step_revolutions": np.array([u.step_revolutions for u in updates]),
+        "volume_rate": np.array([u.volume_rate for u in updates]),
+        "bearing": np.array([u.bearing for u in updates]),
+        "journal": np.array([u.journal for u in updates]),
+        "rate_bearing": np.array([u.rate_bearing for u in updates]),
+        "rate_journal": np.array([u.rate_journal for u in updates]),
+        "response": np.array([[u.response[k] for k in RESPONSE] for u in updates]),
+    }
+
+    def write(tmp: Path) -> None:
+        with open(tmp, "wb") as handle:
+            np.savez(handle, **arrays)
+
+    return write_atomic(Path(outdir) / STATE, write)
+
+
+def load_state(outdir: Path, scene) -> list[Update]:
+    """The updates stored in ``outdir`` (empty if none); StateMismatch if they are of another scene."""
+    path = Path(outdir) / STATE
+    if not path.exists():
+        return []
+    with np.load(path, allow_pickle=False) as data:
+        if str(data["scene"]) != scene_identity(scene):
+            raise StateMismatch(f"{path} holds a wear prediction of another scene or other [joint_e.wear] "
+                                "settings; choose another output directory with -o, or delete it to start over")
+        return [Update(float(data["hours"][i]), float(data["revolutions"][i]), data["bearing"][i].copy(),
+                       data["journal"][i].copy(), float(data["step_revolutions"][i]), data["rate_bearing"][i].copy(),
+                       data["rate_journal"][i].copy(), float(data["volume_rate"][i]),
+                       dict(zip(RESPONSE, map(float, data["response"][i]))))
+                for i in range(data["hours"].size)]
+
+
+def volumes(updates: list[Update]) -> np.ndarray:
+    """Cumulative wear volume (bearing + journal, m^3) at the start of each update."""
+    grown = np.array([u.volume_rate * u.step_revolutions for u in updates])
+    return np.concatenate([[0.0], np.cumsum(grown)[:-1]])
+
+
+def table(scene, updates: list[Update]) -> dict[str, np.ndarray]:
+    """Columns of ``wear.csv`` (one row per update, at the geometry it simulated)."""
+    c0 = scene.joint.clearance
+    col = {
+        "hours": [u.hours for u in updates],
+        "revolutions": [u.revolutions for u in updates],
+        "update_revolutions": [u.step_revolutions for u in updates],
+        "bearing_wear_max_mm": [1e3 * u.bearing.max() for u in updates],
+        "bearing_wear_mean_mm": [1e3 * u.bearing.mean() for u in updates],
+        "journal_wear_max_mm": [1e3 * u.journal.max() for u in updates],
+        "journal_wear_mean_mm": [1e3 * u.journal.mean() for u in updates],
+        "effective_clearance_mm": [1e3 * effective_clearance(c0, u.bearing, u.journal) for u in updates],
+        "wear_volume_mm3": 1e9 * volumes(updates),
+    }
+    for key in RESPONSE:
+        col[key] = [u.response[key] for u in updates]
+    return {k: np.asarray(v, dtype=float) for k, v in col.items()}
+
+
+def write_table(target: Path, scene, updates: list[Update]) -> Path:
+    return write_csv(target, table(scene, updates))
+
+
+def write_profiles(target: Path, updates: list[Update], which: str = "bearing") -> Path:
+    """``psi_deg`` and the worn depth (mm) of one body's profile at each update (column per update)."""
+    n = updates[0].bearing.size
+    columns = {"psi_deg": np.arange(n) * (360.0 / n)}
+    for i, u in enumerate(updates):
+        columns[f"h_{which[0]}_mm_update{i}_{u.hours:.6g}h"] = 1e3 * getattr(u, which)
+    return write_csv(target, columns)
+
+
+def summary(scene, updates: list[Update], hours: float, limit: float | None, wall_time: float) -> dict:
+    """Contents of ``wear.json``."""
+    from weftsim.scene import to_file_keys
+
+    c0 = scene.joint.clearance
+    last = updates[-1]
+    out = {
+        "scene": to_file_keys(scene),
+        "engine": "reference",
+        "hours_requested": hours,
+        "hours_reached": last.hours,
+        "complete": last.step_revolutions == 0.0 and last.hours >= hours * (1.0 - 1e-12),
+        "updates": len(updates),
+        "revolutions": last.revolutions,
+        "initial_clearance_mm": 1e3 * c0,
+        "final_effective_clearance_mm": 1e3 * effective_clearance(c0, last.bearing, last.journal),
+        "final_bearing_wear_max_mm": 1e3 * float(last.bearing.max()),
+        "final_journal_wear_max_mm": 1e3 * float(last.journal.max()),
+        "wear_volume_mm3": 1e9 * float(volumes(updates)[-1]),
+        "wall_time_s": wall_time,
+    }
+    if limit is not None:
+        reached = limit_hours(updates, c0, limit)
+        out["limit_clearance_mm"] = 1e3 * limit
+        out["hours_to_limit"] = reached
+        if reached is None:
+            out["note"] = f"the effective clearance did not reach {1e3 * limit:g} mm within {last.hours:.6g} h"
+    return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in out.items()}
