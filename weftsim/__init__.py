@@ -50,6 +50,7 @@ from weftsim.errors import (  # noqa: E402
     RunFailed,
     SceneError,
     SweepError,
+    WearError,
     WeftsimError,
     WriteFailed,
 )
@@ -68,6 +69,7 @@ __all__ = [
     "Scene",
     "SceneError",
     "SweepError",
+    "WearError",
     "WeftsimError",
     "WriteFailed",
     "bundled_scenes",
