@@ -26,7 +26,7 @@ from weftsim.exudyn_engine.onset import (
 from weftsim.params import ClearanceJoint
 
 C = 0.25e-3
-JOINT = ClearanceJoint(clearance=C)
+JOINT = ClearanceJoint(clearance=C, law="variable_kd")
 
 
 def test_onset_interpolation_is_exact_for_linear_motion():
@@ -181,7 +181,7 @@ def test_add_clearance_joint_rejects_ideal_and_friction():
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
     with pytest.raises(ValueError, match="clearance"):
-        add_clearance_joint(mbs, 0, 1, ClearanceJoint(clearance=0.0))
+        add_clearance_joint(mbs, 0, 1, dataclasses.replace(JOINT, clearance=0.0))
     with pytest.raises(NotImplementedError, match="friction"):
         add_clearance_joint(mbs, 0, 1, dataclasses.replace(JOINT, friction_coefficient=0.1))
     with pytest.raises(ValueError, match="callback"):

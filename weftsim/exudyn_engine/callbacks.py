@@ -135,11 +135,12 @@ def make_tree_force(prm: np.ndarray, memory: list, stash: list, route: str = "nu
 
     The contact of the moving bearing, projected on the joints by virtual work, is
     :func:`weftsim.kernel.chain.tree_joint_force`.  ``prm``: the scene's kernel parameter array
-    (:func:`weftsim.reference.dynamics.pack_parameters`); ``memory`` = [v_held, delta0, rate0] of
-    the last accepted step (written by the post-step bookkeeping); every call leaves
-    [t, delta, delta_dot, F_b,x, F_b,y] in ``stash`` (F_b = F_N n, the force on the bearing): the
-    last call of an accepted step is at its end state (the last DOPRI5 / ODE23 stage), so the
-    bookkeeping needs no extra evaluation.
+    (:func:`weftsim.reference.dynamics.pack_parameters`, friction included); ``memory`` =
+    [v_held, delta0, rate0] of the last accepted step (written by the post-step bookkeeping); every
+    call leaves [t, delta, delta_dot, F_b,x, F_b,y, F_N, M_b, F_T v_T] in ``stash`` (F_b = F_N n - F_T t,
+    the force on the bearing; M_b its friction moment; F_T v_T the friction power): the last call of
+    an accepted step is at its end state (the last DOPRI5 / ODE23 stage), so the bookkeeping needs no
+    extra evaluation.
     """
     force = _kernel(kernel_chain.tree_joint_force, route)
     prm = prm.copy()
@@ -151,8 +152,8 @@ def make_tree_force(prm: np.ndarray, memory: list, stash: list, route: str = "nu
 
     def tree_force(mbs, t, itemNumber, q, q_t):
         counter[0] += 1
-        g0, g1, stash[1], stash[2], stash[3], stash[4] = force(prm, t, q[0], q[1], q_t[0], q_t[1],
-                                                               memory[0], memory[1], memory[2])  # fmt: skip
+        g0, g1, stash[1], stash[2], stash[3], stash[4], stash[5], stash[6], stash[7] = force(
+            prm, t, q[0], q[1], q_t[0], q_t[1], memory[0], memory[1], memory[2])
         stash[0] = t
         return [g0, g1]
 

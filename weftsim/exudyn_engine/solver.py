@@ -84,9 +84,10 @@ def check_settings(scene: Scene) -> str | None:
     if scene.joint.impact_velocity_rule not in IMPACT_VELOCITY_RULES:
         return (f"`joint.impact_velocity_rule` must be one of {IMPACT_VELOCITY_RULES}, "
                 f"got {scene.joint.impact_velocity_rule!r}")  # fmt: skip
-    if scene.joint.friction_coefficient > 0.0 and not scene.joint.is_ideal:
-        return ("the Exudyn engine has no friction in the clearance joint (docs/clearance-joint.md); "
-                "set `friction_coefficient` = 0 or use the reference engine")  # fmt: skip
+    if scene.joint.friction_coefficient > 0.0 and not scene.joint.is_ideal and select_model(scene)[0] == "rigid_body":
+        return ("the Exudyn 'rigid_body' model has no friction in the clearance joint yet (docs/clearance-joint.md); "
+                "use `exudyn_solver.model` = 'kinematic_tree' (or 'auto'), the reference engine, "
+                "or `friction_coefficient` = 0")  # fmt: skip
     return None
 
 

@@ -34,7 +34,8 @@ from numba import njit
 
 from weftsim.kernel.joint import connector_force
 from weftsim.kernel.joint import (  # noqa: F401 - the joint block is part of this array
-    BEARING_RADIUS, CLEARANCE, COEF, KIND, MU, N_JOINT, TRACK_MAX, V_MIN, clearance_force,
+    BEARING_RADIUS, CLEARANCE, COEF, KIND, MU, N_JOINT, TRACK_MAX, V_MIN, clearance_force, friction_force,
+    tangential_velocity,
 )  # fmt: skip
 from weftsim.kernel.laws import elastic_force
 
@@ -104,9 +105,7 @@ def chain(prm, t, y, contact, impact_velocity, out):
     if contact and length > 0.0:
         v_t = 0.0
         if prm[MU] > 0.0:
-            # v_T = e_dot.t + w_j (R_b - |e|) - w_b R_b (weftsim.clearance.tangential_velocity)
-            r_b = prm[BEARING_RADIUS]
-            v_t = (ecc_y * v_z - ecc_z * v_y) / length + dpsi * (r_b - length) - omega * dphi * r_b
+            v_t = tangential_velocity(ecc_y, ecc_z, v_y, v_z, length, dpsi, omega * dphi, prm[BEARING_RADIUS])
         f_y, f_z, f_n, _, delta, delta_dot, m_j, m_b = clearance_force(prm, ecc_y, ecc_z, v_y, v_z, v_t,
                                                                        impact_velocity)  # fmt: skip
         f_el = elastic_force(prm[KIND], prm[COEF], prm[CLEARANCE], delta)
@@ -160,12 +159,18 @@ def tree_joint_force(prm, t, a, q1, da, dq1, held, delta0, rate0):
 
         P_j = G + L_FG u(a) + L_EF u(b),  v_j = L_FG a' u'(a) + L_EF b' u'(b),
 
-    go through :func:`moving_bearing_force` (the force F_b = F_N n on the bearing); the force on
-    the journal, -F_b, enters the joints by virtual work:
+    go through :func:`moving_bearing_force` (the normal force F_N n on the bearing).  With friction
+    (``prm[MU]`` > 0, in contact) the journal also gets F_T t (:func:`~weftsim.kernel.joint.friction_force`
+    at the tangential velocity of :func:`~weftsim.kernel.joint.tangential_velocity`, rod turning at
+    b', rocker at omega phi') and the moment M_j = (R_b - |e|) F_T about P_j, the bearing
+    M_b = -R_b F_T about P_b.  The force on the bearing is F_b = F_N n - F_T t; the journal's, -F_b,
+    and M_j enter the joints by virtual work (db/dq0 = db/dq1 = 1):
 
-        Q1 = -F_b . dP_j/dq1 = L_EF (F_bx sin b - F_by cos b),   Q0 = L_FG (F_bx sin a - F_by cos a) + Q1.
+        Q1 = -F_b . dP_j/dq1 + M_j = L_EF (F_bx sin b - F_by cos b) + M_j,
+        Q0 = L_FG (F_bx sin a - F_by cos a) + Q1.
 
-    Returns (Q0, Q1, delta, delta_dot, F_bx, F_by): N m, N m, m, m/s, N, N.
+    Returns (Q0, Q1, delta, delta_dot, F_bx, F_by, F_N, M_b, F_T v_T): N m, N m, m, m/s, N, N, N,
+    N m, W (the friction power on the pair, <= 0; 0 without friction).
     """
     l_fg, l_ef = prm[L_FG], prm[L_EF]
     b = a + q1
@@ -176,5 +181,21 @@ def tree_joint_force(prm, t, a, q1, da, dq1, held, delta0, rate0):
     vx = -l_fg * sa * da - l_ef * sb * db
     vy = l_fg * ca * da + l_ef * cb * db
     fx, fy, delta, rate = moving_bearing_force(prm, t, px, py, vx, vy, held, delta0, rate0)
-    g1 = l_ef * (fx * sb - fy * cb)
-    return l_fg * (fx * sa - fy * ca) + g1, g1, delta, rate, fx, fy
+    f_n = math.hypot(fx, fy)  # as the channels computed it before friction (np.hypot): bit-identical at mu = 0
+    m_j = m_b = power = 0.0
+    if prm[MU] > 0.0 and f_n > 0.0:
+        b_y, b_z, db_y, db_z, dphi = crank_side(prm, t)
+        omega = prm[OMEGA]
+        ex, ey = px - b_y, py - b_z
+        length = math.sqrt(ex * ex + ey * ey)
+        r_b = prm[BEARING_RADIUS]
+        v_t = tangential_velocity(ex, ey, vx - omega * db_y, vy - omega * db_z, length, db, omega * dphi, r_b)
+        f_t = friction_force(prm, f_n, v_t)
+        nx, ny = ex / length, ey / length
+        fx += f_t * ny  # - F_T t on the bearing, t = (-n_y, n_x)
+        fy -= f_t * nx
+        m_j = (r_b - length) * f_t
+        m_b = -r_b * f_t
+        power = f_t * v_t
+    g1 = l_ef * (fx * sb - fy * cb) + m_j
+    return l_fg * (fx * sa - fy * ca) + g1, g1, delta, rate, fx, fy, f_n, m_b, power
