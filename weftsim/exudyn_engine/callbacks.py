@@ -22,7 +22,8 @@ f = F_N n with n = e/|e| pulls the journal back to the bearing centre::
                                       delta_dot' = delta_dot less a dead zone of +-1e-6 v_min
 
 All of it is :func:`weftsim.kernel.joint.connector_force` (and, for the kinematic tree, whose
-bearing moves with the crank, :func:`weftsim.kernel.chain.moving_bearing_force`).  Routes:
+bearing moves with the crank, :func:`weftsim.kernel.chain.tree_joint_force`, through
+:func:`weftsim.kernel.joint.connector_friction_force`).  Routes:
 
 - ``"numba"``: the compiled kernel called from a thin Python callback (numba's cache: nothing
   to compile in a new process after the first run on a machine);
@@ -77,13 +78,13 @@ def connector_parameters(law, clearance: float, min_impact_velocity: float, max_
     return prm
 
 
-def _for_route(prm: np.ndarray, route: str):
+def parameters_for_route(prm: np.ndarray, route: str):
     """The parameters as the route reads them fastest: a numpy array compiled, a list of floats in
     plain Python (numpy scalars would make every operation of the kernel's source ~5x slower)."""
     return prm.tolist() if route == "python" else prm
 
 
-def _kernel(function, route: str):
+def kernel_form(function, route: str):
     if route == "python":
         return python_form(function)
     if route == "numba":
@@ -99,8 +100,8 @@ def make_force(law, clearance: float, min_impact_velocity: float, route: str = "
     one-element list incremented per call (benchmarks only); ``max_approach`` selects the held
     impact velocity rule (False: ``"onset"``).
     """
-    force = _kernel(kernel_joint.connector_force, route)
-    prm = _for_route(connector_parameters(law, clearance, min_impact_velocity, max_approach), route)
+    force = kernel_form(kernel_joint.connector_force, route)
+    prm = parameters_for_route(connector_parameters(law, clearance, min_impact_velocity, max_approach), route)
     if route == "numba":
         force(prm, 1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0)  # load (or compile) now, not inside the first step
 
@@ -142,10 +143,10 @@ def make_tree_force(prm: np.ndarray, memory: list, stash: list, route: str = "nu
     an accepted step is at its end state (the last DOPRI5 / ODE23 stage), so the bookkeeping needs no
     extra evaluation.
     """
-    force = _kernel(kernel_chain.tree_joint_force, route)
+    force = kernel_form(kernel_chain.tree_joint_force, route)
     prm = prm.copy()
     prm[kernel_joint.DEAD_RATE] = RESTING_RATE_FRACTION * prm[kernel_joint.V_MIN]
-    prm = _for_route(prm, route)
+    prm = parameters_for_route(prm, route)
     counter = [0] if counter is None else counter
     if route == "numba":
         force(prm, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0)  # load (or compile) now

@@ -14,10 +14,11 @@ bookkeeping runs in a post-step user function, i.e. on accepted steps only.  Usa
     mbs.SolveDynamic(settings)
     model.tracker.history()     # time, held impact velocity, contact flag per step
 
-Friction (``joint.friction_coefficient > 0``) is not implemented here: the Cartesian
-connector applies its force at the two centres and cannot carry the friction moments
-about them (docs/clearance-joint.md says what it would take; the loom's kinematic-tree
-model has friction).
+Friction (``joint.friction_coefficient > 0``, :mod:`.joint_friction`): the connector's force
+then includes the friction force, and a torque load on each rotating body carries its friction
+moment about its centre; solve with ``timeIntegration.computeLoadsJacobian = 2`` so that Newton
+sees the loads' dependence on the state.  Friction off adds nothing: the frictionless joint is
+exactly the former one.
 
 Misuse is loud, not silent (:class:`JointMisuse`, raised from inside the solve, where Exudyn
 reports it as a ``ModelError`` carrying this message):
@@ -42,7 +43,9 @@ from exudyn.itemInterface import ObjectConnectorCartesianSpringDamper
 
 from weftsim.contact import make_law
 from weftsim.exudyn_engine import callbacks
+from weftsim.exudyn_engine.joint_friction import JointFriction
 from weftsim.exudyn_engine.onset import OnsetTracker, penetration_state
+from weftsim.kernel.joint import joint_parameters
 from weftsim.params import ClearanceJoint
 
 ROUTES = callbacks.ROUTES
@@ -124,6 +127,7 @@ class ClearanceJointModel:
     keep_alive: object = field(default=None, repr=False)  # symbolic function must outlive the system
     # [latest trial time seen by the force callback] (the overwritten post-step check, add_clearance_joint)
     trial_time: list = field(default_factory=lambda: [0.0], repr=False)
+    friction: JointFriction | None = None  # friction force and moments (joint.friction_coefficient > 0)
 
     def state(self, mbs) -> tuple[float, float]:
         """Current (delta, delta_dot) of the joint, m and m/s."""
@@ -169,8 +173,6 @@ def add_clearance_joint(mbs, marker_bearing, marker_journal, joint: ClearanceJoi
     ------
     ValueError
         For c <= 0 (use an ideal revolute joint) or an unknown route.
-    NotImplementedError
-        For friction_coefficient > 0.
     JointMisuse
         During the solve (Exudyn reports it as ``exudyn.ModelError`` with this message): a post-step
         function set after this call, a second solve without :meth:`ClearanceJointModel.reset`, bodies
@@ -184,12 +186,6 @@ def add_clearance_joint(mbs, marker_bearing, marker_journal, joint: ClearanceJoi
     if not joint.clearance > 0.0:
         raise ValueError(f"`clearance` must be > 0 for a clearance joint, got {joint.clearance}; "
                          "use ObjectJointRevolute2D for an ideal joint")  # fmt: skip
-    if joint.friction_coefficient > 0.0:
-        raise NotImplementedError(
-            "friction in the Exudyn clearance joint is not implemented (the Cartesian connector "
-            "cannot apply the friction moments about the joint centres); set "
-            "`friction_coefficient` = 0 or use the reference engine (docs/clearance-joint.md)"
-        )
     if callbacks.route_error(callback):
         raise ValueError(callbacks.route_error(callback))
     law = make_law(joint) if law is None else law
@@ -205,7 +201,12 @@ def add_clearance_joint(mbs, marker_bearing, marker_journal, joint: ClearanceJoi
     max_approach = joint.impact_velocity_rule == "max_approach"
     tracker = OnsetTracker(c, v_min, rule=joint.impact_velocity_rule)  # checks the rule's name
     keep = None
-    if route == "python":
+    friction = None
+    if joint.friction_coefficient > 0.0:
+        friction = JointFriction(mbs, marker_bearing, marker_journal, joint_parameters(joint, law), route,
+                                 lambda: model.tracker.callback_state)  # fmt: skip
+        force = friction.spring_force
+    elif route == "python":
         force = callbacks.make_python_force(law, c, v_min, call_counter, max_approach)
     else:
         force = callbacks.make_numba_force(law, c, v_min, max_approach)
@@ -226,7 +227,9 @@ def add_clearance_joint(mbs, marker_bearing, marker_journal, joint: ClearanceJoi
         stiffness=tracker.callback_state, damping=[0.0, 0.0, 0.0], offset=[0.0, 0.0, 0.0],
         springForceUserFunction=checked_force,
     ))  # fmt: skip
-    model = ClearanceJointModel(connector, joint, law, route, tracker, keep, trial)
+    model = ClearanceJointModel(connector, joint, law, route, tracker, keep, trial, friction)
+    if friction is not None:
+        friction.install(mbs, connector)
     displacement = exu.OutputVariableType.Displacement
     velocity = exu.OutputVariableType.Velocity
 
@@ -238,6 +241,8 @@ def add_clearance_joint(mbs, marker_bearing, marker_journal, joint: ClearanceJoi
             raise JointMisuse(f"the clearance joint's time went backwards (from {model.tracker.t:.6g} s to {t:.6g} s): "
                               "the system is solved again; call model.reset(mbs) before every new solve")
         trial[0] = min(trial[0], t)
+        if friction is not None:
+            friction.accept(mbs, t)
         delta, rate = penetration_state(u[0], u[1], v[0], v[1], c)
         model.tracker.accept(t, delta, rate)
         mbs.SetObjectParameter(connector, "stiffness", model.tracker.callback_state)

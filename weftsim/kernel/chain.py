@@ -32,10 +32,9 @@ import math
 
 from numba import njit
 
-from weftsim.kernel.joint import connector_force
+from weftsim.kernel.joint import connector_force, connector_friction_force
 from weftsim.kernel.joint import (  # noqa: F401 - the joint block is part of this array
-    BEARING_RADIUS, CLEARANCE, COEF, KIND, MU, N_JOINT, TRACK_MAX, V_MIN, clearance_force, friction_force,
-    tangential_velocity,
+    BEARING_RADIUS, CLEARANCE, COEF, KIND, MU, N_JOINT, TRACK_MAX, V_MIN, clearance_force, tangential_velocity,
 )  # fmt: skip
 from weftsim.kernel.laws import elastic_force
 
@@ -138,19 +137,6 @@ def rhs(prm, t, y, contact, impact_velocity, out):
 
 
 @njit(cache=True, error_model="numpy")
-def moving_bearing_force(prm, t, px, py, vx, vy, held, delta0, rate0):
-    """Connector force with the bearing centre moving as the crank side prescribes (kinematic tree).
-
-    ``(px, py)``, ``(vx, vy)``: journal centre P_j and its velocity (m, m/s) at time t; the
-    eccentricity is P_j - P_b with P_b of :func:`crank_side`.  Returns
-    :func:`weftsim.kernel.joint.connector_force` (f_x, f_y, delta, delta_dot).
-    """
-    b_y, b_z, db_y, db_z, _ = crank_side(prm, t)
-    omega = prm[OMEGA]
-    return connector_force(prm, px - b_y, py - b_z, vx - omega * db_y, vy - omega * db_z, held, delta0, rate0)
-
-
-@njit(cache=True, error_model="numpy")
 def tree_joint_force(prm, t, a, q1, da, dq1, held, delta0, rate0):
     """Generalized contact force on the two joints of the kinematic tree (Exudyn's tree model).
 
@@ -159,11 +145,10 @@ def tree_joint_force(prm, t, a, q1, da, dq1, held, delta0, rate0):
 
         P_j = G + L_FG u(a) + L_EF u(b),  v_j = L_FG a' u'(a) + L_EF b' u'(b),
 
-    go through :func:`moving_bearing_force` (the normal force F_N n on the bearing).  With friction
-    (``prm[MU]`` > 0, in contact) the journal also gets F_T t (:func:`~weftsim.kernel.joint.friction_force`
-    at the tangential velocity of :func:`~weftsim.kernel.joint.tangential_velocity`, rod turning at
-    b', rocker at omega phi') and the moment M_j = (R_b - |e|) F_T about P_j, the bearing
-    M_b = -R_b F_T about P_b.  The force on the bearing is F_b = F_N n - F_T t; the journal's, -F_b,
+    less the bearing centre P_b(t) of :func:`crank_side` and its velocity, go through
+    :func:`weftsim.kernel.joint.connector_friction_force`: the normal force F_N n on the bearing and,
+    with friction (``prm[MU]`` > 0, in contact), F_T t on the journal (rod turning at b', rocker at
+    omega phi') with the moments M_j = (R_b - |e|) F_T about P_j and M_b = -R_b F_T about P_b.  The force on the bearing is F_b = F_N n - F_T t; the journal's, -F_b,
     and M_j enter the joints by virtual work (db/dq0 = db/dq1 = 1):
 
         Q1 = -F_b . dP_j/dq1 + M_j = L_EF (F_bx sin b - F_by cos b) + M_j,
@@ -180,22 +165,10 @@ def tree_joint_force(prm, t, a, q1, da, dq1, held, delta0, rate0):
     py = l_fg * sa + l_ef * sb
     vx = -l_fg * sa * da - l_ef * sb * db
     vy = l_fg * ca * da + l_ef * cb * db
-    fx, fy, delta, rate = moving_bearing_force(prm, t, px, py, vx, vy, held, delta0, rate0)
-    f_n = math.hypot(fx, fy)  # as the channels computed it before friction (np.hypot): bit-identical at mu = 0
-    m_j = m_b = power = 0.0
-    if prm[MU] > 0.0 and f_n > 0.0:
-        b_y, b_z, db_y, db_z, dphi = crank_side(prm, t)
-        omega = prm[OMEGA]
-        ex, ey = px - b_y, py - b_z
-        length = math.sqrt(ex * ex + ey * ey)
-        r_b = prm[BEARING_RADIUS]
-        v_t = tangential_velocity(ex, ey, vx - omega * db_y, vy - omega * db_z, length, db, omega * dphi, r_b)
-        f_t = friction_force(prm, f_n, v_t)
-        nx, ny = ex / length, ey / length
-        fx += f_t * ny  # - F_T t on the bearing, t = (-n_y, n_x)
-        fy -= f_t * nx
-        m_j = (r_b - length) * f_t
-        m_b = -r_b * f_t
-        power = f_t * v_t
+    b_y, b_z, db_y, db_z, dphi = crank_side(prm, t)
+    omega = prm[OMEGA]
+    # F_N = hypot of the normal force, as the channels computed it before friction: bit-identical at mu = 0.
+    fx, fy, delta, rate, f_n, f_t, m_j, m_b, v_t = connector_friction_force(
+        prm, px - b_y, py - b_z, vx - omega * db_y, vy - omega * db_z, held, delta0, rate0, db, omega * dphi)
     g1 = l_ef * (fx * sb - fy * cb) + m_j
-    return l_fg * (fx * sa - fy * ca) + g1, g1, delta, rate, fx, fy, f_n, m_b, power
+    return l_fg * (fx * sa - fy * ca) + g1, g1, delta, rate, fx, fy, f_n, m_b, f_t * v_t

@@ -137,3 +137,29 @@ def connector_force(prm, ex, ey, vx, vy, held, delta0, rate0):
     f = normal_force(prm[KIND], prm[COEF], prm[CLEARANCE], prm[XI], delta, damping_rate(rate, prm[DEAD_RATE]),
                      v_imp)  # fmt: skip
     return f * nx, f * ny, delta, rate
+
+
+@njit(cache=True, error_model="numpy")
+def connector_friction_force(prm, ex, ey, vx, vy, held, delta0, rate0, omega_j, omega_b):
+    """:func:`connector_force` with the modified Coulomb friction (the rigid-body Exudyn joint).
+
+    ``omega_j``, ``omega_b``: angular velocities (rad/s, about +z) of the journal's and the bearing's
+    body.  The normal force is :func:`connector_force`'s; in contact the journal also gets F_T t
+    (:func:`friction_force` at :func:`tangential_velocity`) and the moment M_j = (R_b - |e|) F_T about
+    P_j, the bearing -F_T t and M_b = -R_b F_T about P_b.
+
+    Returns
+    -------
+    (f_x, f_y, delta, delta_dot, F_N, F_T, M_j, M_b, v_T): the force on the bearing F_N n - F_T t (N),
+    penetration (m) and rate (m/s), normal and friction force (N), moments (N m), sliding speed (m/s).
+    """
+    fx, fy, delta, rate = connector_force(prm, ex, ey, vx, vy, held, delta0, rate0)
+    if delta <= 0.0:
+        return fx, fy, delta, rate, 0.0, 0.0, 0.0, 0.0, 0.0
+    length = math.sqrt(ex * ex + ey * ey)
+    f_n = math.hypot(fx, fy)
+    r_b = prm[BEARING_RADIUS]
+    v_t = tangential_velocity(ex, ey, vx, vy, length, omega_j, omega_b, r_b)
+    f_t = friction_force(prm, f_n, v_t)
+    nx, ny = ex / length, ey / length
+    return fx + f_t * ny, fy - f_t * nx, delta, rate, f_n, f_t, (r_b - length) * f_t, -r_b * f_t, v_t
