@@ -177,13 +177,11 @@ def test_numba_route_equals_python(max_approach):
                                    py(None, 0.0, 0, e, e_dot, mem, None, None), rtol=1e-13, atol=1e-9)  # fmt: skip
 
 
-def test_add_clearance_joint_rejects_ideal_and_friction():
+def test_add_clearance_joint_rejects_ideal_joints_and_unknown_routes():
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
     with pytest.raises(ValueError, match="clearance"):
         add_clearance_joint(mbs, 0, 1, dataclasses.replace(JOINT, clearance=0.0))
-    with pytest.raises(NotImplementedError, match="friction"):
-        add_clearance_joint(mbs, 0, 1, dataclasses.replace(JOINT, friction_coefficient=0.1))
     with pytest.raises(ValueError, match="callback"):
         add_clearance_joint(mbs, 0, 1, JOINT, callback="fortran")
 

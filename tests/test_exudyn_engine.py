@@ -211,12 +211,9 @@ def test_output_grid_and_every_step(startup):
     assert np.all(st["penetration_m"][inside] > 0.0) and np.all(st["impact_velocity_m_s"][inside] > 0.0)
 
 
-def test_invalid_settings_and_friction_fail_naming_the_setting():
+def test_invalid_settings_fail_naming_the_setting():
     r = solve(dataclasses.replace(scene(), exudyn_solver=ExudynSolver(model="rigid_body", spectral_radius=1.5)))
     assert r.status == "failed" and "spectral_radius" in r.message
-    friction = dataclasses.replace(scene(model="rigid_body"), joint=dataclasses.replace(scene().joint, friction_coefficient=0.1))
-    r = solve(friction)
-    assert r.status == "failed" and "friction" in r.message and "kinematic_tree" in r.message
     # An unknown rule no longer reaches an engine: the joint itself refuses it, naming the allowed rules.
     with pytest.raises(ValueError, match="impact_velocity_rule.*max_approach.*largest"):
         scene(rule="largest")

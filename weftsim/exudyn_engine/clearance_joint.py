@@ -144,6 +144,8 @@ class ClearanceJointModel:
                                     self.joint.impact_velocity_rule)
         mbs.SetObjectParameter(self.connector, "stiffness", self.tracker.callback_state)
         self.trial_time[0] = t0
+        if self.friction is not None:
+            self.friction.history.clear()
 
 
 def add_clearance_joint(mbs, marker_bearing, marker_journal, joint: ClearanceJoint, law=None,
