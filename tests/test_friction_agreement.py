@@ -129,3 +129,19 @@ def test_the_trees_contact_with_friction_is_the_reference_chains():
         want = -(fbx * jac[0] + fby * jac[1]) + m_j
         # Central difference of a 0.3 m lever at 1e-7 rad: ~1e-14 m truncation, 1e-9 m round-off / 2e-7.
         assert got == pytest.approx(want, rel=1e-6)
+
+
+@pytest.mark.slow
+def test_the_rigid_body_model_with_friction_agrees_with_the_reference_engine():
+    """The reusable joint's friction (connector force + torque loads, joint_friction.py) in the full
+    rigid-body loom against the reference: the same checks as the tree's, on one case."""
+    from weftsim import exudyn_engine, reference
+    from weftsim.scene import apply_overrides
+
+    scene = _scene(0.15, "0p25")
+    rigid = apply_overrides(scene, {"solver.exudyn.model": "rigid_body"})
+    ref, exu = reference.solve(scene), exudyn_engine.solve(rigid)
+    assert ref.ok and exu.ok, (ref.message, exu.message)
+    assert exu.path["model"] == "rigid_body"
+    failed = [c for c in agreement_checks(exu, ref) if not c["passed"]]  # 0.1 deg and 1 %
+    assert not failed, failed
