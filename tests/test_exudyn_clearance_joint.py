@@ -450,7 +450,7 @@ def test_a_journal_leaving_the_xy_plane_is_an_error():
     mbs = sc.AddSystem()
     ground = mbs.CreateGround()
     node = mbs.AddNode(NodePoint(referenceCoordinates=[0.0, 0.0, 0.0]))
-    mass = mbs.AddObject(ObjectMassPoint(nodeNumber=node, physicsMass=1.0))
+    mass = mbs.AddObject(ObjectMassPoint(nodeNumber=node, mass=1.0))
     bearing = mbs.AddMarker(MarkerBodyPosition(bodyNumber=ground, localPosition=[0.0, 0.0, 0.0]))
     journal = mbs.AddMarker(MarkerNodePosition(nodeNumber=node))
     from exudyn.itemInterface import LoadMassProportional, MarkerBodyMass
