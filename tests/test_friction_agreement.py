@@ -13,7 +13,12 @@ journal sticks, ~2.5 million tree steps per revolution (95 s) against ~21 000 wi
 Measured (tree at its default rtol 1e-6, reference numba_DOP853 at rtol 1e-8; relative differences):
 
     mu    c mm   first contact deg   max F_N    max rapier acc.   max torque
+    0     0.25   5.6e-6              1e-7       2.6e-5            7.8e-4
     0.15  0.25   5.6e-6              1.1e-7     2.7e-4            5.5e-3
+    0.05  0.50   2.5e-6              5.0e-7     4.2e-3            4.0e-3
+
+Rigid-body model (reusable joint, full Newton), mu 0.15, c 0.25 mm, default local error 3e-10 m:
+1.8e-6 deg, 1.8e-3, 1.8e-3, 8.1e-3 (the start-up peaks converge with the tolerance: see its test).
 """
 
 from __future__ import annotations
@@ -134,12 +139,17 @@ def test_the_trees_contact_with_friction_is_the_reference_chains():
 @pytest.mark.slow
 def test_the_rigid_body_model_with_friction_agrees_with_the_reference_engine():
     """The reusable joint's friction (connector force + torque loads, joint_friction.py) in the full
-    rigid-body loom against the reference: the same checks as the tree's, on one case."""
+    rigid-body loom against the reference: the same checks as the tree's, on one case.
+
+    At the default local error 3e-10 m the adaptive step is coarse through the start-up impact with
+    friction (406 steps over 18 deg): max F_N 1.8e-3, acceleration 1.8e-3, torque 8.1e-3 off (318 s).
+    The start-up peaks converge to the reference's as the tolerance shrinks (F_N 1.8e-3, 7e-5, 2.6e-5 at
+    3e-10, 3e-11, 3e-12 m): the test runs at 3e-11 m for a margin below the 1 %."""
     from weftsim import exudyn_engine, reference
     from weftsim.scene import apply_overrides
 
     scene = _scene(0.15, "0p25")
-    rigid = apply_overrides(scene, {"solver.exudyn.model": "rigid_body"})
+    rigid = apply_overrides(scene, {"solver.exudyn.model": "rigid_body", "solver.exudyn.local_error_m": 3e-11})
     ref, exu = reference.solve(scene), exudyn_engine.solve(rigid)
     assert ref.ok and exu.ok, (ref.message, exu.message)
     assert exu.path["model"] == "rigid_body"
