@@ -16,9 +16,10 @@ bookkeeping runs in a post-step user function, i.e. on accepted steps only.  Usa
 
 Friction (``joint.friction_coefficient > 0``, :mod:`.joint_friction`): the connector's force
 then includes the friction force, and a torque load on each rotating body carries its friction
-moment about its centre; solve with ``timeIntegration.computeLoadsJacobian = 2`` so that Newton
-sees the loads' dependence on the state.  Friction off adds nothing: the frictionless joint is
-exactly the former one.
+moment about its centre; solve with ``timeIntegration.computeLoadsJacobian = 2`` and full Newton
+(``newton.useModifiedNewton = False``) so that Newton sees the loads' dependence on the state when
+the journal starts to stick.  Friction off adds nothing: the frictionless joint gives bit-identical
+results to the former one.
 
 Misuse is loud, not silent (:class:`JointMisuse`, raised from inside the solve, where Exudyn
 reports it as a ``ModelError`` carrying this message):

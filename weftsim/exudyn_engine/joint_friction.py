@@ -20,8 +20,9 @@ evaluated once per state and shared by the connector callback and the two loads.
 
 Newton: the connector's numerical Jacobian contains the friction force's dependence on e and e_dot;
 the loads' and the rates' dependence is in the Jacobian only with
-``timeIntegration.computeLoadsJacobian = 2`` (set by the loom's rigid-body model; a user's own settings
-should set it too), else a stiff stick phase (ramp slope mu F_N / (v1 - v0)) can stall Newton.
+``timeIntegration.computeLoadsJacobian = 2``, and a stale Jacobian (modified Newton) does not follow the
+journal from sliding into sticking (ramp slope mu F_N / (v1 - v0) ~ 1e8 N s/m on the loom): the loom's
+rigid-body model sets both (solver.py, with what failed without them); a user's own settings need them too.
 
 A body without rotation (ground, mass point) turns at 0 and takes no moment.
 """
