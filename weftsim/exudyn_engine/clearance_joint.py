@@ -198,8 +198,8 @@ def add_clearance_joint(mbs, marker_bearing, marker_journal, joint: ClearanceJoi
                       f"'{law.name}' law's damping was derived for: its contacts will not return this restitution; "
                       "choose a law valid there (e.g. 'flores' for any ce)", UserWarning, stacklevel=2)
     route = callbacks.resolve_route(callback)
-    if call_counter is not None and route != "python":
-        raise ValueError("`call_counter` works with callback='python' only")
+    if call_counter is not None and (route != "python" or joint.friction_coefficient > 0.0):
+        raise ValueError("`call_counter` works with callback='python' and no friction only")
     c, v_min = joint.clearance, joint.min_impact_velocity
     max_approach = joint.impact_velocity_rule == "max_approach"
     tracker = OnsetTracker(c, v_min, rule=joint.impact_velocity_rule)  # checks the rule's name
