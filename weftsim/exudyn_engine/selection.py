@@ -56,9 +56,10 @@ def select_path(scene: Scene) -> dict:
     model, reason = select_model(scene)
     if model == "kinematic_tree":
         from weftsim.exudyn_engine.callbacks import resolve_route
+        from weftsim.exudyn_engine.tree_solve import tree_relative_tolerance
 
         return {"model": model, "reason": reason,
-                "method": f"{s.explicit_method} rtol {s.relative_tolerance:g}, {resolve_route(s.callback)} callback"}
+                "method": f"{s.explicit_method} rtol {tree_relative_tolerance(scene):g}, {resolve_route(s.callback)} callback"}
     from weftsim.exudyn_engine.solver import adaptive, step_plan
 
     if adaptive(scene):
