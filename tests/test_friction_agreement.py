@@ -71,10 +71,11 @@ def test_friction_runs_agree_with_the_reference_engine(mu, clearance):
 
 
 @pytest.mark.slow
-def test_friction_changes_the_tree_and_its_power_is_dissipated():
-    """A short run through the start-up impact: friction enters the tree (the first peaks move) and the
-    energy balance, with the friction work among the dissipated energy, closes as it does without."""
-    from weftsim import exudyn_engine
+def test_friction_work_is_dissipated_and_the_energy_balance_closes():
+    """Through the start-up impact (0.05 revolution, mu = 0.15): the tree's dissipated energy, friction work
+    included, is the reference engine's, it exceeds the frictionless run's, and the energy balance closes
+    as it does without friction."""
+    from weftsim import exudyn_engine, reference
 
     runs = {mu: exudyn_engine.solve(_scene(mu, "0p25", revolutions=0.05)) for mu in (0.0, 0.15)}
     for mu, r in runs.items():
@@ -83,10 +84,15 @@ def test_friction_changes_the_tree_and_its_power_is_dissipated():
         residual = (st["driving_work_J"] - (st["kinetic_energy_J"] - st["kinetic_energy_J"][0])
                     - (st["potential_energy_J"] - st["potential_energy_J"][0]) - st["contact_energy_J"]
                     - st["dissipated_energy_J"])  # fmt: skip
-        # As tests/test_tree_model.py bounds it without friction: 2e-3 of the largest kinetic energy.
+        # As tests/test_tree_model.py bounds it without friction: 2e-3 of the largest kinetic energy (82 J);
+        # measured 2.6e-3 J (mu = 0) and 1.2e-3 J (mu = 0.15).
         assert np.abs(residual).max() < 2e-3 * st["kinetic_energy_J"].max(), mu
     dissipated = {mu: r.steps["dissipated_energy_J"][-1] for mu, r in runs.items()}
-    assert dissipated[0.15] > 1.5 * dissipated[0.0]
+    ref = reference.solve(_scene(0.15, "0p25", revolutions=0.05)).steps["dissipated_energy_J"][-1]
+    # Measured: tree 2.93853 J, reference 2.93881 J (1e-4); the start-up impact dissipates 2.79 J without
+    # friction, so friction adds 0.15 J here (over a whole revolution 33.4 J against 13.0 J).
+    assert dissipated[0.15] == pytest.approx(ref, rel=1e-3)
+    assert dissipated[0.15] > dissipated[0.0] + 0.1
 
 
 def test_the_trees_contact_with_friction_is_the_reference_chains():
