@@ -90,7 +90,7 @@ def main() -> None:
     parser.add_argument("--profile", action="store_true")
     args = parser.parse_args()
     scene = Scene(drive=Drive(revolutions=args.revolutions))
-    ideal = dataclasses.replace(scene, joint=ClearanceJoint(clearance=0.0))
+    ideal = dataclasses.replace(scene, joint=dataclasses.replace(scene.joint, clearance=0.0))
     h, n = step_plan(scene)
     print(f"scene: c = {scene.joint.clearance * 1e3} mm, {scene.drive.speed * 30 / math.pi:.0f} rpm, "
           f"{args.revolutions} rev, h = {h:.4g} s, {n} steps, law {scene.joint.law}")  # fmt: skip

@@ -13,10 +13,10 @@ from weftsim.clearance import (
     tangential_velocity,
 )
 from weftsim.contact import make_law
-from weftsim.params import ClearanceJoint
+from weftsim.params import LOOM_JOINT_E
 
 RNG = np.random.default_rng(7)
-JOINT = ClearanceJoint(friction_coefficient=0.1)  # reference joint, c = 0.25 mm, with friction
+JOINT = dataclasses.replace(LOOM_JOINT_E, friction_coefficient=0.1)  # reference joint, c = 0.25 mm, with friction
 FRICTIONLESS = dataclasses.replace(JOINT, friction_coefficient=0.0)
 
 

@@ -37,7 +37,7 @@ RNG = np.random.default_rng(20200101)
 
 
 def law_of(name, **kw):
-    return make_law(ClearanceJoint(law=name, **kw))
+    return make_law(ClearanceJoint(**{"clearance": 0.25e-3, **kw, "law": name}))
 
 
 def test_registry_has_the_six_spec_laws():
@@ -95,13 +95,13 @@ def test_continuous_at_first_contact(name):
 def test_lankarani_nikravesh_stiffness_check_values():
     # docs/physics.md section 3 gives 3 significant digits: compare to half a unit of the last digit.
     for clearance, expected in ((0.5e-3, 6.95e10), (0.25e-3, 9.71e10), (0.01e-3, 4.80e11)):
-        k = lankarani_nikravesh_stiffness(ClearanceJoint(clearance=clearance))
+        k = lankarani_nikravesh_stiffness(ClearanceJoint(clearance=clearance, law="lankarani_nikravesh"))
         assert k == pytest.approx(expected, abs=0.005 * 10 ** math.floor(math.log10(expected)))
         assert law_of("lankarani_nikravesh", clearance=clearance).stiffness(1e-6) == k
 
 
 def test_bai_zhao_stiffness_check_value():
-    joint = ClearanceJoint(clearance=0.01e-3)
+    joint = ClearanceJoint(clearance=0.01e-3, law="variable_kd")
     k = make_law(joint).stiffness(5e-6)
     assert k == bai_zhao_stiffness(5e-6, joint.clearance, joint.effective_modulus)
     # We get 9.7248e10; docs/physics.md section 3 gives 9.73e10 (apparently double-rounded 9.7248 -> 9.725 -> 9.73),
@@ -111,7 +111,7 @@ def test_bai_zhao_stiffness_check_value():
 
 
 def test_bai_zhao_is_the_derivative_of_liu_force_per_length():
-    joint = ClearanceJoint(clearance=0.01e-3)
+    joint = ClearanceJoint(clearance=0.01e-3, law="variable_kd")
     e_star, c = joint.effective_modulus, joint.clearance
 
     def liu(d):  # Liu et al. (2007) force per unit length, N/m
@@ -265,4 +265,4 @@ def test_friction_factor_bounds_and_monotonicity():
                                           ({"law": "elastic_foundation", "bearing_length": 0.0}, "bearing_length")])
 def test_invalid_joint_parameters_name_the_argument(kw, argument):
     with pytest.raises(ValueError, match=argument):
-        make_law(ClearanceJoint(**kw))
+        make_law(ClearanceJoint(**{"clearance": 0.25e-3, "law": "variable_kd", **kw}))

@@ -48,7 +48,8 @@ def test_auto_takes_the_rigid_body_model_where_the_scene_needs_it():
     assert path["model"] == "rigid_body" and "ideal joint" in path["reason"]
     assert path["method"] == f"generalized-alpha, fixed step h {h:.3g} s"
     friction = dataclasses.replace(base, joint=dataclasses.replace(base.joint, friction_coefficient=0.1))
-    assert select_path(friction)["model"] == "rigid_body" and "friction" in select_path(friction)["reason"]
+    # The tree carries friction (force at the contact point, moments on rod and rocker): no reason to leave it.
+    assert select_path(friction)["model"] == "kinematic_tree" and select_path(friction)["reason"].startswith("auto")
 
 
 def test_explicit_models_stay_choices():

@@ -26,7 +26,7 @@ START = 30.0 / 360.0  # revolutions: free flight to the first contact (6.6 deg),
 
 def scene(revolutions=START, **solver) -> Scene:
     """The rigid-body model (named: the automatic selection takes the kinematic tree for this scene)."""
-    return Scene(joint=ClearanceJoint(clearance=0.25e-3), drive=Drive(speed=400.0 * RPM, revolutions=revolutions),
+    return Scene(joint=ClearanceJoint(clearance=0.25e-3, law="variable_kd"), drive=Drive(speed=400.0 * RPM, revolutions=revolutions),
                  exudyn_solver=ExudynSolver(**{"model": "rigid_body", **solver}))  # fmt: skip
 
 

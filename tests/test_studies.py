@@ -144,7 +144,7 @@ def test_stiffness_curve_is_the_law_and_its_log_slope_the_analytic_one():
     from weftsim.params import ClearanceJoint
     from weftsim.studies.contact_law import log_slope, stiffness_curve
 
-    joint = ClearanceJoint(clearance=0.01e-3)
+    joint = ClearanceJoint(clearance=0.01e-3, law="variable_kd")
     curve = stiffness_curve(joint, points=101)
     law = make_law(joint)
     np.testing.assert_allclose(curve["stiffness"], law.stiffness(curve["penetration_mm"] * 1e-3), rtol=1e-14)

@@ -16,7 +16,7 @@ import pytest
 
 from weftsim import reference
 from weftsim.kernel.wear import deposit
-from weftsim.params import ClearanceJoint, WearModel
+from weftsim.params import LOOM_JOINT_E, WearModel
 from weftsim.reference.dynamics import pack_parameters
 from weftsim.scene import load_scene
 from weftsim.wear.archard import contact_rows, run_wear, wear_from_rows
@@ -38,7 +38,7 @@ def _centroid(profile: np.ndarray) -> float:
 
 def test_closed_form_constant_load_and_sliding():
     """A journal pressed by W while sliding at v for T loses V = k W s / H (s = v T), at the load angle."""
-    joint = ClearanceJoint(wear=WearModel(wear_coefficient=3e-7, bearing_hardness=1.5e9, journal_hardness=2.5e9))
+    joint = dc.replace(LOOM_JOINT_E, wear=WearModel(wear_coefficient=3e-7, bearing_hardness=1.5e9, journal_hardness=2.5e9))
     load, speed, duration = 1200.0, 0.04, 2.0
     angle_b, angle_j = 1.0, -2.3  # off the profile grid (1 deg cells)
     time = np.linspace(0.0, duration, 2001)
@@ -64,7 +64,7 @@ def test_closed_form_constant_load_and_sliding():
 @pytest.mark.parametrize("force, speed", [(0.0, 0.1), (500.0, 0.0)])
 def test_zero_load_or_zero_sliding_gives_zero_wear(force, speed):
     time = np.linspace(0.0, 1.0, 101)
-    wear = wear_from_rows(ClearanceJoint(), time, _rows(time.size, force, speed, 0.3, 0.1, 0.05))
+    wear = wear_from_rows(LOOM_JOINT_E, time, _rows(time.size, force, speed, 0.3, 0.1, 0.05))
     assert wear.bearing_volume == wear.journal_volume == 0.0
     assert not wear.bearing.any() and not wear.journal.any()
 

@@ -12,7 +12,7 @@ coordinates are (Y, Z) = (y, z).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 
 @dataclass(frozen=True)
@@ -145,14 +145,24 @@ class WearModel:
     profile_points: int = 360
 
 
-@dataclass(frozen=True)
+# Impact velocity rules of ClearanceJoint.impact_velocity_rule (weftsim.scene re-exports it).
+IMPACT_VELOCITY_RULES = ("max_approach", "onset")
+
+
+@dataclass(frozen=True, kw_only=True)
 class ClearanceJoint:
     """A revolute joint with radial clearance: E, or F (docs/physics.md sections 2 and 3).
+
+    ``clearance`` and ``law`` have no default: a joint is a choice of both (the loom's joint at E of
+    the reference mechanism is :data:`LOOM_JOINT_E`, c = 0.25 mm with the paper's ``variable_kd``).
+    The other fields default to a steel journal of 10 mm radius in a 20 mm bearing, ce = 0.9, no
+    friction.  Every value is checked here (one line naming the field and what is allowed), so a
+    joint built in Python is as safe as one loaded from a scene.
 
     Attributes
     ----------
     clearance : float
-        Radial clearance c = R_b - R_j, m.  0 means the ideal revolute joint.
+        Radial clearance c = R_b - R_j, m, >= 0.  0 means the ideal revolute joint.
     journal_radius : float
         R_j, m.  Bearing radius R_b = R_j + c.
     bearing_length : float
@@ -182,12 +192,12 @@ class ClearanceJoint:
         c(psi) = c + h_b + h_j along the eccentricity direction (docs/wear.md).
     """
 
-    clearance: float = 0.25e-3
+    clearance: float
     journal_radius: float = 10e-3
     bearing_length: float = 20e-3
     journal_material: Material = field(default_factory=Material)
     bearing_material: Material = field(default_factory=Material)
-    law: str = "variable_kd"
+    law: str
     restitution: float = 0.9
     friction_coefficient: float = 0.0
     friction_velocities: tuple[float, float] = (1e-4, 2e-4)
@@ -201,6 +211,11 @@ class ClearanceJoint:
     def is_worn(self) -> bool:
         return bool(self.bearing_wear or self.journal_wear)
 
+    def __post_init__(self):
+        problem = joint_problem(self)
+        if problem is not None:
+            raise ValueError(problem)
+
     @property
     def is_ideal(self) -> bool:
         return self.clearance == 0.0
@@ -213,6 +228,51 @@ class ClearanceJoint:
     def effective_modulus(self) -> float:
         """E* = 1 / (sigma_b + sigma_j), Pa."""
         return 1.0 / (self.journal_material.compliance + self.bearing_material.compliance)
+
+
+def _positive_finite(value) -> bool:
+    return isinstance(value, (int, float)) and math.isfinite(value) and value > 0.0
+
+
+def joint_problem(joint: ClearanceJoint) -> str | None:
+    """One line naming the first invalid field of ``joint`` and what is allowed, or None.
+
+    The law's name is checked where the laws live (:func:`weftsim.contact.make_law`).
+    """
+    c = joint.clearance
+    if not (isinstance(c, (int, float)) and math.isfinite(c) and c >= 0.0):
+        return f"`clearance` must be >= 0 (m; 0 = ideal joint), got {c!r}"
+    for name in ("journal_radius", "bearing_length", "min_impact_velocity"):
+        value = getattr(joint, name)
+        if not _positive_finite(value):
+            unit = "m/s" if name == "min_impact_velocity" else "m"
+            return f"`{name}` must be > 0 ({unit}), got {value!r}"
+    if not isinstance(joint.law, str) or not joint.law:
+        return f"`law` must name a contact law (weftsim.contact.LAWS), got {joint.law!r}"
+    ce = joint.restitution
+    if not (isinstance(ce, (int, float)) and 0.0 < ce <= 1.0):
+        return f"`restitution` must be in (0, 1], got {ce!r}"
+    mu = joint.friction_coefficient
+    if not (isinstance(mu, (int, float)) and math.isfinite(mu) and mu >= 0.0):
+        return f"`friction_coefficient` must be >= 0 (0 = no friction), got {mu!r}"
+    ramp = tuple(joint.friction_velocities)
+    if len(ramp) != 2 or not all(isinstance(v, (int, float)) and math.isfinite(v) for v in ramp) \
+            or not 0.0 <= ramp[0] < ramp[1]:
+        return f"`friction_velocities` must be (v0, v1) with 0 <= v0 < v1 (m/s), got {joint.friction_velocities!r}"
+    if joint.impact_velocity_rule not in IMPACT_VELOCITY_RULES:
+        return f"`impact_velocity_rule` must be one of {IMPACT_VELOCITY_RULES}, got {joint.impact_velocity_rule!r}"
+    for side in ("journal_material", "bearing_material"):
+        m = getattr(joint, side)
+        if not _positive_finite(m.youngs_modulus):
+            return f"`{side}.youngs_modulus` must be > 0 (Pa), got {m.youngs_modulus!r}"
+        if not (isinstance(m.poisson_ratio, (int, float)) and 0.0 <= m.poisson_ratio < 0.5):
+            return f"`{side}.poisson_ratio` must be in [0, 0.5), got {m.poisson_ratio!r}"
+    return None
+
+
+# The loom's joint at E in the reference mechanism (docs/physics.md sections 1-3): c = 0.25 mm,
+# the paper's law; the default of Scene.joint, which every scene file then overrides key by key.
+LOOM_JOINT_E = ClearanceJoint(clearance=0.25e-3, law="variable_kd")
 
 
 @dataclass(frozen=True)
@@ -346,9 +406,9 @@ class Scene:
     name: str = "reference"
     geometry: Geometry = field(default_factory=Geometry)
     inertia: Inertia = field(default_factory=Inertia)
-    joint: ClearanceJoint = field(default_factory=ClearanceJoint)  # joint E (rocker 3 - rod 4)
+    joint: ClearanceJoint = LOOM_JOINT_E  # joint E (rocker 3 - rod 4)
     # Joint F (rod 4 - sector 5): ideal unless a scene gives it a clearance (docs/clearance-f.md).
-    joint_f: ClearanceJoint = field(default_factory=lambda: ClearanceJoint(clearance=0.0))
+    joint_f: ClearanceJoint = field(default_factory=lambda: replace(LOOM_JOINT_E, clearance=0.0))
     drive: Drive = field(default_factory=Drive)
     reference_solver: ReferenceSolver = field(default_factory=ReferenceSolver)
     exudyn_solver: ExudynSolver = field(default_factory=ExudynSolver)

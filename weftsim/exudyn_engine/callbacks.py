@@ -22,7 +22,8 @@ f = F_N n with n = e/|e| pulls the journal back to the bearing centre::
                                       delta_dot' = delta_dot less a dead zone of +-1e-6 v_min
 
 All of it is :func:`weftsim.kernel.joint.connector_force` (and, for the kinematic tree, whose
-bearing moves with the crank, :func:`weftsim.kernel.chain.moving_bearing_force`).  Routes:
+bearing moves with the crank, :func:`weftsim.kernel.chain.tree_joint_force`, through
+:func:`weftsim.kernel.joint.connector_friction_force`).  Routes:
 
 - ``"numba"``: the compiled kernel called from a thin Python callback (numba's cache: nothing
   to compile in a new process after the first run on a machine);
@@ -77,13 +78,13 @@ def connector_parameters(law, clearance: float, min_impact_velocity: float, max_
     return prm
 
 
-def _for_route(prm: np.ndarray, route: str):
+def parameters_for_route(prm: np.ndarray, route: str):
     """The parameters as the route reads them fastest: a numpy array compiled, a list of floats in
     plain Python (numpy scalars would make every operation of the kernel's source ~5x slower)."""
     return prm.tolist() if route == "python" else prm
 
 
-def _kernel(function, route: str):
+def kernel_form(function, route: str):
     if route == "python":
         return python_form(function)
     if route == "numba":
@@ -99,8 +100,8 @@ def make_force(law, clearance: float, min_impact_velocity: float, route: str = "
     one-element list incremented per call (benchmarks only); ``max_approach`` selects the held
     impact velocity rule (False: ``"onset"``).
     """
-    force = _kernel(kernel_joint.connector_force, route)
-    prm = _for_route(connector_parameters(law, clearance, min_impact_velocity, max_approach), route)
+    force = kernel_form(kernel_joint.connector_force, route)
+    prm = parameters_for_route(connector_parameters(law, clearance, min_impact_velocity, max_approach), route)
     if route == "numba":
         force(prm, 1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0)  # load (or compile) now, not inside the first step
 
@@ -135,24 +136,25 @@ def make_tree_force(prm: np.ndarray, memory: list, stash: list, route: str = "nu
 
     The contact of the moving bearing, projected on the joints by virtual work, is
     :func:`weftsim.kernel.chain.tree_joint_force`.  ``prm``: the scene's kernel parameter array
-    (:func:`weftsim.reference.dynamics.pack_parameters`); ``memory`` = [v_held, delta0, rate0] of
-    the last accepted step (written by the post-step bookkeeping); every call leaves
-    [t, delta, delta_dot, F_b,x, F_b,y] in ``stash`` (F_b = F_N n, the force on the bearing): the
-    last call of an accepted step is at its end state (the last DOPRI5 / ODE23 stage), so the
-    bookkeeping needs no extra evaluation.
+    (:func:`weftsim.reference.dynamics.pack_parameters`, friction included); ``memory`` =
+    [v_held, delta0, rate0] of the last accepted step (written by the post-step bookkeeping); every
+    call leaves [t, delta, delta_dot, F_b,x, F_b,y, F_N, M_b, F_T v_T] in ``stash`` (F_b = F_N n - F_T t,
+    the force on the bearing; M_b its friction moment; F_T v_T the friction power): the last call of
+    an accepted step is at its end state (the last DOPRI5 / ODE23 stage), so the bookkeeping needs no
+    extra evaluation.
     """
-    force = _kernel(kernel_chain.tree_joint_force, route)
+    force = kernel_form(kernel_chain.tree_joint_force, route)
     prm = prm.copy()
     prm[kernel_joint.DEAD_RATE] = RESTING_RATE_FRACTION * prm[kernel_joint.V_MIN]
-    prm = _for_route(prm, route)
+    prm = parameters_for_route(prm, route)
     counter = [0] if counter is None else counter
     if route == "numba":
         force(prm, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0)  # load (or compile) now
 
     def tree_force(mbs, t, itemNumber, q, q_t):
         counter[0] += 1
-        g0, g1, stash[1], stash[2], stash[3], stash[4] = force(prm, t, q[0], q[1], q_t[0], q_t[1],
-                                                               memory[0], memory[1], memory[2])  # fmt: skip
+        g0, g1, stash[1], stash[2], stash[3], stash[4], stash[5], stash[6], stash[7] = force(
+            prm, t, q[0], q[1], q_t[0], q_t[1], memory[0], memory[1], memory[2])
         stash[0] = t
         return [g0, g1]
 

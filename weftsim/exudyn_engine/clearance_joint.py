@@ -14,13 +14,29 @@ bookkeeping runs in a post-step user function, i.e. on accepted steps only.  Usa
     mbs.SolveDynamic(settings)
     model.tracker.history()     # time, held impact velocity, contact flag per step
 
-Friction (``joint.friction_coefficient > 0``) is not implemented here: the Cartesian
-connector applies its force at the two centres and cannot carry the friction moments
-about them (docs/clearance-joint.md says what it would take).
+Friction (``joint.friction_coefficient > 0``, :mod:`.joint_friction`): the connector's force
+then includes the friction force, and a torque load on each rotating body carries its friction
+moment about its centre; solve with ``timeIntegration.computeLoadsJacobian = 2`` and full Newton
+(``newton.useModifiedNewton = False``) so that Newton sees the loads' dependence on the state when
+the journal starts to stick.  Friction off adds nothing: the frictionless joint gives bit-identical
+results to the former one.
+
+Misuse is loud, not silent (:class:`JointMisuse`, raised from inside the solve, where Exudyn
+reports it as a ``ModelError`` carrying this message):
+
+- a post-step function set with ``mbs.SetPostStepUserFunction`` after this joint replaces its
+  bookkeeping: the force callback notices a step ending without the bookkeeping having run;
+- solving the same system again without ``model.reset(mbs)``: the bookkeeping sees time go
+  backwards;
+- bodies that leave Exudyn's XY plane: an eccentricity with an out-of-plane part larger than the
+  clearance (the contact only sees the in-plane part).
+
+A restitution outside the law's valid range (``law.valid_restitution``) is a warning.
 """
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import exudyn as exu
@@ -28,13 +44,37 @@ from exudyn.itemInterface import ObjectConnectorCartesianSpringDamper
 
 from weftsim.contact import make_law
 from weftsim.exudyn_engine import callbacks
+from weftsim.exudyn_engine.joint_friction import JointFriction
 from weftsim.exudyn_engine.onset import OnsetTracker, penetration_state
+from weftsim.kernel.joint import joint_parameters
 from weftsim.params import ClearanceJoint
 
 ROUTES = callbacks.ROUTES
 DEFAULT_ROUTE = callbacks.DEFAULT_ROUTE
 
 _HOOKS = "weftsim_post_step_hooks"
+
+
+class JointMisuse(RuntimeError):
+    """The clearance joint is used in a way that would give wrong results silently."""
+
+
+OVERWRITTEN_POST_STEP = ("the clearance joint's post-step bookkeeping did not run after a step (was "
+                         "mbs.SetPostStepUserFunction called after add_clearance_joint? it replaces the joint's "
+                         "function): set your function before add_clearance_joint, or add it with "
+                         "weftsim.exudyn_engine.clearance_joint.register_post_step(mbs, function)")
+
+
+def out_of_plane_message(e_z: float, clearance: float) -> str:
+    """One line for an eccentricity with an out-of-plane part |e_z| > c."""
+    return (f"the clearance joint's bodies left Exudyn's XY plane: the eccentricity has an out-of-plane part "
+            f"e_z = {e_z:.3g} m, more than the clearance c = {clearance:.3g} m; the joint acts in the XY plane "
+            "only (joint axis Z): build the bodies in the XY plane (2-D bodies) or constrain their motion along Z")
+
+
+def _check_plane(e_z: float, clearance: float) -> None:
+    if abs(e_z) > clearance:
+        raise JointMisuse(out_of_plane_message(e_z, clearance))
 
 
 def register_post_step(mbs, hook) -> None:
@@ -86,6 +126,9 @@ class ClearanceJointModel:
     route: str
     tracker: OnsetTracker
     keep_alive: object = field(default=None, repr=False)  # symbolic function must outlive the system
+    # [latest trial time seen by the force callback] (the overwritten post-step check, add_clearance_joint)
+    trial_time: list = field(default_factory=lambda: [0.0], repr=False)
+    friction: JointFriction | None = None  # friction force and moments (joint.friction_coefficient > 0)
 
     def state(self, mbs) -> tuple[float, float]:
         """Current (delta, delta_dot) of the joint, m and m/s."""
@@ -95,10 +138,15 @@ class ClearanceJointModel:
 
     def reset(self, mbs, t0: float = 0.0) -> None:
         """Start the bookkeeping from the current (assembled, initial) state of ``mbs``."""
+        u = mbs.GetObjectOutput(self.connector, exu.OutputVariableType.Displacement)
+        _check_plane(u[2], self.joint.clearance)
         delta, rate = self.state(mbs)
         self.tracker = OnsetTracker(self.joint.clearance, self.joint.min_impact_velocity, t0, delta, rate,
                                     self.joint.impact_velocity_rule)
         mbs.SetObjectParameter(self.connector, "stiffness", self.tracker.callback_state)
+        self.trial_time[0] = t0
+        if self.friction is not None:
+            self.friction.history.clear()
 
 
 def add_clearance_joint(mbs, marker_bearing, marker_journal, joint: ClearanceJoint, law=None,
@@ -128,44 +176,76 @@ def add_clearance_joint(mbs, marker_bearing, marker_journal, joint: ClearanceJoi
     ------
     ValueError
         For c <= 0 (use an ideal revolute joint) or an unknown route.
-    NotImplementedError
-        For friction_coefficient > 0.
+    JointMisuse
+        During the solve (Exudyn reports it as ``exudyn.ModelError`` with this message): a post-step
+        function set after this call, a second solve without :meth:`ClearanceJointModel.reset`, bodies
+        leaving the XY plane (module docstring).
+
+    Warns
+    -----
+    UserWarning
+        When ``joint.restitution`` is outside the law's ``valid_restitution``.
     """
     if not joint.clearance > 0.0:
         raise ValueError(f"`clearance` must be > 0 for a clearance joint, got {joint.clearance}; "
                          "use ObjectJointRevolute2D for an ideal joint")  # fmt: skip
-    if joint.friction_coefficient > 0.0:
-        raise NotImplementedError(
-            "friction in the Exudyn clearance joint is not implemented (the Cartesian connector "
-            "cannot apply the friction moments about the joint centres); set "
-            "`friction_coefficient` = 0 or use the reference engine (docs/clearance-joint.md)"
-        )
     if callbacks.route_error(callback):
         raise ValueError(callbacks.route_error(callback))
     law = make_law(joint) if law is None else law
+    lo, hi = law.valid_restitution
+    if not lo <= joint.restitution <= hi:
+        warnings.warn(f"`restitution` = {joint.restitution:g} is outside {lo:g}..{hi:g}, the range the "
+                      f"'{law.name}' law's damping was derived for: its contacts will not return this restitution; "
+                      "choose a law valid there (e.g. 'flores' for any ce)", UserWarning, stacklevel=2)
     route = callbacks.resolve_route(callback)
-    if call_counter is not None and route != "python":
-        raise ValueError("`call_counter` works with callback='python' only")
+    if call_counter is not None and (route != "python" or joint.friction_coefficient > 0.0):
+        raise ValueError("`call_counter` works with callback='python' and no friction only")
     c, v_min = joint.clearance, joint.min_impact_velocity
     max_approach = joint.impact_velocity_rule == "max_approach"
     tracker = OnsetTracker(c, v_min, rule=joint.impact_velocity_rule)  # checks the rule's name
     keep = None
-    if route == "python":
+    friction = None
+    if joint.friction_coefficient > 0.0:
+        friction = JointFriction(mbs, marker_bearing, marker_journal, joint_parameters(joint, law), route,
+                                 lambda: model.tracker.callback_state)  # fmt: skip
+        force = friction.spring_force
+    elif route == "python":
         force = callbacks.make_python_force(law, c, v_min, call_counter, max_approach)
     else:
         force = callbacks.make_numba_force(law, c, v_min, max_approach)
+    model = None
+    # The latest trial time the callback saw.  A call at a later time while the tracker's last accepted
+    # time is still below that one means a step ended there and the bookkeeping never ran.
+    trial = [tracker.t]
+
+    def checked_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
+        if t > trial[0]:
+            if trial[0] > model.tracker.t:
+                raise JointMisuse(OVERWRITTEN_POST_STEP)
+            trial[0] = t
+        return force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset)
+
     connector = mbs.AddObject(ObjectConnectorCartesianSpringDamper(
         markerNumbers=[marker_bearing, marker_journal],
         stiffness=tracker.callback_state, damping=[0.0, 0.0, 0.0], offset=[0.0, 0.0, 0.0],
-        springForceUserFunction=force,
+        springForceUserFunction=checked_force,
     ))  # fmt: skip
-    model = ClearanceJointModel(connector, joint, law, route, tracker, keep)
+    model = ClearanceJointModel(connector, joint, law, route, tracker, keep, trial, friction)
+    if friction is not None:
+        friction.install(mbs, connector)
     displacement = exu.OutputVariableType.Displacement
     velocity = exu.OutputVariableType.Velocity
 
     def accept(mbs, t):
         u = mbs.GetObjectOutput(connector, displacement)
         v = mbs.GetObjectOutput(connector, velocity)
+        _check_plane(u[2], c)
+        if t < model.tracker.t:
+            raise JointMisuse(f"the clearance joint's time went backwards (from {model.tracker.t:.6g} s to {t:.6g} s): "
+                              "the system is solved again; call model.reset(mbs) before every new solve")
+        trial[0] = min(trial[0], t)
+        if friction is not None:
+            friction.accept(mbs, t)
         delta, rate = penetration_state(u[0], u[1], v[0], v[1], c)
         model.tracker.accept(t, delta, rate)
         mbs.SetObjectParameter(connector, "stiffness", model.tracker.callback_state)

@@ -12,11 +12,11 @@
   for members 1-3.  What forces it (:func:`rigid_body_needs`):
   an ideal joint at E (c = 0: no coordinate moves freely; the rigid-body model then steps
   0.25 deg of crank, :data:`weftsim.exudyn_engine.solver.IDEAL_JOINT_STEP_ANGLE`, and never a
-  contact time scale); friction in the clearance joint (the tree's contact acts at the journal
-  centre and carries no friction moment on the rocker; the Exudyn engine has no friction in
-  either model today, so such a scene is refused with a message).  A clearance or a flexible body anywhere in members
-  1-3 would also need the rigid-body model (members 1-3 no longer move in closed form); weftsim's
-  scenes have neither yet.
+  contact time scale).  Friction in the clearance joint does not: the tree's generalized force
+  carries the friction force at the contact point and its moments on the rod and, through the
+  driving torque, on the rocker (:func:`weftsim.kernel.chain.tree_joint_force`).  A clearance or a
+  flexible body anywhere in members 1-3 would need the rigid-body model (members 1-3 no longer move
+  in closed form); weftsim's scenes have neither yet.
 
 ``"rigid_body"`` and ``"kinematic_tree"`` stay explicit choices.  :func:`weftsim.exudyn_engine.solve`
 runs exactly the model this module names.
@@ -39,8 +39,6 @@ def rigid_body_needs(scene: Scene) -> list[str]:
     if scene.is_ideal:
         needs.append("ideal joint at E (c = 0): no free coordinate, one generalized-alpha step per "
                      "0.25 deg of crank")  # fmt: skip
-    if joint.friction_coefficient > 0.0 and not joint.is_ideal:
-        needs.append("friction in the clearance joint (the kinematic tree carries no friction moment)")
     return needs
 
 
@@ -61,9 +59,10 @@ def select_path(scene: Scene) -> dict:
     model, reason = select_model(scene)
     if model == "kinematic_tree":
         from weftsim.exudyn_engine.callbacks import resolve_route
+        from weftsim.exudyn_engine.tree_solve import tree_relative_tolerance
 
         return {"model": model, "reason": reason,
-                "method": f"{s.explicit_method} rtol {s.relative_tolerance:g}, {resolve_route(s.callback)} callback"}
+                "method": f"{s.explicit_method} rtol {tree_relative_tolerance(scene):g}, {resolve_route(s.callback)} callback"}
     from weftsim.exudyn_engine.solver import adaptive, step_plan
 
     if adaptive(scene):

@@ -14,8 +14,10 @@ Every sensor stores internally at every accepted step (``storeInternal=True``,
     potential energy  sum of m g Y_com (gravity along -Y)
     contact energy    law.elastic_energy(delta), summed over the clearance joints
     driving work      integral T dtheta (trapezoid over accepted steps; theta_dot = omega)
-    dissipated        integral (F_N - F_el(delta)) delta_dot dt (trapezoid over accepted steps),
-                      the energy the contact damping takes out (all clearance joints)
+    dissipated        integral (F_N - F_el(delta)) delta_dot - F_T v_T dt (trapezoid over accepted
+                      steps), the energy the contact damping and friction take out (all clearance
+                      joints; with friction, F_N and F_T v_T come from the joint's record of every
+                      accepted state, joint_friction.py, since the connector's force then also holds F_T t)
 
 The trapezoid rules have errors O(h^2) per step; the integrator's own numerical
 dissipation (generalized-alpha, spectral radius < 1) is not in any channel, so the
@@ -124,11 +126,16 @@ def _joint_channels(cl, data: dict, joint: str, t: np.ndarray, n: int) -> dict[s
     rate = np.where(length > 0.0, np.sum(ecc * rate_vec, axis=1) / safe, 0.0)
     force = data[f"force_{joint}"]
     f_n = np.hypot(force[:n, 1], force[:n, 2])
+    friction_power = np.zeros(n)
     f_el = np.where(delta > 0.0, cl.law.elastic_force(np.maximum(delta, 0.0)), 0.0)
     hist = cl.tracker.history()
     # The tracker records every post-step call (Exudyn also calls it once at t = 0): take,
     # for each stored step, the tracker's last record at that time.
     row = np.clip(np.searchsorted(hist["time"], t * (1.0 + 1e-12), side="right") - 1, 0, len(hist["time"]) - 1)
+    if cl.friction is not None:
+        record = np.array(cl.friction.history).reshape(-1, 3)  # t, F_N, F_T v_T: one row per tracker record after t = 0
+        at = np.clip(np.searchsorted(record[:, 0], t * (1.0 + 1e-12), side="right") - 1, 0, len(record) - 1)
+        f_n, friction_power = record[at, 1], record[at, 2]
     return {
         "contact_force_N": f_n,
         "penetration_m": delta,
@@ -137,7 +144,7 @@ def _joint_channels(cl, data: dict, joint: str, t: np.ndarray, n: int) -> dict[s
         "impact_velocity_m_s": hist["impact_velocity"][row],
         "in_contact": hist["in_contact"][row],
         "contact_energy_J": np.where(delta > 0.0, cl.law.elastic_energy(np.maximum(delta, 0.0)), 0.0),
-        "dissipated_energy_J": _cumtrapz((f_n - f_el) * rate, t),
+        "dissipated_energy_J": _cumtrapz((f_n - f_el) * rate - friction_power, t),
         "penetration_rate_m_s": rate,
     }
 

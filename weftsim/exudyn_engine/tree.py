@@ -23,17 +23,20 @@ journal centre and its velocity from the joint coordinates, subtracts P_b(t) and
     e = P_j - P_b(t),   e_dot = v_j - V_b(t),
 
 applies the same law, onset interpolation and held impact velocity rule
-(``joint.impact_velocity_rule``) as every other route, and returns the joint torques of the
-contact force by virtual work.  No constraints remain, so an error-controlled
+(``joint.impact_velocity_rule``) as every other route, adds the modified Coulomb friction at the
+contact point when ``joint.friction_coefficient`` > 0 (its tangential velocity from the rod's and the
+rocker's rotation rates, its moments about both centres), and returns the joint torques of the
+contact force and moment by virtual work.  No constraints remain, so an error-controlled
 explicit solver (DOPRI5 with automatic step size) integrates it; there is no Jacobian and no
 Newton iteration.
 
 The driving torque comes from the contact force in closed form, with the crank-side
 terms of :mod:`weftsim.reference.ideal` (docs/physics.md section 4, docs/reference-solver.md):
 
-    T = 1/2 J13'(theta) omega^2 + U13'(theta) - Q3,   Q3 = F_b . dP_b/dtheta
+    T = 1/2 J13'(theta) omega^2 + U13'(theta) - Q3,   Q3 = F_b . dP_b/dtheta + M_b phi'(theta)
 
-(F_b = F_N n, the force on the bearing, recorded by the callback at every accepted state).  The full rigid-body
+(F_b = F_N n - F_T t, the force on the bearing, and M_b = -R_b F_T, its friction moment, recorded by
+the callback at every accepted state).  The full rigid-body
 model (:mod:`.mechanism`) stays the general path; ``tests/test_fast_paths.py`` checks the
 two against each other.
 """
@@ -67,22 +70,22 @@ class TreeModel:
     tracker: OnsetTracker
     route: str
     memory: list  # [v_held, delta0, rate0] read by the force callback
-    stash: list  # [t, delta, delta_dot, F_b,x, F_b,y] of the last callback
+    stash: list  # [t, delta, delta_dot, F_b,x, F_b,y, F_N, M_b, F_T v_T] of the last callback
     callback_calls: list = field(default_factory=lambda: [0])  # [count]
-    bearing_force: list = field(default_factory=list)  # [t, F_b,x, F_b,y] per accepted state
+    # [t, F_b,x, F_b,y, F_N, M_b, F_T v_T] per accepted state (tree_joint_force's contact on the bearing)
+    bearing_force: list = field(default_factory=list)
 
     def accept(self, mbs, t: float) -> None:
         """Post-step bookkeeping: onset, held impact velocity, callback memory, force on the bearing."""
-        t_call, delta, rate, fx, fy = self.stash
-        if t_call != t:  # no evaluation at this state yet (the initial state)
+        if self.stash[0] != t:  # no evaluation at this state yet (the initial state)
             q = mbs.GetNodeOutput(self.node, exu.OutputVariableType.Coordinates)
             q_t = mbs.GetNodeOutput(self.node, exu.OutputVariableType.Coordinates_t)
             self.force(mbs, t, self.tree, q, q_t)
-            t_call, delta, rate, fx, fy = self.stash
+        _, delta, rate, fx, fy, f_n, m_b, power = self.stash
         tracker = self.tracker
         tracker.accept(t, delta, rate)
         self.memory[0], self.memory[1], self.memory[2] = tracker.held, delta, rate
-        self.bearing_force.append((t, fx, fy))
+        self.bearing_force.append((t, fx, fy, f_n, m_b, power))
 
 
 def build_tree(mbs, scene: Scene, callback: str = "auto") -> TreeModel:
@@ -90,7 +93,8 @@ def build_tree(mbs, scene: Scene, callback: str = "auto") -> TreeModel:
 
     Initial state: the ideal mechanism at theta = 0, journal centred
     (:func:`weftsim.reference.dynamics.initial_state`).  ``callback``: "auto" (:func:`weftsim.exudyn_engine.callbacks.resolve_route`),
-    "python" or "numba"; both evaluate :func:`weftsim.kernel.chain.tree_joint_force`.  Needs ``scene.joint.clearance > 0`` and no friction.
+    "python" or "numba"; both evaluate :func:`weftsim.kernel.chain.tree_joint_force`.  Needs ``scene.joint.clearance > 0``;
+    friction (``joint.friction_coefficient`` > 0) acts at the contact point with its moments on rod and rocker.
     """
     g, m, joint = scene.geometry, scene.inertia, scene.joint
     a0, psi0, da0, dpsi0 = initial_state(scene)[:4]
@@ -101,7 +105,7 @@ def build_tree(mbs, scene: Scene, callback: str = "auto") -> TreeModel:
     calls = [0]
     tracker = OnsetTracker(joint.clearance, joint.min_impact_velocity, rule=joint.impact_velocity_rule)
     memory = list(tracker.callback_state)
-    stash = [math.nan, 0.0, 0.0, 0.0, 0.0]
+    stash = [math.nan] + [0.0] * 7
     force = callbacks.make_tree_force(pack_parameters(scene), memory, stash, route, calls)
     node = mbs.AddNode(NodeGenericODE2(
         referenceCoordinates=[0.0, 0.0], initialCoordinates=[a0, psi0 + math.pi - a0],

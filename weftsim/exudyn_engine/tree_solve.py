@@ -1,7 +1,8 @@
 """``solve`` of the kinematic-tree model (:mod:`.tree`): explicit solver, channels, failures.
 
 Solver: Exudyn's explicit ``exudyn_solver.explicit_method`` (DOPRI5 or ODE23) with
-automatic step size, ``relative_tolerance`` and ``absolute_tolerance`` (on the joint
+automatic step size, ``relative_tolerance`` (at most :data:`FRICTION_RELATIVE_TOLERANCE` with
+friction) and ``absolute_tolerance`` (on the joint
 angles, rad, and rates, rad/s), end-of-step accelerations on (else the rapier acceleration
 lags a stage), largest step = half an output sample period (:data:`STEPS_PER_SAMPLE`).  Output samples are interpolated
 linearly between accepted steps (peaks and statistics use the steps themselves).
@@ -11,11 +12,13 @@ Channels, at every accepted step (docs/physics.md section 4 signs):
     a, psi           q0, q0 + q1 - pi;   rapier s, v, a = (d5 d7/d6) (a - a(0), a', a'')
     e, delta, F_N    from a, psi and the closed-form bearing motion
                      (:func:`weftsim.reference.dynamics.eccentricity`); F_N = |connector Force|
-    torque           1/2 J13' omega^2 + U13' - Q3, Q3 = F_b . dP_b/dtheta (:mod:`weftsim.reference.ideal`)
+    torque           1/2 J13' omega^2 + U13' - Q3, Q3 = F_b . dP_b/dtheta + M_b phi' (:mod:`weftsim.reference.ideal`;
+                     F_b, M_b: force and friction moment on the bearing)
     energies         kinetic 1/2 J13 omega^2 + chain (:func:`~weftsim.reference.dynamics.chain_energy`),
                      potential U13 + m4 g z4, contact law.elastic_energy(delta), driving work
                      [1/2 J13 omega^2 + U13]_0^t + integral -Q3 omega dt, dissipated
-                     integral (F_N - F_el) delta_dot dt (trapezoids over accepted steps)
+                     integral (F_N - F_el) delta_dot - F_T v_T dt (damping and friction work,
+                     :func:`contact_work` over accepted steps)
 
 Failures as in :mod:`.solver`: the run guards of :mod:`weftsim.guards` after every step,
 Exudyn exceptions, non-finite values, a premature stop; :func:`weftsim.guards.vet_result`.
@@ -51,6 +54,19 @@ EXPLICIT_METHODS = {"DOPRI5": exu.DynamicSolverType.DOPRI5, "ODE23": exu.Dynamic
 STEPS_PER_SAMPLE = 2
 _PROGRESS_EVERY = 0.001  # every 0.1 % of the run: a long run shows its first line soon (issue 16)
 END_OF_STEP_ACCELERATIONS = False
+# Largest relative tolerance of the tree with friction.  The friction ramp sticks the journal in phases
+# where DOPRI5 steps at its stability limit, and at rtol 1e-6 the error left there broke the energy balance
+# (4.5 J, 8e-3 of the largest kinetic energy, in one revolution at mu = 0.15, c = 0.5 mm) and the torque
+# maximum (1.1 % off the reference engine); at 1e-8: 0.02 J and 6e-5, and no more steps than at 1e-6
+# (the stick phases' steps are set by stability, not accuracy).  A tighter scene value is kept.
+FRICTION_RELATIVE_TOLERANCE = 1e-8
+
+
+def tree_relative_tolerance(scene: Scene) -> float:
+    """The explicit solver's relative tolerance: the scene's, at most :data:`FRICTION_RELATIVE_TOLERANCE`
+    with friction in the joint."""
+    rtol = scene.exudyn_solver.relative_tolerance
+    return min(rtol, FRICTION_RELATIVE_TOLERANCE) if scene.joint.friction_coefficient > 0.0 else rtol
 
 
 def check_tree_settings(scene: Scene) -> str | None:
@@ -134,7 +150,7 @@ def tree_settings(scene: Scene) -> exu.SimulationSettings:
     ti.endTime = t_end
     ti.numberOfSteps = STEPS_PER_SAMPLE * max(1, math.ceil(t_end / (scene.output.sample_angle / omega) * (1.0 - 1e-12)))
     ti.automaticStepSize = True
-    ti.relativeTolerance = s.relative_tolerance
+    ti.relativeTolerance = tree_relative_tolerance(scene)
     ti.absoluteTolerance = s.absolute_tolerance
     ti.minimumStepSize = scene.limits.min_step
     ti.explicit.computeEndOfStepAccelerations = END_OF_STEP_ACCELERATIONS
@@ -154,13 +170,13 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
     da, dpsi = q_t[:, 1], q_t[:, 1] + q_t[:, 2]
     p = ChainConstants.from_scene(scene)
     omega = p.omega
-    ecc_y, ecc_z, v_y, v_z, _, db_y, db_z = eccentricity(NUMPY, p, t, a, psi, da, dpsi)
+    ecc_y, ecc_z, v_y, v_z, dphi, db_y, db_z = eccentricity(NUMPY, p, t, a, psi, da, dpsi)
     length = np.hypot(ecc_y, ecc_z)
     delta = length - p.clearance
     rate = np.where(length > 0.0, (ecc_y * v_y + ecc_z * v_z) / np.where(length > 0.0, length, 1.0), 0.0)
-    f_b = force[:, 1:3]  # F_N n, the force on the bearing
-    f_n = np.hypot(f_b[:, 0], f_b[:, 1])
-    q3 = f_b[:, 0] * db_y + f_b[:, 1] * db_z
+    f_b = force[:, 1:3]  # F_N n - F_T t, the force on the bearing
+    f_n, m_b, friction_power = force[:, 3], force[:, 4], force[:, 5]
+    q3 = f_b[:, 0] * db_y + f_b[:, 1] * db_z + m_b * dphi
     theta = omega * t
     j13, dj13 = crank_side_inertia(theta, scene)
     u13, du13 = crank_side_potential(theta, scene)
@@ -194,7 +210,7 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
         "potential_energy_J": u13 + pot48,
         "contact_energy_J": energy,
         "driving_work_J": kin13 + u13 - (0.5 * float(j13_0) * omega**2 + float(u13_0)) + contact_work(-q3 * omega, t, delta),
-        "dissipated_energy_J": contact_work((f_n - f_el) * rate, t, delta),
+        "dissipated_energy_J": contact_work((f_n - f_el) * rate - friction_power, t, delta),
         "penetration_rate_m_s": rate,
     }
 
@@ -250,7 +266,7 @@ def solve_tree(scene: Scene, progress=None, callback: str | None = None) -> RunR
         kind = "non_finite" if isinstance(exc, exu.SolverError) else "model" if isinstance(exc, exu.ModelError) else "solver"
     wall_solve = _time.perf_counter() - wall_solve
     data = {k: mbs.GetSensorStoredData(v) for k, v in sensors.items()}
-    data["force"] = np.array(model.bearing_force).reshape(-1, 3)
+    data["force"] = np.array(model.bearing_force).reshape(-1, 6)
     steps = tree_channels(model, data) if min(len(v) for v in data.values()) else empty_channels()
     bad = first_nonfinite_row(steps)
     if bad is not None:
@@ -274,7 +290,7 @@ def solve_tree(scene: Scene, progress=None, callback: str | None = None) -> RunR
     stats = {
         "method": scene.exudyn_solver.explicit_method,
         "model": "kinematic_tree",
-        "relative_tolerance": scene.exudyn_solver.relative_tolerance,
+        "relative_tolerance": tree_relative_tolerance(scene),
         "steps": n_done,
         "rejected_steps": int(it.rejectedAutomaticStepSizeSteps),
         "min_step_s": state["min_step"],

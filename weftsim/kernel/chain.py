@@ -32,12 +32,13 @@ import math
 
 from numba import njit
 
-from weftsim.kernel.joint import connector_force
+from weftsim.kernel.joint import connector_force, connector_friction_force
 from weftsim.kernel.joint import (  # noqa: F401 - the joint block is part of this array
     BEARING_RADIUS, CLEARANCE, COEF, KIND, MU, N_JOINT, TRACK_MAX, V_MIN, clearance_force, clearance_force_at,
+    tangential_velocity,
 )  # fmt: skip
 from weftsim.kernel.laws import elastic_force
-from weftsim.kernel.wear import sliding_velocity, worn_clearance
+from weftsim.kernel.wear import worn_clearance
 
 # Indices of the chain's constants, after the joint block.
 (OMEGA, TAN_BETA, COS_OE0, SIN_OE0, L_OE, L_EF, L_FG, L_OG, ROD_MASS, GRAVITY, M11, M22,
@@ -136,7 +137,7 @@ def chain(prm, t, y, contact, impact_velocity, out):
     if contact and length > 0.0:
         v_t = 0.0
         if prm[MU] > 0.0:
-            v_t = sliding_velocity(ecc_y, ecc_z, v_y, v_z, length, dpsi, omega * dphi, prm[BEARING_RADIUS])
+            v_t = tangential_velocity(ecc_y, ecc_z, v_y, v_z, length, dpsi, omega * dphi, prm[BEARING_RADIUS])
         f_y, f_z, f_n, _, delta, delta_dot, m_j, m_b = clearance_force_at(
             prm, c, c_rate, ecc_y, ecc_z, v_y, v_z, v_t, impact_velocity)
         f_el = elastic_force(prm[KIND], prm[COEF], c, delta)
@@ -171,19 +172,6 @@ def rhs(prm, t, y, contact, impact_velocity, out):
 
 
 @njit(cache=True, error_model="numpy")
-def moving_bearing_force(prm, t, px, py, vx, vy, held, delta0, rate0):
-    """Connector force with the bearing centre moving as the crank side prescribes (kinematic tree).
-
-    ``(px, py)``, ``(vx, vy)``: journal centre P_j and its velocity (m, m/s) at time t; the
-    eccentricity is P_j - P_b with P_b of :func:`crank_side`.  Returns
-    :func:`weftsim.kernel.joint.connector_force` (f_x, f_y, delta, delta_dot).
-    """
-    b_y, b_z, db_y, db_z, _ = crank_side(prm, t)
-    omega = prm[OMEGA]
-    return connector_force(prm, px - b_y, py - b_z, vx - omega * db_y, vy - omega * db_z, held, delta0, rate0)
-
-
-@njit(cache=True, error_model="numpy")
 def tree_joint_force(prm, t, a, q1, da, dq1, held, delta0, rate0):
     """Generalized contact force on the two joints of the kinematic tree (Exudyn's tree model).
 
@@ -192,12 +180,17 @@ def tree_joint_force(prm, t, a, q1, da, dq1, held, delta0, rate0):
 
         P_j = G + L_FG u(a) + L_EF u(b),  v_j = L_FG a' u'(a) + L_EF b' u'(b),
 
-    go through :func:`moving_bearing_force` (the force F_b = F_N n on the bearing); the force on
-    the journal, -F_b, enters the joints by virtual work:
+    less the bearing centre P_b(t) of :func:`crank_side` and its velocity, go through
+    :func:`weftsim.kernel.joint.connector_friction_force`: the normal force F_N n on the bearing and,
+    with friction (``prm[MU]`` > 0, in contact), F_T t on the journal (rod turning at b', rocker at
+    omega phi') with the moments M_j = (R_b - |e|) F_T about P_j and M_b = -R_b F_T about P_b.  The force on the bearing is F_b = F_N n - F_T t; the journal's, -F_b,
+    and M_j enter the joints by virtual work (db/dq0 = db/dq1 = 1):
 
-        Q1 = -F_b . dP_j/dq1 = L_EF (F_bx sin b - F_by cos b),   Q0 = L_FG (F_bx sin a - F_by cos a) + Q1.
+        Q1 = -F_b . dP_j/dq1 + M_j = L_EF (F_bx sin b - F_by cos b) + M_j,
+        Q0 = L_FG (F_bx sin a - F_by cos a) + Q1.
 
-    Returns (Q0, Q1, delta, delta_dot, F_bx, F_by): N m, N m, m, m/s, N, N.
+    Returns (Q0, Q1, delta, delta_dot, F_bx, F_by, F_N, M_b, F_T v_T): N m, N m, m, m/s, N, N, N,
+    N m, W (the friction power on the pair, <= 0; 0 without friction).
     """
     l_fg, l_ef = prm[L_FG], prm[L_EF]
     b = a + q1
@@ -207,6 +200,10 @@ def tree_joint_force(prm, t, a, q1, da, dq1, held, delta0, rate0):
     py = l_fg * sa + l_ef * sb
     vx = -l_fg * sa * da - l_ef * sb * db
     vy = l_fg * ca * da + l_ef * cb * db
-    fx, fy, delta, rate = moving_bearing_force(prm, t, px, py, vx, vy, held, delta0, rate0)
-    g1 = l_ef * (fx * sb - fy * cb)
-    return l_fg * (fx * sa - fy * ca) + g1, g1, delta, rate, fx, fy
+    b_y, b_z, db_y, db_z, dphi = crank_side(prm, t)
+    omega = prm[OMEGA]
+    # F_N = hypot of the normal force, as the channels computed it before friction: bit-identical at mu = 0.
+    fx, fy, delta, rate, f_n, f_t, m_j, m_b, v_t = connector_friction_force(
+        prm, px - b_y, py - b_z, vx - omega * db_y, vy - omega * db_z, held, delta0, rate0, db, omega * dphi)
+    g1 = l_ef * (fx * sb - fy * cb) + m_j
+    return l_fg * (fx * sa - fy * ca) + g1, g1, delta, rate, fx, fy, f_n, m_b, f_t * v_t

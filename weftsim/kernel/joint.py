@@ -54,6 +54,33 @@ def joint_parameters(joint, law) -> np.ndarray:
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def friction_force(prm, f_n, v_t):
+    """F_T, N: the modified Coulomb friction on the journal along t (Ambrosio 2003).
+
+    F_T = -mu c_d(|v_T|) F_N sign(v_T), with c_d the ramp of :func:`~weftsim.kernel.laws.friction_factor`
+    between ``prm[V0]`` and ``prm[V1]``; 0 when mu = 0 or F_N = 0.  ``v_t``: relative tangential velocity
+    of the contact points (journal relative to bearing, :func:`tangential_velocity`), m/s.
+    """
+    mu = prm[MU]
+    if mu > 0.0 and f_n > 0.0:
+        c_d = friction_factor(v_t, prm[V0], prm[V1])
+        if c_d > 0.0:
+            return -mu * c_d * f_n if v_t > 0.0 else mu * c_d * f_n
+    return 0.0
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def tangential_velocity(ex, ey, ex_dot, ey_dot, length, omega_j, omega_b, r_b):
+    """v_T = e_dot . t + omega_j (R_b - |e|) - omega_b R_b, m/s (``length`` = |e| > 0).
+
+    The velocity of the journal's material point at the contact point Q = P_b + R_b n relative to
+    the bearing's, along t = (-n_y, n_x): Q - P_j = (R_b - |e|) n and Q - P_b = R_b n, so the two
+    bodies' rotations (omega_j, omega_b about +z, rad/s) add omega (Q - P) x z-turned terms along t.
+    """
+    return (ex * ey_dot - ey * ex_dot) / length + omega_j * (r_b - length) - omega_b * r_b
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def clearance_force(prm, ex, ey, ex_dot, ey_dot, v_t, v_imp):
     """Force of the joint at eccentricity e and its rate, with held impact velocity v_imp.
 
@@ -87,12 +114,7 @@ def clearance_force_at(prm, clearance, clearance_rate, ex, ey, ex_dot, ey_dot, v
     delta_dot = ex_dot * nx + ey_dot * ny - clearance_rate
     v = effective_impact_velocity(v_imp, delta_dot, prm[TRACK_MAX] != 0.0)
     f_n = normal_force(prm[KIND], prm[COEF], clearance, prm[XI], delta, delta_dot, v)
-    f_t = 0.0
-    mu = prm[MU]
-    if mu > 0.0 and f_n > 0.0:
-        c_d = friction_factor(v_t, prm[V0], prm[V1])
-        if c_d > 0.0:
-            f_t = -mu * c_d * f_n if v_t > 0.0 else mu * c_d * f_n
+    f_t = friction_force(prm, f_n, v_t)
     r_b = prm[BEARING_RADIUS]
     fx = -f_n * nx - f_t * ny
     fy = -f_n * ny + f_t * nx
@@ -126,3 +148,29 @@ def connector_force(prm, ex, ey, vx, vy, held, delta0, rate0):
     f = normal_force(prm[KIND], prm[COEF], prm[CLEARANCE], prm[XI], delta, damping_rate(rate, prm[DEAD_RATE]),
                      v_imp)  # fmt: skip
     return f * nx, f * ny, delta, rate
+
+
+@njit(cache=True, error_model="numpy")
+def connector_friction_force(prm, ex, ey, vx, vy, held, delta0, rate0, omega_j, omega_b):
+    """:func:`connector_force` with the modified Coulomb friction (the rigid-body Exudyn joint).
+
+    ``omega_j``, ``omega_b``: angular velocities (rad/s, about +z) of the journal's and the bearing's
+    body.  The normal force is :func:`connector_force`'s; in contact the journal also gets F_T t
+    (:func:`friction_force` at :func:`tangential_velocity`) and the moment M_j = (R_b - |e|) F_T about
+    P_j, the bearing -F_T t and M_b = -R_b F_T about P_b.
+
+    Returns
+    -------
+    (f_x, f_y, delta, delta_dot, F_N, F_T, M_j, M_b, v_T): the force on the bearing F_N n - F_T t (N),
+    penetration (m) and rate (m/s), normal and friction force (N), moments (N m), sliding speed (m/s).
+    """
+    fx, fy, delta, rate = connector_force(prm, ex, ey, vx, vy, held, delta0, rate0)
+    if delta <= 0.0:
+        return fx, fy, delta, rate, 0.0, 0.0, 0.0, 0.0, 0.0
+    length = math.sqrt(ex * ex + ey * ey)
+    f_n = math.hypot(fx, fy)
+    r_b = prm[BEARING_RADIUS]
+    v_t = tangential_velocity(ex, ey, vx, vy, length, omega_j, omega_b, r_b)
+    f_t = friction_force(prm, f_n, v_t)
+    nx, ny = ex / length, ey / length
+    return fx + f_t * ny, fy - f_t * nx, delta, rate, f_n, f_t, (r_b - length) * f_t, -r_b * f_t, v_t

@@ -115,17 +115,6 @@ def worn_clearance(prm, start, c0, angle_b, angle_j, rate_b, rate_j):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def sliding_velocity(ecc_y, ecc_z, v_y, v_z, length, w_j, w_b, r_b):
-    """v_T of the journal's contact point relative to the bearing's, along t = n turned +90 deg, m/s.
-
-    v_T = e_dot . t + w_j (R_b - |e|) - w_b R_b: the tangential eccentricity rate plus the journal's
-    rotation (lever R_j - delta = R_b - |e| from P_j) minus the bearing's (lever R_b from P_b);
-    ``w_j``, ``w_b`` the angular speeds of rod 4 and rocker 3, rad/s; ``length`` = |e| > 0.
-    """
-    return (ecc_y * v_z - ecc_z * v_y) / length + w_j * (r_b - length) - w_b * r_b
-
-
-@njit(cache=True, error_model="numpy", inline="always")
 def contact_half_angle(clearance, delta):
     """phi0 = acos(c / (c + delta)): half the arc over which journal and bearing overlap, rad (0 if delta <= 0)."""
     if delta <= 0.0:

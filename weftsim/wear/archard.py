@@ -1,7 +1,7 @@
 """Archard wear of one run at joint E, from the run's accepted steps (docs/wear.md section 1).
 
 At every step row the kernel gives the normal force F_N, the sliding velocity v_T of the contact
-points (:func:`weftsim.kernel.wear.sliding_velocity`: the journal's rotation relative to the
+points (:func:`weftsim.kernel.joint.tangential_velocity`: the journal's rotation relative to the
 bearing plus the tangential eccentricity rate), the contact direction in the bearing's and in the
 journal's frame and the contact half-angle.  The sliding work integral W = int F_N |v_T| dt is
 taken with the trapezoidal weights of the rows (:func:`weftsim.analysis.time_weights`), so each row
@@ -20,7 +20,8 @@ from numba import njit
 
 from weftsim.analysis import time_weights
 from weftsim.kernel.chain import BEARING_RADIUS, OMEGA, chain, eccentricity, local_clearance, rocker_angle
-from weftsim.kernel.wear import contact_half_angle, deposit, sliding_velocity
+from weftsim.kernel.joint import tangential_velocity
+from weftsim.kernel.wear import contact_half_angle, deposit
 
 
 @njit(cache=True, error_model="numpy")
@@ -43,7 +44,7 @@ def contact_rows(prm, time, states, contact, impact, out):
             c = local_clearance(prm, t, ecc_y, ecc_z, v_y, v_z, y)[0]
             direction = math.atan2(ecc_z, ecc_y)
             out[i, 0] = f_n
-            out[i, 1] = sliding_velocity(ecc_y, ecc_z, v_y, v_z, length, y[3], prm[OMEGA] * dphi, prm[BEARING_RADIUS])
+            out[i, 1] = tangential_velocity(ecc_y, ecc_z, v_y, v_z, length, y[3], prm[OMEGA] * dphi, prm[BEARING_RADIUS])
             out[i, 2] = direction - rocker_angle(prm, t)
             out[i, 3] = direction - y[1]
             out[i, 4] = contact_half_angle(c, length - c)

@@ -1,0 +1,141 @@
+"""Friction of the reusable clearance joint on rigid bodies (docs/physics.md section 2).
+
+The modified Coulomb friction (Ambrosio 2003) acts at the contact point Q = P_b + R_b n.  The joint's
+``ObjectConnectorCartesianSpringDamper`` applies one force at the two centres, so Q's force is split
+into that force and two pure moments, one per body::
+
+    journal: f_j = -F_N n + F_T t at P_j,   M_j = (R_b - |e|) F_T     (Q - P_j = (R_b - |e|) n)
+    bearing: -f_j at P_b,                   M_b = -R_b F_T            (Q - P_b = R_b n)
+
+M_j + M_b = -|e| F_T balances the moment e x f_j of the force pair about the two centres, so the two
+moments differ and cannot be one equal-and-opposite connector torque: each is a ``LoadTorqueVector``
+with a user function on its own body.  The sliding speed needs the bodies' rotation rates,
+
+    v_T = e_dot . t + omega_j (R_b - |e|) - omega_b R_b,
+
+which the Cartesian connector's callback does not receive: it reads them from the system
+(``GetObjectOutputBody``, the current trial state inside Newton).  Force, moments and v_T are
+:func:`weftsim.kernel.joint.connector_friction_force` (compiled or plain Python, the joint's route),
+evaluated once per state and shared by the connector callback and the two loads.
+
+Newton: the connector's numerical Jacobian contains the friction force's dependence on e and e_dot;
+the loads' and the rates' dependence is in the Jacobian only with
+``timeIntegration.computeLoadsJacobian = 2``, and a stale Jacobian (modified Newton) does not follow the
+journal from sliding into sticking (ramp slope mu F_N / (v1 - v0) ~ 1e8 N s/m on the loom): the loom's
+rigid-body model sets both (solver.py, with what failed without them); a user's own settings need them too.
+
+A body without rotation (ground, mass point) turns at 0 and takes no moment.
+"""
+
+from __future__ import annotations
+
+import exudyn as exu
+from exudyn.itemInterface import LoadTorqueVector, MarkerBodyRigid
+
+from weftsim.exudyn_engine import callbacks
+from weftsim.kernel import joint as kernel_joint
+
+_ROTATING = ("RigidBody", "RigidBody2D")
+_FIXED = ("Ground", "MassPoint", "MassPoint2D")
+_OMEGA = exu.OutputVariableType.AngularVelocity
+
+
+def _body_of(mbs, marker) -> tuple[int | None, list, bool]:
+    """(body, local position, rotates) of a position marker; body None for a node marker (a point)."""
+    item = mbs.GetMarker(marker)
+    if "bodyNumber" not in item:
+        node_type = str(mbs.GetNode(item["nodeNumber"])["nodeType"])
+        if "Point" not in node_type or "Rigid" in node_type:
+            raise ValueError(f"friction in the clearance joint needs MarkerBodyPosition markers on rigid bodies, "
+                             f"ground or mass points, or node markers on point nodes; got a marker on a {node_type} node")
+        return None, [0.0, 0.0, 0.0], False
+    body = item["bodyNumber"]
+    kind = str(mbs.GetObject(body)["objectType"])
+    if kind not in _ROTATING + _FIXED:
+        raise ValueError(f"friction in the clearance joint needs the markers on rigid bodies, ground or mass "
+                         f"points; got a body of type {kind!r}")
+    return body, list(item.get("localPosition", [0.0, 0.0, 0.0])), kind in _ROTATING
+
+
+class JointFriction:
+    """Friction force and moments of one clearance joint (module docstring).
+
+    Parameters
+    ----------
+    mbs : exudyn.MainSystem
+    marker_bearing, marker_journal : exudyn MarkerIndex
+        The joint's position markers (bearing centre, journal centre).
+    prm : numpy.ndarray
+        The joint block of :func:`weftsim.kernel.joint.joint_parameters` (friction included).
+    route : {"numba", "python"}
+    memory : callable
+        Returns the connector's memory [v_held, delta0, rate0] (the tracker's ``callback_state``).
+
+    Attributes
+    ----------
+    history : list of tuple
+        (t, F_N, F_T v_T) at every accepted state (:meth:`accept`): normal force (N) and friction
+        power on the pair (W, <= 0).
+    """
+
+    def __init__(self, mbs, marker_bearing, marker_journal, prm, route: str, memory):
+        self.bearing, _, self.bearing_rotates = _body_of(mbs, marker_bearing)
+        self.journal, self.journal_local, self.journal_rotates = _body_of(mbs, marker_journal)
+        self.bearing_local = _body_of(mbs, marker_bearing)[1]
+        self.kernel = callbacks.kernel_form(kernel_joint.connector_friction_force, route)
+        self.prm = callbacks.parameters_for_route(prm, route)
+        if route == "numba":
+            self.kernel(self.prm, 1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0)  # load (or compile) now
+        self.memory = memory
+        self.connector = None
+        self._key = None
+        self._value = None
+        self.history: list = []
+
+    def rates(self, mbs) -> tuple[float, float]:
+        """(omega_j, omega_b), rad/s about Z, of the current (trial) state."""
+        w_j = mbs.GetObjectOutputBody(self.journal, _OMEGA, [0.0, 0.0, 0.0])[2] if self.journal_rotates else 0.0
+        w_b = mbs.GetObjectOutputBody(self.bearing, _OMEGA, [0.0, 0.0, 0.0])[2] if self.bearing_rotates else 0.0
+        return w_j, w_b
+
+    def evaluate(self, mbs, ex, ey, vx, vy):
+        """The kernel's (f_x, f_y, delta, delta_dot, F_N, F_T, M_j, M_b, v_T) at this state (memoized)."""
+        w_j, w_b = self.rates(mbs)
+        held, delta0, rate0 = self.memory()
+        key = (ex, ey, vx, vy, w_j, w_b, held, delta0, rate0)
+        if key != self._key:
+            self._key = key
+            self._value = self.kernel(self.prm, ex, ey, vx, vy, held, delta0, rate0, w_j, w_b)
+        return self._value
+
+    def spring_force(self, mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
+        """``springForceUserFunction`` of the connector: F_N n - F_T t, the force on the bearing."""
+        out = self.evaluate(mbs, displacement[0], displacement[1], velocity[0], velocity[1])
+        return [out[0], out[1], 0.0]
+
+    def _state(self, mbs):
+        u = mbs.GetObjectOutput(self.connector, exu.OutputVariableType.Displacement)
+        v = mbs.GetObjectOutput(self.connector, exu.OutputVariableType.Velocity)
+        return self.evaluate(mbs, u[0], u[1], v[0], v[1])
+
+    def install(self, mbs, connector) -> None:
+        """Add the torque loads M_j and M_b on the bodies that rotate (after the connector exists)."""
+        self.connector = connector
+
+        def journal_moment(mbs, t, load):
+            return [0.0, 0.0, self._state(mbs)[6]]
+
+        def bearing_moment(mbs, t, load):
+            return [0.0, 0.0, self._state(mbs)[7]]
+
+        for rotates, body, local, moment in ((self.journal_rotates, self.journal, self.journal_local, journal_moment),
+                                             (self.bearing_rotates, self.bearing, self.bearing_local, bearing_moment)):
+            if rotates:
+                marker = mbs.AddMarker(MarkerBodyRigid(bodyNumber=body, localPosition=local))
+                mbs.AddLoad(LoadTorqueVector(markerNumber=marker, loadVector=[0.0, 0.0, 0.0],
+                                             loadVectorUserFunction=moment))  # fmt: skip
+
+    def accept(self, mbs, t: float) -> None:
+        """Record (t, F_N, F_T v_T) of an accepted state (post-step, before the tracker's update)."""
+        out = self._state(mbs)
+        self.history.append((t, out[4], out[5] * out[8]))
