@@ -6,9 +6,11 @@ evaluate one kernel (:func:`weftsim.kernel.joint.friction_force` at the tangenti
 generalized force (:func:`weftsim.kernel.chain.tree_joint_force`), so what is compared is the two
 integrations of the same model.  Compared as without friction (tests/test_engine_agreement.py, the
 scene's ``[compare]`` table): first contact within 0.1 deg, first-revolution maxima of contact force,
-rapier acceleration and driving torque within 1 %.  One revolution each: the friction ramp
-(v0 = 0.1 mm/s, v1 = 0.2 mm/s) makes both explicit integrators step at their stability limit while the
-journal sticks, ~2.5 million tree steps per revolution (95 s) against ~21 000 without friction.
+rapier acceleration and driving torque within 1 %, here over the first 0.1 revolution (the start-up
+impact and the sliding contact after it; 2-31 s a case).  A whole revolution was measured once (the table
+below) but is too long for every CI run: the friction ramp (v0 = 0.1 mm/s, v1 = 0.2 mm/s) makes both
+explicit integrators step at their stability limit while the journal sticks, ~2.5 million tree steps per
+revolution (95-220 s) against ~21 000 without friction.
 
 Measured (reference numba_DOP853 at rtol 1e-8; relative differences).  The tree first ran at the
 frictionless default rtol 1e-6:
@@ -50,24 +52,43 @@ def _scene(mu: float, clearance: str, revolutions: float = 1.0):
     })  # fmt: skip
 
 
+# The span the agreement tests run: the start-up impact (first contact at 5-10 deg) and the lasting,
+# sliding contact after it, where friction acts; a whole revolution costs 95-220 s a case on the tree
+# (stick phases, see above), too long for every CI run.  Its figures are the table above.
+SPAN_REVOLUTIONS = 0.1
+PEAK_CHANNELS = ("contact_force_N", "rapier_acceleration_m_s2", "driving_torque_Nm")
+
+
+def _span_disagreements(exu, ref) -> list[str]:
+    """First contact within the scene's 0.1 deg and the maxima of |x| over the span within its 1 %
+    (the tolerances of the first-revolution checks, weftsim.compare.agreement_checks)."""
+    tol = ref.scene.compare
+    out = []
+    gap = abs(exu.first_contact_angle_deg - ref.first_contact_angle_deg)
+    if not gap <= np.degrees(tol.first_contact_angle):
+        out.append(f"first contact {exu.first_contact_angle_deg} vs {ref.first_contact_angle_deg} deg")
+    for name in PEAK_CHANNELS:
+        a, b = np.abs(exu.steps[name]).max(), np.abs(ref.steps[name]).max()
+        if not abs(a - b) <= tol.first_revolution_peaks * b:
+            out.append(f"{name}: max |x| {a:.6g} vs {b:.6g} ({abs(a - b) / b:.2e})")
+    return out
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("clearance", ["0p25", "0p50"])
 @pytest.mark.parametrize("mu", [0.05, 0.15])
 def test_friction_runs_agree_with_the_reference_engine(mu, clearance):
     from weftsim import exudyn_engine, reference
 
-    scene = _scene(mu, clearance)
+    scene = _scene(mu, clearance, revolutions=SPAN_REVOLUTIONS)
     ref, exu = reference.solve(scene), exudyn_engine.solve(scene)
     assert ref.ok and exu.ok, (ref.message, exu.message)
     assert exu.path["model"] == "kinematic_tree" and exu.path["reason"].startswith("auto")
-    checks = agreement_checks(exu, ref)
-    assert any("first contact" in c["name"] for c in checks)
-    assert sum("first revolution" in c["name"] for c in checks) == 3
-    failed = [c for c in checks if not c["passed"]]  # 0.1 deg and 1 %, the scene's [compare] table
-    assert not failed, failed
-    # Friction did something: it dissipates more than the contact damping alone does in the same run.
-    free = reference.solve(_scene(0.0, clearance))
-    assert ref.steps["dissipated_energy_J"][-1] > 1.2 * free.steps["dissipated_energy_J"][-1]
+    problems = _span_disagreements(exu, ref)
+    assert not problems, problems
+    # Friction did something: it dissipates more than the contact damping alone does in the same span.
+    free = reference.solve(_scene(0.0, clearance, revolutions=SPAN_REVOLUTIONS))
+    assert ref.steps["dissipated_energy_J"][-1] > free.steps["dissipated_energy_J"][-1] + 0.1
 
 
 @pytest.mark.slow
@@ -152,7 +173,8 @@ def test_the_trees_contact_with_friction_is_the_reference_chains():
 @pytest.mark.slow
 def test_the_rigid_body_model_with_friction_agrees_with_the_reference_engine():
     """The reusable joint's friction (connector force + torque loads, joint_friction.py) in the full
-    rigid-body loom against the reference: the same checks as the tree's, on one case.
+    rigid-body loom against the reference: the same checks as the tree's, on one case, over the first
+    0.05 revolution (through the start-up impact).
 
     At the default local error 3e-10 m the adaptive step is coarse through the start-up impact with
     friction (406 steps over 18 deg): max F_N 1.8e-3, acceleration 1.8e-3, torque 8.1e-3 off (318 s).
@@ -161,10 +183,10 @@ def test_the_rigid_body_model_with_friction_agrees_with_the_reference_engine():
     from weftsim import exudyn_engine, reference
     from weftsim.scene import apply_overrides
 
-    scene = _scene(0.15, "0p25")
+    scene = _scene(0.15, "0p25", revolutions=SPAN_REVOLUTIONS / 2)
     rigid = apply_overrides(scene, {"solver.exudyn.model": "rigid_body", "solver.exudyn.local_error_m": 3e-11})
     ref, exu = reference.solve(scene), exudyn_engine.solve(rigid)
     assert ref.ok and exu.ok, (ref.message, exu.message)
     assert exu.path["model"] == "rigid_body"
-    failed = [c for c in agreement_checks(exu, ref) if not c["passed"]]  # 0.1 deg and 1 %
-    assert not failed, failed
+    problems = _span_disagreements(exu, ref)
+    assert not problems, problems
