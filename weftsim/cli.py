@@ -80,6 +80,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="animation file, .gif (or .mp4 with ffmpeg) (default: out/<scene name>/<engine>/animation.gif)")
     p.add_argument("--engine", default="auto", choices=ENGINE_CHOICES, help="as for run")
     p.add_argument("--frames", type=positive(int), default=72, help="frames over the revolution (default 72)")
+    p.add_argument("--viewer", action="store_true",
+                   help="instead of the GIF, replay the run in Exudyn's own viewer (needs a display): the rigid-body "
+                   "model is solved over the scene's revolutions, its coordinates stored in a solution file "
+                   "(-o, default out/<scene name>/exudyn/viewer-solution.txt)")
 
     p = sub.add_parser("compare", help="run both engines on one scene and compare them")
     add_scene_flags(p)
@@ -365,6 +369,8 @@ def cmd_animate(args) -> int:
 
     scene = scene_from_args(args)
     engine = resolve_engine(args.engine)
+    if args.viewer:
+        return _replay_in_viewer(args, scene, engine)
     target = Path(args.output) if args.output else output_directory(args, scene, engine) / "animation.gif"
     try:
         check_format(target)
@@ -387,6 +393,31 @@ def cmd_animate(args) -> int:
     print(f"wrote {target}: {args.frames} frames over crank angles {frames.crank_angle_deg[0]:.1f}.."
           f"{frames.crank_angle_deg[-1]:.1f} deg; "
           f"drawn rod EF within {closure:.1e} m of L_EF = {scene.geometry.l_ef:g} m")
+    return 0
+
+
+def _replay_in_viewer(args, scene, engine: str) -> int:
+    """``animate --viewer``: solve the rigid-body Exudyn model into a solution file, then replay it in
+    Exudyn's viewer (:mod:`weftsim.exudyn_engine.viewer`); refused at once where no window can open."""
+    if engine != "exudyn":
+        raise CliError(f"--viewer replays an Exudyn run; drop --engine {engine} (or use --engine exudyn)")
+    from weftsim.exudyn_engine.viewer import display_problem, period_label, record_solution, show_solution
+
+    problem = display_problem()
+    if problem is not None:
+        raise CliError(problem)
+    target = Path(args.output) if args.output else output_directory(args, scene, "exudyn") / "viewer-solution.txt"
+    _check_fits(scene, target.parent)
+    print(f"scene {scene.name}: solving the Exudyn rigid-body model for the viewer ({period_label(scene)})",
+          flush=True)
+    try:
+        with _stdout_to_stderr():  # Exudyn's banners
+            recording = record_solution(scene, target)
+    except OSError as exc:
+        raise CliError(f"cannot write {target}: {exc.strerror or exc}") from None
+    print(f"wrote {target}: {recording.rows} rows of {recording.coordinates} coordinates in "
+          f"{recording.wall_time_s:.1f} s; opening Exudyn's viewer (close its window or press Q to end)", flush=True)
+    show_solution(recording)
     return 0
 
 
