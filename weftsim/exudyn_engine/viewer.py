@@ -45,6 +45,7 @@ BAR_WIDTH = 0.012
 SHAFT_RADIUS = 0.008
 SHAFT_LENGTH = 0.08  # the crank, coupler and rocker shafts along their axes through O
 TILES = 16  # facets of a cylinder
+SECTOR_DISC_COLOR = [0.7, 0.7, 0.7, 0.25]  # RGBA: translucent, the rod and the pin F stay visible through it
 
 
 class ViewerUnavailable(WeftsimError):
@@ -103,7 +104,7 @@ def add_body_graphics(mbs, model: MechanismModel) -> None:
         "rod": [_bar(g.l_ef, graphics.color.green, start=-rod_half)],
         "sector": [_bar(g.l_fg, graphics.color.steelblue),
                    graphics.Cylinder(pAxis=[0.0, 0.0, -0.5 * BAR_WIDTH], vAxis=[0.0, 0.0, 0.2 * BAR_WIDTH],
-                                     radius=g.sector_pitch_radius, color=graphics.color.lightgrey, nTiles=4 * TILES)],
+                                     radius=g.sector_pitch_radius, color=SECTOR_DISC_COLOR, nTiles=4 * TILES)],
     }
     for name, shape in shapes.items():
         if name in model.bodies:
@@ -206,6 +207,8 @@ def show_solution(recording: Recording) -> None:
     settings.nodes.show = False
     settings.connectors.show = False
     settings.markers.show = False
+    settings.loads.show = False  # the gravity arrows, longer than the linkage, would set the zoom
+    settings.sensors.show = False
     with contextlib.redirect_stdout(sys.stderr):  # Exudyn's notes on loading; stdout stays the report's
         solution = LoadSolutionFile(str(recording.path), verbose=False)
     try:
