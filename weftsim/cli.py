@@ -113,13 +113,15 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("study", help="one of the paper's studies: figures, CSV and JSON (docs/paper-comparison.md)",
                        description="Run a study of the paper: contact-law (Fig. 7-9), clearance (Fig. 12), "
                        "speed (Fig. 13, with the acceleration spectrum), engines (Fig. 16), or all of them.  "
-                       "Each study sets its own scenes; --revolutions is the one scene flag it takes.")
+                       "Each study sets its own scenes; --set and the shorthands apply to every run of it, "
+                       "except what the study sets itself (the clearance of 'clearance', the speed of 'speed', "
+                       "the speed and clearance of 'contact-law': refused).")
     p.add_argument("name", help="contact-law, clearance, speed, engines or all")
     p.add_argument("-o", "--output", default=None,
                    help="output directory (default: out/study-NAME; with 'all': parent of one directory per study)")
     p.add_argument("--models", default=None,
                    help="directory of the scene files (default: the bundled scenes, 'weftsim scenes')")
-    p.add_argument("--revolutions", type=positive(float), help="override the study's crank revolutions per run")
+    add_scene_flags(p, positional=False)
     p.add_argument("--force", action="store_true",
                    help="write into an output directory that holds files weftsim did not write")
 
@@ -483,13 +485,18 @@ def cmd_sweep(args) -> int:
 
 
 def cmd_study(args) -> int:
-    from weftsim.studies import STUDIES, format_study, run_study
+    from weftsim.api import scene_overrides
+    from weftsim.studies import STUDIES, check_overrides, format_study, run_study
 
     names = list(STUDIES) if args.name == "all" else [args.name]
+    overrides = scene_overrides(set_overrides(args), where="command line", **shorthand_values(args))
+    revolutions = overrides.pop("drive.revolutions", None)
+    for name in names:  # every refusal before the first study runs
+        check_overrides(name, overrides, revolutions)
     models = models_directory(args)
     for name in names:
         outdir = Path(args.output) / name if args.output and args.name == "all" else args.output
-        report = run_study(name, outdir, models, args.revolutions, args.force)
+        report = run_study(name, outdir, models, revolutions, args.force, overrides=overrides)
         print(format_study(name, report))
     return 0
 
