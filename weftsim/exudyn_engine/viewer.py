@@ -88,7 +88,8 @@ def add_body_graphics(mbs, model: MechanismModel) -> None:
     """Give the bodies of a built mechanism simple graphics (their body frames, :mod:`.mechanism`).
 
     Crank 1: shaft along axis A (body z).  Coupler 2: a ball at O (its axes B and C both pass there).
-    Rocker 3: shaft along axis D (body z) and bar O-E (body x, length L_OE).  Rod 4: bar E-F (body x,
+    Rocker 3: shaft along axis D (body z), bar O-E (body x, length L_OE) and the joint E as a disc of the
+    journal radius.  Rod 4: bar E-F (body x,
     centred on its middle).  Sector 5: bar G-F (body x, length L_FG) and a disc of the pitch radius d5.
     The reflected gears 6/7 and rapier 8 (``reflect_gears=True``) have no bodies to draw.
     """
@@ -99,8 +100,8 @@ def add_body_graphics(mbs, model: MechanismModel) -> None:
         "coupler": [graphics.Sphere(point=[0.0, 0.0, 0.0], radius=2.0 * SHAFT_RADIUS, color=graphics.color.orange,
                                     nTiles=TILES)],
         "rocker": [_shaft([0.0, 0.0, 1.0], graphics.color.blue), _bar(g.l_oe, graphics.color.blue),
-                   _shaft([0.0, 0.0, 1.0], graphics.color.red, length=2.0 * BAR_WIDTH, radius=model.scene.joint.journal_radius,
-                          centre=(g.l_oe, 0.0, 0.0))],
+                   _shaft([0.0, 0.0, 1.0], graphics.color.red, length=2.0 * BAR_WIDTH,
+                          radius=model.scene.joint.journal_radius, centre=(g.l_oe, 0.0, 0.0))],
         "rod": [_bar(g.l_ef, graphics.color.green, start=-rod_half)],
         "sector": [_bar(g.l_fg, graphics.color.steelblue),
                    graphics.Cylinder(pAxis=[0.0, 0.0, -0.5 * BAR_WIDTH], vAxis=[0.0, 0.0, 0.2 * BAR_WIDTH],
@@ -176,7 +177,8 @@ def record_solution(scene: Scene, path: str | Path) -> Recording:
         ok = solver.SolveSystem(mbs, settings)
     except exu.ExudynError as exc:
         lines = str(exc).strip().splitlines()
-        raise RunFailed(f"the Exudyn solve for the viewer failed: {lines[-1] if lines else type(exc).__name__}") from None
+        last = lines[-1] if lines else type(exc).__name__
+        raise RunFailed(f"the Exudyn solve for the viewer failed: {last}") from None
     if not ok:
         raise RunFailed(f"the Exudyn solve for the viewer stopped at t = {mbs.systemData.GetTime():.6g} s "
                         "(Newton did not converge); `weftsim run SCENE --engine exudyn` reports why")
@@ -219,5 +221,6 @@ def show_solution(recording: Recording) -> None:
 
 def period_label(scene: Scene) -> str:
     """The replayed span, for the command's report: crank revolutions and rows."""
-    return (f"{scene.drive.revolutions:g} revolutions at {scene.drive.speed * 30.0 / math.pi:g} rpm, "
+    turns = scene.drive.revolutions
+    return (f"{turns:g} revolution{'' if turns == 1 else 's'} at {scene.drive.speed * 30.0 / math.pi:g} rpm, "
             f"{expected_rows(scene)} frames {math.degrees(scene.output.sample_angle):g} deg apart")

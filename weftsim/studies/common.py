@@ -205,6 +205,7 @@ def study_overrides(study: str, sets: dict[str, str], revolutions: float | None,
                              "(neither --set nor its shorthand flag)")
     if "drive.revolutions" in given:
         if revolutions is not None:
-            raise StudyError("the revolutions are given twice (as revolutions and as drive.revolutions); give them once")
+            raise StudyError("the revolutions are given twice (as revolutions and as drive.revolutions); "
+                             "give them once")
         revolutions = given.pop("drive.revolutions")
     return {**given, **revolutions_override(revolutions, default)}
