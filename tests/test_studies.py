@@ -257,3 +257,54 @@ def test_report_has_a_row_per_paper_statement_and_links_existing_figures(reduced
     produced = {p.name for _, outdir in reduced.values() for p in outdir.glob("study-*.png")}
     linked = set(re.findall(r"\(img/(study-[a-z-]+\.png)\)", text))
     assert linked == produced
+
+
+@pytest.mark.parametrize("args, words", [
+    (["clearance", "--clearance-mm", "0.3"], "clearance study sets joint_e.clearance_mm itself"),
+    (["clearance", "--set", "clearance_mm=0.3"], "clearance study sets joint_e.clearance_mm itself"),
+    (["speed", "--speed-rpm", "600"], "speed study sets drive.speed_rpm itself"),
+    (["contact-law", "--set", "joint_e.clearance_mm=0.1"], "contact-law study sets joint_e.clearance_mm"),
+    (["all", "--speed-rpm", "600"], "study sets drive.speed_rpm itself"),  # refused before the first study runs
+    (["engines", "--set", "name=x"], "'name'"),  # not a --set key at all (the API refuses it as its own)
+    (["engines", "--revolutions", "2", "--set", "revolutions=3"], "given twice"),
+])
+def test_study_refuses_overrides_of_what_it_sets(args, words, tmp_path, capsys):
+    from weftsim.cli import main
+
+    out = tmp_path / "out"
+    assert main(["study", *args, "-o", str(out), "--models", str(MODELS)]) == 2
+    err = capsys.readouterr().err
+    assert words in err and err.count("\n") == 1
+    assert not out.exists()  # nothing computed or created
+
+
+def test_study_overrides_reach_every_run(tmp_path, capsys):
+    """--law and --set reach the contact-law study's run: the Lankarani-Nikravesh law has a constant
+    stiffness (log slope 0) and the hysteresis factor 3 (1 - e^2) / 4 of its restitution (docs/physics.md
+    section 2), here e = 0.8 -> 0.27 against the scene's 0.9 -> 0.1425."""
+    import json
+
+    from weftsim.cli import main
+
+    out = tmp_path / "cl"
+    assert main(["study", "contact-law", "-o", str(out), "--models", str(MODELS), "--revolutions", "0.05",
+                 "--law", "lankarani_nikravesh", "--set", "restitution=0.8"]) == 0
+    report = json.loads((out / "contact-law.json").read_text())
+    assert report["law"] == "lankarani_nikravesh"
+    # Both sides are the same closed form in double precision: 1e-12 is round-off room only.
+    assert report["hysteresis"] == pytest.approx(0.75 * (1.0 - 0.8**2), rel=1e-12)
+    # A constant K gives a log slope of exactly 0 (the same value at both points of the difference); 1e-6
+    # leaves room for round-off in K, far below the 0.1..1 slopes of the variable law.
+    assert all(abs(slope) < 1e-6 for slope in report["curve"]["stiffness_log_slope"].values())
+    assert report["speed_rpm"] == 500.0 and report["clearance_mm"] == 0.01  # what the study sets stays
+
+
+def test_study_overrides_refuse_the_name_and_take_short_keys():
+    from weftsim.studies.common import study_overrides
+
+    with pytest.raises(StudyError, match="names its own runs"):
+        study_overrides("engines", {}, None, 10.0, {"name": "x"})
+    with pytest.raises(StudyError, match="sets joint_e.clearance_mm itself"):
+        study_overrides("clearance", {"joint_e.clearance_mm": "varied"}, None, 10.0, {"clearance_mm": 0.3})
+    assert study_overrides("engines", {}, None, 10.0, {"restitution": 0.8, "revolutions": 3}) == {
+        "joint_e.restitution": 0.8, "drive.revolutions": 3}

@@ -80,6 +80,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="animation file, .gif (or .mp4 with ffmpeg) (default: out/<scene name>/<engine>/animation.gif)")
     p.add_argument("--engine", default="auto", choices=ENGINE_CHOICES, help="as for run")
     p.add_argument("--frames", type=positive(int), default=72, help="frames over the revolution (default 72)")
+    p.add_argument("--viewer", action="store_true",
+                   help="instead of the GIF, replay the run in Exudyn's own viewer (needs a display): the rigid-body "
+                   "model is solved over the scene's revolutions, its coordinates stored in a solution file "
+                   "(-o, default out/<scene name>/exudyn/viewer-solution.txt)")
 
     p = sub.add_parser("compare", help="run both engines on one scene and compare them")
     add_scene_flags(p)
@@ -109,13 +113,15 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("study", help="one of the paper's studies: figures, CSV and JSON (docs/paper-comparison.md)",
                        description="Run a study of the paper: contact-law (Fig. 7-9), clearance (Fig. 12), "
                        "speed (Fig. 13, with the acceleration spectrum), engines (Fig. 16), or all of them.  "
-                       "Each study sets its own scenes; --revolutions is the one scene flag it takes.")
+                       "Each study sets its own scenes; --set and the shorthands apply to every run of it, "
+                       "except what the study sets itself (the clearance of 'clearance', the speed of 'speed', "
+                       "the speed and clearance of 'contact-law': refused).")
     p.add_argument("name", help="contact-law, clearance, speed, engines or all")
     p.add_argument("-o", "--output", default=None,
                    help="output directory (default: out/study-NAME; with 'all': parent of one directory per study)")
     p.add_argument("--models", default=None,
                    help="directory of the scene files (default: the bundled scenes, 'weftsim scenes')")
-    p.add_argument("--revolutions", type=positive(float), help="override the study's crank revolutions per run")
+    add_scene_flags(p, positional=False)
     p.add_argument("--force", action="store_true",
                    help="write into an output directory that holds files weftsim did not write")
 
@@ -365,6 +371,8 @@ def cmd_animate(args) -> int:
 
     scene = scene_from_args(args)
     engine = resolve_engine(args.engine)
+    if args.viewer:
+        return _replay_in_viewer(args, scene, engine)
     target = Path(args.output) if args.output else output_directory(args, scene, engine) / "animation.gif"
     try:
         check_format(target)
@@ -387,6 +395,31 @@ def cmd_animate(args) -> int:
     print(f"wrote {target}: {args.frames} frames over crank angles {frames.crank_angle_deg[0]:.1f}.."
           f"{frames.crank_angle_deg[-1]:.1f} deg; "
           f"drawn rod EF within {closure:.1e} m of L_EF = {scene.geometry.l_ef:g} m")
+    return 0
+
+
+def _replay_in_viewer(args, scene, engine: str) -> int:
+    """``animate --viewer``: solve the rigid-body Exudyn model into a solution file, then replay it in
+    Exudyn's viewer (:mod:`weftsim.exudyn_engine.viewer`); refused at once where no window can open."""
+    if engine != "exudyn":
+        raise CliError(f"--viewer replays an Exudyn run; drop --engine {engine} (or use --engine exudyn)")
+    from weftsim.exudyn_engine.viewer import display_problem, period_label, record_solution, show_solution
+
+    problem = display_problem()
+    if problem is not None:
+        raise CliError(problem)
+    target = Path(args.output) if args.output else output_directory(args, scene, "exudyn") / "viewer-solution.txt"
+    _check_fits(scene, target.parent)
+    print(f"scene {scene.name}: solving the Exudyn rigid-body model for the viewer ({period_label(scene)})",
+          flush=True)
+    try:
+        with _stdout_to_stderr():  # Exudyn's banners
+            recording = record_solution(scene, target)
+    except OSError as exc:
+        raise CliError(f"cannot write {target}: {exc.strerror or exc}") from None
+    print(f"wrote {target}: {recording.rows} rows of {recording.coordinates} coordinates in "
+          f"{recording.wall_time_s:.1f} s; opening Exudyn's viewer (close its window or press Q to end)", flush=True)
+    show_solution(recording)
     return 0
 
 
@@ -452,13 +485,18 @@ def cmd_sweep(args) -> int:
 
 
 def cmd_study(args) -> int:
-    from weftsim.studies import STUDIES, format_study, run_study
+    from weftsim.api import scene_overrides
+    from weftsim.studies import STUDIES, check_overrides, format_study, run_study
 
     names = list(STUDIES) if args.name == "all" else [args.name]
+    overrides = scene_overrides(set_overrides(args), where="command line", **shorthand_values(args))
+    revolutions = overrides.pop("drive.revolutions", None)
+    for name in names:  # every refusal before the first study runs
+        check_overrides(name, overrides, revolutions)
     models = models_directory(args)
     for name in names:
         outdir = Path(args.output) / name if args.output and args.name == "all" else args.output
-        report = run_study(name, outdir, models, args.revolutions, args.force)
+        report = run_study(name, outdir, models, revolutions, args.force, overrides=overrides)
         print(format_study(name, report))
     return 0
 

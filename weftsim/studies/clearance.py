@@ -24,6 +24,7 @@ IDEAL_SCENE = "ideal.toml"
 SCENES = {0.01: "paper/clearance_0p01mm_400rpm.toml", 0.25: "paper/clearance_0p25mm_400rpm.toml",
           0.50: "paper/clearance_0p50mm_400rpm.toml"}
 REVOLUTIONS = 10.0  # 9 revolutions after the start-up one for the statistics (~10 s each)
+SETS = {"joint_e.clearance_mm": "it varies the clearance: 0 (ideal), 0.01, 0.25, 0.50 mm"}  # common.study_overrides
 BIN_DEG = 10.0
 COLOURS = {0.01: "tab:blue", 0.25: "tab:orange", 0.50: "tab:red"}
 
@@ -119,13 +120,16 @@ def trend_row(metrics: dict, ideal: dict) -> dict:
 
 
 def run(outdir: str | Path, models: str | Path = "models", revolutions: float | None = None,
-        force: bool = False, progress: bool = True) -> dict:
-    """Run the clearance study into ``outdir``; returns what ``clearance.json`` holds."""
+        force: bool = False, progress: bool = True, overrides: dict | None = None) -> dict:
+    """Run the clearance study into ``outdir``; returns what ``clearance.json`` holds.
+
+    ``overrides``: scene keys (file units) applied to every run, except the clearance (:data:`SETS`).
+    """
     from weftsim.output import finish_directory, prepare_directory, write_figure, write_json
     from weftsim.studies.figures import channel_panels, deviation_panel, trend_panels
 
+    overrides = common.study_overrides("clearance", SETS, revolutions, REVOLUTIONS, overrides)
     outdir = prepare_directory(outdir, force)
-    overrides = common.revolutions_override(revolutions, REVOLUTIONS)
     ideal_result = common.solve(common.load(models, IDEAL_SCENE, overrides), progress=progress)
     ideal = common.run_metrics(ideal_result)
     results = {c: common.solve(common.load(models, name, overrides), progress=progress) for c, name in SCENES.items()}

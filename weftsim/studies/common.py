@@ -161,3 +161,51 @@ def revolutions_override(revolutions: float | None, default: float) -> dict:
     if not (value > 0 and math.isfinite(value)):
         raise StudyError(f"revolutions must be > 0, got {value}")
     return {"drive.revolutions": value}
+
+
+def _dotted(key: str) -> str:
+    """A scene key as its full dotted path (``clearance_mm`` -> ``joint_e.clearance_mm``), else as given
+    (an unknown key is then reported by the scene loader)."""
+    from weftsim.errors import SweepError
+    from weftsim.sweep.grid import resolve_key
+
+    try:
+        return resolve_key(key).path
+    except SweepError:
+        return key
+
+
+def study_overrides(study: str, sets: dict[str, str], revolutions: float | None, default: float,
+                    overrides: dict | None = None) -> dict:
+    """The scene overrides of every run of a study: the user's ``overrides`` and the revolutions.
+
+    Parameters
+    ----------
+    study : str
+        The study's name, for the messages.
+    sets : dict
+        The keys the study sets itself (what it varies or what defines it) -> why; overriding one is
+        refused, as is ``name`` (each study names its runs).
+    revolutions : float or None
+        Crank revolutions per run (``drive.revolutions``; None: ``default``, or the value in ``overrides``).
+    overrides : dict, optional
+        Scene keys in file units (dotted keys, or their last part where unique), applied to every scene.
+
+    Raises
+    ------
+    StudyError
+        A key the study sets itself, or the revolutions given twice.
+    """
+    given = {_dotted(key): value for key, value in (overrides or {}).items()}
+    for key in given:
+        if key == "name":
+            raise StudyError(f"the {study} study names its own runs; leave 'name' out of the overrides")
+        if key in sets:
+            raise StudyError(f"the {study} study sets {key} itself ({sets[key]}); do not override it "
+                             "(neither --set nor its shorthand flag)")
+    if "drive.revolutions" in given:
+        if revolutions is not None:
+            raise StudyError("the revolutions are given twice (as revolutions and as drive.revolutions); "
+                             "give them once")
+        revolutions = given.pop("drive.revolutions")
+    return {**given, **revolutions_override(revolutions, default)}

@@ -24,6 +24,9 @@ from weftsim.studies import common
 SCENE = "paper/clearance_0p01mm_400rpm.toml"
 SPEED_RPM = 500.0  # paper Fig. 7-9
 REVOLUTIONS = 2.0  # the start-up revolution and one more, which is plotted
+# What defines the study (common.study_overrides): the paper's case of Fig. 7-9, which its run's name says.
+SETS = {"drive.speed_rpm": "the paper's Fig. 7-9 case is at 500 rpm",
+        "joint_e.clearance_mm": "the paper's Fig. 7-9 case is at c = 0.01 mm"}
 CURVE_POINTS = 601
 CURVE_RANGE = 3.0  # stiffness curve up to 3 c (the paper's Fig. 7 spans ~0.02 mm at c = 0.01 mm)
 FLATTENING_MM = 0.005  # paper: K(delta) flattens after 0.005 mm
@@ -91,15 +94,19 @@ def contact_steps(result, revolution: int) -> dict[str, np.ndarray]:
 
 
 def run(outdir: str | Path, models: str | Path = "models", revolutions: float | None = None,
-        force: bool = False, progress: bool = True) -> dict:
-    """Run the contact-law study into ``outdir``; returns what ``contact-law.json`` holds."""
+        force: bool = False, progress: bool = True, overrides: dict | None = None) -> dict:
+    """Run the contact-law study into ``outdir``; returns what ``contact-law.json`` holds.
+
+    ``overrides``: scene keys (file units) applied to its run, except its speed and clearance (:data:`SETS`).
+    """
     from weftsim.contact import make_law
     from weftsim.output import finish_directory, prepare_directory, write_csv, write_figure, write_json
     from weftsim.studies.figures import contact_law_panels
 
+    overrides = common.study_overrides("contact-law", SETS, revolutions, REVOLUTIONS, overrides)
     outdir = prepare_directory(outdir, force)
     scene = common.load(models, SCENE, {"drive.speed_rpm": SPEED_RPM, "name": "contact_law_0p01mm_500rpm",
-                                        **common.revolutions_override(revolutions, REVOLUTIONS)})
+                                        **overrides})
     curve = stiffness_curve(scene.joint)
     result = common.solve(scene, "reference", progress=progress)
     from weftsim.analysis import complete_revolutions

@@ -20,6 +20,7 @@ from weftsim.studies import common
 
 SCENE = "paper/clearance_0p50mm_400rpm.toml"
 REVOLUTIONS = 10.0  # compare.py checks statistics from 10 revolutions on
+SETS: dict[str, str] = {}  # both engines run the same scene: any key may be overridden (common.study_overrides)
 ENGINES = ("reference", "exudyn")
 STYLES = {"reference": {"color": "tab:blue", "lw": 1.1}, "exudyn": {"color": "tab:red", "lw": 0.8, "ls": "--"}}
 LABELS = {"reference": "reference (closed-form Lagrange; the paper's model)",
@@ -44,14 +45,18 @@ def peak_ratios(reference: dict, exudyn: dict) -> dict:
 
 
 def run(outdir: str | Path, models: str | Path = "models", revolutions: float | None = None,
-        force: bool = False, progress: bool = True) -> dict:
-    """Run the engine comparison into ``outdir``; returns what ``engines.json`` holds."""
+        force: bool = False, progress: bool = True, overrides: dict | None = None) -> dict:
+    """Run the engine comparison into ``outdir``; returns what ``engines.json`` holds.
+
+    ``overrides``: scene keys (file units) applied to the scene both engines run.
+    """
     from weftsim.compare import compare_results
     from weftsim.output import finish_directory, prepare_directory, write_figure, write_json
     from weftsim.studies.figures import channel_panels
 
+    overrides = common.study_overrides("engines", SETS, revolutions, REVOLUTIONS, overrides)
     outdir = prepare_directory(outdir, force)
-    scene = common.load(models, SCENE, common.revolutions_override(revolutions, REVOLUTIONS))
+    scene = common.load(models, SCENE, overrides)
     results = {engine: common.solve(scene, engine, progress=progress) for engine in ENGINES}
     metrics = {engine: common.run_metrics(r) for engine, r in results.items()}
     comparison = compare_results(results["exudyn"], results["reference"])

@@ -25,6 +25,7 @@ IDEAL_SCENE = "ideal.toml"
 SCENES = {300.0: "paper/speed_300rpm_c0p25mm.toml", 500.0: "paper/speed_500rpm_c0p25mm.toml",
           800.0: "paper/speed_800rpm_c0p25mm.toml"}
 REVOLUTIONS = 10.0  # 9 whole revolutions after the start-up one: spectrum lines every f_rev / 9
+SETS = {"drive.speed_rpm": "it varies the crank speed: 300, 500, 800 rpm"}  # common.study_overrides
 PAIRS = ((800.0, 500.0), (500.0, 300.0), (800.0, 300.0))
 PAPER_BAND_HZ = 10.0  # paper: "the main frequency fluctuation is between 0 and 10 Hz"
 COLOURS = {300.0: "tab:blue", 500.0: "tab:orange", 800.0: "tab:red"}
@@ -66,13 +67,16 @@ def spectrum_summary(spectrum, speed_rpm: float) -> dict:
 
 
 def run(outdir: str | Path, models: str | Path = "models", revolutions: float | None = None,
-        force: bool = False, progress: bool = True) -> dict:
-    """Run the speed study into ``outdir``; returns what ``speed.json`` holds."""
+        force: bool = False, progress: bool = True, overrides: dict | None = None) -> dict:
+    """Run the speed study into ``outdir``; returns what ``speed.json`` holds.
+
+    ``overrides``: scene keys (file units) applied to every run, except the speed (:data:`SETS`).
+    """
     from weftsim.output import finish_directory, prepare_directory, write_csv, write_figure, write_json
     from weftsim.studies.figures import channel_panels, spectrum_panels, trend_panels
 
+    overrides = common.study_overrides("speed", SETS, revolutions, REVOLUTIONS, overrides)
     outdir = prepare_directory(outdir, force)
-    overrides = common.revolutions_override(revolutions, REVOLUTIONS)
     results, ideals = {}, {}
     for rpm, name in SCENES.items():
         ideals[rpm] = common.solve(common.load(models, IDEAL_SCENE, {**overrides, "drive.speed_rpm": rpm,
