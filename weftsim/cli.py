@@ -149,7 +149,7 @@ def _add_wear_flags(p: argparse.ArgumentParser) -> None:
     add_flags(p, positive)
 
 
-def cmd_wear(args) -> int:
+def cmd_wear(args: argparse.Namespace) -> int:
     from weftsim.wear.command import run
 
     scene = scene_from_args(args)
@@ -245,7 +245,7 @@ KINEMATICS_COLUMNS = ("crank_angle_deg", "rapier_displacement_m", "rapier_veloci
                       "transmission_angle_deg")
 
 
-def cmd_kinematics(args) -> int:
+def cmd_kinematics(args: argparse.Namespace) -> int:
     import numpy as np
 
     from weftsim.kinematics import linkage_state
@@ -335,7 +335,7 @@ def _interrupted_line(result, outdir: Path, signum: int) -> str:
             f"there are in {outdir} (summary.json says complete: false); rerun to compute the whole run")
 
 
-def cmd_run(args) -> int:
+def cmd_run(args: argparse.Namespace) -> int:
     from weftsim.api import resolve_engine
     from weftsim.output import prepare_directory, write_run
     from weftsim.plausibility import report_lines
@@ -359,7 +359,7 @@ def cmd_run(args) -> int:
     return 0
 
 
-def cmd_animate(args) -> int:
+def cmd_animate(args: argparse.Namespace) -> int:
     from weftsim.animate import check_format, write_animation
     from weftsim.api import resolve_engine
 
@@ -390,7 +390,7 @@ def cmd_animate(args) -> int:
     return 0
 
 
-def cmd_compare(args) -> int:
+def cmd_compare(args: argparse.Namespace) -> int:
     from weftsim.compare import format_report, run_compare
     from weftsim.output import prepare_directory, to_json
 
@@ -420,7 +420,7 @@ def _raise_terminated(signum, frame):
     raise _SweepTerminated(signum)
 
 
-def cmd_sweep(args) -> int:
+def cmd_sweep(args: argparse.Namespace) -> int:
     from weftsim.api import SCENE_FLAGS, resolve_engine, scene_overrides
     from weftsim.sweep import format_report, plan_sweep, run_sweep
 
@@ -451,7 +451,7 @@ def cmd_sweep(args) -> int:
     return 0
 
 
-def cmd_study(args) -> int:
+def cmd_study(args: argparse.Namespace) -> int:
     from weftsim.studies import STUDIES, format_study, run_study
 
     names = list(STUDIES) if args.name == "all" else [args.name]
@@ -463,7 +463,7 @@ def cmd_study(args) -> int:
     return 0
 
 
-def cmd_bench(args) -> int:
+def cmd_bench(args: argparse.Namespace) -> int:
     from weftsim.bench import CASES, run_benchmark
 
     unknown = [c for c in args.case or [] if c not in CASES]
@@ -482,7 +482,7 @@ def cmd_bench(args) -> int:
     return 0
 
 
-def cmd_scenes(args) -> int:
+def cmd_scenes(args: argparse.Namespace) -> int:
     """``weftsim scenes``: each bundled scene's name and description, one a line."""
     from weftsim.scene import bundled_directory, bundled_scene_path, bundled_scenes, scene_description
 
