@@ -50,6 +50,7 @@ from weftsim.params import ClearanceJoint
 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
+
     from weftsim.contact import _Law
 
 # Array forms for analysis and tests, plain Python per element (the engines call the compiled kernel).

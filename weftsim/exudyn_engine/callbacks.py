@@ -48,7 +48,9 @@ from weftsim.kernel.python import python_form
 
 if TYPE_CHECKING:
     from collections.abc import Callable
+
     from numba.core.registry import CPUDispatcher
+
     from weftsim.contact import _Law
 
 ROUTES = ("python", "numba")

@@ -52,6 +52,7 @@ from weftsim.params import ClearanceJoint
 
 if TYPE_CHECKING:
     from collections.abc import Callable
+
     from weftsim.contact import _Law
 
 ROUTES = callbacks.ROUTES

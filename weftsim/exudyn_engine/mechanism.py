@@ -53,6 +53,7 @@ from weftsim.params import Scene
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
+
     from numpy.typing import ArrayLike
 
 # Model-frame vector (x, y, z) (docs/physics.md section 1) -> Exudyn (X, Y, Z) = (y, z, x).

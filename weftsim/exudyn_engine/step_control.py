@@ -42,6 +42,7 @@ from weftsim.exudyn_engine.clearance_joint import register_post_step
 
 if TYPE_CHECKING:
     import numpy as np
+
     from weftsim.exudyn_engine.mechanism import MechanismModel
     from weftsim.params import Scene
 

@@ -31,6 +31,7 @@ from weftsim.reference.ideal import sector_chain_inertia
 
 if TYPE_CHECKING:
     from types import ModuleType
+
     from numpy.typing import ArrayLike
 
 # Kept for callers that name the array backend of :func:`eccentricity` (it is always numpy now).

@@ -35,6 +35,7 @@ from weftsim.kernel.roots import END_FRACTION, ROOT_XTOL, SAMPLES  # noqa: F401 
 
 if TYPE_CHECKING:
     from collections.abc import Callable
+
     import numpy as np
 
 _FIRST_CROSSING = python_form(roots.first_crossing)
