@@ -15,10 +15,13 @@ or loops: it embeds the function's address).
 from __future__ import annotations
 
 import types
-from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from numba import njit
 from numba.core.registry import CPUDispatcher
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 _FORMS: dict = {}
 

@@ -19,12 +19,13 @@ maxima by golden-section search (Kiefer 1953).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from numba import njit
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
+
     import numpy as np
 
 ROOT_XTOL = 1e-13  # s: event time accuracy (delta_dot ~ 1 m/s -> 1e-13 m in delta)

@@ -24,10 +24,13 @@ so p(phi) ~ cos phi - cos phi0 on |phi| < phi0 = acos(c / (c + delta)) (:func:`d
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
-from numpy.typing import ArrayLike
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 WEAR_HEADER = 2  # n_b, n_j before the two tables
 
