@@ -36,12 +36,19 @@ import math
 import shutil
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from weftsim.kinematics import fourbar, rocker_angle
 from weftsim.results import RunResult
 from weftsim.spherical import crank_axis, rocker_axis
+
+if TYPE_CHECKING:
+    from collections.abc import Callable, Iterator
+
+    from matplotlib.artist import Artist
+    from matplotlib.figure import Figure
 
 FORMATS = (".gif", ".mp4")
 DEFAULT_FRAMES = 72  # one frame per 5 deg of crank: smooth enough, ~1 MB as a GIF
@@ -243,7 +250,8 @@ def _rapier_artists(ax, frames: MechanismFrames, stroke: float):
     return move, (head, rack, text)
 
 
-def animation_figure(result: RunResult, frames: MechanismFrames, magnification: float | None = None):
+def animation_figure(result: RunResult, frames: MechanismFrames,
+                     magnification: float | None = None) -> tuple[Figure, Callable[[int], None], tuple[Artist, ...]]:
     """The figure of the animation and a function ``draw(k)`` that puts it at frame k.
 
     Parameters
@@ -308,7 +316,8 @@ def animation_figure(result: RunResult, frames: MechanismFrames, magnification: 
     return fig, draw, moving
 
 
-def render_frames(fig, draw, moving, count: int):
+def render_frames(fig: Figure, draw: Callable[[int], None], moving: tuple[Artist, ...],
+                  count: int) -> Iterator[np.ndarray]:
     """Yield frame k = 0..count-1 as an RGB array (height, width, 3) of uint8.
 
     Blitting: the static figure is drawn once; each frame restores it and draws only the moving

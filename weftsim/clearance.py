@@ -37,7 +37,7 @@ Sources: Flores & Ambrosio, Comput. Struct. 82 (2004); Li et al. (2020) Eqs. 1-1
 from __future__ import annotations
 
 import math
-from typing import Callable, NamedTuple
+from typing import TYPE_CHECKING, Callable, NamedTuple
 
 import numpy as np
 
@@ -47,6 +47,11 @@ from weftsim.kernel import joint as kernel_joint
 from weftsim.kernel.joint import joint_parameters
 from weftsim.kernel.python import python_form
 from weftsim.params import ClearanceJoint
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+    from weftsim.contact import _Law
 
 # Array forms for analysis and tests, plain Python per element (the engines call the compiled kernel).
 _EFFECTIVE_IMPACT_VELOCITY = np.vectorize(python_form(hold.effective_impact_velocity), otypes=[float])
@@ -77,7 +82,8 @@ class ClearanceContact(NamedTuple):
     contact_offset: np.ndarray
 
 
-def contact_geometry(ecc, ecc_rate, clearance: float):
+def contact_geometry(ecc: ArrayLike, ecc_rate: ArrayLike,
+                     clearance: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Penetration, its rate and the normal from the eccentricity (docs/physics.md section 2).
 
     Parameters
@@ -102,8 +108,9 @@ def contact_geometry(ecc, ecc_rate, clearance: float):
     return length - clearance, rate, normal
 
 
-def tangential_velocity(ecc, bearing_velocity, bearing_angular_velocity,
-                        journal_velocity, journal_angular_velocity, bearing_radius: float):
+def tangential_velocity(ecc: ArrayLike, bearing_velocity: ArrayLike, bearing_angular_velocity: ArrayLike,
+                        journal_velocity: ArrayLike, journal_angular_velocity: ArrayLike,
+                        bearing_radius: float) -> np.ndarray:
     """Relative tangential velocity v_T of the contact points (journal relative to bearing), m/s.
 
     Both material points sit at Q = P_b + R_b n::
@@ -131,7 +138,8 @@ def tangential_velocity(ecc, bearing_velocity, bearing_angular_velocity,
     return np.where(length > 0.0, v_t, 0.0)
 
 
-def effective_impact_velocity(held, penetration_rate, joint: ClearanceJoint):
+def effective_impact_velocity(held: ArrayLike, penetration_rate: ArrayLike,
+                              joint: ClearanceJoint) -> np.ndarray | float:
     """The impact velocity delta_dot^- of the damping term, m/s (arrays, broadcast).
 
     ``held``: the engine's held value (onset rate floored at v_min, raised at its updates);
@@ -142,8 +150,8 @@ def effective_impact_velocity(held, penetration_rate, joint: ClearanceJoint):
     return _EFFECTIVE_IMPACT_VELOCITY(held, penetration_rate, rule)[()]
 
 
-def clearance_contact(ecc, ecc_rate, rel_tangential_velocity, impact_velocity, law,
-                      joint: ClearanceJoint) -> ClearanceContact:
+def clearance_contact(ecc: ArrayLike, ecc_rate: ArrayLike, rel_tangential_velocity: ArrayLike,
+                      impact_velocity: ArrayLike, law: _Law, joint: ClearanceJoint) -> ClearanceContact:
     """Normal and friction force of the clearance joint, with moments (arrays, broadcast).
 
     :func:`weftsim.kernel.joint.clearance_force` at every element.
@@ -184,7 +192,8 @@ def clearance_contact(ecc, ecc_rate, rel_tangential_velocity, impact_velocity, l
     )
 
 
-def clearance_force(ecc, ecc_rate, rel_tangential_velocity, impact_velocity, law, joint: ClearanceJoint):
+def clearance_force(ecc: ArrayLike, ecc_rate: ArrayLike, rel_tangential_velocity: ArrayLike, impact_velocity: ArrayLike,
+                    law: _Law, joint: ClearanceJoint) -> tuple[np.ndarray | float, ...]:
     """Force on the journal (..., 2) N, F_N (N), delta (m), delta_dot (m/s): the agreed short form.
 
     See :func:`clearance_contact` for parameters, moments and the force on the bearing (-force).
@@ -196,7 +205,7 @@ def clearance_force(ecc, ecc_rate, rel_tangential_velocity, impact_velocity, law
 ClearanceKernel = Callable[[float, float, float, float, float, float], tuple]
 
 
-def make_clearance_kernel(law, joint: ClearanceJoint, jit: bool = False) -> ClearanceKernel:
+def make_clearance_kernel(law: _Law, joint: ClearanceJoint, jit: bool = False) -> ClearanceKernel:
     """Scalar form of :func:`clearance_contact` for inner loops.
 
     Returns ``kernel(ex, ey, ex_dot, ey_dot, v_t, v_imp) -> (fx, fy, F_N, delta, delta_dot,

@@ -155,7 +155,7 @@ def _add_wear_flags(p: argparse.ArgumentParser) -> None:
     add_flags(p, positive)
 
 
-def cmd_wear(args) -> int:
+def cmd_wear(args: argparse.Namespace) -> int:
     from weftsim.wear.command import run
 
     scene = scene_from_args(args)
@@ -251,7 +251,7 @@ KINEMATICS_COLUMNS = ("crank_angle_deg", "rapier_displacement_m", "rapier_veloci
                       "transmission_angle_deg")
 
 
-def cmd_kinematics(args) -> int:
+def cmd_kinematics(args: argparse.Namespace) -> int:
     import numpy as np
 
     from weftsim.kinematics import linkage_state
@@ -341,7 +341,7 @@ def _interrupted_line(result, outdir: Path, signum: int) -> str:
             f"there are in {outdir} (summary.json says complete: false); rerun to compute the whole run")
 
 
-def cmd_run(args) -> int:
+def cmd_run(args: argparse.Namespace) -> int:
     from weftsim.api import resolve_engine
     from weftsim.output import prepare_directory, write_run
     from weftsim.plausibility import report_lines
@@ -365,7 +365,7 @@ def cmd_run(args) -> int:
     return 0
 
 
-def cmd_animate(args) -> int:
+def cmd_animate(args: argparse.Namespace) -> int:
     from weftsim.animate import check_format, write_animation
     from weftsim.api import resolve_engine
 
@@ -398,7 +398,7 @@ def cmd_animate(args) -> int:
     return 0
 
 
-def _replay_in_viewer(args, scene, engine: str) -> int:
+def _replay_in_viewer(args: argparse.Namespace, scene, engine: str) -> int:
     """``animate --viewer``: solve the rigid-body Exudyn model into a solution file, then replay it in
     Exudyn's viewer (:mod:`weftsim.exudyn_engine.viewer`); refused at once where no window can open."""
     if engine != "exudyn":
@@ -423,7 +423,7 @@ def _replay_in_viewer(args, scene, engine: str) -> int:
     return 0
 
 
-def cmd_compare(args) -> int:
+def cmd_compare(args: argparse.Namespace) -> int:
     from weftsim.compare import format_report, run_compare
     from weftsim.output import prepare_directory, to_json
 
@@ -453,7 +453,7 @@ def _raise_terminated(signum, frame):
     raise _SweepTerminated(signum)
 
 
-def cmd_sweep(args) -> int:
+def cmd_sweep(args: argparse.Namespace) -> int:
     from weftsim.api import SCENE_FLAGS, resolve_engine, scene_overrides
     from weftsim.sweep import format_report, plan_sweep, run_sweep
 
@@ -484,7 +484,7 @@ def cmd_sweep(args) -> int:
     return 0
 
 
-def cmd_study(args) -> int:
+def cmd_study(args: argparse.Namespace) -> int:
     from weftsim.api import scene_overrides
     from weftsim.studies import STUDIES, check_overrides, format_study, run_study
 
@@ -501,7 +501,7 @@ def cmd_study(args) -> int:
     return 0
 
 
-def cmd_bench(args) -> int:
+def cmd_bench(args: argparse.Namespace) -> int:
     from weftsim.bench import CASES, run_benchmark
 
     unknown = [c for c in args.case or [] if c not in CASES]
@@ -520,7 +520,7 @@ def cmd_bench(args) -> int:
     return 0
 
 
-def cmd_scenes(args) -> int:
+def cmd_scenes(args: argparse.Namespace) -> int:
     """``weftsim scenes``: each bundled scene's name and description, one a line."""
     from weftsim.scene import bundled_directory, bundled_scene_path, bundled_scenes, scene_description
 

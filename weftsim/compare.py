@@ -18,11 +18,18 @@ ratio of each peak, as the paper reports 1.035 and 1.099 against ADAMS) is infor
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from weftsim.analysis import channel_statistics, complete_revolutions, peak_channels, peaks, statistics
 from weftsim.results import RunResult
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+    from pathlib import Path
+
+    from weftsim.params import Scene
 
 FIRST_REVOLUTION_CHANNELS = ("contact_force_N", "rapier_acceleration_m_s2", "driving_torque_Nm")
 IDEAL_CURVE_CHANNELS = ("rapier_acceleration_m_s2", "driving_torque_Nm")
@@ -168,7 +175,7 @@ def format_report(report: dict) -> str:
     return "\n".join(lines)
 
 
-def verdict(report: dict, outdir) -> tuple[int, str]:
+def verdict(report: dict, outdir: str | Path) -> tuple[int, str]:
     """Exit status of a comparison and, when it is not 0, the one line that says why.
 
     3 when an engine failed (its message, and where its partial results are), 4 when both ran
@@ -192,7 +199,8 @@ def verdict(report: dict, outdir) -> tuple[int, str]:
     return 0, ""
 
 
-def run_compare(scene, outdir, solve, force: bool = False) -> tuple[dict, int, str]:
+def run_compare(scene: Scene, outdir: str | Path, solve: Callable[[Scene, str], RunResult],
+                force: bool = False) -> tuple[dict, int, str]:
     """Run both engines, write the overlay figure and both runs' files.
 
     Returns the report (:func:`compare_results`), the exit status and the line saying why it is

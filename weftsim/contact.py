@@ -72,7 +72,7 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
-from typing import Callable, ClassVar
+from typing import TYPE_CHECKING, Callable, ClassVar
 
 import numpy as np
 
@@ -81,6 +81,9 @@ from numba import njit
 from weftsim.kernel import laws as kernel
 from weftsim.kernel.python import python_form
 from weftsim.params import ClearanceJoint
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 ScalarLaw = Callable[[float, float, float], float]
 
@@ -137,7 +140,7 @@ def lankarani_nikravesh_stiffness(joint: ClearanceJoint) -> float:
     return 4.0 / 3.0 * joint.effective_modulus * math.sqrt(r_b * r_j / (r_b - r_j))
 
 
-def bai_zhao_stiffness(penetration, clearance: float, effective_modulus: float):
+def bai_zhao_stiffness(penetration: ArrayLike, clearance: float, effective_modulus: float) -> np.ndarray | float:
     """K_BZ(delta) = (pi/8) E* sqrt(2 delta (3c + 2 delta)^2 / (c + delta)^3) (Bai & Zhao 2013).
 
     Empirical SI stiffness (N/m^2 dimensionally, used as N/m^1.5); 0 for delta <= 0.
@@ -146,7 +149,7 @@ def bai_zhao_stiffness(penetration, clearance: float, effective_modulus: float):
                       penetration)  # fmt: skip
 
 
-def check_impact_velocity(delta, impact_velocity) -> None:
+def check_impact_velocity(delta: ArrayLike, impact_velocity: ArrayLike) -> None:
     """``ValueError`` where delta > 0 and the impact velocity is not > 0 (arrays, broadcast)."""
     bad = (delta > 0.0) & ~(impact_velocity > 0.0)
     if np.any(bad):
@@ -187,26 +190,27 @@ class _Law:
         """(kind, coef, clearance, xi): the law's numbers for :mod:`weftsim.kernel.laws`."""
         return self.kind, self.coefficient, getattr(self, "clearance", 0.0), self.hysteresis
 
-    def stiffness(self, penetration):
+    def stiffness(self, penetration: ArrayLike) -> np.ndarray | float:
         """K(delta), N/m^1.5 (at delta <= 0 the value at 0)."""
         kind, coef, c, _ = self.parameters
         return _law_array(kernel.stiffness, kind, coef, c, penetration)
 
-    def elastic_force(self, penetration):
+    def elastic_force(self, penetration: ArrayLike) -> np.ndarray | float:
         """F_el = K(delta) delta^1.5 for delta > 0, else 0, N."""
         kind, coef, c, _ = self.parameters
         return _law_array(kernel.elastic_force, kind, coef, c, penetration)
 
-    def elastic_energy(self, penetration):
+    def elastic_energy(self, penetration: ArrayLike) -> np.ndarray | float:
         """W = integral_0^delta F_el, J (0 for delta <= 0); closed forms in :func:`weftsim.kernel.laws.elastic_energy`."""
         kind, coef, c, _ = self.parameters
         return _law_array(kernel.elastic_energy, kind, coef, c, penetration)
 
-    def damping(self, penetration, impact_velocity):
+    def damping(self, penetration: ArrayLike, impact_velocity: ArrayLike) -> np.ndarray | float:
         """D = xi K(delta) delta^1.5 / v_imp, N s/m (paper Eqs. 19, 23)."""
         return self.hysteresis * self.elastic_force(penetration) / np.asarray(impact_velocity, dtype=float)
 
-    def normal_force(self, penetration, penetration_rate, impact_velocity):
+    def normal_force(self, penetration: ArrayLike, penetration_rate: ArrayLike,
+                     impact_velocity: ArrayLike) -> np.ndarray | float:
         """F_N = max(0, K delta^1.5 (1 + xi delta_dot / v_imp)) for delta > 0, else 0, N.
 
         Parameters (broadcast together)
@@ -465,7 +469,7 @@ _friction_factor = python_form(kernel.friction_factor)
 _FRICTION_FACTOR = np.vectorize(_friction_factor, otypes=[float])
 
 
-def friction_factor(tangential_speed, v0: float, v1: float):
+def friction_factor(tangential_speed: ArrayLike, v0: float, v1: float) -> np.ndarray | float:
     """Dynamic correction factor c_d of the modified Coulomb law (Ambrosio 2003), in [0, 1].
 
     Piecewise linear in ``|v_T|`` as in Ambrosio's law::

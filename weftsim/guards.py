@@ -44,6 +44,7 @@ import numpy as np
 from weftsim.params import Scene
 
 if TYPE_CHECKING:
+    from weftsim.plausibility import Plausibility
     from weftsim.results import RunResult
 
 KINDS = ("non_finite", "penetration", "step_size", "steps", "wall_time", "energy", "plausibility", "interrupted")
@@ -213,7 +214,7 @@ def energy_residual(steps: dict) -> np.ndarray:
     )  # fmt: skip
 
 
-def result_breach(result) -> tuple[int, Breach] | None:
+def result_breach(result: RunResult) -> tuple[int, Breach] | None:
     """The first step of a finished run's channels that crosses a criterion, and the breach.
 
     Checked on the per-step channels, in this order: non-finite values, the penetration
@@ -255,7 +256,7 @@ def result_breach(result) -> tuple[int, Breach] | None:
     return None
 
 
-def plausibility_breach(result, report) -> tuple[int, Breach] | None:
+def plausibility_breach(result: RunResult, report: Plausibility) -> tuple[int, Breach] | None:
     """The first step showing a defect of :func:`weftsim.plausibility.assess`'s report, and the breach."""
     from weftsim.plausibility import HINT, first_defect_row
 
@@ -265,7 +266,7 @@ def plausibility_breach(result, report) -> tuple[int, Breach] | None:
     return first_defect_row(result, report), Breach("plausibility", "; ".join(defects), HINT)
 
 
-def vet_result(result) -> RunResult:
+def vet_result(result: RunResult) -> RunResult:
     """``result`` with its plausibility report attached, failed if a criterion is crossed.
 
     Applied by both engines to every run, so a criterion crossed without the step-by-step

@@ -21,6 +21,7 @@ general input-output law) lives in :mod:`weftsim.spherical` and is re-exported h
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -34,6 +35,9 @@ from weftsim.spherical import (
     spherical_4r,
     spherical_4r_assembles,
 )
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 __all__ = [
     "rocker_angle",
@@ -79,7 +83,7 @@ def _point_on_arm(length, angle, d_angle, dd_angle):
     return length * u, length * d1 * n, length * (d2 * n - d1 * d1 * u)
 
 
-def fourbar_assembly_argument(theta_oe, geometry: Geometry) -> np.ndarray:
+def fourbar_assembly_argument(theta_oe: ArrayLike, geometry: Geometry) -> np.ndarray:
     """Argument of the acos in the assembly formula; the four-bar closes iff it is in [-1, 1].
 
     With a = L_OG - E_Y, b' = -E_Z, D = hypot(a, b'):
@@ -111,7 +115,7 @@ class FourBarState:
     dd_theta_ef: np.ndarray
 
 
-def fourbar(theta_oe, geometry: Geometry) -> FourBarState:
+def fourbar(theta_oe: ArrayLike, geometry: Geometry) -> FourBarState:
     """Solve the planar four-bar for the rocker-arm angle theta_OE.
 
     Position (docs/physics.md section 1, branch = ``geometry.fourbar_branch``, +1 = "+")::
@@ -209,7 +213,7 @@ class LinkageState:
     transmission_angle: np.ndarray
 
 
-def linkage_state(theta, geometry: Geometry, rocker_com_distance: float | None = None) -> LinkageState:
+def linkage_state(theta: ArrayLike, geometry: Geometry, rocker_com_distance: float | None = None) -> LinkageState:
     """Positions, velocities and accelerations (per unit crank speed) of members 3-8.
 
     Chain rule through the rocker: theta_OE = theta_OE0 + phi(theta), so for any
@@ -271,7 +275,7 @@ def linkage_state(theta, geometry: Geometry, rocker_com_distance: float | None =
     )  # fmt: skip
 
 
-def rapier_motion(theta, omega, geometry: Geometry) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def rapier_motion(theta: ArrayLike, omega: float, geometry: Geometry) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Rapier displacement, velocity and acceleration at constant crank speed.
 
     s = (d5 d7/d6)(theta_FG - theta_FG(0)),  v = omega s',  a = omega^2 s''.

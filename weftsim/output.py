@@ -24,11 +24,17 @@ import shutil
 import tempfile
 from pathlib import Path
 from typing import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from weftsim.errors import OutputError, WriteFailed
 from weftsim.results import RunResult
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+    from weftsim.params import Scene
 
 
 MANIFEST = ".weftsim-output.json"
@@ -136,7 +142,7 @@ def write_csv(target: Path, columns: dict[str, np.ndarray]) -> Path:
     return write_atomic(target, write)
 
 
-def write_figure(target: Path, figure) -> Path:
+def write_figure(target: Path, figure: Figure) -> Path:
     import sys
 
     try:
@@ -332,7 +338,7 @@ def check_output_fits(rows: float, columns: int, outdir: Path, what: str, runs: 
         raise OutputError(f"{what} gives {rows:.3g} output samples, {' and '.join(short)}: use {fix}")
 
 
-def output_rows(scene) -> float:
+def output_rows(scene: Scene) -> float:
     """Samples of a run's output grid: one per ``output.sample_deg`` of crank over the run, and the end."""
     return math.floor(scene.drive.end_time * scene.drive.speed / scene.output.sample_angle) + 2
 

@@ -51,8 +51,14 @@ from __future__ import annotations
 import math
 import sys
 from dataclasses import asdict, dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from weftsim.contact import _Law
+    from weftsim.params import ClearanceJoint, Scene
+    from weftsim.results import RunResult
 
 PENETRATION_WARNING_RATIO = 0.1  # delta_max / c; reason in the module docstring
 TRESCA_LINE_CONTACT_YIELD = 1.67  # p0 / Y at first yield under a Hertz line contact (Johnson 1985, 6.2)
@@ -160,7 +166,7 @@ class Plausibility:
                 "negative penetration")
 
 
-def roundoff_penetration(scene) -> float:
+def roundoff_penetration(scene: Scene) -> float:
     """Round-off of ``delta = |e| - c``, m: :data:`ROUNDOFF_ULPS` ulps of the summed link lengths."""
     g = scene.geometry
     return ROUNDOFF_ULPS * float(np.finfo(float).eps) * (g.l_oe + g.l_ef + g.l_fg + g.l_og)
@@ -181,7 +187,7 @@ def damping_excess(ratio: np.ndarray, limit: float) -> np.ndarray:
     return ratio > limit * (1.0 + DAMPING_ROUNDOFF)
 
 
-def damping_ratio(steps: dict, law) -> np.ndarray:
+def damping_ratio(steps: dict, law: _Law) -> np.ndarray:
     """(F_N - F_el) / (xi F_el) = delta_dot / v_imp at the steps in contact (delta > 0) whose force is at
     least :data:`DAMPING_FORCE_FLOOR` of the run's largest; 0 elsewhere."""
     delta = np.asarray(steps["penetration_m"])
@@ -199,7 +205,7 @@ def damping_ratio(steps: dict, law) -> np.ndarray:
     return ratio
 
 
-def line_contact_pressure(force: float, joint) -> float:
+def line_contact_pressure(force: float, joint: ClearanceJoint) -> float:
     """Hertz peak pressure p0 = sqrt(P' E* / (pi R*)) of a journal in a conforming bore, Pa.
 
     P' = force / L_b (N/m), 1/R* = 1/R_j - 1/R_b (Johnson 1985, section 4.3).
@@ -223,7 +229,7 @@ def _engine_count(result) -> int | None:
     return None
 
 
-def validity_warnings(scene, law, max_penetration_ratio: float, peak_pressure: float,
+def validity_warnings(scene: Scene, law: _Law, max_penetration_ratio: float, peak_pressure: float,
                       yield_pressure: float | None, damping_steps: int = 0, max_damping: float = 0.0,
                       table: str = "joint_e") -> list[str]:
     """The law-range warnings of a clearance run (module docstring); ``damping_steps`` count under "onset".
@@ -254,7 +260,7 @@ def validity_warnings(scene, law, max_penetration_ratio: float, peak_pressure: f
     return out
 
 
-def joint_view(result, joint: str):
+def joint_view(result: RunResult, joint: str) -> tuple[Scene, dict[str, np.ndarray]]:
     """(scene, steps) of one clearance joint in E's place: ``scene.joint`` is the joint, the steps hold its
     channels under joint E's names (joint F's ``_f`` channels renamed), so every check reads one joint."""
     import dataclasses
@@ -268,7 +274,7 @@ def joint_view(result, joint: str):
     return dataclasses.replace(result.scene, joint=result.scene.joint_f), steps
 
 
-def assess(result) -> Plausibility | None:
+def assess(result: RunResult) -> Plausibility | None:
     """Counts and warnings of a run with clearance joints; None for the ideal mechanism or no steps.
 
     Each joint with a clearance is judged on its own channels (:func:`joint_view`); with two, the
@@ -344,7 +350,7 @@ HINT = ("the contact history is broken, so its forces are not to be trusted: for
         "impact velocity as the rule says (report it; limits.max_damping_ratio only sets the round-off margin)")
 
 
-def first_defect_row(result, report: Plausibility) -> int:
+def first_defect_row(result: RunResult, report: Plausibility) -> int:
     """Index of the first step showing one of the defects (for the failure message's time), at any joint."""
     from weftsim.contact import make_law
 
@@ -363,7 +369,7 @@ def first_defect_row(result, report: Plausibility) -> int:
     return min(rows) if rows else 0
 
 
-def format_lines(result) -> list[str]:
+def format_lines(result: RunResult) -> list[str]:
     """The counts line and one ``warning:`` line per validity warning of a result's report (stderr)."""
     block = result.plausibility
     if not block:
@@ -372,7 +378,7 @@ def format_lines(result) -> list[str]:
     return [report.summary_line()] + [f"warning: {text}" for text in report.warnings]
 
 
-def report_lines(result, label: str) -> None:
+def report_lines(result: RunResult, label: str) -> None:
     """The plausibility counts and each validity warning of a finished run, one line each on stderr
     (``weftsim <label>: ...``; once per run, where its results are written).  A failed run says
     only why it failed (its summary.json still holds the block)."""

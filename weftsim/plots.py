@@ -8,9 +8,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
+    from collections.abc import Sequence
     from types import ModuleType
 
     from matplotlib.figure import Figure
+
+    from weftsim.params import Scene
+    from weftsim.results import RunResult
 
 PANELS = (
     ("rapier_displacement_m", "rapier displacement [mm]", 1e3),
@@ -27,14 +31,14 @@ PANELS_F = (
 )
 
 
-def clearance_label(scene) -> str:
+def clearance_label(scene: Scene) -> str:
     """``c = 0.25 mm`` (clearance at E alone, as before), or the clearance of each joint: ``c_E = 0.25, c_F = 0.25 mm``."""
     if scene.joint_f.is_ideal:
         return f"c = {scene.joint.clearance * 1e3:g} mm"
     return f"c_E = {scene.joint.clearance * 1e3:g}, c_F = {scene.joint_f.clearance * 1e3:g} mm"
 
 
-def figure(**options) -> Figure:
+def figure(**options: object) -> Figure:
     """A matplotlib Figure drawn by the Agg backend, without pyplot (whose import costs ~0.2 s of a
     ``weftsim run``); save it with :func:`weftsim.output.write_figure`."""
     from matplotlib.figure import Figure
@@ -51,7 +55,7 @@ def pyplot() -> ModuleType:
     return plt
 
 
-def last_revolution(result) -> tuple[dict[str, np.ndarray], int]:
+def last_revolution(result: RunResult) -> tuple[dict[str, np.ndarray], int]:
     """Per-step channels of the last complete revolution (all steps if the run is shorter)."""
     from weftsim.analysis import complete_revolutions
 
@@ -65,7 +69,7 @@ def last_revolution(result) -> tuple[dict[str, np.ndarray], int]:
     return {k: v[keep] for k, v in steps.items()}, n - 1
 
 
-def channel_panels(curves, title: str, panels=None) -> Figure:
+def channel_panels(curves: list[tuple], title: str, panels: tuple | None = None) -> Figure:
     """Six panels like the paper's Fig. 12/13/16 against crank angle over one revolution (eight when
     every curve has joint F's channels: its contact force and penetration below).
 
@@ -102,7 +106,8 @@ def channel_panels(curves, title: str, panels=None) -> Figure:
     return fig
 
 
-def plot_channels(results, labels=None, title=None) -> Figure:
+def plot_channels(results: Sequence[RunResult], labels: Sequence[str] | None = None,
+                  title: str | None = None) -> Figure:
     """Six panels over the last complete revolution of each result."""
     labels = labels or [f"{r.engine}, {clearance_label(r.scene)}, "
                         f"{r.scene.drive.speed * 30 / math.pi:g} rpm" for r in results]
@@ -113,7 +118,7 @@ def plot_channels(results, labels=None, title=None) -> Figure:
     return channel_panels(curves, title or (results[0].scene.name + " (last revolution)"))
 
 
-def plot_kinematics(angle_deg, s, v, a, title="") -> Figure:
+def plot_kinematics(angle_deg: np.ndarray, s: np.ndarray, v: np.ndarray, a: np.ndarray, title: str = "") -> Figure:
     """Ideal rapier displacement, velocity and acceleration over one revolution."""
     fig = figure(figsize=(8, 8))
     axes = fig.subplots(3, 1, sharex=True)
@@ -129,7 +134,7 @@ def plot_kinematics(angle_deg, s, v, a, title="") -> Figure:
     return fig
 
 
-def contact_onsets(steps) -> np.ndarray:
+def contact_onsets(steps: dict[str, np.ndarray]) -> np.ndarray:
     """Rows of the per-step channels that start a contact at E (an impact).
 
     A contact segment is where the engine holds an impact velocity (docs/physics.md section 2):
@@ -140,7 +145,7 @@ def contact_onsets(steps) -> np.ndarray:
     return onset_rows(contact_mode(steps))
 
 
-def plot_orbit(result, title=None):
+def plot_orbit(result: RunResult, title: str | None = None) -> Figure:
     """Orbit of the journal centre inside the clearance circle at E, with the impacts marked.
 
     The eccentricity e = P_j - P_b (journal centre minus bearing centre, docs/physics.md

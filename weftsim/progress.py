@@ -4,6 +4,10 @@ from __future__ import annotations
 
 import sys
 import time
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from weftsim.params import Scene
 
 
 class Progress:
@@ -74,7 +78,7 @@ SHOW_ESTIMATE_S = 10.0  # shorter runs end before the line would be read
 LONG_RUN_S = 600.0  # above 10 min the estimate is a warning: the user may not have meant it
 
 
-def estimate_run_time(scene, engine: str) -> float:
+def estimate_run_time(scene: Scene, engine: str) -> float:
     """Estimated wall-clock seconds of one run of ``scene`` with ``engine`` (see
     :data:`SECONDS_PER_REVOLUTION`); 0 for the closed-form ideal joint of the reference engine."""
     revolutions = scene.drive.revolutions

@@ -22,7 +22,12 @@ The public names are re-exported by :mod:`weftsim.kinematics`.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 __all__ = [
     "rocker_angle",
@@ -35,7 +40,7 @@ __all__ = [
 ]
 
 
-def rocker_angle(theta, beta) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def rocker_angle(theta: ArrayLike, beta: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Rocker angle of the loom's spherical 4R and its derivatives.
 
     With arcs B-C = C-D = A-D = 90 deg the closure b . c = 0 gives
@@ -86,7 +91,8 @@ def _spherical_4r_coefficients(theta_in, alpha1, alpha2, alpha3, alpha4):
     return (a, da, dda), (b, db, ddb), (c, dc, ddc)
 
 
-def spherical_4r_assembles(theta_in, alpha1, alpha2, alpha3, alpha4) -> np.ndarray:
+def spherical_4r_assembles(theta_in: ArrayLike, alpha1: ArrayLike, alpha2: ArrayLike, alpha3: ArrayLike,
+                           alpha4: ArrayLike) -> np.ndarray:
     """True where the general spherical 4R can be assembled, C^2 <= A^2 + B^2.
 
     Same arguments as :func:`spherical_4r`; returns a boolean array of the shape of
@@ -98,7 +104,8 @@ def spherical_4r_assembles(theta_in, alpha1, alpha2, alpha3, alpha4) -> np.ndarr
     return c * c <= a * a + b * b
 
 
-def spherical_4r(theta_in, alpha1, alpha2, alpha3, alpha4, branch) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def spherical_4r(theta_in: ArrayLike, alpha1: ArrayLike, alpha2: ArrayLike, alpha3: ArrayLike, alpha4: ArrayLike,
+                 branch: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """General spherical 4R input-output law (docs/physics.md section 1) with derivatives.
 
     In the mechanism's own frame (a = z, d = R_y(alpha1) z,
@@ -158,7 +165,7 @@ def spherical_4r(theta_in, alpha1, alpha2, alpha3, alpha4, branch) -> tuple[np.n
     return phi, dphi, ddphi
 
 
-def crank_axis(theta, beta) -> np.ndarray:
+def crank_axis(theta: ArrayLike, beta: float) -> np.ndarray:
     """Crank axis b(theta) = (-sin beta sin theta, sin beta cos theta, cos beta), shape (..., 3)."""
     theta = np.asarray(theta, dtype=float)
     sb = np.sin(beta)
@@ -167,13 +174,13 @@ def crank_axis(theta, beta) -> np.ndarray:
     )
 
 
-def rocker_axis(phi) -> np.ndarray:
+def rocker_axis(phi: ArrayLike) -> np.ndarray:
     """Rocker axis c(phi) = (0, cos phi, sin phi), shape (..., 3)."""
     phi = np.asarray(phi, dtype=float)
     return np.stack([np.zeros_like(phi), np.cos(phi), np.sin(phi)], axis=-1)
 
 
-def coupler_frame(theta, beta) -> np.ndarray:
+def coupler_frame(theta: ArrayLike, beta: float) -> np.ndarray:
     """Rotation matrix of the coupler (member 2): columns [b, c, b x c].
 
     Parameters
@@ -195,7 +202,7 @@ def coupler_frame(theta, beta) -> np.ndarray:
     return np.stack([b, c, np.cross(b, c)], axis=-1)
 
 
-def coupler_angular_velocity(theta, beta) -> tuple[np.ndarray, np.ndarray]:
+def coupler_angular_velocity(theta: ArrayLike, beta: float) -> tuple[np.ndarray, np.ndarray]:
     """Angular velocity of the coupler per unit crank speed, in the fixed frame.
 
     The coupler turns relative to the crank about b and relative to the rocker

@@ -28,6 +28,8 @@ from typing import TYPE_CHECKING
 from weftsim.analysis import complete_revolutions, peaks, statistics
 
 if TYPE_CHECKING:
+    from collections.abc import Callable, Sequence
+
     from weftsim.params import Scene
     from weftsim.results import RunResult
 
@@ -119,7 +121,7 @@ def _solver(engine: str):
     return solve
 
 
-def timed_solve(scene, engine: str) -> tuple[RunResult, float, float]:
+def timed_solve(scene: Scene, engine: str) -> tuple[RunResult, float, float]:
     """(result, wall s, CPU s) of one ``solve``."""
     solve = _solver(engine)
     wall0, cpu0 = time.perf_counter(), time.process_time()
@@ -127,7 +129,7 @@ def timed_solve(scene, engine: str) -> tuple[RunResult, float, float]:
     return result, time.perf_counter() - wall0, time.process_time() - cpu0
 
 
-def quantities(result) -> dict | None:
+def quantities(result: RunResult) -> dict | None:
     """First-revolution maxima, RMS and mean over revolutions 2..N, first contact angle."""
     n = complete_revolutions(result)
     if n < 1:
@@ -160,7 +162,7 @@ def errors(q: dict | None, ref: dict) -> dict | None:
     return out
 
 
-def converged_solution(case: str, models, revolutions: float, log=print) -> dict:
+def converged_solution(case: str, models: str | Path, revolutions: float, log: Callable[[str], None] = print) -> dict:
     """Quantities of the converged ensemble (:data:`CONVERGED`) and its spread (the error floor).
 
     Peaks come from the tightest run; RMS and mean are the median over the ensemble (they
@@ -188,7 +190,7 @@ def converged_solution(case: str, models, revolutions: float, log=print) -> dict
     return ref
 
 
-def measure(case: str, setting: Setting, ref: dict, models, revolutions: float, repeats: int,
+def measure(case: str, setting: Setting, ref: dict, models: str | Path, revolutions: float, repeats: int,
             repeat_limit: float, timing_revolutions: float) -> dict:
     """Run one setting: one full run for the errors, ``repeats`` timed runs for the time.
 
@@ -231,7 +233,7 @@ def measure(case: str, setting: Setting, ref: dict, models, revolutions: float, 
     return row
 
 
-def startup_costs(models, log=print) -> dict:
+def startup_costs(models: str | Path, log: Callable[[str], None] = print) -> dict:
     """First call against second call of each engine path on a tiny run (imports, numba cache, compile)."""
     out = {}
     paths = {
@@ -254,8 +256,10 @@ def startup_costs(models, log=print) -> dict:
     return out
 
 
-def run_benchmark(outdir, models="models", quick: bool = False, cases=None, revolutions: float | None = None,
-                  repeats: int = 5, repeat_limit: float | None = None, force: bool = False, log=None) -> dict:
+def run_benchmark(outdir: str | Path, models: str | Path = "models", quick: bool = False,
+                  cases: Sequence[str] | None = None, revolutions: float | None = None, repeats: int = 5,
+                  repeat_limit: float | None = None, force: bool = False,
+                  log: Callable[[str], None] | None = None) -> dict:
     """Run the whole benchmark and write its report into ``outdir``; returns the report dict."""
     from weftsim.bench.report import machine_info, write_report
 
@@ -296,7 +300,7 @@ def _fmt(value) -> str:
     return "-" if value is None else f"{value:.1e}"
 
 
-def main(argv=None) -> int:
+def main(argv: list[str] | None = None) -> int:
     import argparse
 
     p = argparse.ArgumentParser(prog="python -m weftsim.bench", description=__doc__.splitlines()[0])

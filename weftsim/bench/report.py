@@ -170,7 +170,7 @@ def figure(report: dict, case: str) -> Figure:
     return fig
 
 
-def write_report(report: dict, outdir, force: bool = False) -> list[Path]:
+def write_report(report: dict, outdir: str | Path, force: bool = False) -> list[Path]:
     """bench.json, bench.md and one figure per case into ``outdir``; returns the files."""
     from weftsim.output import begin_directory, finish_directory, prepare_directory, write_figure, write_json, write_text
 

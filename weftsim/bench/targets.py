@@ -25,8 +25,12 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from weftsim.bench.measure import Setting, _ref, _rigid, converged_solution, measure
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 CASE = "c0.25mm-400rpm"
 # Issue 12's targets: loom time / wall time of the in-process solves, wall seconds of the rest.
@@ -68,14 +72,14 @@ def _process_walls(commands: list[list[str]], warmup: int = 0) -> dict:
             "wall_median_s": _stats.median(walls)}
 
 
-def cli_run(engine: str, models, repeats: int, workdir: Path) -> dict:
+def cli_run(engine: str, models: str | Path, repeats: int, workdir: Path) -> dict:
     """``weftsim run`` as a new process, 2 revolutions, start to exit; ``repeats`` runs after one warm-up run."""
     command = [sys.executable, "-m", "weftsim.cli", "run", str(Path(models) / "reference.toml"), "--engine", engine,
                "--revolutions", "2", "-o", str(workdir / f"run-{engine}"), "--force"]
     return _process_walls([command] * (repeats + 1), warmup=1)
 
 
-def clearance_speed_map(models, jobs: int, repeats: int, workdir: Path) -> dict:
+def clearance_speed_map(models: str | Path, jobs: int, repeats: int, workdir: Path) -> dict:
     """The 121-cell map at 10 revolutions per cell, from scratch each time (a fresh output directory)."""
     commands = [[sys.executable, "-m", "weftsim.cli", "sweep", str(Path(models) / "reference.toml"),
                  "--vary", MAP_VARY[0], "--vary", MAP_VARY[1], "--set", "revolutions=10", "--engine", "reference",
@@ -93,7 +97,8 @@ def _met(name: str, item: dict) -> bool | None:
     return item["wall_median_s"] <= target["wall_at_most_s"]
 
 
-def run_targets(models="models", repeats: int = 5, jobs: int = 2, map_repeats: int = 1, log=print) -> dict:
+def run_targets(models: str | Path = "models", repeats: int = 5, jobs: int = 2, map_repeats: int = 1,
+                log: Callable[[str], None] = print) -> dict:
     """Measure every target and its baseline in one process; returns the report (see module doc)."""
     started = time.perf_counter()
     log(f"converged solution of {CASE}")
@@ -148,7 +153,7 @@ def markdown(report: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def write_targets(report: dict, outdir, force: bool = False) -> list[Path]:
+def write_targets(report: dict, outdir: str | Path, force: bool = False) -> list[Path]:
     """targets.json and targets.md into ``outdir``; returns the files."""
     from weftsim.bench.report import machine_info
     from weftsim.output import begin_directory, finish_directory, prepare_directory, write_json, write_text

@@ -37,12 +37,21 @@ faster on the rigid-body model and ~6x slower on the kinematic tree, docs/cleara
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from weftsim.kernel import chain as kernel_chain
 from weftsim.kernel import joint as kernel_joint
 from weftsim.kernel.hold import RESTING_RATE_FRACTION
 from weftsim.kernel.python import python_form
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from numba.core.registry import CPUDispatcher
+
+    from weftsim.contact import _Law
 
 ROUTES = ("python", "numba")
 # Fastest route on the loom model, rigid body and kinematic tree (scripts/bench_callbacks.py,
@@ -66,7 +75,7 @@ def route_error(callback: str) -> str | None:
     return None
 
 
-def connector_parameters(law, clearance: float, min_impact_velocity: float, max_approach: bool) -> np.ndarray:
+def connector_parameters(law: _Law, clearance: float, min_impact_velocity: float, max_approach: bool) -> np.ndarray:
     """The joint block of :mod:`weftsim.kernel.joint` the connector force needs (no friction)."""
     prm = np.zeros(kernel_joint.N_JOINT)
     kind, coef, _, xi = law.parameters
@@ -78,13 +87,13 @@ def connector_parameters(law, clearance: float, min_impact_velocity: float, max_
     return prm
 
 
-def parameters_for_route(prm: np.ndarray, route: str):
+def parameters_for_route(prm: np.ndarray, route: str) -> np.ndarray | list[float]:
     """The parameters as the route reads them fastest: a numpy array compiled, a list of floats in
     plain Python (numpy scalars would make every operation of the kernel's source ~5x slower)."""
     return prm.tolist() if route == "python" else prm
 
 
-def kernel_form(function, route: str):
+def kernel_form(function: CPUDispatcher, route: str) -> Callable:
     if route == "python":
         return python_form(function)
     if route == "numba":
@@ -92,8 +101,8 @@ def kernel_form(function, route: str):
     raise ValueError(route_error(route) or f"`callback` = {route!r} has no kernel form")
 
 
-def make_force(law, clearance: float, min_impact_velocity: float, route: str = "numba",
-               counter: list | None = None, max_approach: bool = True):
+def make_force(law: _Law, clearance: float, min_impact_velocity: float, route: str = "numba",
+               counter: list | None = None, max_approach: bool = True) -> Callable[..., list[float]]:
     """Callback of a connector between a bearing marker and a journal marker (fixed frame).
 
     ``route``: ``"numba"`` or ``"python"`` (module docstring); ``counter``, if given, is a
@@ -120,18 +129,20 @@ def make_force(law, clearance: float, min_impact_velocity: float, route: str = "
     return counted
 
 
-def make_python_force(law, clearance: float, min_impact_velocity: float, counter: list | None = None,
-                      max_approach: bool = True):
+def make_python_force(law: _Law, clearance: float, min_impact_velocity: float, counter: list | None = None,
+                      max_approach: bool = True) -> Callable[..., list[float]]:
     """:func:`make_force` on the ``"python"`` route."""
     return make_force(law, clearance, min_impact_velocity, "python", counter, max_approach)
 
 
-def make_numba_force(law, clearance: float, min_impact_velocity: float, max_approach: bool = True):
+def make_numba_force(law: _Law, clearance: float, min_impact_velocity: float,
+                     max_approach: bool = True) -> Callable[..., list[float]]:
     """:func:`make_force` on the ``"numba"`` route."""
     return make_force(law, clearance, min_impact_velocity, "numba", None, max_approach)
 
 
-def make_tree_force(prm: np.ndarray, memory: list, stash: list, route: str = "numba", counter: list | None = None):
+def make_tree_force(prm: np.ndarray, memory: list, stash: list, route: str = "numba",
+                    counter: list | None = None) -> Callable[..., list[float]]:
     """``forceUserFunction(mbs, t, itemNumber, q, q_t)`` of the kinematic tree: its two joint torques.
 
     The contact of the moving bearing, projected on the joints by virtual work, is

@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import exudyn as exu
 from exudyn.itemInterface import ObjectConnectorCartesianSpringDamper
@@ -48,6 +49,11 @@ from weftsim.exudyn_engine.joint_friction import JointFriction
 from weftsim.exudyn_engine.onset import OnsetTracker, penetration_state
 from weftsim.kernel.joint import joint_parameters
 from weftsim.params import ClearanceJoint
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from weftsim.contact import _Law
 
 ROUTES = callbacks.ROUTES
 DEFAULT_ROUTE = callbacks.DEFAULT_ROUTE
@@ -77,7 +83,7 @@ def _check_plane(e_z: float, clearance: float) -> None:
         raise JointMisuse(out_of_plane_message(e_z, clearance))
 
 
-def register_post_step(mbs, hook) -> None:
+def register_post_step(mbs: exu.MainSystem, hook: Callable[[exu.MainSystem, float], object]) -> None:
     """Run ``hook(mbs, t)`` after every accepted step, alongside other registered hooks.
 
     Exudyn has one post-step function per system; the first registration installs a
@@ -130,13 +136,13 @@ class ClearanceJointModel:
     trial_time: list = field(default_factory=lambda: [0.0], repr=False)
     friction: JointFriction | None = None  # friction force and moments (joint.friction_coefficient > 0)
 
-    def state(self, mbs) -> tuple[float, float]:
+    def state(self, mbs: exu.MainSystem) -> tuple[float, float]:
         """Current (delta, delta_dot) of the joint, m and m/s."""
         u = mbs.GetObjectOutput(self.connector, exu.OutputVariableType.Displacement)
         v = mbs.GetObjectOutput(self.connector, exu.OutputVariableType.Velocity)
         return penetration_state(u[0], u[1], v[0], v[1], self.joint.clearance)
 
-    def reset(self, mbs, t0: float = 0.0) -> None:
+    def reset(self, mbs: exu.MainSystem, t0: float = 0.0) -> None:
         """Start the bookkeeping from the current (assembled, initial) state of ``mbs``."""
         u = mbs.GetObjectOutput(self.connector, exu.OutputVariableType.Displacement)
         _check_plane(u[2], self.joint.clearance)
@@ -149,8 +155,9 @@ class ClearanceJointModel:
             self.friction.history.clear()
 
 
-def add_clearance_joint(mbs, marker_bearing, marker_journal, joint: ClearanceJoint, law=None,
-                        callback: str = "auto", call_counter: list | None = None) -> ClearanceJointModel:
+def add_clearance_joint(mbs: exu.MainSystem, marker_bearing: exu.MarkerIndex, marker_journal: exu.MarkerIndex,
+                        joint: ClearanceJoint, law: _Law | None = None, callback: str = "auto",
+                        call_counter: list | None = None) -> ClearanceJointModel:
     """Add a planar revolute clearance joint between two position markers.
 
     Parameters

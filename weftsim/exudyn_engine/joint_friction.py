@@ -29,11 +29,16 @@ A body without rotation (ground, mass point) turns at 0 and takes no moment.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import exudyn as exu
 from exudyn.itemInterface import LoadTorqueVector, MarkerBodyRigid
 
 from weftsim.exudyn_engine import callbacks
 from weftsim.kernel import joint as kernel_joint
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
 
 _ROTATING = ("RigidBody", "RigidBody2D")
 _FIXED = ("Ground", "MassPoint", "MassPoint2D")
@@ -92,13 +97,13 @@ class JointFriction:
         self._value = None
         self.history: list = []
 
-    def rates(self, mbs) -> tuple[float, float]:
+    def rates(self, mbs: exu.MainSystem) -> tuple[float, float]:
         """(omega_j, omega_b), rad/s about Z, of the current (trial) state."""
         w_j = mbs.GetObjectOutputBody(self.journal, _OMEGA, [0.0, 0.0, 0.0])[2] if self.journal_rotates else 0.0
         w_b = mbs.GetObjectOutputBody(self.bearing, _OMEGA, [0.0, 0.0, 0.0])[2] if self.bearing_rotates else 0.0
         return w_j, w_b
 
-    def evaluate(self, mbs, ex, ey, vx, vy):
+    def evaluate(self, mbs: exu.MainSystem, ex: float, ey: float, vx: float, vy: float) -> tuple[float, ...]:
         """The kernel's (f_x, f_y, delta, delta_dot, F_N, F_T, M_j, M_b, v_T) at this state (memoized)."""
         w_j, w_b = self.rates(mbs)
         held, delta0, rate0 = self.memory()
@@ -108,7 +113,9 @@ class JointFriction:
             self._value = self.kernel(self.prm, ex, ey, vx, vy, held, delta0, rate0, w_j, w_b)
         return self._value
 
-    def spring_force(self, mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
+    def spring_force(self, mbs: exu.MainSystem, t: float, itemNumber: int, displacement: Sequence[float],
+                     velocity: Sequence[float], stiffness: Sequence[float], damping: Sequence[float],
+                     offset: Sequence[float]) -> list[float]:
         """``springForceUserFunction`` of the connector: F_N n - F_T t, the force on the bearing."""
         out = self.evaluate(mbs, displacement[0], displacement[1], velocity[0], velocity[1])
         return [out[0], out[1], 0.0]
@@ -118,7 +125,7 @@ class JointFriction:
         v = mbs.GetObjectOutput(self.connector, exu.OutputVariableType.Velocity)
         return self.evaluate(mbs, u[0], u[1], v[0], v[1])
 
-    def install(self, mbs, connector) -> None:
+    def install(self, mbs: exu.MainSystem, connector: exu.ObjectIndex) -> None:
         """Add the torque loads M_j and M_b on the bodies that rotate (after the connector exists)."""
         self.connector = connector
 
@@ -135,7 +142,7 @@ class JointFriction:
                 mbs.AddLoad(LoadTorqueVector(markerNumber=marker, loadVector=[0.0, 0.0, 0.0],
                                              loadVectorUserFunction=moment))  # fmt: skip
 
-    def accept(self, mbs, t: float) -> None:
+    def accept(self, mbs: exu.MainSystem, t: float) -> None:
         """Record (t, F_N, F_T v_T) of an accepted state (post-step, before the tracker's update)."""
         out = self._state(mbs)
         self.history.append((t, out[4], out[5] * out[8]))

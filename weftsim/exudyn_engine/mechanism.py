@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import exudyn as exu
 import numpy as np
@@ -50,6 +51,11 @@ from weftsim.exudyn_engine.clearance_joint import ClearanceJointModel, add_clear
 from weftsim.kinematics import coupler_angular_velocity, coupler_frame, crank_axis, linkage_state, rocker_axis
 from weftsim.params import Scene
 
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    from numpy.typing import ArrayLike
+
 # Model-frame vector (x, y, z) (docs/physics.md section 1) -> Exudyn (X, Y, Z) = (y, z, x).
 SPEC_TO_EXUDYN = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
 # Mass given to balanced members whose mass the scene does not specify (no effect on results), kg.
@@ -58,12 +64,12 @@ CRANK_COORDINATE = 5  # rz of the crank's Rxyz node = crank angle theta
 ROTATION_2D = 2  # coordinate index of the angle of a 2-D rigid body node
 
 
-def to_exudyn(vector) -> np.ndarray:
+def to_exudyn(vector: ArrayLike) -> np.ndarray:
     """Model-frame vector(s) (docs/physics.md section 1) (..., 3) to Exudyn's frame."""
     return np.asarray(vector, dtype=float) @ SPEC_TO_EXUDYN.T
 
 
-def plane_point(yz) -> list[float]:
+def plane_point(yz: Sequence[float]) -> list[float]:
     """Four-bar plane point (Y, Z) to an Exudyn position (X, Y, 0)."""
     return [float(yz[0]), float(yz[1]), 0.0]
 
@@ -122,7 +128,7 @@ def _pin(mbs, body0, local0, body1, local1):
     return mbs.AddObject(ObjectJointRevolute2D(markerNumbers=[m0, m1]))
 
 
-def build_mechanism(mbs, scene: Scene, callback: str | None = None, reflect_gears: bool = True,
+def build_mechanism(mbs: exu.MainSystem, scene: Scene, callback: str | None = None, reflect_gears: bool = True,
                     call_counter: list | None = None) -> MechanismModel:
     """Add members 1-8, their joints, gravity and the crank drive to ``mbs`` (not assembled).
 

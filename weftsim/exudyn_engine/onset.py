@@ -141,7 +141,7 @@ def hermite_extremum(delta0: float, rate0: float, delta1: float, rate1: float, h
     return min(values) if rate0 < 0.0 else max(values)
 
 
-def penetration_state(ex: float, ey: float, vx: float, vy: float, clearance: float):
+def penetration_state(ex: float, ey: float, vx: float, vy: float, clearance: float) -> tuple[float, float]:
     """delta = |e| - c and delta_dot = e_dot . e/|e| of an in-plane eccentricity (m, m/s).
 
     delta_dot is 0 when the journal is exactly centred (e = 0: no normal defined).

@@ -40,7 +40,7 @@ def _sensor(mbs, item):
     return mbs.AddSensor(item)
 
 
-def add_sensors(mbs, model: MechanismModel) -> dict:
+def add_sensors(mbs: exu.MainSystem, model: MechanismModel) -> dict:
     """Add every sensor the channels need; returns name -> SensorIndex (or list of them)."""
     store = {"storeInternal": True, "writeToFile": False}
     sector = model.nodes["sector"]
@@ -75,7 +75,7 @@ def _cumtrapz(y, x):
     return out
 
 
-def step_channels(mbs, model: MechanismModel, sensors: dict) -> dict[str, np.ndarray]:
+def step_channels(mbs: exu.MainSystem, model: MechanismModel, sensors: dict) -> dict[str, np.ndarray]:
     """All :data:`~weftsim.results.CHANNELS` at every stored step (rows cut to a common length)."""
     scene = model.scene
     get = mbs.GetSensorStoredData
@@ -183,7 +183,7 @@ def first_nonfinite_row(steps: dict[str, np.ndarray]) -> int | None:
     return int(idx[0]) if idx.size else None
 
 
-def silence(settings) -> None:
+def silence(settings: exu.SimulationSettings) -> None:
     """No console output and no files: results come from sensors stored in memory (EXUDYN.md)."""
     settings.timeIntegration.verboseMode = 0
     settings.solution.file.write = False

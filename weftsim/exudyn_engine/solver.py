@@ -17,6 +17,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time as _time
+from typing import TYPE_CHECKING
 
 import exudyn as exu
 
@@ -30,6 +31,9 @@ from weftsim.guards import RunGuard, failure_message, non_finite_breach, vet_res
 from weftsim.params import Scene
 from weftsim.scene import IMPACT_VELOCITY_RULES, STEP_CONTROLS
 from weftsim.results import RunResult, angle_grid, empty_channels
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 MODELS = ("auto", "rigid_body", "kinematic_tree")  # auto: selection.py; kinematic_tree: tree.py, tree_solve.py
 # Modified Newton: iterations with one Jacobian before it is updated.  3 instead of
@@ -192,7 +196,7 @@ def _failure_reason(solver, scene: Scene) -> tuple[str, str]:
     return "newton", "Newton did not converge"
 
 
-def solve(scene: Scene, progress=None, callback: str | None = None) -> RunResult:
+def solve(scene: Scene, progress: Callable[[float], None] | None = None, callback: str | None = None) -> RunResult:
     """Simulate a scene with Exudyn.
 
     Parameters

@@ -34,10 +34,17 @@ with that step.  The ideal joint does not use it (solver.py: a fixed crank-angle
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import exudyn as exu
 
 from weftsim.exudyn_engine.clearance_joint import register_post_step
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from weftsim.exudyn_engine.mechanism import MechanismModel
+    from weftsim.params import Scene
 
 # Controller constants (Hairer, Norsett and Wanner, section II.4): aim at 0.9 of the tolerance,
 # never shrink below 0.2 or grow beyond 2x in one step (a step that grows faster meets an impact
@@ -98,7 +105,8 @@ class StepController:
         self.largest = 0.0
 
     @classmethod
-    def for_mechanism(cls, mbs, solver, model, scene) -> "StepController":
+    def for_mechanism(cls, mbs: exu.MainSystem, solver: exu.MainSolverImplicitSecondOrder, model: MechanismModel,
+                      scene: Scene) -> "StepController":
         """The controller of a built mechanism (:func:`~weftsim.exudyn_engine.mechanism.build_mechanism`)
         under the scene's settings: tolerance ``exudyn_solver.local_error``, steps between
         ``limits.min_step`` and one output sample period."""
@@ -108,11 +116,11 @@ class StepController:
         return cls(mbs, solver, model.nodes["rod"], math.hypot(journal[0], journal[1]), s.local_error, scene.limits.min_step, period, period,
                    newmark_beta(s.spectral_radius))
 
-    def acceleration(self):
+    def acceleration(self) -> np.ndarray:
         """Acceleration (x, y, angular) of the journal's body in the current trial or accepted state."""
         return self.mbs.GetNodeOutput(self.node, _OVT.Coordinates_tt)
 
-    def error(self, h: float, a1) -> float:
+    def error(self, h: float, a1: np.ndarray) -> float:
         """Local error estimate of a step of size h ending with journal-body acceleration a1, m.
 
         |a1 - a0| of the journal point is bounded by that of the body's centre plus |r| times the
@@ -131,7 +139,7 @@ class StepController:
             ratio = min(GROWTH_MAX, max(SHRINK_MIN, SAFETY * (self.tolerance / error) ** (1.0 / 3.0)))
         return min(self.max_step, max(self.min_step, h * ratio))
 
-    def post_newton(self, mbs, t):
+    def post_newton(self, mbs: exu.MainSystem, t: float) -> list[float]:
         """Exudyn post-Newton function: [error flag, recommended step] of the converged trial step."""
         h = self.it.currentStepSize
         a1 = self.acceleration()
@@ -143,7 +151,7 @@ class StepController:
         self.accel_trial, self.error_trial = a1, err
         return [_ACCEPT, _NO_RECOMMENDATION]
 
-    def post_step(self, mbs, t):
+    def post_step(self, mbs: exu.MainSystem, t: float) -> bool:
         """After an accepted step (and once at t = 0): plan the next step, ending on the sample grid."""
         if t <= 0.0 or self.accel_trial is None:
             self.accel_start = self.acceleration()

@@ -75,7 +75,7 @@ class TreeModel:
     # [t, F_b,x, F_b,y, F_N, M_b, F_T v_T] per accepted state (tree_joint_force's contact on the bearing)
     bearing_force: list = field(default_factory=list)
 
-    def accept(self, mbs, t: float) -> None:
+    def accept(self, mbs: exu.MainSystem, t: float) -> None:
         """Post-step bookkeeping: onset, held impact velocity, callback memory, force on the bearing."""
         if self.stash[0] != t:  # no evaluation at this state yet (the initial state)
             q = mbs.GetNodeOutput(self.node, exu.OutputVariableType.Coordinates)
@@ -88,7 +88,7 @@ class TreeModel:
         self.bearing_force.append((t, fx, fy, f_n, m_b, power))
 
 
-def build_tree(mbs, scene: Scene, callback: str = "auto") -> TreeModel:
+def build_tree(mbs: exu.MainSystem, scene: Scene, callback: str = "auto") -> TreeModel:
     """Add the kinematic tree of members 4-8, gravity and the clearance contact to ``mbs``.
 
     Initial state: the ideal mechanism at theta = 0, journal centred

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 import time as _time
+from typing import TYPE_CHECKING
 
 import exudyn as exu
 import numpy as np
@@ -42,6 +43,9 @@ from weftsim.params import Scene
 from weftsim.reference.dynamics import NUMPY, ChainConstants, chain_energy, eccentricity, initial_state
 from weftsim.reference.ideal import crank_side_inertia, crank_side_potential
 from weftsim.results import RunResult, angle_grid, empty_channels
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 OVT = exu.OutputVariableType
 EXPLICIT_METHODS = {"DOPRI5": exu.DynamicSolverType.DOPRI5, "ODE23": exu.DynamicSolverType.ODE23}
@@ -91,7 +95,7 @@ def check_tree_settings(scene: Scene) -> str | None:
     return None
 
 
-def contact_work(y, t, delta):
+def contact_work(y: np.ndarray, t: np.ndarray, delta: np.ndarray) -> np.ndarray:
     """Running integral of a contact power y (0 in free flight) over the stored steps, J.
 
     In contact the steps (~15 us) are not short against the contact oscillation (~0.15 ms): a
@@ -215,7 +219,7 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
     }
 
 
-def solve_tree(scene: Scene, progress=None, callback: str | None = None) -> RunResult:
+def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, callback: str | None = None) -> RunResult:
     """Simulate a scene with the kinematic-tree model (settings checked by the caller)."""
     wall0 = _time.perf_counter()
     omega, t_end = scene.drive.speed, scene.drive.end_time

@@ -29,6 +29,7 @@ from a scene), so numba compiles these functions once per machine and loads them
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 from numba import njit
 
@@ -40,6 +41,9 @@ from weftsim.kernel.joint import (  # noqa: F401 - the joint block is part of th
 from weftsim.kernel.laws import elastic_force
 from weftsim.kernel.wear import worn_clearance
 
+if TYPE_CHECKING:
+    import numpy as np
+
 # Indices of the chain's constants, after the joint block.
 (OMEGA, TAN_BETA, COS_OE0, SIN_OE0, L_OE, L_EF, L_FG, L_OG, ROD_MASS, GRAVITY, M11, M22,
  COUPLING) = range(N_JOINT, N_JOINT + 13)  # fmt: skip
@@ -50,7 +54,7 @@ WEAR_E = N_PARAMETERS + N_JOINT + 3
 
 
 @njit(cache=True, error_model="numpy")
-def crank_side(prm, t):
+def crank_side(prm: np.ndarray, t: float) -> tuple[float, ...]:
     """Bearing centre P_b = E of the rocker: (P_b, dP_b/dtheta, phi') at time t.
 
     phi = -atan(u), u = tan(beta) cos(theta); theta_OE = theta_OE0 + phi; sin and cos of
@@ -69,7 +73,7 @@ def crank_side(prm, t):
 
 
 @njit(cache=True, error_model="numpy")
-def eccentricity(prm, t, y):
+def eccentricity(prm: np.ndarray, t: float, y: np.ndarray) -> tuple[float, ...]:
     """e = P_j - P_b, its rate, and sin/cos of a, psi (m, m/s) of state y at time t."""
     b_y, b_z, db_y, db_z, dphi = crank_side(prm, t)
     sa, ca, sp, cp = math.sin(y[0]), math.cos(y[0]), math.sin(y[1]), math.cos(y[1])
@@ -82,7 +86,8 @@ def eccentricity(prm, t, y):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def local_clearance(prm, t, ecc_y, ecc_z, v_y, v_z, y):
+def local_clearance(prm: np.ndarray, t: float, ecc_y: float, ecc_z: float, v_y: float, v_z: float,
+                    y: np.ndarray) -> tuple[float, float]:
     """(c, dc/dt) along the eccentricity e of state y at time t: (c0, 0) when round, else (:mod:`.wear`)
     c0 + h_b + h_j with the rate of c as the contact direction turns in each body's frame, m, m/s.
 
@@ -101,13 +106,13 @@ def local_clearance(prm, t, ecc_y, ecc_z, v_y, v_z, y):
 
 
 @njit(cache=True, error_model="numpy")
-def rocker_angle(prm, t):
+def rocker_angle(prm: np.ndarray, t: float) -> float:
     """theta_OE = theta_OE0 + phi, phi = -atan(tan(beta) cos(omega t)): the bearing's frame angle, rad."""
     return math.atan2(prm[SIN_OE0], prm[COS_OE0]) - math.atan(prm[TAN_BETA] * math.cos(prm[OMEGA] * t))
 
 
 @njit(cache=True, error_model="numpy")
-def penetration(prm, t, y):
+def penetration(prm: np.ndarray, t: float, y: np.ndarray) -> tuple[float, float]:
     """(delta, delta_dot) = (|e| - c, e_dot . n - dc/dt) of state y at time t (m, m/s), c and dc/dt of
     :func:`local_clearance` (round: c0 and 0)."""
     ecc_y, ecc_z, v_y, v_z = eccentricity(prm, t, y)[:4]
@@ -118,7 +123,8 @@ def penetration(prm, t, y):
 
 
 @njit(cache=True, error_model="numpy")
-def chain(prm, t, y, contact, impact_velocity, out):
+def chain(prm: np.ndarray, t: float, y: np.ndarray, contact: bool, impact_velocity: float,
+          out: np.ndarray) -> tuple[float, ...]:
     """y' of the clearance mode into ``out`` (6,) (module docstring).
 
     Free flight (``contact`` False): no contact force, W3' = D' = 0.
@@ -166,13 +172,14 @@ def chain(prm, t, y, contact, impact_velocity, out):
 
 
 @njit(cache=True, error_model="numpy")
-def rhs(prm, t, y, contact, impact_velocity, out):
+def rhs(prm: np.ndarray, t: float, y: np.ndarray, contact: bool, impact_velocity: float, out: np.ndarray) -> float:
     """y' into ``out`` (:func:`chain`); returns q3 (N m)."""
     return chain(prm, t, y, contact, impact_velocity, out)[0]
 
 
 @njit(cache=True, error_model="numpy")
-def tree_joint_force(prm, t, a, q1, da, dq1, held, delta0, rate0):
+def tree_joint_force(prm: np.ndarray, t: float, a: float, q1: float, da: float, dq1: float, held: float, delta0: float,
+                     rate0: float) -> tuple[float, ...]:
     """Generalized contact force on the two joints of the kinematic tree (Exudyn's tree model).
 
     Joint coordinates q0 = a, q1 = psi + pi - a (b = q0 + q1 = psi + pi is the absolute angle of

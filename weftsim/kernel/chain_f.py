@@ -35,12 +35,16 @@ scene with clearance at E alone integrates bit for bit as before.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 from numba import njit
 
 from weftsim.kernel import chain as kc
 from weftsim.kernel.joint import BEARING_RADIUS, CLEARANCE, KIND, COEF, MU, N_JOINT, clearance_force
 from weftsim.kernel.laws import elastic_force
+
+if TYPE_CHECKING:
+    import numpy as np
 
 # Indices after the chain's constants: joint F's block, the topology, J_FG and J4.
 JOINT_F = kc.N_PARAMETERS
@@ -57,19 +61,19 @@ BLOCKS = (0, JOINT_F)
 
 
 @njit(cache=True, error_model="numpy")
-def degrees_of_freedom(prm):
+def degrees_of_freedom(prm: np.ndarray) -> int:
     """Coordinates of the chain: 2 (E only, F only) or 4 (E and F)."""
     return 4 if prm[TOPOLOGY] == E_AND_F else 2
 
 
 @njit(cache=True, error_model="numpy")
-def state_size(prm):
+def state_size(prm: np.ndarray) -> int:
     """Length of the state y: coordinates, their rates, W3 and D."""
     return 2 * degrees_of_freedom(prm) + 2
 
 
 @njit(cache=True, error_model="numpy")
-def joint_is_loose(prm, joint):
+def joint_is_loose(prm: np.ndarray, joint: int) -> bool:
     """True when ``joint`` (:data:`JOINT_E_INDEX` or :data:`JOINT_F_INDEX`) has a clearance."""
     topology = prm[TOPOLOGY]
     if joint == JOINT_E_INDEX:
@@ -78,7 +82,7 @@ def joint_is_loose(prm, joint):
 
 
 @njit(cache=True, error_model="numpy")
-def crank_side_acceleration(prm, t):
+def crank_side_acceleration(prm: np.ndarray, t: float) -> tuple[float, ...]:
     """P_E, dP_E/dtheta and d^2P_E/dtheta^2 (m, m/rad, m/rad^2) and phi' at time t.
 
     phi' = tan(beta) sin(theta) / w and phi'' = tan(beta) cos(theta) / w + 2 tan^3(beta) cos(theta)
@@ -97,7 +101,8 @@ def crank_side_acceleration(prm, t):
 
 
 @njit(cache=True, error_model="numpy")
-def contact_terms(jp, ecc_y, ecc_z, v_y, v_z, w_j, w_b, impact_velocity):
+def contact_terms(jp: np.ndarray, ecc_y: float, ecc_z: float, v_y: float, v_z: float, w_j: float, w_b: float,
+                  impact_velocity: float) -> tuple[float, ...]:
     """Force of one joint in contact (block ``jp``) on its journal, and the power it dissipates.
 
     ``w_j``, ``w_b``: angular velocities of the journal's and the bearing's bodies (rad/s).
@@ -122,7 +127,7 @@ def contact_terms(jp, ecc_y, ecc_z, v_y, v_z, w_j, w_b, impact_velocity):
 
 
 @njit(cache=True, error_model="numpy")
-def eccentricities(prm, t, y):
+def eccentricities(prm: np.ndarray, t: float, y: np.ndarray) -> tuple[float, ...]:
     """Eccentricity and its rate at E and at F of state y (topologies F_ONLY, E_AND_F).
 
     Returns (e_E, e_dot_E, e_F, e_dot_F) as eight floats (m, m/s; zeros at an ideal E), then the
@@ -163,7 +168,7 @@ def _rate(e_y, e_z, v_y, v_z):
 
 
 @njit(cache=True, error_model="numpy")
-def penetration_at(prm, t, y, joint):
+def penetration_at(prm: np.ndarray, t: float, y: np.ndarray, joint: int) -> tuple[float, float]:
     """(delta, delta_dot) of ``joint`` (0 = E, 1 = F) of state y at time t (m, m/s)."""
     if prm[TOPOLOGY] == E_ONLY:
         return kc.penetration(prm, t, y)
@@ -176,7 +181,8 @@ def penetration_at(prm, t, y, joint):
 
 
 @njit(cache=True, error_model="numpy")
-def chain_f(prm, t, y, contact, impact, out):
+def chain_f(prm: np.ndarray, t: float, y: np.ndarray, contact: int, impact: np.ndarray,
+            out: np.ndarray) -> tuple[float, ...]:
     """y' of topologies F_ONLY and E_AND_F into ``out`` (module docstring).
 
     ``contact``: bit 0 (E) and bit 1 (F) set for the joints in a contact segment; ``impact`` (2,):
@@ -239,7 +245,7 @@ def chain_f(prm, t, y, contact, impact, out):
 
 
 @njit(cache=True, error_model="numpy")
-def rhs_any(prm, t, y, contact, impact, out):
+def rhs_any(prm: np.ndarray, t: float, y: np.ndarray, contact: int, impact: np.ndarray, out: np.ndarray) -> float:
     """y' of any topology into ``out``; returns delta of the first loose joint (the E-only chain's value).
 
     E_ONLY: :func:`weftsim.kernel.chain.chain` with contact bit 0 and impact[0], unchanged.
@@ -251,7 +257,7 @@ def rhs_any(prm, t, y, contact, impact, out):
 
 
 @njit(cache=True, error_model="numpy")
-def rod_energy(prm, t, y):
+def rod_energy(prm: np.ndarray, t: float, y: np.ndarray) -> tuple[float, float]:
     """Kinetic and potential energy (J) of members 4-8 in topologies F_ONLY and E_AND_F."""
     l_ef, m4, g = prm[kc.L_EF], prm[kc.ROD_MASS], prm[kc.GRAVITY]
     if prm[TOPOLOGY] == E_AND_F:

@@ -33,7 +33,7 @@ RESTING_RATE_FRACTION = 1e-6
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def effective_impact_velocity(held, penetration_rate, max_approach):
+def effective_impact_velocity(held: float, penetration_rate: float, max_approach: bool) -> float:
     """v_imp of the damping term, m/s: ``max(held, delta_dot)`` under "max_approach", else ``held``."""
     if max_approach and penetration_rate > held:
         return penetration_rate
@@ -41,7 +41,7 @@ def effective_impact_velocity(held, penetration_rate, max_approach):
 
 
 @njit(cache=True, error_model="numpy")
-def onset_fraction(delta0, delta1):
+def onset_fraction(delta0: float, delta1: float) -> float:
     """Fraction s in [0, 1] of the step at which delta crosses 0 (linear in delta).
 
     ``delta0`` (<= 0) and ``delta1`` (> 0): penetration at the start and end of the step, m;
@@ -55,13 +55,14 @@ def onset_fraction(delta0, delta1):
 
 
 @njit(cache=True, error_model="numpy")
-def onset_velocity(delta0, rate0, delta1, rate1):
+def onset_velocity(delta0: float, rate0: float, delta1: float, rate1: float) -> float:
     """Penetration rate at the zero crossing of delta, linear in-step interpolation, m/s."""
     return rate0 + onset_fraction(delta0, delta1) * (rate1 - rate0)
 
 
 @njit(cache=True, error_model="numpy")
-def callback_impact_velocity(held, delta0, rate0, delta, rate, v_min, max_approach):
+def callback_impact_velocity(held: float, delta0: float, rate0: float, delta: float, rate: float, v_min: float,
+                             max_approach: bool) -> float:
     """Impact velocity the force law uses at a trial state in contact (delta > 0), m/s.
 
     ``held``, ``delta0``, ``rate0``: held v_imp, penetration and rate of the last accepted state;
@@ -83,7 +84,7 @@ def callback_impact_velocity(held, delta0, rate0, delta, rate, v_min, max_approa
 
 
 @njit(cache=True, error_model="numpy")
-def damping_rate(rate, dead_rate):
+def damping_rate(rate: float, dead_rate: float) -> float:
     """Penetration rate that drives the damping term: delta_dot less a dead zone +-dead_rate, m/s.
 
     Continuous and piecewise linear: 0 for |rate| <= dead_rate, rate -+ dead_rate outside

@@ -21,6 +21,7 @@ chain's parameter array (:mod:`.chain`) starts with the same block, so these fun
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
@@ -29,12 +30,16 @@ from weftsim.kernel.hold import RESTING_RATE_FRACTION, callback_impact_velocity,
 from weftsim.kernel.hold import effective_impact_velocity
 from weftsim.kernel.laws import friction_factor, normal_force
 
+if TYPE_CHECKING:
+    from weftsim.contact import _Law
+    from weftsim.params import ClearanceJoint
+
 # Indices into the joint parameter block.
 (KIND, COEF, CLEARANCE, XI, BEARING_RADIUS, MU, V0, V1, V_MIN, TRACK_MAX, DEAD_RATE) = range(11)  # fmt: skip
 N_JOINT = 11
 
 
-def joint_parameters(joint, law) -> np.ndarray:
+def joint_parameters(joint: ClearanceJoint, law: _Law) -> np.ndarray:
     """The joint block: the law's (kind, coef, c, xi), R_b, mu, friction ramp, v_min, rule flag, dead zone.
 
     ``joint``: a :class:`weftsim.params.ClearanceJoint`; ``law``: a law of :mod:`weftsim.contact`
@@ -54,7 +59,7 @@ def joint_parameters(joint, law) -> np.ndarray:
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def friction_force(prm, f_n, v_t):
+def friction_force(prm: np.ndarray, f_n: float, v_t: float) -> float:
     """F_T, N: the modified Coulomb friction on the journal along t (Ambrosio 2003).
 
     F_T = -mu c_d(|v_T|) F_N sign(v_T), with c_d the ramp of :func:`~weftsim.kernel.laws.friction_factor`
@@ -70,7 +75,8 @@ def friction_force(prm, f_n, v_t):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def tangential_velocity(ex, ey, ex_dot, ey_dot, length, omega_j, omega_b, r_b):
+def tangential_velocity(ex: float, ey: float, ex_dot: float, ey_dot: float, length: float, omega_j: float,
+                        omega_b: float, r_b: float) -> float:
     """v_T = e_dot . t + omega_j (R_b - |e|) - omega_b R_b, m/s (``length`` = |e| > 0).
 
     The velocity of the journal's material point at the contact point Q = P_b + R_b n relative to
@@ -81,7 +87,8 @@ def tangential_velocity(ex, ey, ex_dot, ey_dot, length, omega_j, omega_b, r_b):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def clearance_force(prm, ex, ey, ex_dot, ey_dot, v_t, v_imp):
+def clearance_force(prm: np.ndarray, ex: float, ey: float, ex_dot: float, ey_dot: float, v_t: float,
+                    v_imp: float) -> tuple[float, ...]:
     """Force of the joint at eccentricity e and its rate, with held impact velocity v_imp.
 
     The round joint: :func:`clearance_force_at` with the clearance ``prm[CLEARANCE]``.
@@ -90,7 +97,8 @@ def clearance_force(prm, ex, ey, ex_dot, ey_dot, v_t, v_imp):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def clearance_force_at(prm, clearance, clearance_rate, ex, ey, ex_dot, ey_dot, v_t, v_imp):
+def clearance_force_at(prm: np.ndarray, clearance: float, clearance_rate: float, ex: float, ey: float, ex_dot: float,
+                       ey_dot: float, v_t: float, v_imp: float) -> tuple[float, ...]:
     """Force of the joint with the clearance ``clearance`` along e (m) changing at ``clearance_rate``
     (m/s; a worn joint's local values, :func:`weftsim.kernel.wear.worn_clearance`; the round joint
     passes (c, 0)), at eccentricity e and its rate, held impact velocity v_imp.
@@ -122,7 +130,8 @@ def clearance_force_at(prm, clearance, clearance_rate, ex, ey, ex_dot, ey_dot, v
 
 
 @njit(cache=True, error_model="numpy")
-def connector_force(prm, ex, ey, vx, vy, held, delta0, rate0):
+def connector_force(prm: np.ndarray, ex: float, ey: float, vx: float, vy: float, held: float, delta0: float,
+                    rate0: float) -> tuple[float, ...]:
     """Force F_N n of the Exudyn clearance connector (on the bearing side; -F_N n on the journal).
 
     ``(ex, ey)``, ``(vx, vy)``: eccentricity P_j - P_b (m) and its rate (m/s) at a trial state;
@@ -151,7 +160,8 @@ def connector_force(prm, ex, ey, vx, vy, held, delta0, rate0):
 
 
 @njit(cache=True, error_model="numpy")
-def connector_friction_force(prm, ex, ey, vx, vy, held, delta0, rate0, omega_j, omega_b):
+def connector_friction_force(prm: np.ndarray, ex: float, ey: float, vx: float, vy: float, held: float, delta0: float,
+                             rate0: float, omega_j: float, omega_b: float) -> tuple[float, ...]:
     """:func:`connector_force` with the modified Coulomb friction (the rigid-body Exudyn joint).
 
     ``omega_j``, ``omega_b``: angular velocities (rad/s, about +z) of the journal's and the bearing's

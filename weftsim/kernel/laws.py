@@ -56,7 +56,7 @@ _EF_SERIES = _moment_coefficients(1.5, -0.5)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def stiffness(kind, coef, clearance, delta):
+def stiffness(kind: float, coef: float, clearance: float, delta: float) -> float:
     """K(delta) of the law, N/m^1.5 (delta <= 0 gives the value at 0)."""
     d = delta if delta > 0.0 else 0.0
     if kind == LAW_VARIABLE_KD:
@@ -69,7 +69,7 @@ def stiffness(kind, coef, clearance, delta):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def elastic_force(kind, coef, clearance, delta):
+def elastic_force(kind: float, coef: float, clearance: float, delta: float) -> float:
     """F_el = K(delta) delta^1.5 for delta > 0, else 0, N."""
     if delta <= 0.0:
         return 0.0
@@ -77,7 +77,8 @@ def elastic_force(kind, coef, clearance, delta):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def normal_force(kind, coef, clearance, xi, delta, delta_dot, impact_velocity):
+def normal_force(kind: float, coef: float, clearance: float, xi: float, delta: float, delta_dot: float,
+                 impact_velocity: float) -> float:
     """F_N = max(0, F_el(delta) (1 + xi delta_dot / v_imp)) for delta > 0, else 0, N (v_imp > 0)."""
     if delta <= 0.0:
         return 0.0
@@ -86,13 +87,14 @@ def normal_force(kind, coef, clearance, xi, delta, delta_dot, impact_velocity):
 
 
 @njit(cache=True, error_model="numpy")
-def damping_coefficient(kind, coef, clearance, xi, delta, impact_velocity):
+def damping_coefficient(kind: float, coef: float, clearance: float, xi: float, delta: float,
+                        impact_velocity: float) -> float:
     """D = xi F_el(delta) / v_imp, N s/m (Lankarani & Nikravesh 1990), so F_N = F_el + D delta_dot."""
     return xi * elastic_force(kind, coef, clearance, delta) / impact_velocity
 
 
 @njit(cache=True, error_model="numpy")
-def elastic_energy(kind, coef, clearance, delta):
+def elastic_energy(kind: float, coef: float, clearance: float, delta: float) -> float:
     """W = integral_0^delta F_el(s) ds, J (0 for delta <= 0).
 
     Constant K: W = k delta^2.5 / 2.5.  variable_kd: W = a sqrt(2) c^2.5 g(x), x = delta / c,
@@ -129,7 +131,7 @@ def elastic_energy(kind, coef, clearance, delta):
 
 
 @njit(cache=True, error_model="numpy")
-def friction_factor(tangential_speed, v0, v1):
+def friction_factor(tangential_speed: float, v0: float, v1: float) -> float:
     """Dynamic correction factor c_d in [0, 1] of the modified Coulomb law (Ambrosio 2003).
 
     c_d = 0 for |v_T| <= v0, (|v_T| - v0) / (v1 - v0) for v0 < |v_T| < v1, 1 for |v_T| >= v1.

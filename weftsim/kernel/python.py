@@ -15,9 +15,13 @@ or loops: it embeds the function's address).
 from __future__ import annotations
 
 import types
+from typing import TYPE_CHECKING
 
 from numba import njit
 from numba.core.registry import CPUDispatcher
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 _FORMS: dict = {}
 
@@ -41,7 +45,7 @@ def _rebuild(fn, bind: dict, compile_it: bool, memo: dict):
     return result
 
 
-def python_form(fn, **bind):
+def python_form(fn: CPUDispatcher, **bind: Callable) -> Callable:
     """The plain-Python function of the numba function ``fn``, calling plain-Python callees.
 
     ``bind``: globals of ``fn`` and its callees to replace (by name), e.g. a state function.
@@ -53,7 +57,7 @@ def python_form(fn, **bind):
     return form
 
 
-def specialize(fn, **bind):
+def specialize(fn: CPUDispatcher, **bind: Callable) -> CPUDispatcher:
     """``fn`` and its callees compiled (``cache=True``) with the globals in ``bind`` replaced.
 
     Bind each name to one function per process: numba's cache keys a function by its source and

@@ -19,8 +19,14 @@ maxima by golden-section search (Kiefer 1953).
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 from numba import njit
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    import numpy as np
 
 ROOT_XTOL = 1e-13  # s: event time accuracy (delta_dot ~ 1 m/s -> 1e-13 m in delta)
 # Sub-intervals sampled per step when an event is possible: the grid of the dense-output points
@@ -39,13 +45,13 @@ CROSSING, MINUS_CROSSING, RATE = 0, 1, 2
 
 
 @njit(cache=True, error_model="numpy")
-def state(t, dense):
+def state(t: float, dense: Callable) -> tuple[float, float]:
     """The dense output's (delta, delta_dot) at t: a stand-in that callers bind to their own."""
     return dense(t)
 
 
 @njit(cache=True, error_model="numpy")
-def pick(delta_and_rate, what, sign):
+def pick(delta_and_rate: tuple[float, float], what: int, sign: float) -> float:
     """sign * delta (``CROSSING``), -sign * delta (``MINUS_CROSSING``) or delta_dot (``RATE``)."""
     if what == CROSSING:
         return sign * delta_and_rate[0]
@@ -55,7 +61,7 @@ def pick(delta_and_rate, what, sign):
 
 
 @njit(cache=True, error_model="numpy")
-def locate_root(args, sign, lo, hi, g_lo, g_hi):
+def locate_root(args: tuple, sign: float, lo: float, hi: float, g_lo: float, g_hi: float) -> float:
     """Root of g = sign * delta between lo (g <= 0) and hi (g > 0), returned on the positive side.
 
     Illinois regula falsi with the bracket kept, to :data:`ROOT_XTOL`.
@@ -82,7 +88,7 @@ def locate_root(args, sign, lo, hi, g_lo, g_hi):
 
 
 @njit(cache=True, error_model="numpy")
-def maximum(args, what, sign, lo, hi):
+def maximum(args: tuple, what: int, sign: float, lo: float, hi: float) -> tuple[float, float]:
     """(t, value) of the largest :func:`pick` on [lo, hi]: golden section, the ends are candidates.
 
     Exact for a unimodal function; ties keep the earliest candidate (lo, x1, x2, hi).
@@ -113,7 +119,8 @@ def maximum(args, what, sign, lo, hi):
 
 
 @njit(cache=True, error_model="numpy")
-def crossing_in(args, times, deltas, rates, sign, k):
+def crossing_in(args: tuple, times: np.ndarray, deltas: np.ndarray, rates: np.ndarray, sign: float,
+                k: int) -> tuple[bool, float, float]:
     """(found, t, sign * delta_dot) of a rising crossing of sign * delta in [times[k], times[k + 1]]."""
     lo, hi = times[k], times[k + 1]
     g_lo, g_hi = sign * deltas[k], sign * deltas[k + 1]
@@ -138,7 +145,8 @@ def crossing_in(args, times, deltas, rates, sign, k):
 
 
 @njit(cache=True, error_model="numpy")
-def first_crossing(args, times, deltas, rates, sign):
+def first_crossing(args: tuple, times: np.ndarray, deltas: np.ndarray, rates: np.ndarray,
+                   sign: float) -> tuple[bool, float, float]:
     """First rising crossing of g = sign * delta within the sampled step.
 
     Parameters
@@ -164,7 +172,7 @@ def first_crossing(args, times, deltas, rates, sign):
 
 
 @njit(cache=True, error_model="numpy")
-def rate_peak(args, times, rates, n, held):
+def rate_peak(args: tuple, times: np.ndarray, rates: np.ndarray, n: int, held: float) -> tuple[bool, float, float]:
     """(found, t, delta_dot) of a maximum of delta_dot above ``held`` inside the step.
 
     ``times[:n]``, ``rates[:n]`` sample the step (the last is the step's end, or the separation

@@ -24,14 +24,18 @@ so p(phi) ~ cos phi - cos phi0 on |phi| < phi0 = acos(c / (c + delta)) (:func:`d
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
 
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
 WEAR_HEADER = 2  # n_b, n_j before the two tables
 
 
-def wear_block(bearing_wear, journal_wear) -> np.ndarray:
+def wear_block(bearing_wear: ArrayLike, journal_wear: ArrayLike) -> np.ndarray:
     """``[n_b, n_j, h_b..., h_j...]`` (m) to append to a kernel parameter array; empty when both are empty."""
     bearing = np.asarray(bearing_wear, dtype=float)
     journal = np.asarray(journal_wear, dtype=float)
@@ -59,7 +63,7 @@ def _knots(table, first, n, i):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def periodic_value(table, first, n, angle):
+def periodic_value(table: np.ndarray, first: int, n: int, angle: float) -> float:
     """Periodic cubic Hermite (Catmull-Rom) interpolation of ``table[first:first + n]`` at ``angle`` (rad).
 
     The table holds values at the angles 2 pi i / n; the slopes at the knots are the central
@@ -78,7 +82,7 @@ def periodic_value(table, first, n, angle):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def periodic_slope(table, first, n, angle):
+def periodic_slope(table: np.ndarray, first: int, n: int, angle: float) -> float:
     """d/d(angle) of :func:`periodic_value`, per rad."""
     i, f = _cell(n, angle)
     p0, p1, p2, p3 = _knots(table, first, n, i)
@@ -91,7 +95,8 @@ def periodic_slope(table, first, n, angle):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def worn_clearance(prm, start, c0, angle_b, angle_j, rate_b, rate_j):
+def worn_clearance(prm: np.ndarray, start: int, c0: float, angle_b: float, angle_j: float, rate_b: float,
+                   rate_j: float) -> tuple[float, float]:
     """(c, dc/dt): c = c0 + h_b(angle_b) + h_j(angle_j), m, from the wear block at ``prm[start:]``.
 
     ``angle_b``, ``angle_j``: direction of the eccentricity in the bearing's and the journal's frame,
@@ -115,7 +120,7 @@ def worn_clearance(prm, start, c0, angle_b, angle_j, rate_b, rate_j):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def contact_half_angle(clearance, delta):
+def contact_half_angle(clearance: float, delta: float) -> float:
     """phi0 = acos(c / (c + delta)): half the arc over which journal and bearing overlap, rad (0 if delta <= 0)."""
     if delta <= 0.0:
         return 0.0
@@ -129,7 +134,7 @@ def _pressure_share(phi, cos0, norm):
 
 
 @njit(cache=True, error_model="numpy")
-def deposit(profile, angle, half_angle, depth):
+def deposit(profile: np.ndarray, angle: float, half_angle: float, depth: float) -> None:
     """Add the depth ``depth`` (m, if it all fell on one cell) to ``profile`` spread over the contact arc.
 
     ``profile`` (n,): depths at angles 2 pi i / n, cell i covering +-pi/n around its angle; the arc is

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 import time as _time
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -28,6 +29,9 @@ from weftsim.guards import vet_result
 from weftsim.params import Scene
 from weftsim.reference.integrate import AUTO, METHODS
 from weftsim.results import RunResult, empty_channels
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 __all__ = ["solve", "select_path", "METHODS", "AUTO", "COMPILED_METHODS"]
 
@@ -137,7 +141,8 @@ def _solve_clearance(scene: Scene, progress, step_states) -> RunResult:
     return RunResult(scene, "reference", traj.status, traj.message, samples, steps, stats, traj.events)
 
 
-def solve(scene: Scene, progress=None, step_states=None) -> RunResult:
+def solve(scene: Scene, progress: Callable[[float], None] | None = None,
+          step_states: Callable[..., None] | None = None) -> RunResult:
     """Run the reference solver on a scene.
 
     Parameters

@@ -25,7 +25,8 @@ import numpy as np
 from weftsim.params import Scene
 
 
-def clearance_channels(scene: Scene, time, states, contact, impact) -> dict[str, np.ndarray]:
+def clearance_channels(scene: Scene, time: np.ndarray, states: np.ndarray, contact: np.ndarray,
+                       impact: np.ndarray) -> dict[str, np.ndarray]:
     """All :data:`weftsim.results.CHANNELS` at the given times.
 
     Parameters

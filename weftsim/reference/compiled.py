@@ -138,8 +138,10 @@ def _events_of_joint(prm, method, F, t, h, y, tmp, joint, in_contact, held, g_ol
 
 
 @njit(cache=True, error_model="numpy")
-def advance(prm, method, rtol, atol, max_step, t_end, t_pause, limits, y, f, fst, ist, sample_times,
-            smp_t, smp_y, smp_c, smp_i, stp_t, stp_y, stp_c, stp_i):
+def advance(prm: np.ndarray, method: int, rtol: float, atol: float, max_step: float, t_end: float, t_pause: float,
+            limits: np.ndarray, y: np.ndarray, f: np.ndarray, fst: np.ndarray, ist: np.ndarray,
+            sample_times: np.ndarray, smp_t: np.ndarray, smp_y: np.ndarray, smp_c: np.ndarray, smp_i: np.ndarray,
+            stp_t: np.ndarray, stp_y: np.ndarray, stp_c: np.ndarray, stp_i: np.ndarray) -> tuple[int, int]:
     """Integrate from fst[T] until t_end, t >= t_pause, the step buffer is nearly full, or a guard.
 
     Steps, events and contact substeps go to ``stp_*`` from row 0 (count returned),

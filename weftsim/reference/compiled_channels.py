@@ -75,7 +75,7 @@ def crank_side_table(scene: Scene) -> np.ndarray:
 
 
 @njit(cache=True, error_model="numpy")
-def crank_side_eval(table, theta, out):
+def crank_side_eval(table: np.ndarray, theta: float, out: np.ndarray) -> None:
     """(J13, J13', U13, U13') at crank angle theta from :func:`crank_side_table` into out (4,)."""
     n = table.shape[1]
     h = 2.0 * math.pi / n
@@ -181,7 +181,8 @@ def _fill_f(prm, table, a0, ratio, time, states, contact, impact, out):
         out[i, n_base + 6] = kf.penetration_at(prm, t, y, kf.JOINT_F_INDEX)[1]
 
 
-def compiled_channels(scene: Scene, time, states, contact, impact) -> dict[str, np.ndarray]:
+def compiled_channels(scene: Scene, time: np.ndarray, states: np.ndarray, contact: np.ndarray,
+                      impact: np.ndarray) -> dict[str, np.ndarray]:
     """All :data:`~weftsim.results.CHANNELS` at the given rows (arguments as ``clearance_channels``).
 
     With clearance at F (``scene.joint_f``) also :data:`~weftsim.results.JOINT_F_CHANNELS`; then

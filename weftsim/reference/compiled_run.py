@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 import time as _time
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -25,6 +26,9 @@ from weftsim.kernel.chain_f import N_JOINTS
 from weftsim.reference.dynamics import initial_state, pack_parameters
 from weftsim.reference.integrate import _PROGRESS_EVERY
 from weftsim.results import RunResult
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 __all__ = ["integrate_compiled", "solve_compiled", "METHODS"]
 
@@ -55,7 +59,8 @@ def _rows(scene: Scene, rows):
     return t, y, mask, impact
 
 
-def integrate_compiled(scene: Scene, progress=None, method: str = "numba_DOP853"):
+def integrate_compiled(scene: Scene, progress: Callable[[float], None] | None = None,
+                       method: str = "numba_DOP853") -> tuple[tuple, tuple, dict, dict, str, str]:
     """Run the compiled integrator; returns (steps, samples, stats, events, status, message).
 
     ``steps`` and ``samples`` are tuples (t, y (n, 6 or 10), contact mask (bit 0 E, bit 1 F), held
@@ -161,7 +166,8 @@ def integrate_compiled(scene: Scene, progress=None, method: str = "numba_DOP853"
     return steps, samples, stats, events, status, message
 
 
-def solve_compiled(scene: Scene, progress=None, method: str | None = None, step_states=None) -> RunResult:
+def solve_compiled(scene: Scene, progress: Callable[[float], None] | None = None, method: str | None = None,
+                   step_states: Callable[..., None] | None = None) -> RunResult:
     """The reference engine's clearance mode through the compiled integrator.
 
     ``method``: one of :data:`METHODS`; default ``scene.reference_solver.method``.

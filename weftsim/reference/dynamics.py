@@ -15,6 +15,7 @@ import functools
 import math
 from dataclasses import dataclass
 from types import SimpleNamespace
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
@@ -27,6 +28,11 @@ from weftsim.kernel.joint import N_JOINT, joint_parameters
 from weftsim.kernel.wear import wear_block
 from weftsim.params import Scene
 from weftsim.reference.ideal import sector_chain_inertia
+
+if TYPE_CHECKING:
+    from types import ModuleType
+
+    from numpy.typing import ArrayLike
 
 # Kept for callers that name the array backend of :func:`eccentricity` (it is always numpy now).
 NUMPY = SimpleNamespace(sin=np.sin, cos=np.cos, atan=np.arctan, hypot=np.hypot)
@@ -133,7 +139,8 @@ def _eccentricity_rows(prm, t, a, psi, da, dpsi, out):
         out[4, i], out[5, i], out[6, i] = dphi, db_y, db_z
 
 
-def eccentricity(xp, p: ChainConstants, t, a, psi, da, dpsi):
+def eccentricity(xp: ModuleType | None, p: ChainConstants, t: ArrayLike, a: ArrayLike, psi: ArrayLike, da: ArrayLike,
+                 dpsi: ArrayLike) -> tuple[np.ndarray | float, ...]:
     """Eccentricity e = P_j - P_b, its rate and the bearing's motion, over arrays (broadcast).
 
     :func:`weftsim.kernel.chain.eccentricity` at every element (``xp`` is ignored: kept for callers
@@ -151,12 +158,13 @@ def eccentricity(xp, p: ChainConstants, t, a, psi, da, dpsi):
     return tuple(row.reshape(shape)[()] for row in out)
 
 
-def penetration(p: ChainConstants, t: float, y) -> tuple[float, float]:
+def penetration(p: ChainConstants, t: float, y: np.ndarray) -> tuple[float, float]:
     """delta = |e| - c (m) and delta_dot = e_dot . n (m/s) of a state y (:func:`weftsim.kernel.chain.penetration`)."""
     return kc.penetration(_geometry_parameters(p), float(t), np.asarray(y[:4], dtype=float))
 
 
-def chain_energy(p: ChainConstants, a, psi, da, dpsi):
+def chain_energy(p: ChainConstants, a: ArrayLike, psi: ArrayLike, da: ArrayLike,
+                 dpsi: ArrayLike) -> tuple[np.ndarray | float, np.ndarray | float]:
     """Kinetic and potential energy of members 4-8 (J): 1/2 q'^T M q', m4 g z4."""
     m12 = -p.coupling * np.cos(np.asarray(psi) - a)
     kinetic = 0.5 * (p.m11 * da * da + 2.0 * m12 * da * dpsi + p.m22 * dpsi * dpsi)

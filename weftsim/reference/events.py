@@ -27,15 +27,23 @@ The located times are returned; the caller takes the state there from the dense 
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from weftsim.kernel import roots
 from weftsim.kernel.python import python_form
 from weftsim.kernel.roots import END_FRACTION, ROOT_XTOL, SAMPLES  # noqa: F401 - the search's constants
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    import numpy as np
 
 _FIRST_CROSSING = python_form(roots.first_crossing)
 _RATE_PEAK = python_form(roots.rate_peak)
 
 
-def first_crossing(state, times, deltas, rates, sign: float):
+def first_crossing(state: Callable[[float], tuple[float, float]], times: np.ndarray, deltas: np.ndarray,
+                   rates: np.ndarray, sign: float) -> tuple[float, float] | None:
     """First rising crossing of g = sign * delta within the sampled step, or None.
 
     ``state(t) -> (delta, delta_dot)``; ``times``, ``deltas``, ``rates`` sample the step at
@@ -46,7 +54,8 @@ def first_crossing(state, times, deltas, rates, sign: float):
     return (t, rate) if found else None
 
 
-def rate_peak(rate_of, times, rates, held: float):
+def rate_peak(rate_of: Callable[[float], float], times: np.ndarray, rates: np.ndarray,
+              held: float) -> tuple[float, float] | None:
     """Time and value of a maximum of delta_dot above ``held`` inside the step, or None.
 
     ``rate_of(t)`` is delta_dot on the dense output (:func:`weftsim.kernel.roots.rate_peak`).

@@ -31,12 +31,17 @@ separate: :func:`crank_side_inertia` and :func:`crank_side_potential`.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 
 import numpy as np
 
 
 from weftsim import kinematics as kin
 from weftsim.params import Scene
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 
 def _coupler_terms(theta, scene: Scene):
@@ -53,7 +58,7 @@ def _coupler_terms(theta, scene: Scene):
     )
 
 
-def crank_side_inertia(theta, scene: Scene):
+def crank_side_inertia(theta: ArrayLike, scene: Scene) -> tuple[np.ndarray, np.ndarray]:
     """Generalized inertia of members 1-3 about the crank angle and its derivative.
 
     J13 = J1 + w^T I_O w + J3 phi'^2,  J13' = 2 w^T I_O w' + 2 J3 phi' phi''.
@@ -72,7 +77,7 @@ def crank_side_inertia(theta, scene: Scene):
     return j13, dj13
 
 
-def crank_side_potential(theta, scene: Scene):
+def crank_side_potential(theta: ArrayLike, scene: Scene) -> tuple[np.ndarray, np.ndarray]:
     """Gravity potential of members 1-3: U13 = m3 g r3 sin(theta_OE), and dU13/dtheta.
 
     Only the rocker's centre of mass (on OE at r3 from O) moves in z; the crank is
@@ -96,7 +101,7 @@ def sector_chain_inertia(scene: Scene) -> float:
     )
 
 
-def equivalent_inertia(theta, scene: Scene):
+def equivalent_inertia(theta: ArrayLike, scene: Scene) -> tuple[np.ndarray, np.ndarray]:
     """J_eq(theta) of the whole ideal-joint linkage (members 1-8) and dJ_eq/dtheta.
 
     ::
@@ -126,7 +131,7 @@ def equivalent_inertia(theta, scene: Scene):
     return j, dj
 
 
-def potential_energy(theta, scene: Scene):
+def potential_energy(theta: ArrayLike, scene: Scene) -> tuple[np.ndarray, np.ndarray]:
     """U(theta) = m3 g z3 + m4 g z4 (J) and dU/dtheta (J/rad), ideal joints."""
     theta = np.asarray(theta, dtype=float)
     inert = scene.inertia
@@ -136,7 +141,7 @@ def potential_energy(theta, scene: Scene):
     return u13 + weight4 * st.rod_com[..., 1], du13 + weight4 * st.d_rod_com[..., 1]
 
 
-def ideal_torque(theta, scene: Scene):
+def ideal_torque(theta: ArrayLike, scene: Scene) -> np.ndarray:
     """Driving torque of the ideal-joint linkage at constant crank speed, N m.
 
     T = 1/2 J_eq'(theta) omega^2 + U'(theta), about +z, applied by the motor on the crank
@@ -148,7 +153,7 @@ def ideal_torque(theta, scene: Scene):
     return 0.5 * dj * omega**2 + du
 
 
-def ideal_channels(time, scene: Scene) -> dict[str, np.ndarray]:
+def ideal_channels(time: np.ndarray, scene: Scene) -> dict[str, np.ndarray]:
     """All :data:`weftsim.results.CHANNELS` of the ideal-joint run at the given times.
 
     theta = omega t.  Kinetic energy 1/2 J_eq omega^2, potential U; driving work

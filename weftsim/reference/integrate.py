@@ -32,6 +32,7 @@ import math
 import time as _time
 import warnings
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -41,6 +42,9 @@ from weftsim.kernel.chain import rhs as chain_rhs
 from weftsim.params import Scene
 from weftsim.reference import events
 from weftsim.reference.dynamics import initial_state, pack_parameters
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 # scipy.integrate's solvers by name (imported when a scipy method runs: not on the compiled path).
 METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
@@ -102,13 +106,13 @@ class Trajectory:
     status: str = "success"
     message: str = ""
 
-    def add_step(self, t, y, contact, impact):
+    def add_step(self, t: float, y: np.ndarray, contact: bool, impact: float) -> None:
         self.step_t.append(t)
         self.step_y.append(np.array(y[:6]))
         self.step_contact.append(contact)
         self.step_impact.append(impact)
 
-    def add_samples(self, ts, ys, contact, impact):
+    def add_samples(self, ts: np.ndarray, ys: np.ndarray, contact: bool, impact: float) -> None:
         for t, y in zip(ts, ys):
             self.sample_t.append(t)
             self.sample_y.append(np.array(y))
@@ -116,12 +120,12 @@ class Trajectory:
             self.sample_impact.append(impact)
 
 
-def penetration(prm: np.ndarray, t: float, y) -> tuple[float, float]:
+def penetration(prm: np.ndarray, t: float, y: np.ndarray) -> tuple[float, float]:
     """(delta, delta_dot) of a state y at time t: :func:`weftsim.kernel.chain.penetration`."""
     return kernel_chain.penetration(prm, float(t), np.ascontiguousarray(y, dtype=float))
 
 
-def make_rhs(prm: np.ndarray, counter: list):
+def make_rhs(prm: np.ndarray, counter: list) -> tuple[Callable, Callable]:
     """Right-hand sides y' = f(t, y) for free flight and for contact with held v_imp.
 
     The compiled right-hand side of :mod:`weftsim.kernel.chain` (the one the compiled path
@@ -151,7 +155,7 @@ def make_rhs(prm: np.ndarray, counter: list):
     return free, contact_factory
 
 
-def integrate(scene: Scene, progress=None) -> Trajectory:
+def integrate(scene: Scene, progress: Callable[[float], None] | None = None) -> Trajectory:
     """Integrate the clearance-mode equations from t = 0 to the scene's end time.
 
     Never raises for a failing integration: the returned trajectory then has

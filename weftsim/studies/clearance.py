@@ -15,10 +15,15 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from weftsim.studies import common
+
+if TYPE_CHECKING:
+    from weftsim.params import Geometry
+    from weftsim.results import RunResult
 
 IDEAL_SCENE = "ideal.toml"
 SCENES = {0.01: "paper/clearance_0p01mm_400rpm.toml", 0.25: "paper/clearance_0p25mm_400rpm.toml",
@@ -29,7 +34,7 @@ BIN_DEG = 10.0
 COLOURS = {0.01: "tab:blue", 0.25: "tab:orange", 0.50: "tab:red"}
 
 
-def ideal_features(geometry, omega: float, points: int = 36001) -> dict[str, list[float]]:
+def ideal_features(geometry: Geometry, omega: float, points: int = 36001) -> dict[str, list[float]]:
     """Crank angles (deg) of the ideal rapier acceleration extremes, velocity extremes and velocity zeros."""
     from weftsim.kinematics import rapier_motion
 
@@ -48,7 +53,8 @@ def ideal_features(geometry, omega: float, points: int = 36001) -> dict[str, lis
     }
 
 
-def acceleration_deviation(result, bin_deg: float = BIN_DEG, skip_revolutions: int = 1) -> tuple[np.ndarray, np.ndarray]:
+def acceleration_deviation(result: RunResult, bin_deg: float = BIN_DEG,
+                           skip_revolutions: int = 1) -> tuple[np.ndarray, np.ndarray]:
     """Time-weighted RMS of a - a_ideal per crank-angle bin over revolutions after ``skip_revolutions``.
 
     Returns

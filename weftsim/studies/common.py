@@ -47,7 +47,7 @@ def load(models: str | Path, name: str, overrides: dict | None = None) -> Scene:
     return load_scene(scene_path(models, name), overrides)
 
 
-def solve(scene, engine: str = "reference", label: str | None = None, progress: bool = True) -> RunResult:
+def solve(scene: Scene, engine: str = "reference", label: str | None = None, progress: bool = True) -> RunResult:
     """Run one engine on a scene (progress on stderr for long runs); a failed run raises SimulationFailed."""
     from weftsim.progress import Progress
 
@@ -70,15 +70,15 @@ def solve(scene, engine: str = "reference", label: str | None = None, progress: 
     return result
 
 
-def speed_rpm(scene) -> float:
+def speed_rpm(scene: Scene) -> float:
     return round(scene.drive.speed * RPM, 9)
 
 
-def clearance_mm(scene) -> float:
+def clearance_mm(scene: Scene) -> float:
     return round(scene.joint.clearance * 1e3, 12)
 
 
-def percentile(result, channel: str, q: float, skip_revolutions: int = 1) -> float | None:
+def percentile(result: RunResult, channel: str, q: float, skip_revolutions: int = 1) -> float | None:
     """Time-weighted percentile q of a channel over the whole revolutions after ``skip_revolutions``."""
     from weftsim.analysis import complete_revolutions, time_weights, weighted_percentile
 
@@ -91,7 +91,7 @@ def percentile(result, channel: str, q: float, skip_revolutions: int = 1) -> flo
     return weighted_percentile(result.steps[channel][keep], time_weights(t[keep]), q)
 
 
-def run_metrics(result) -> dict:
+def run_metrics(result: RunResult) -> dict:
     """The numbers of one run that the studies and the report use (JSON-ready).
 
     ``statistics`` (revolutions 2..N) adds ``p1`` (1st percentile) to the fields of
@@ -135,7 +135,7 @@ def ratio(a: float | None, b: float | None) -> float | None:
     return a / b
 
 
-def revolution_steps(result, revolution: int) -> dict[str, np.ndarray]:
+def revolution_steps(result: RunResult, revolution: int) -> dict[str, np.ndarray]:
     """Per-step channels of one (0-based) revolution, crank angle folded to 0..360 deg."""
     period = result.scene.drive.period
     t = result.steps["time_s"]

@@ -16,10 +16,17 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from weftsim.studies import common
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from weftsim.params import ClearanceJoint
+    from weftsim.results import RunResult
 
 SCENE = "paper/clearance_0p01mm_400rpm.toml"
 SPEED_RPM = 500.0  # paper Fig. 7-9
@@ -33,13 +40,13 @@ FLATTENING_MM = 0.005  # paper: K(delta) flattens after 0.005 mm
 DAMPING_LINEAR_MM = 0.015  # paper: D(delta) nonlinear up to ~0.015 mm, then closer to linear
 
 
-def log_slope(function, x: float, h: float = 1e-4) -> float:
+def log_slope(function: Callable[[float], float], x: float, h: float = 1e-4) -> float:
     """d ln f / d ln x at x by a central difference in ln x (relative step h)."""
     return float((math.log(function(x * (1 + h))) - math.log(function(x * (1 - h)))) /
                  (math.log1p(h) - math.log1p(-h)))
 
 
-def stiffness_curve(joint, points: int = CURVE_POINTS, extent: float = CURVE_RANGE) -> dict:
+def stiffness_curve(joint: ClearanceJoint, points: int = CURVE_POINTS, extent: float = CURVE_RANGE) -> dict:
     """K(delta) of ``joint``'s law on 0..extent x c, and the numbers quoted against the paper."""
     from dataclasses import replace
 
@@ -73,7 +80,7 @@ def stiffness_curve(joint, points: int = CURVE_POINTS, extent: float = CURVE_RAN
     }
 
 
-def contact_steps(result, revolution: int) -> dict[str, np.ndarray]:
+def contact_steps(result: RunResult, revolution: int) -> dict[str, np.ndarray]:
     """Steps in contact of one revolution with K(delta) and D(delta, v_imp) from the scene's law."""
     from weftsim.contact import make_law
 

@@ -12,10 +12,13 @@ import numpy as np
 from weftsim.plots import pyplot, channel_panels  # noqa: F401 - channel_panels re-exported for the studies
 
 if TYPE_CHECKING:
+    from collections.abc import Sequence
+
     from matplotlib.figure import Figure
 
 
-def trend_panels(x, x_label: str, panels, title: str, x_ticks=None) -> Figure:
+def trend_panels(x: Sequence[float], x_label: str, panels: list[tuple], title: str,
+                 x_ticks: Sequence[float] | None = None) -> Figure:
     """Rows of reproducible quantities against a study parameter.
 
     Parameters
@@ -40,7 +43,7 @@ def trend_panels(x, x_label: str, panels, title: str, x_ticks=None) -> Figure:
     return fig
 
 
-def spectrum_panels(spectra, title: str, low_band_hz: float = 100.0) -> Figure:
+def spectrum_panels(spectra: list[tuple], title: str, low_band_hz: float = 100.0) -> Figure:
     """Amplitude spectra: 0..low_band_hz on a linear scale, the whole band on a log scale.
 
     Parameters
@@ -69,7 +72,7 @@ def spectrum_panels(spectra, title: str, low_band_hz: float = 100.0) -> Figure:
     return fig
 
 
-def contact_law_panels(curve, revolution, law_lines, title: str) -> Figure:
+def contact_law_panels(curve: dict, revolution: dict, law_lines: list[tuple], title: str) -> Figure:
     """Paper Fig. 7-9: K against penetration, K along a revolution, D against penetration.
 
     Parameters
@@ -119,7 +122,7 @@ def contact_law_panels(curve, revolution, law_lines, title: str) -> Figure:
     return fig
 
 
-def deviation_panel(bin_centres, deviations, markers, title: str) -> Figure:
+def deviation_panel(bin_centres: np.ndarray, deviations: list[tuple], markers: list[tuple], title: str) -> Figure:
     """RMS deviation of the rapier acceleration from the ideal one per crank-angle bin.
 
     Parameters

@@ -35,7 +35,11 @@ import numpy as np
 from weftsim.studies.common import StudyError
 
 if TYPE_CHECKING:
+    from collections.abc import Sequence
+    from typing import TextIO
+
     from weftsim.params import Scene
+    from weftsim.results import RunResult
 
 # The frequency study of the outliers: every paper scene at these tolerances (72 runs).
 STUDY_RTOLS = {
@@ -115,8 +119,9 @@ def _check_methods(methods, allowed=tuple(STUDY_RTOLS)) -> None:
         raise StudyError(f"--methods: unknown method(s) {unknown}; allowed: {sorted(allowed)}")
 
 
-def study_cells(models: str | Path, methods=None, only=None, revolutions=STUDY_REVOLUTIONS,
-                overrides=()) -> list[Cell]:  # fmt: skip
+def study_cells(models: str | Path, methods: Sequence[str] | None = None, only: Sequence[str] | None = None,
+                revolutions: float = STUDY_REVOLUTIONS,
+                overrides: Sequence[tuple[str, object]] = ()) -> list[Cell]:  # fmt: skip
     """Cells of the study: ``models/paper/*.toml`` x :data:`STUDY_RTOLS`, compiled method first (fastest).
 
     ``methods``: subset of :data:`STUDY_RTOLS`; ``only``: keep scenes whose name contains one of these.
@@ -135,8 +140,9 @@ def study_cells(models: str | Path, methods=None, only=None, revolutions=STUDY_R
             for m in order for f in files for rtol in STUDY_RTOLS[m]]  # fmt: skip
 
 
-def flores_cells(models: str | Path, methods=("numba_DOP853", "DOP853"), rtol: float = 1e-9,
-                 revolutions=STUDY_REVOLUTIONS, overrides=()) -> list[Cell]:  # fmt: skip
+def flores_cells(models: str | Path, methods: Sequence[str] = ("numba_DOP853", "DOP853"), rtol: float = 1e-9,
+                 revolutions: float = STUDY_REVOLUTIONS,
+                 overrides: Sequence[tuple[str, object]] = ()) -> list[Cell]:  # fmt: skip
     """The flores ce = 0.3 case: the reference scene with ``flores`` at restitution 0.3, each
     impact-velocity rule (``onset``, the literature's; ``max_approach``, the largest approach rate
     since the onset), unless ``overrides`` sets the rule.  rtol 1e-9 (atol 1e-12) is the reference
@@ -155,7 +161,7 @@ def flores_cells(models: str | Path, methods=("numba_DOP853", "DOP853"), rtol: f
             for rule in rules for m in methods]  # fmt: skip
 
 
-def peak_ratios(peaks, skip: int = 1) -> tuple[float, float, int]:
+def peak_ratios(peaks: Sequence[float], skip: int = 1) -> tuple[float, float, int]:
     """Median of the per-revolution peaks after the first ``skip``, and the worst ratio to it.
 
     Parameters
@@ -188,13 +194,13 @@ class Onsets:
     held_impact_velocity_m_s: np.ndarray
 
 
-def onset_rows(contact) -> np.ndarray:
+def onset_rows(contact: np.ndarray) -> np.ndarray:
     """Indices of the rows that start a contact segment (contact mode after a free-flight row)."""
     c = np.asarray(contact, dtype=bool)
     return np.flatnonzero(c[1:] & ~c[:-1]) + 1
 
 
-def onsets(scene, t, y, contact, impact) -> Onsets:
+def onsets(scene: Scene, t: np.ndarray, y: np.ndarray, contact: np.ndarray, impact: np.ndarray) -> Onsets:
     """Onsets of a reference-engine run from its raw step rows (see ``step_states`` of
     :func:`weftsim.reference.solve`), with the approach rate of the state at each onset.
 
@@ -210,7 +216,7 @@ def onsets(scene, t, y, contact, impact) -> Onsets:
     return Onsets(np.asarray(t, dtype=float)[rows], rates, np.asarray(impact, dtype=float)[rows])
 
 
-def negative_penetration_in_contact(contact, penetration) -> tuple[int, int]:
+def negative_penetration_in_contact(contact: np.ndarray, penetration: np.ndarray) -> tuple[int, int]:
     """Rows in a contact segment with delta < 0, and the number of contact segments that hold any.
 
     Each such segment had a free flight that started and ended between two step ends (a
@@ -223,7 +229,7 @@ def negative_penetration_in_contact(contact, penetration) -> tuple[int, int]:
     return int(bad.sum()), int(np.unique(segment[bad]).size)
 
 
-def revolution_peaks(result, channel: str = "contact_force_N") -> list[float]:
+def revolution_peaks(result: RunResult, channel: str = "contact_force_N") -> list[float]:
     """Peak (max) of a channel in every complete revolution of the run."""
     from weftsim.analysis import complete_revolutions, peaks
 
@@ -328,7 +334,8 @@ def write_rows(path: str | Path, rows: list[dict], revolutions: int = STUDY_REVO
     tmp.replace(path)
 
 
-def run_study(cells: list[Cell], csv_path: str | Path, jobs: int = 1, force: bool = False, stream=None) -> list[dict]:
+def run_study(cells: list[Cell], csv_path: str | Path, jobs: int = 1, force: bool = False,
+              stream: TextIO | None = None) -> list[dict]:
     """Run the cells not yet in ``csv_path`` (all with ``force``), updating the CSV after each run.
 
     A progress line per finished run goes to ``stream`` (stderr).  ``jobs`` processes (1 or 2).

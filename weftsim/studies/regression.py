@@ -32,6 +32,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
+    from pathlib import Path
+
     from weftsim.results import RunResult
 
 # kind -> floor on the relative tolerance, and the factor on the largest measured shift.
@@ -138,7 +141,7 @@ def _resolve(overrides: dict, base_scene) -> dict:
     return out
 
 
-def run_case(case: Case, root, extra: dict | None = None) -> RunResult:
+def run_case(case: Case, root: Path, extra: dict | None = None) -> RunResult:
     """Load and solve a case (``root`` = repository root); a failed run raises RuntimeError."""
     from weftsim.scene import load_scene
     from weftsim.studies.common import solve
@@ -149,7 +152,7 @@ def run_case(case: Case, root, extra: dict | None = None) -> RunResult:
     return solve(scene, case.engine, label=f"{case.engine} {case.name}", progress=False)
 
 
-def quantities(case: Case, result) -> dict[str, float]:
+def quantities(case: Case, result: RunResult) -> dict[str, float]:
     """The stored quantities of a case, named ``<channel>.<statistic>`` (plus the first contact angle)."""
     from weftsim.analysis import peaks, statistics
 
@@ -193,7 +196,7 @@ def tolerance_entry(kind: str, name: str, value: float, shifts: dict[str, float]
                       f"max({FLOOR[kind]:g}, {SAFETY[kind]:g} x shift)"}
 
 
-def build_entry(case: Case, root, log=print) -> dict:
+def build_entry(case: Case, root: Path, log: Callable[[str], None] = print) -> dict:
     """Run a case and its perturbations; the table entry with values, tolerances and reasons."""
     start = time.perf_counter()
     result = run_case(case, root)

@@ -27,8 +27,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from weftsim.results import RunResult
 
 DEFAULT_BINS_PER_REVOLUTION = 720  # 0.5 deg, the output grid of the scenes
 
@@ -133,7 +137,7 @@ def amplitude_spectrum(time: np.ndarray, values: np.ndarray, t0: float, t1: floa
     return Spectrum(frequency, amplitude, (float(t0), float(t1)), revolutions)
 
 
-def acceleration_spectrum(result, skip_revolutions: int = 1,
+def acceleration_spectrum(result: RunResult, skip_revolutions: int = 1,
                           bins_per_revolution: int = DEFAULT_BINS_PER_REVOLUTION,
                           channel: str = "rapier_acceleration_m_s2") -> Spectrum:
     """Amplitude spectrum of the rapier acceleration over the whole revolutions after ``skip_revolutions``.

@@ -15,11 +15,15 @@ Besides the overlaid curves of the last revolution, it gives
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from weftsim.studies import common
 from weftsim.studies.spectrum import acceleration_spectrum
+
+if TYPE_CHECKING:
+    from weftsim.studies.spectrum import Spectrum
 
 IDEAL_SCENE = "ideal.toml"
 SCENES = {300.0: "paper/speed_300rpm_c0p25mm.toml", 500.0: "paper/speed_500rpm_c0p25mm.toml",
@@ -43,7 +47,7 @@ def amplitude_measures(metrics: dict, channel: str) -> dict[str, float | None]:
     }
 
 
-def spectrum_summary(spectrum, speed_rpm: float) -> dict:
+def spectrum_summary(spectrum: Spectrum, speed_rpm: float) -> dict:
     f_rev = speed_rpm / 60.0
     peak_f, peak_a = spectrum.peak()
     try:

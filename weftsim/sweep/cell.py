@@ -24,8 +24,12 @@ import time
 import traceback
 from pathlib import Path
 from typing import Any
+from typing import TYPE_CHECKING
 
 from weftsim import __version__
+
+if TYPE_CHECKING:
+    from weftsim.results import RunResult
 
 CELL_FILE = "cell.json"
 ERROR_FILE = "error.txt"
@@ -47,7 +51,7 @@ def _peak(window: dict[str, dict[str, float]], channel: str) -> float:
     return max(abs(window[channel]["min"]), abs(window[channel]["max"]))
 
 
-def cell_metrics(result) -> dict[str, Any]:
+def cell_metrics(result: RunResult) -> dict[str, Any]:
     """Peaks and percentiles of one run for the sweep table.
 
     ``*_rev1_peak`` is the largest magnitude over the first crank revolution (or the
@@ -127,7 +131,7 @@ def _scratch_places() -> list[str | None]:
     return places
 
 
-def render_run(result, figure: bool) -> dict[str, bytes]:
+def render_run(result: RunResult, figure: bool) -> dict[str, bytes]:
     """The files :func:`weftsim.output.write_run` writes for ``result``, as bytes (name -> content).
 
     They are written to a private temporary directory of this process and read back; a memory

@@ -25,6 +25,7 @@ import logging
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from weftsim.sweep.cell import CELL_FILE, cell_record, is_finished, solve_cell, store_cell, write_cell_record
 from weftsim.sweep.grid import SweepError
@@ -32,6 +33,9 @@ from weftsim.sweep.lock import SweepLock
 from weftsim.sweep.plan import PlannedCell, SweepPlan
 from weftsim.sweep.pool import SweepProgress, executor
 from weftsim.sweep.store import SWEEP_FILE, TABLE_FILE, collect_rows, manifest, merge_manifest, table_text
+
+if TYPE_CHECKING:
+    from typing import TextIO
 
 log = logging.getLogger(__name__)
 
@@ -104,7 +108,7 @@ def _open_directory(outdir: Path, plan: SweepPlan, lock: SweepLock) -> None:
 
 
 def run_sweep(plan: SweepPlan, outdir: str | Path, jobs: int | None = None, scheduler: str | None = None,
-              cell_figures: bool = False, progress: bool = True, stream=None) -> SweepReport:
+              cell_figures: bool = False, progress: bool = True, stream: TextIO | None = None) -> SweepReport:
     """Run every unfinished cell of ``plan`` into ``outdir`` and write the table and figure.
 
     Parameters

@@ -19,15 +19,21 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from weftsim.wear.extrapolate import WearError, predict
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from weftsim.params import Scene
 
 __all__ = ["ENGINES", "WearError", "predict", "predict_to_directory"]
 
 ENGINES = ("reference", "exudyn")
 
 
-def check_request(scene, hours: float, engine: str, limit: float | None) -> None:
+def check_request(scene: Scene, hours: float, engine: str, limit: float | None) -> None:
     """Refuse what cannot be predicted, with one line naming what is wrong and what is allowed."""
     import math
 
@@ -48,8 +54,9 @@ def check_request(scene, hours: float, engine: str, limit: float | None) -> None
                         "(docs/wear.md); set joint_f.clearance_mm = 0 or leave out [joint_f]")
 
 
-def predict_to_directory(scene, hours: float, outdir, engine: str = "reference", limit: float | None = None,
-                         progress=None, stop=None, figures: bool = True) -> dict:
+def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine: str = "reference",
+                         limit: float | None = None, progress: Callable[[float], None] | None = None,
+                         stop: Callable[[], bool] | None = None, figures: bool = True) -> dict:
     """Predict the wear over ``hours`` of operation into ``outdir``, resuming a stored state.
 
     Parameters

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
@@ -23,9 +24,13 @@ from weftsim.kernel.chain import BEARING_RADIUS, OMEGA, chain, eccentricity, loc
 from weftsim.kernel.joint import tangential_velocity
 from weftsim.kernel.wear import contact_half_angle, deposit
 
+if TYPE_CHECKING:
+    from weftsim.params import ClearanceJoint, Scene
+
 
 @njit(cache=True, error_model="numpy")
-def contact_rows(prm, time, states, contact, impact, out):
+def contact_rows(prm: np.ndarray, time: np.ndarray, states: np.ndarray, contact: np.ndarray, impact: np.ndarray,
+                 out: np.ndarray) -> None:
     """Per step row into ``out`` (n, 5): F_N (N), v_T (m/s), psi_b, psi_j (rad), phi0 (rad).
 
     ``psi_b``, ``psi_j``: the contact direction n in the bearing's (rocker) and the journal's (rod)
@@ -51,7 +56,8 @@ def contact_rows(prm, time, states, contact, impact, out):
 
 
 @njit(cache=True, error_model="numpy")
-def deposit_rows(rows, work, depth_b, depth_j, bearing, journal):
+def deposit_rows(rows: np.ndarray, work: np.ndarray, depth_b: float, depth_j: float, bearing: np.ndarray,
+                 journal: np.ndarray) -> None:
     """Add each row's worn depth (``work`` (n,) times ``depth_b`` or ``depth_j``, m/J) to the profiles."""
     for i in range(work.size):
         if work[i] > 0.0:
@@ -76,7 +82,7 @@ class RunWear:
     sliding_distance: float  # int |v_T| dt in contact, m
 
 
-def wear_from_rows(joint, time, rows) -> RunWear:
+def wear_from_rows(joint: ClearanceJoint, time: np.ndarray, rows: np.ndarray) -> RunWear:
     """Archard wear of contact rows (``rows`` (n, 5) as :func:`contact_rows` fills them) at times ``time`` (s).
 
     ``joint``: the :class:`~weftsim.params.ClearanceJoint` (radii, length, ``wear``).
@@ -97,7 +103,8 @@ def wear_from_rows(joint, time, rows) -> RunWear:
     return RunWear(bearing, journal, k_b * total, k_j * total, total, sliding)
 
 
-def run_wear(scene, prm, time, states, contact, impact) -> RunWear:
+def run_wear(scene: Scene, prm: np.ndarray, time: np.ndarray, states: np.ndarray, contact: np.ndarray,
+             impact: np.ndarray) -> RunWear:
     """Archard wear over the given step rows (times (n,) s, states (n, 6), modes, held impact velocities).
 
     ``prm``: the kernel parameter array of ``scene`` (:func:`weftsim.reference.dynamics.pack_parameters`).

@@ -3,11 +3,20 @@
 from __future__ import annotations
 
 import sys
+from typing import TYPE_CHECKING
 
 from weftsim.exitcodes import EXIT_FAILED
 
+if TYPE_CHECKING:
+    import argparse
+    from collections.abc import Callable
+    from contextlib import AbstractContextManager
+    from pathlib import Path
 
-def add_flags(p, positive) -> None:
+    from weftsim.params import Scene
+
+
+def add_flags(p: argparse.ArgumentParser, positive: Callable[[Callable[[str], float]], Callable[[str], float]]) -> None:
     """Flags of ``weftsim wear SCENE --hours H [--engine E] [--limit-clearance-mm X]`` beside the shared
     scene and output flags."""
     p.add_argument("--hours", type=positive(float), required=True, help="operating hours to predict")
@@ -18,7 +27,8 @@ def add_flags(p, positive) -> None:
     p.add_argument("--no-plot", action="store_true", help="skip the figures")
 
 
-def run(args, scene, outdir, stop_on_interrupt, cli_error) -> int:
+def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
+        stop_on_interrupt: Callable[[str], AbstractContextManager], cli_error: Callable[..., Exception]) -> int:
     """Predict, report progress on stderr and the result on stdout; Ctrl-C keeps the state for a resume."""
     from weftsim.output import prepare_directory
     from weftsim.progress import Progress

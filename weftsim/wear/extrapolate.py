@@ -16,12 +16,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from weftsim.analysis import channel_statistics
 from weftsim.errors import WearError
 from weftsim.wear.archard import run_wear
+
+if TYPE_CHECKING:
+    from collections.abc import Callable, Sequence
+
+    from weftsim.params import Scene
+    from weftsim.wear.archard import RunWear
 
 SECONDS_PER_HOUR = 3600.0
 # Solver tolerance of the runs on a worn geometry: at the reference engine's default (rtol 1e-5) the
@@ -62,7 +69,8 @@ def effective_clearance(c0: float, bearing: np.ndarray, journal: np.ndarray) -> 
     return c0 + float(np.max(bearing, initial=0.0)) + float(np.max(journal, initial=0.0))
 
 
-def worn_scene(scene, bearing: np.ndarray, journal: np.ndarray, revolutions: float, retry: bool = False):
+def worn_scene(scene: Scene, bearing: np.ndarray, journal: np.ndarray, revolutions: float,
+               retry: bool = False) -> Scene:
     """``scene`` on the worn geometry (unworn when both profiles are zero) for ``revolutions``.
 
     The solver tolerance of a worn geometry is at most WORN_RTOL, WORN_ATOL; ``retry``: RETRY_*.
@@ -91,7 +99,7 @@ def _response(steps: dict, t0: float) -> dict:
             "contact_force_max_N": force["max"]}
 
 
-def simulate_update(scene, bearing: np.ndarray, journal: np.ndarray):
+def simulate_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray) -> tuple[RunWear, dict]:
     """Run the reference engine on the worn geometry; returns (wear per steady revolution, response).
 
     Raises WearError when the run fails.
@@ -115,7 +123,8 @@ def simulate_update(scene, bearing: np.ndarray, journal: np.ndarray):
     return wear, {**_response(result.steps, t0), "solver_rtol": run_scene.reference_solver.rtol}
 
 
-def next_update(scene, hours_done: float, revolutions_done: float, bearing, journal, hours: float) -> Update:
+def next_update(scene: Scene, hours_done: float, revolutions_done: float, bearing: np.ndarray, journal: np.ndarray,
+                hours: float) -> Update:
     """Simulate the current geometry and choose the revolutions of this update (module docstring)."""
     w = scene.joint.wear
     wear, response = simulate_update(scene, bearing, journal)
@@ -130,7 +139,7 @@ def next_update(scene, hours_done: float, revolutions_done: float, bearing, jour
                   (wear.bearing_volume + wear.journal_volume) * per_rev, response)
 
 
-def advance(update: Update, scene):
+def advance(update: Update, scene: Scene) -> tuple[float, float, np.ndarray, np.ndarray]:
     """(hours, revolutions, bearing, journal) after the update's N revolutions."""
     revs_per_hour = scene.drive.speed / (2.0 * math.pi) * SECONDS_PER_HOUR
     n = update.step_revolutions
@@ -138,7 +147,9 @@ def advance(update: Update, scene):
             update.bearing + n * update.rate_bearing, update.journal + n * update.rate_journal)
 
 
-def predict(scene, hours: float, updates=(), on_update=None, stop=None):
+def predict(scene: Scene, hours: float, updates: Sequence[Update] = (),
+            on_update: Callable[[list[Update]], None] | None = None,
+            stop: Callable[[], bool] | None = None) -> list[Update]:
     """Run the cycle extrapolation to ``hours`` of operation; returns the list of :class:`Update`.
 
     ``updates``: updates already done (resume: the run continues after the last);
@@ -172,7 +183,7 @@ def predict(scene, hours: float, updates=(), on_update=None, stop=None):
         state = advance(update, scene)
 
 
-def limit_hours(updates, c0: float, limit: float) -> float | None:
+def limit_hours(updates: Sequence[Update], c0: float, limit: float) -> float | None:
     """Operating hours at which c_eff first reaches ``limit`` (m), linear between updates; None if never."""
     c = [effective_clearance(c0, u.bearing, u.journal) for u in updates]
     h = [u.hours for u in updates]

@@ -3,9 +3,19 @@ clearance and the response against the hours.  matplotlib is imported only when 
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from weftsim.plots import figure
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    from matplotlib.figure import Figure
+
+    from weftsim.params import Scene
+    from weftsim.wear.extrapolate import Update
 
 
 def _chosen(updates, count: int = 6):
@@ -14,7 +24,7 @@ def _chosen(updates, count: int = 6):
     return [updates[i] for i in idx]
 
 
-def profile_figure(scene, updates, title: str = ""):
+def profile_figure(scene: Scene, updates: Sequence[Update], title: str = "") -> Figure:
     """Bearing clearance c0 + h_b(psi) (mm) and journal wear, polar, at several updates."""
     fig = figure(figsize=(10, 5))
     c0 = scene.joint.clearance * 1e3
@@ -39,7 +49,7 @@ def statistic_label(name: str) -> str:
     return next((word for word in ("mean", "rms", "p99", "max") if f"_{word}_" in name), name)
 
 
-def growth_figure(columns: dict, title: str = ""):
+def growth_figure(columns: dict, title: str = "") -> Figure:
     """Effective clearance, contact force and rapier acceleration against operating hours (``wear.csv`` columns)."""
     fig = figure(figsize=(7, 8))
     hours = columns["hours"]

@@ -10,11 +10,15 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from weftsim.output import write_atomic, write_csv
 from weftsim.wear.extrapolate import Update, effective_clearance, limit_hours
+
+if TYPE_CHECKING:
+    from weftsim.params import Scene
 
 STATE = "wear_state.npz"
 RESPONSE = ("rapier_acceleration_rms_m_s2", "rapier_acceleration_p99_m_s2", "driving_torque_rms_Nm",
@@ -26,14 +30,14 @@ class StateMismatch(ValueError):
     """The directory's stored state belongs to another scene or other wear settings."""
 
 
-def scene_identity(scene) -> str:
+def scene_identity(scene: Scene) -> str:
     """The scene's file keys as canonical JSON: what a stored state must match to be resumed."""
     from weftsim.scene import to_file_keys
 
     return json.dumps(to_file_keys(scene), sort_keys=True, default=str)
 
 
-def save_state(outdir: Path, scene, updates: list[Update]) -> Path:
+def save_state(outdir: Path, scene: Scene, updates: list[Update]) -> Path:
     arrays = {
         "scene": np.array(scene_identity(scene)),
         "hours": np.array([u.hours for u in updates]),
@@ -54,7 +58,7 @@ def save_state(outdir: Path, scene, updates: list[Update]) -> Path:
     return write_atomic(Path(outdir) / STATE, write)
 
 
-def load_state(outdir: Path, scene) -> list[Update]:
+def load_state(outdir: Path, scene: Scene) -> list[Update]:
     """The updates stored in ``outdir`` (empty if none); StateMismatch if they are of another scene."""
     path = Path(outdir) / STATE
     if not path.exists():
@@ -76,7 +80,7 @@ def volumes(updates: list[Update]) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(grown)[:-1]])
 
 
-def table(scene, updates: list[Update]) -> dict[str, np.ndarray]:
+def table(scene: Scene, updates: list[Update]) -> dict[str, np.ndarray]:
     """Columns of ``wear.csv`` (one row per update, at the geometry it simulated)."""
     c0 = scene.joint.clearance
     col = {
@@ -95,7 +99,7 @@ def table(scene, updates: list[Update]) -> dict[str, np.ndarray]:
     return {k: np.asarray(v, dtype=float) for k, v in col.items()}
 
 
-def write_table(target: Path, scene, updates: list[Update]) -> Path:
+def write_table(target: Path, scene: Scene, updates: list[Update]) -> Path:
     return write_csv(target, table(scene, updates))
 
 
@@ -108,7 +112,7 @@ def write_profiles(target: Path, updates: list[Update], which: str = "bearing") 
     return write_csv(target, columns)
 
 
-def summary(scene, updates: list[Update], hours: float, limit: float | None, wall_time: float) -> dict:
+def summary(scene: Scene, updates: list[Update], hours: float, limit: float | None, wall_time: float) -> dict:
     """Contents of ``wear.json``."""
     from weftsim.scene import to_file_keys
 
