@@ -32,9 +32,10 @@ for hours, clearance, p99 in zip(columns["hours"], columns["effective_clearance_
 # %%
 # The worn profiles
 # -----------------
-# The bearing wears where the journal presses on it: the load direction of the loom's cycle, seen in
-# the rocker's frame. The journal turns relative to the bearing (the rod swings against the rocker), so
-# its wear is spread over more of its circumference.
+# Each surface wears where the contact force presses on it, seen in its own body frame: the bearing
+# (in the rocker) over two arcs, around 30 deg and 250 deg, the journal (in the rod) at 0 and 180 deg,
+# along the rod's axis, which carries the joint's load in tension and in compression. The rod swings
+# against the rocker, so the same load direction sweeps a wider arc of the bearing than of the journal.
 from weftsim.wear.figures import growth_figure, profile_figure
 
 profiles = profile_figure(scene, updates, title="Joint E, reference loom at 400 rpm")
