@@ -197,7 +197,7 @@ def plot_orbit(result: RunResult, title: str | None = None) -> Figure:
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2)
     rpm = result.scene.drive.speed * 30 / math.pi
-    ax.set_title(title or f"scene {result.scene.name}, engine {result.engine}: journal orbit at E "
+    ax.set_title(title or f"scene {result.scene.name}, engine {result.engine}:\njournal orbit at E "
                           f"(c = {c_mm:g} mm, {rpm:g} rpm)", fontsize=10)
     fig.tight_layout()
     return fig
