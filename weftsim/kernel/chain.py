@@ -33,7 +33,7 @@ from typing import TYPE_CHECKING
 
 from numba import njit
 
-from weftsim.kernel.joint import connector_force, connector_friction_force
+from weftsim.kernel.joint import connector_friction_force
 from weftsim.kernel.joint import (  # noqa: F401 - the joint block is part of this array
     BEARING_RADIUS, CLEARANCE, COEF, KIND, MU, N_JOINT, TRACK_MAX, V_MIN, clearance_force, clearance_force_at,
     tangential_velocity,

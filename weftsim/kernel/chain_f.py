@@ -40,7 +40,7 @@ from typing import TYPE_CHECKING
 from numba import njit
 
 from weftsim.kernel import chain as kc
-from weftsim.kernel.joint import BEARING_RADIUS, CLEARANCE, KIND, COEF, MU, N_JOINT, clearance_force
+from weftsim.kernel.joint import BEARING_RADIUS, CLEARANCE, KIND, COEF, MU, N_JOINT, clearance_force, tangential_velocity
 from weftsim.kernel.laws import elastic_force
 
 if TYPE_CHECKING:
@@ -64,12 +64,6 @@ BLOCKS = (0, JOINT_F)
 def degrees_of_freedom(prm: np.ndarray) -> int:
     """Coordinates of the chain: 2 (E only, F only) or 4 (E and F)."""
     return 4 if prm[TOPOLOGY] == E_AND_F else 2
-
-
-@njit(cache=True, error_model="numpy")
-def state_size(prm: np.ndarray) -> int:
-    """Length of the state y: coordinates, their rates, W3 and D."""
-    return 2 * degrees_of_freedom(prm) + 2
 
 
 @njit(cache=True, error_model="numpy")
@@ -106,7 +100,7 @@ def contact_terms(jp: np.ndarray, ecc_y: float, ecc_z: float, v_y: float, v_z: f
     """Force of one joint in contact (block ``jp``) on its journal, and the power it dissipates.
 
     ``w_j``, ``w_b``: angular velocities of the journal's and the bearing's bodies (rad/s).
-    v_T = e_dot.t + w_j (R_b - |e|) - w_b R_b (:func:`weftsim.clearance.tangential_velocity`);
+    v_T = e_dot.t + w_j (R_b - |e|) - w_b R_b (:func:`weftsim.kernel.joint.tangential_velocity`);
     dissipated power = -(f.e_dot + M_j w_j + M_b w_b) - F_el delta_dot (the contact's power less
     the rate of its elastic energy).
 
@@ -118,8 +112,7 @@ def contact_terms(jp: np.ndarray, ecc_y: float, ecc_z: float, v_y: float, v_z: f
         return 0.0, 0.0, 0.0, delta, 0.0, 0.0, 0.0
     v_t = 0.0
     if jp[MU] > 0.0:
-        r_b = jp[BEARING_RADIUS]
-        v_t = (ecc_y * v_z - ecc_z * v_y) / length + w_j * (r_b - length) - w_b * r_b
+        v_t = tangential_velocity(ecc_y, ecc_z, v_y, v_z, length, w_j, w_b, jp[BEARING_RADIUS])
     f_y, f_z, f_n, _, delta, delta_dot, m_j, m_b = clearance_force(jp, ecc_y, ecc_z, v_y, v_z, v_t, impact_velocity)
     f_el = elastic_force(jp[KIND], jp[COEF], jp[CLEARANCE], delta)
     dissipated = -(f_y * v_y + f_z * v_z + m_j * w_j + m_b * w_b) - f_el * delta_dot

@@ -170,6 +170,8 @@ def advance(prm: np.ndarray, method: int, rtol: float, atol: float, max_step: fl
     impact = np.zeros(N_JOINTS)
     g_old = np.empty(N_JOINTS)
     r_old = np.empty(N_JOINTS)
+    g_new = np.empty(N_JOINTS)
+    r_new = np.empty(N_JOINTS)
     grid_t = np.empty(SAMPLES + 1)
     grid_d = np.empty(SAMPLES + 1)
     grid_r = np.empty(SAMPLES + 1)
@@ -233,8 +235,9 @@ def advance(prm: np.ndarray, method: int, rtol: float, atol: float, max_step: fl
             fst[slot] = -math.inf
             if loose[j]:
                 g_old[j], r_old[j] = penetration_at(prm, t, y, j)
+                g_new[j], r_new[j] = penetration_at(prm, t_new, y_new, j)
                 if (contact >> j) & 1:  # only contact steps are model states
-                    fst[slot] = penetration_at(prm, t_new, y_new, j)[0]
+                    fst[slot] = g_new[j]
         breach = (breach or fst[LAST_PENETRATION] > limits[PENETRATION_LIMIT]
                   or fst[LAST_PENETRATION_F] > limits[PENETRATION_LIMIT_F])
         if breach:
@@ -255,16 +258,15 @@ def advance(prm: np.ndarray, method: int, rtol: float, atol: float, max_step: fl
             if not loose[j]:
                 continue
             in_contact = ((contact >> j) & 1) == 1
-            g_new, r_new = penetration_at(prm, t_new, y_new, j)
             sign = -1.0 if in_contact else 1.0
-            possible = sign * g_new > 0.0 or sign * r_old[j] > 0.0 > sign * r_new
+            possible = sign * g_new[j] > 0.0 or sign * r_old[j] > 0.0 > sign * r_new[j]
             if not (in_contact or possible):
                 continue
             if not dense:
                 _dense_coefficients(prm, method, t, y, y_new, f_new, h, K, contact, impact, ist, F, tmp)
                 dense = True
             j_kind, j_stop, j_value = _events_of_joint(prm, method, F, t, h, y, tmp, j, in_contact, impact[j],
-                                                       g_old[j], r_old[j], g_new, r_new, t_new, grid_t, grid_d,
+                                                       g_old[j], r_old[j], g_new[j], r_new[j], t_new, grid_t, grid_d,
                                                        grid_r, peak_t, peak_r)  # fmt: skip
             if j_kind != NO_EVENT and (kind == NO_EVENT or j_stop < t_stop):
                 kind, t_stop, value, event_joint = j_kind, j_stop, j_value, j
