@@ -36,7 +36,6 @@ Sources: Flores & Ambrosio, Comput. Struct. 82 (2004); Li et al. (2020) Eqs. 1-1
 
 from __future__ import annotations
 
-import math
 from typing import TYPE_CHECKING, Callable, NamedTuple
 
 import numpy as np
@@ -214,9 +213,6 @@ def make_clearance_kernel(law: _Law, joint: ClearanceJoint, jit: bool = False) -
     (plain Python, or compiled with ``jit=True``), with the joint's impact-velocity rule applied
     to the held v_imp.  No argument checks: v_imp must be > 0 in contact.
     """
-    v0, v1 = joint.friction_velocities
-    if not 0.0 <= v0 < v1:
-        raise ValueError(f"friction velocities must satisfy 0 <= v0 < v1, got {joint.friction_velocities}")
     prm = joint_parameters(joint, law)
     if jit:
         import numba

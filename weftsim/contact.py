@@ -249,10 +249,9 @@ class _Law:
 
     @classmethod
     def from_joint(cls, joint: ClearanceJoint) -> "_Law":
-        """The law of ``joint`` (restitution, clearance, radii, materials, bearing length)."""
+        """The law of ``joint`` (restitution, clearance, radii, materials, bearing length; the joint
+        checked them when it was built, :func:`weftsim.params.joint_problem`)."""
         ce = joint.restitution
-        if not 0.0 < ce <= 1.0:
-            raise ValueError(f"`restitution` must be in (0, 1], got {ce}")
         if joint.clearance <= 0.0:
             raise ValueError(f"`clearance` must be > 0 for a contact law (0 is the ideal joint), "
                              f"got {joint.clearance}")
