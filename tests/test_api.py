@@ -135,16 +135,20 @@ def test_missing_optional_packages_name_the_extra(monkeypatch, tmp_path):
         weftsim.load_sweep(tmp_path)
 
 
-def test_a_saved_result_loads_back_equal(tmp_path):
-    """Lossless: both tables bit for bit, the scene, statistics, events, plausibility and path."""
-    scene = weftsim.load_scene("paper/clearance_0p50mm_400rpm", revolutions=0.5)
+@pytest.mark.parametrize("name", ["paper/clearance_0p50mm_400rpm", "clearance_ef"])
+def test_a_saved_result_loads_back_equal(tmp_path, name):
+    """Lossless: both tables bit for bit (joint F's channels too), the scene, statistics, events,
+    plausibility and path; the pandas table has every channel."""
+    scene = weftsim.load_scene(name, revolutions=0.5)
     result = weftsim.simulate(scene, engine="reference")
     assert result.steps["time_s"].size > result.samples["time_s"].size  # the per-step table is the larger one
     path = weftsim.save_result(result, tmp_path / "run.npz")
     loaded = weftsim.load_result(path)
     assert loaded.scene == result.scene  # every SI value exactly, not via the file's units
+    assert loaded.channel_names == result.channel_names
+    assert list(result.to_pandas("steps").columns) == list(result.channel_names)
     for table in ("samples", "steps"):
-        for name in CHANNELS:
+        for name in result.channel_names:
             assert np.array_equal(getattr(loaded, table)[name], getattr(result, table)[name]), (table, name)
     for field in ("engine", "status", "message", "solver_stats", "events", "plausibility", "path"):
         assert getattr(loaded, field) == getattr(result, field), field

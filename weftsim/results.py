@@ -223,7 +223,7 @@ class RunResult:
         Returns
         -------
         pandas.DataFrame
-            Columns :data:`CHANNELS` (SI units, named in the column names) as float64, a
+            Columns :attr:`channel_names` (SI units, named in the column names) as float64, a
             ``RangeIndex``; ``attrs`` hold the scene name, engine, status and ``which``.
 
         Raises
@@ -235,7 +235,7 @@ class RunResult:
             raise ValueError(f"which must be 'samples' or 'steps', got {which!r}")
         pd = require("pandas", "data", "RunResult.to_pandas")
         table = self.samples if which == "samples" else self.steps
-        frame = pd.DataFrame({name: np.array(table[name]) for name in CHANNELS})
+        frame = pd.DataFrame({name: np.array(table[name]) for name in self.channel_names})
         frame.attrs.update({"scene": self.scene.name, "engine": self.engine, "status": self.status, "table": which})
         return frame
 
@@ -324,7 +324,8 @@ def save_npz(result: RunResult, path: str | os.PathLike) -> Path:
     meta = {"format": NPZ_FORMAT, "scene": _plain(result.scene), "engine": result.engine, "status": result.status,
             "message": result.message, "solver_stats": _plain(result.solver_stats), "events": _plain(result.events),
             "plausibility": _plain(result.plausibility), "path": _plain(result.path)}
-    arrays = {f"{table}/{name}": getattr(result, table)[name] for table in ("samples", "steps") for name in CHANNELS}
+    arrays = {f"{table}/{name}": getattr(result, table)[name] for table in ("samples", "steps")
+              for name in result.channel_names}
     # allow_nan: NaN and inf statistics come back as they were (Python's JSON reads its own NaN back).
     arrays["meta"] = np.array(json.dumps(meta, allow_nan=True))
     with path.open("wb") as file:
@@ -347,7 +348,8 @@ def load_npz(path: str | os.PathLike) -> RunResult:
             if not isinstance(meta, dict) or meta.get("format") != NPZ_FORMAT:
                 raise OutputError(f"{path}: not a weftsim result of format {NPZ_FORMAT} "
                                   f"(found {meta.get('format') if isinstance(meta, dict) else meta!r})")
-            tables = {table: {name: data[f"{table}/{name}"] for name in CHANNELS} for table in ("samples", "steps")}
+            names = CHANNELS + (JOINT_F_CHANNELS if f"samples/{JOINT_F_CHANNELS[0]}" in data.files else ())
+            tables = {table: {name: data[f"{table}/{name}"] for name in names} for table in ("samples", "steps")}
     except OutputError:
         raise
     except FileNotFoundError:
