@@ -21,7 +21,7 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from weftsim.wear.extrapolate import WearError, predict
+from weftsim.errors import WearError
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -29,6 +29,17 @@ if TYPE_CHECKING:
     from weftsim.params import Scene
 
 __all__ = ["ENGINES", "WearError", "predict", "predict_to_directory"]
+
+
+def __getattr__(name: str):
+    # ``predict`` loads the numba kernels: imported when asked for, so that building the command line
+    # (which imports this package for the ``wear`` flags) does not pay for them.
+    if name == "predict":
+        from weftsim.wear.extrapolate import predict
+
+        return predict
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 ENGINES = ("reference", "exudyn")
 
@@ -94,6 +105,8 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
         store.save_state(outdir, scene, updates)
         if progress is not None and updates[-1].hours > 0.0:  # no time-left estimate from a zero fraction
             progress(min(updates[-1].hours / hours, 1.0))
+
+    from weftsim.wear.extrapolate import predict
 
     updates = predict(scene, hours, done, on_update=on_update, stop=stop)
     wall = time.perf_counter() - wall0
