@@ -131,7 +131,6 @@ class ClearanceJointModel:
     law: object
     route: str
     tracker: OnsetTracker
-    keep_alive: object = field(default=None, repr=False)  # symbolic function must outlive the system
     # [latest trial time seen by the force callback] (the overwritten post-step check, add_clearance_joint)
     trial_time: list = field(default_factory=lambda: [0.0], repr=False)
     friction: JointFriction | None = None  # friction force and moments (joint.friction_coefficient > 0)
@@ -210,7 +209,6 @@ def add_clearance_joint(mbs: exu.MainSystem, marker_bearing: exu.MarkerIndex, ma
     c, v_min = joint.clearance, joint.min_impact_velocity
     max_approach = joint.impact_velocity_rule == "max_approach"
     tracker = OnsetTracker(c, v_min, rule=joint.impact_velocity_rule)  # checks the rule's name
-    keep = None
     friction = None
     if joint.friction_coefficient > 0.0:
         friction = JointFriction(mbs, marker_bearing, marker_journal, joint_parameters(joint, law), route,
@@ -237,7 +235,7 @@ def add_clearance_joint(mbs: exu.MainSystem, marker_bearing: exu.MarkerIndex, ma
         stiffness=tracker.callback_state, damping=[0.0, 0.0, 0.0], offset=[0.0, 0.0, 0.0],
         springForceUserFunction=checked_force,
     ))  # fmt: skip
-    model = ClearanceJointModel(connector, joint, law, route, tracker, keep, trial, friction)
+    model = ClearanceJointModel(connector, joint, law, route, tracker, trial, friction)
     if friction is not None:
         friction.install(mbs, connector)
     displacement = exu.OutputVariableType.Displacement

@@ -84,9 +84,8 @@ class JointFriction:
     """
 
     def __init__(self, mbs, marker_bearing, marker_journal, prm, route: str, memory):
-        self.bearing, _, self.bearing_rotates = _body_of(mbs, marker_bearing)
+        self.bearing, self.bearing_local, self.bearing_rotates = _body_of(mbs, marker_bearing)
         self.journal, self.journal_local, self.journal_rotates = _body_of(mbs, marker_journal)
-        self.bearing_local = _body_of(mbs, marker_bearing)[1]
         self.kernel = callbacks.kernel_form(kernel_joint.connector_friction_force, route)
         self.prm = callbacks.parameters_for_route(prm, route)
         if route == "numba":

@@ -31,7 +31,6 @@ AUTO = "auto"
 
 def rigid_body_needs(scene: Scene) -> list[str]:
     """Reasons why ``scene`` needs the rigid-body model (empty: the kinematic tree carries it)."""
-    joint = scene.joint
     needs = []
     if not scene.joint_f.is_ideal:
         needs.append("clearance at F (the kinematic tree carries the clearance at E only; the rigid-body "
