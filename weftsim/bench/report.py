@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import os
 import platform
-import subprocess
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -21,16 +20,9 @@ if TYPE_CHECKING:
 FAILED_Y = 1.0  # where failed runs are drawn (relative error 100 %)
 
 
-def _version(module: str) -> str:
-    try:
-        mod = __import__(module)
-        return str(getattr(mod, "__version__", "?"))
-    except ImportError:
-        return "not installed"
-
-
 def machine_info() -> dict:
-    """CPU, cores, load average, OS, Python and package versions, git commit."""
+    """CPU, cores, load average, OS, Python and package versions, git commit (:mod:`weftsim.provenance`,
+    as ``summary.json`` records them)."""
     cpu = platform.processor() or "?"
     try:
         for line in Path("/proc/cpuinfo").read_text().splitlines():
@@ -39,19 +31,16 @@ def machine_info() -> dict:
                 break
     except OSError:
         pass
-    try:
-        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
-                                timeout=10).stdout.strip() or "?"  # fmt: skip
-    except (OSError, subprocess.SubprocessError):
-        commit = "?"
+    from weftsim import provenance
+
     return {
         "cpu": cpu,
         "cores": os.cpu_count(),
         "load_average": list(os.getloadavg()) if hasattr(os, "getloadavg") else None,
         "platform": platform.platform(),
         "python": platform.python_version(),
-        "versions": {m: _version(m) for m in ("numpy", "scipy", "numba", "exudyn", "matplotlib")},
-        "git_commit": commit,
+        "versions": provenance.versions(),  # from package metadata: nothing imported for it
+        "git_commit": provenance.commit(),
     }
 
 
