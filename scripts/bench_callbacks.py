@@ -30,7 +30,7 @@ from weftsim.exudyn_engine.clearance_joint import DEFAULT_ROUTE, ROUTES
 from weftsim.exudyn_engine.mechanism import build_mechanism
 from weftsim.exudyn_engine.sensors import add_sensors, step_channels
 from weftsim.exudyn_engine.solver import simulation_settings, step_plan
-from weftsim.params import ClearanceJoint, Drive, Scene
+from weftsim.params import Drive, Scene
 
 
 def run(scene: Scene, route: str | None, count: bool = False, profile: bool = False):

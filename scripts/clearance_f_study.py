@@ -28,6 +28,7 @@ import numpy as np
 from weftsim.analysis import peaks, statistics
 from weftsim.reference import solve
 from weftsim.scene import load_scene
+from weftsim.studies.common import revolution_steps
 
 ROOT = Path(__file__).resolve().parents[1]
 CASES = {"E only": (0.25, 0.0), "F only": (0.0, 0.25), "E and F": (0.25, 0.25), "ideal": (0.0, 0.0)}
@@ -92,10 +93,7 @@ def figure(results: dict, target: Path) -> None:
               "F only": {"color": "tab:orange"}, "E and F": {"color": "tab:green"}}  # fmt: skip
     curves = []
     for case, result in results.items():
-        st = result.steps
-        keep = (st["time_s"] >= result.scene.drive.period) & (st["time_s"] <= 2.0 * result.scene.drive.period)
-        data = {name: values[keep] for name, values in st.items()}
-        data["crank_angle_deg"] = data["crank_angle_deg"] - 360.0
+        data = revolution_steps(result, 1)
         if result.scene.joint.is_ideal:  # no contact force at an ideal E
             data.pop("contact_force_N")
         curves.append((case, data, {"lw": 0.7} | styles[case]))

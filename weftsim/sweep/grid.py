@@ -68,7 +68,7 @@ def resolve_key(name: str) -> Key:
         return _BY_PATH[name]
     if name in SHORT_NAMES:
         return SHORT_NAMES[name]
-    ambiguous = [key.path for key in SCHEMA if key.path.rpartition(".")[2] == name and key.path in _BY_PATH
+    ambiguous = [key.path for key in SCHEMA if key.path.rpartition(".")[2] == name
                  and not key.path.startswith("joint_f.")]
     if ambiguous:
         raise SweepError(f"sweep key '{name}' is ambiguous; use the full scene key: {', '.join(ambiguous)}")
