@@ -494,3 +494,17 @@ def test_a_stop_request_ends_the_run_as_interrupted_and_keeps_what_was_computed(
     # The next run is not affected: the request was withdrawn.
     again = SOLVERS[engine](scene(degrees=2.0))
     assert again.ok, again.message
+
+
+def test_penetration_bound_at_joint_f_names_joint_f():
+    """Joint F against its own journal radius: a soft bushing at F (E ideal) sinks past a tenth of the
+    radius in the start-up impact, and both engines stop naming [joint_f] (the guard judges each joint
+    with its own bound, weftsim.guards.RunGuard)."""
+    from weftsim import exudyn_engine, reference
+    from weftsim.scene import load_scene
+
+    soft = load_scene("clearance_f", {"drive.revolutions": 0.1, "joint_f.bearing_material.youngs_modulus_gpa": 0.05})
+    for r in (reference.solve(soft), exudyn_engine.solve(soft)):
+        assert_failed(r, "penetration", "exceeds 0.1 of the journal radius (1.0000 mm", "[joint_f]")
+        assert r.steps["penetration_f_m"].max() <= 1.0e-3 * 1.05  # stopped at the first step beyond it
+        assert not np.any(r.steps["penetration_m"])  # E is ideal

@@ -128,6 +128,8 @@ class RunGuard:
         self.ratio = limits.max_penetration
         self.journal_radius = scene.joint.journal_radius
         self.max_penetration = limits.max_penetration * scene.joint.journal_radius
+        # Joint F's bound, against its own journal radius (docs/clearance-f.md).
+        self.max_penetration_f = limits.max_penetration * scene.joint_f.journal_radius
         self.min_step = limits.min_step
 
     @property
@@ -136,7 +138,7 @@ class RunGuard:
         return self.clock() - self.start
 
     def check(self, penetration: float | None = None, step_size: float | None = None, steps: int = 1,
-              finite: bool = True) -> Breach | None:
+              finite: bool = True, penetration_f: float | None = None) -> Breach | None:
         """Count ``steps`` accepted steps and check every criterion.
 
         Parameters
@@ -151,6 +153,8 @@ class RunGuard:
             Accepted steps since the last call.
         finite : bool
             False if the engine found a NaN or inf in the state.
+        penetration_f : float, optional
+            The same at joint F; None while F is ideal.
 
         Returns
         -------
@@ -160,17 +164,19 @@ class RunGuard:
         if _STOP_REQUEST:
             return Breach("interrupted", _STOP_REQUEST[0],
                           "what was computed up to here is kept; rerun to compute the whole run")
-        if not finite or (penetration is not None and not math.isfinite(penetration)):
+        if not finite or any(p is not None and not math.isfinite(p) for p in (penetration, penetration_f)):
             return non_finite_breach()
-        if penetration is not None and penetration > self.max_penetration:
-            return Breach(
-                "penetration",
-                f"the penetration {penetration * 1e3:.4f} mm exceeds {self.ratio:g} of the journal radius "
-                f"({self.max_penetration * 1e3:.4f} mm, limits.max_penetration_ratio)",
-                "the joint is too soft for its load or the contact law is used far outside its range: check "
-                "the materials, clearance and law of [joint_e]; raise limits.max_penetration_ratio only if "
-                "such a deformation is meant",
-            )  # fmt: skip
+        for table, value, bound in (("joint_e", penetration, self.max_penetration),
+                                    ("joint_f", penetration_f, self.max_penetration_f)):
+            if value is not None and value > bound:
+                return Breach(
+                    "penetration",
+                    f"the penetration {value * 1e3:.4f} mm exceeds {self.ratio:g} of the journal radius "
+                    f"({bound * 1e3:.4f} mm, limits.max_penetration_ratio)",
+                    "the joint is too soft for its load or the contact law is used far outside its range: check "
+                    f"the materials, clearance and law of [{table}]; raise limits.max_penetration_ratio only if "
+                    "such a deformation is meant",
+                )  # fmt: skip
         if step_size is not None and step_size < self.min_step:
             return Breach(
                 "step_size",

@@ -241,7 +241,6 @@ def _solve_model(scene: Scene, model: str, progress, callback: str | None, wall0
     # The adaptive step takes about 1/3 of the fixed plan's steps (docs/performance.md).
     report_every = max(1, (n_steps // 3 if adaptive(scene) else n_steps) // _PROGRESS_CALLS)
     guard = RunGuard(scene)
-    guard_f = None if scene.joint_f.is_ideal else RunGuard(dataclasses.replace(scene, joint=scene.joint_f))
     breach = []
 
     def count(mbs, t):
@@ -252,9 +251,8 @@ def _solve_model(scene: Scene, model: str, progress, callback: str | None, wall0
         # Exudyn also calls this once at t = 0: not a step.  Runs after the clearance
         # joint's own post-step hook, so the tracker holds this step's penetration.
         found = guard.check(penetration=model.clearance.tracker.delta if model.clearance else None,
+                            penetration_f=model.clearance_f.tracker.delta if model.clearance_f else None,
                             steps=1 if t > 0.0 else 0)  # fmt: skip
-        if found is None and guard_f is not None:  # joint F's penetration against its own journal radius
-            found = guard_f.check(penetration=model.clearance_f.tracker.delta, steps=0)
         if found is not None:
             breach.append(found)
             return False  # Exudyn stops after this step

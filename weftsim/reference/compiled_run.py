@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import math
 import time as _time
-from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -36,18 +35,6 @@ __all__ = ["integrate_compiled", "solve_compiled", "METHODS"]
 def _empty_buffers(n: int, size: int):
     """Rows of (t, state (n, size), contact mask, held impact velocities (n, 2) at E and F)."""
     return np.zeros(n), np.zeros((n, size)), np.zeros(n, dtype=np.uint8), np.zeros((n, N_JOINTS))
-
-
-def _penetration_breach(scene: Scene, guard: RunGuard, fst) -> tuple[float | None, RunGuard]:
-    """The penetration to report to the guard and the guard that judges it (joint E's, or F's)."""
-    if scene.joint_f.is_ideal or not fst[LAST_PENETRATION_F] > guard_f(scene).max_penetration:
-        return (None if scene.joint.is_ideal else fst[LAST_PENETRATION]), guard
-    return fst[LAST_PENETRATION_F], guard_f(scene)
-
-
-def guard_f(scene: Scene) -> RunGuard:
-    """The penetration guard of joint F: the run guard of the scene with F's joint in E's place."""
-    return RunGuard(replace(scene, joint=scene.joint_f))
 
 
 def _rows(scene: Scene, rows):
@@ -87,7 +74,7 @@ def integrate_compiled(scene: Scene, progress: Callable[[float], None] | None = 
     guard = RunGuard(scene)
     limits = np.array([math.inf if scene.joint.is_ideal else guard.max_penetration, guard.min_step,
                        float(guard.max_steps or 0),
-                       math.inf if scene.joint_f.is_ideal else guard_f(scene).max_penetration])  # fmt: skip
+                       math.inf if scene.joint_f.is_ideal else guard.max_penetration_f])  # fmt: skip
     smp = _empty_buffers(sample_times.size, y.size)
     stp = _empty_buffers(_STEP_BUFFER, y.size)
     chunks = [(np.zeros(1), y[None, :].copy(), np.zeros(1, dtype=np.uint8), np.zeros((1, N_JOINTS)))]
@@ -108,8 +95,9 @@ def integrate_compiled(scene: Scene, progress: Callable[[float], None] | None = 
         t = fst[T]
         breach = None
         if code == GUARD:
-            penetration, judge = _penetration_breach(scene, guard, fst)
-            breach = judge.check(penetration=penetration, step_size=fst[LAST_STEP], steps=int(ist[STEPS]) - steps_seen)
+            breach = guard.check(penetration=None if scene.joint.is_ideal else fst[LAST_PENETRATION],
+                                 penetration_f=None if scene.joint_f.is_ideal else fst[LAST_PENETRATION_F],
+                                 step_size=fst[LAST_STEP], steps=int(ist[STEPS]) - steps_seen)  # fmt: skip
         elif code == STEP_TOO_SMALL:
             breach = guard.check(step_size=10.0 * np.spacing(t), steps=0)
         elif code == NON_FINITE:
