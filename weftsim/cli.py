@@ -159,7 +159,7 @@ def cmd_wear(args: argparse.Namespace) -> int:
     from weftsim.wear.command import run
 
     scene = scene_from_args(args)
-    return run(args, scene, output_directory(args, scene, "wear"), _stop_on_interrupt, CliError)
+    return run(args, scene, output_directory(args, scene, "wear"), _stop_on_interrupt)
 
 
 def _check_fits(scene, outdir: Path, runs: int = 1) -> None:

@@ -28,18 +28,16 @@ def add_flags(p: argparse.ArgumentParser, positive: Callable[[Callable[[str], fl
 
 
 def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
-        stop_on_interrupt: Callable[[str], AbstractContextManager], cli_error: Callable[..., Exception]) -> int:
+        stop_on_interrupt: Callable[[str], AbstractContextManager]) -> int:
     """Predict, report progress on stderr and the result on stdout; Ctrl-C keeps the state for a resume."""
+    from weftsim.cli_grammar import CliError
     from weftsim.output import prepare_directory
     from weftsim.progress import Progress
     from weftsim.wear import WearError, check_request, predict_to_directory
     from weftsim.wear.store import StateMismatch
 
     limit = None if args.limit_clearance_mm is None else args.limit_clearance_mm * 1e-3
-    try:
-        check_request(scene, args.hours, args.engine, limit)
-    except WearError as exc:
-        raise cli_error(str(exc)) from None
+    check_request(scene, args.hours, args.engine, limit)  # a WearError is one line, exit 2
     outdir = prepare_directory(outdir, args.force)
     print(f"scene {scene.name}, wear at E over {args.hours:g} h on the reference engine; each update simulates "
           f"{scene.joint.wear.settle_revolutions} + {scene.joint.wear.revolutions_per_update} revolutions "
@@ -51,9 +49,9 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
             data = predict_to_directory(scene, args.hours, outdir, args.engine, limit, progress,
                                         stop=lambda: state["signal"] is not None, figures=not args.no_plot)
         except StateMismatch as exc:
-            raise cli_error(str(exc)) from None
+            raise CliError(str(exc)) from None
         except WearError as exc:
-            raise cli_error(f"{exc} (the updates before it are kept in {outdir}; rerun to resume)",
+            raise CliError(f"{exc} (the updates before it are kept in {outdir}; rerun to resume)",
                             EXIT_FAILED) from None
         finally:
             progress.close()
@@ -67,6 +65,6 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     for path in data["files"].values():
         print(f"  wrote {path}")
     if not data["complete"]:
-        raise cli_error(f"stopped after {data['hours_reached']:.6g} h; the state is in {outdir}: run the same "
+        raise CliError(f"stopped after {data['hours_reached']:.6g} h; the state is in {outdir}: run the same "
                         "command again to resume", 130)
     return 0
