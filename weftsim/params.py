@@ -102,6 +102,9 @@ class Material:
     youngs_modulus: float = 207e9  # Pa
     poisson_ratio: float = 0.3
     yield_strength: float | None = None  # Pa; None = not given (no contact-pressure warning)
+    # Bushing limits (docs/plausibility.md), read on the bearing side; None = not given (no check).
+    max_pressure: float | None = None  # Pa: permitted projected pin pressure F / (d B)
+    max_pv: float | None = None  # Pa m/s: permitted product of that pressure and the sliding speed
 
     @property
     def compliance(self) -> float:
@@ -186,6 +189,10 @@ class ClearanceJoint:
         alone (Lankarani-Nikravesh, Flores), for comparison with published results.
     wear : WearModel
         Archard wear parameters (``[joint_e.wear]``), used by ``weftsim wear`` only.
+    design_clearance : tuple of float
+        (low, high): the design range of the radial clearance over the journal diameter, c / (2 R_j)
+        (dimensionless).  Default (0.5e-3, 1.0e-3): a bushed pin in oscillating motion (docs/plausibility.md);
+        a clearance outside it is warned about before the run.
     bearing_wear, journal_wear : tuple of float
         Worn depth, m, at equally spaced angles over 360 deg in the bearing's (rocker 3) and the
         journal's (rod 4) body frame; empty = unworn (round).  The contact sees the clearance
@@ -204,6 +211,7 @@ class ClearanceJoint:
     min_impact_velocity: float = 1e-4
     impact_velocity_rule: str = "max_approach"
     wear: WearModel = field(default_factory=WearModel)
+    design_clearance: tuple[float, float] = (0.5e-3, 1.0e-3)
     bearing_wear: tuple[float, ...] = ()
     journal_wear: tuple[float, ...] = ()
 
@@ -267,6 +275,15 @@ def joint_problem(joint: ClearanceJoint) -> str | None:
             return f"`{side}.youngs_modulus` must be > 0 (Pa), got {m.youngs_modulus!r}"
         if not (isinstance(m.poisson_ratio, (int, float)) and 0.0 <= m.poisson_ratio < 0.5):
             return f"`{side}.poisson_ratio` must be in [0, 0.5), got {m.poisson_ratio!r}"
+        for name in ("yield_strength", "max_pressure", "max_pv"):
+            value = getattr(m, name)
+            if value is not None and not _positive_finite(value):
+                return f"`{side}.{name}` must be > 0 or None (not given), got {value!r}"
+    band = tuple(joint.design_clearance)
+    if len(band) != 2 or not all(isinstance(v, (int, float)) and math.isfinite(v) for v in band) \
+            or not 0.0 <= band[0] < band[1]:
+        return (f"`design_clearance` must be (low, high) with 0 <= low < high (radial clearance / diameter), "
+                f"got {joint.design_clearance!r}")
     return None
 
 
@@ -382,6 +399,11 @@ class Limits:
         Largest residual of the energy balance W = dKE + dPE + E_contact + E_dissipated
         at any step, as a fraction of the largest kinetic energy of the run.  Sound runs
         stay below 1e-5; a step that does not resolve the impacts creates energy.
+    max_rapier_acceleration : float
+        Largest rapier acceleration a rapier head is built for, m/s^2 (default 3000: modern looms
+        accelerate the giver rapier up to about 3000 m/s^2, Previdi, Savaresi & Volpi, American
+        Control Conference 2006).  Above it: a warning, before the run from the ideal kinematics and
+        after it from the run (docs/plausibility.md).
     max_damping_ratio : float
         Largest damping force, as a multiple of the law's xi times the elastic force:
         (F_N - F_el) / (xi F_el) = delta_dot / v_imp.  An isolated impact, the case the laws
@@ -397,6 +419,7 @@ class Limits:
     min_step: float = 1e-12
     max_energy_error: float = 0.01
     max_damping_ratio: float = 1.0
+    max_rapier_acceleration: float = 3000.0
 
 
 @dataclass(frozen=True)

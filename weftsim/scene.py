@@ -135,6 +135,13 @@ SCHEMA: tuple[Key, ...] = (
         doc="optional; peak contact pressure above 1.67 x this (first yield) is warned about"),
     Key("joint_e.bearing_material.yield_strength_mpa", "joint.bearing_material.yield_strength", "float", MPA, 0,
         doc="optional; as for the journal (the smaller of the two counts)"),
+    Key("joint_e.bearing_material.max_pressure_mpa", "joint.bearing_material.max_pressure", "float", MPA, 0,
+        doc="optional; the bushing's permitted projected pin pressure F / (d B): a peak above it is warned about"),
+    Key("joint_e.bearing_material.max_pv_mpa_m_s", "joint.bearing_material.max_pv", "float", MPA, 0,
+        doc="optional; the bushing's permitted p x v (MPa x m/s): a cycle mean above it is warned about"),
+    Key("joint_e.design_clearance_per_mille", "joint.design_clearance", "floats2", 1e-3, 0, None, False,
+        doc="optional; [low, high] design range of the radial clearance over the pin diameter, per mille "
+            "(default [0.5, 1.0], a bushed pin in oscillating motion); outside it is warned about"),
     *WEAR_KEYS("joint_e", "joint"),
     Key("drive.speed_rpm", "drive.speed", "float", RPM, 0, 5000, doc="constant crank speed"),
     Key("drive.revolutions", "drive.revolutions", "float", 1, 0, 1000, doc="crank revolutions to simulate"),
@@ -188,6 +195,8 @@ SCHEMA: tuple[Key, ...] = (
         doc="step-size collapse: the smallest step either engine may take"),
     Key("limits.max_energy_error", "limits.max_energy_error", "float", 1, 0, 1, True, False,
         doc="the run fails when the energy balance misses by more than this fraction of the largest kinetic energy"),
+    Key("limits.max_rapier_acceleration_m_s2", "limits.max_rapier_acceleration", "float", 1, 0,
+        doc="largest rapier acceleration a rapier head is built for (default 3000 m/s2); above it is warned about"),
     Key("limits.max_damping_ratio", "limits.max_damping_ratio", "float", 1, 0, None, True,
         doc="damping force bound, multiple of xi x the elastic force (delta_dot / v_imp): <= 1 in an isolated "
             "impact and under max_approach (beyond it the run fails); the onset rule exceeds it (a warning)"),
@@ -214,7 +223,8 @@ TOP_LEVEL = ("name", "description", "extends")
 REQUIRED_SECTIONS = ("mechanism", "inertia", "joint_e", "drive")
 # Model options inside those sections that are not part of the machine: they default.
 OPTIONAL = ("joint_e.impact_velocity_rule", "joint_e.journal_material.yield_strength_mpa",
-            "joint_e.bearing_material.yield_strength_mpa") + tuple(key.path for key in WEAR_KEYS("joint_e", "joint"))
+            "joint_e.bearing_material.yield_strength_mpa", "joint_e.bearing_material.max_pressure_mpa",
+            "joint_e.bearing_material.max_pv_mpa_m_s", "joint_e.design_clearance_per_mille") + tuple(key.path for key in WEAR_KEYS("joint_e", "joint"))
 # [joint_f] is optional as a whole (absent: the ideal revolute joint at F).  Given with a clearance > 0
 # it must give every key [joint_e] must give (a loose joint is part of the machine).
 JOINT_F_REQUIRED = tuple("joint_f." + key.path.partition(".")[2] for key in SCHEMA
@@ -460,6 +470,8 @@ def _convert(key: Key, value: Any, where: str) -> Any:
     if key.target in ("joint.friction_velocities", "joint_f.friction_velocities") and not numbers[0] < numbers[1]:
         # Checked here, not with the other cross-key checks: ClearanceJoint itself refuses v0 >= v1.
         raise fail("must have v0 < v1")
+    if key.target in ("joint.design_clearance", "joint_f.design_clearance") and not numbers[0] < numbers[1]:
+        raise fail("must be [low, high] with low < high")
     if key.kind == "int":
         return value
     scaled = tuple(float(n) * key.scale for n in numbers)
