@@ -12,6 +12,9 @@ load_scene(scene, overrides=None, **flags)
     A scene file or bundled scene name, with overrides in file units.
 simulate(scene, engine="auto")
     Run one engine; returns a :class:`RunResult` (``to_pandas()``, ``samples``, ``steps``).
+plausibility_checks(scene)
+    The checks that need no simulation: reflected mass, pin pressure, p x v, clearance ratio,
+    rapier acceleration against their limits (docs/plausibility.md).
 save_result(result, path), load_result(path)
     Lossless NPZ (``weftsim run`` writes ``result.npz``).
 load_sweep(directory)
@@ -39,6 +42,7 @@ from weftsim.api import (  # noqa: E402 (after __version__, which submodules rea
     load_result,
     load_scene,
     load_sweep,
+    plausibility_checks,
     save_result,
     select_path,
     simulate,
@@ -47,6 +51,7 @@ from weftsim.errors import (  # noqa: E402
     EngineError,
     MissingExtra,
     OutputError,
+    PlausibilityWarning,
     RunFailed,
     SceneError,
     SweepError,
@@ -64,6 +69,7 @@ __all__ = [
     "EngineError",
     "MissingExtra",
     "OutputError",
+    "PlausibilityWarning",
     "RunFailed",
     "RunResult",
     "Scene",
@@ -76,6 +82,7 @@ __all__ = [
     "load_result",
     "load_scene",
     "load_sweep",
+    "plausibility_checks",
     "save_result",
     "select_path",
     "simulate",

@@ -19,12 +19,13 @@ from __future__ import annotations
 
 import difflib
 import os
+import warnings
 from collections.abc import Mapping
 from pathlib import Path
 from types import ModuleType
 from typing import TYPE_CHECKING, Any, Callable
 
-from weftsim.errors import EngineError, RunFailed, SceneError
+from weftsim.errors import EngineError, PlausibilityWarning, RunFailed, SceneError
 from weftsim.params import Scene
 from weftsim.results import RunResult
 
@@ -148,7 +149,8 @@ def _as_scene(scene: Scene | str | os.PathLike) -> Scene:
 
 
 def simulate(scene: Scene | str | os.PathLike, engine: str = "auto", *,
-             progress: Callable[[float], None] | None = None, raise_on_failure: bool = False) -> RunResult:
+             progress: Callable[[float], None] | None = None, raise_on_failure: bool = False,
+             on_warning: Callable[[str], None] | None = None) -> RunResult:
     """Simulate one scene with one engine.
 
     Parameters
@@ -164,6 +166,11 @@ def simulate(scene: Scene | str | os.PathLike, engine: str = "auto", *,
     raise_on_failure : bool
         Raise :class:`weftsim.errors.RunFailed` (holding the partial result) when the run fails,
         instead of returning it with ``status == "failed"``.
+    on_warning : callable, optional
+        Called with each before-run plausibility warning (:func:`plausibility_checks`), one sentence
+        naming the scene key to change, before the engine starts.  Default: issued as a
+        :class:`weftsim.errors.PlausibilityWarning` (Python's ``warnings``).  Every check, before and
+        after the run, is in ``result.plausibility["checks"]``.
 
     Returns
     -------
@@ -181,11 +188,32 @@ def simulate(scene: Scene | str | os.PathLike, engine: str = "auto", *,
     weftsim.errors.RunFailed
         Only with ``raise_on_failure``: the run failed (``exc.result`` holds it).
     """
+    from weftsim.design_checks import before_run, warnings_of
+
     module = _engine_module(engine)
-    result = module.solve(_as_scene(scene), progress=progress)
+    scene = _as_scene(scene)
+    for text in warnings_of(before_run(scene)):
+        if on_warning is None:
+            warnings.warn(text, PlausibilityWarning, stacklevel=2)
+        else:
+            on_warning(text)
+    result = module.solve(scene, progress=progress)
     if raise_on_failure and not result.ok:
         raise RunFailed(f"simulation failed: {result.message}", result)
     return result
+
+
+def plausibility_checks(scene: Scene | str | os.PathLike) -> list[dict]:
+    """The plausibility checks of a scene that need no simulation (docs/plausibility.md).
+
+    Each is a dict: ``name``, ``table`` (the joint's scene table, or None), ``value`` and ``limit``
+    (SI, ``unit``), ``key`` (the scene key of the limit), ``verdict`` ("ok", "warning", "no_limit",
+    "info"), further ``numbers`` and the warning ``message``.  A run adds the after-run checks in
+    ``result.plausibility["checks"]``.
+    """
+    from weftsim.design_checks import before_run
+
+    return [check.as_dict() for check in before_run(_as_scene(scene))]
 
 
 def save_result(result: RunResult, path: str | os.PathLike) -> Path:

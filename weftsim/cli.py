@@ -311,10 +311,22 @@ def _solve(scene, engine: str, label: str | None = None, announce: bool = False)
         path = select_path(scene, engine)
         print(f"scene {scene.name}, engine {engine}: {path['model']}, {path['method']} ({path['reason']})", flush=True)
     progress = Progress(label or f"{engine} {scene.name}")
-    try:
-        return simulate(scene, engine, progress=progress)
+    try:  # the before-run checks are printed once by the command (_announce_checks)
+        return simulate(scene, engine, progress=progress, on_warning=_quiet)
     finally:
         progress.close()
+
+
+def _quiet(text: str) -> None:
+    """Drop a before-run warning that the command has printed already."""
+
+
+def _announce_checks(scene, command: str) -> None:
+    """One ``warning:`` line on stderr per before-run plausibility check that fails (weftsim.design_checks)."""
+    from weftsim.design_checks import before_run_lines
+
+    for line in before_run_lines(scene):
+        print(f"weftsim {command}: {line}", file=sys.stderr, flush=True)
 
 
 def _report_run(result, written) -> None:
@@ -353,6 +365,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     _check_fits(scene, outdir)
     outdir = prepare_directory(outdir, args.force)
     _announce_run_time(scene, (engine,), "run")
+    _announce_checks(scene, "run")
     with _stop_on_interrupt("run") as stop:
         result = _solve(scene, engine, announce=True)
     written = write_run(result, outdir, figure=not args.no_plot, force=args.force, npz=True)
@@ -434,6 +447,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
     prepare_directory(outdir, args.force)  # refused before the estimate is shown
     with _stdout_to_stderr() if args.json else contextlib.nullcontext():  # the estimate imports Exudyn
         _announce_run_time(scene, ("reference", "exudyn"), "compare")
+        _announce_checks(scene, "compare")
         report, status, problem = run_compare(scene, outdir, solve=_solve, force=args.force)
     print(to_json(report) if args.json else format_report(report), end="" if args.json else "\n")
     if status:

@@ -160,6 +160,16 @@ def check_impact_velocity(delta: ArrayLike, impact_velocity: ArrayLike) -> None:
         )
 
 
+# The conformal laws' elastic force is Liu's elastic foundation (Liu, Zhang & Yang, Mech. Mach. Theory 42,
+# 2007): radial springs over the whole arc on which the gap c - e cos(theta) has closed, cos(theta_c) =
+# c / (c + delta), written for small clearances and large loads, where that arc is wide.  Its force
+# F = L_b (pi/2) E* delta sin(theta_c / 2) holds for any arc below the half circle, which no finite delta
+# reaches: the clearance sets no bound.  What bounds it is the material (small strains, no yield): the
+# Hertz pressure against yield and the run's limits.max_penetration_ratio of the journal radius.
+CONFORMAL_BASIS = ("the elastic-foundation force (Liu, Zhang & Yang 2007) is written for the wide arc of a conformal "
+                   "contact at small clearance and large load: no bound on delta / c")
+
+
 @dataclass(frozen=True)
 class _Law:
     """Common part of all laws: F_N = max(0, K(delta) delta^n (1 + xi delta_dot / v_imp)), n = 1.5.
@@ -175,6 +185,15 @@ class _Law:
     kind: ClassVar[int] = kernel.LAW_CONSTANT
     exponent: ClassVar[float] = 1.5
     valid_restitution: ClassVar[tuple[float, float]] = (0.0, 1.0)
+    # Largest penetration / clearance the law's elastic force is derived for (None: no bound from the
+    # clearance), and why.  The Hertz-based laws: Hertz's line contact assumes a contact width small
+    # against the radii; two conforming cylinders at approach delta overlap over a half-width of about
+    # R_j sqrt(2 delta / c), 0.45 R_j (an arc of +-25 deg) at delta = c / 10 (Johnson, Contact Mechanics,
+    # 1985, section 4.3; Pereira, Ramalho & Ambrosio, Nonlinear Dyn. 63, 2011, on the validity domain of
+    # Hertz-based cylinder laws in conformal contact at low clearance).
+    valid_penetration_ratio: ClassVar[float | None] = 0.1
+    penetration_basis: ClassVar[str] = ("Hertz's contact assumes a contact width small against the radii (Johnson "
+                                         "1985, 4.3): at delta = c/10 the overlap spans +-25 deg of the pin")
 
     @staticmethod
     def hysteresis_factor(restitution: float) -> float:
@@ -370,6 +389,8 @@ class VariableKD(_Law):
 
     name: ClassVar[str] = "variable_kd"
     valid_restitution: ClassVar[tuple[float, float]] = (0.8, 1.0)
+    valid_penetration_ratio: ClassVar[float | None] = None
+    penetration_basis: ClassVar[str] = CONFORMAL_BASIS
 
     kind: ClassVar[int] = kernel.LAW_VARIABLE_KD
 
@@ -398,6 +419,8 @@ class ElasticFoundation(_Law):
 
     name: ClassVar[str] = "elastic_foundation"
     valid_restitution: ClassVar[tuple[float, float]] = (0.8, 1.0)
+    valid_penetration_ratio: ClassVar[float | None] = None
+    penetration_basis: ClassVar[str] = CONFORMAL_BASIS
 
     kind: ClassVar[int] = kernel.LAW_ELASTIC_FOUNDATION
 

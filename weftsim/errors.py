@@ -96,3 +96,7 @@ def require(module: str, extra: str, purpose: str) -> Any:
     except ImportError:
         raise MissingExtra(f"{purpose} needs {module}, which is not installed; install it with "
                            f"pip install 'weftsim[{extra}]' (or pip install {module})") from None
+
+
+class PlausibilityWarning(UserWarning):
+    """A scene value outside what a real loom is built for (weftsim.design_checks); the run goes on."""

@@ -273,7 +273,8 @@ def plausibility_breach(result: RunResult, report: Plausibility) -> tuple[int, B
 
 
 def vet_result(result: RunResult) -> RunResult:
-    """``result`` with its plausibility report attached, failed if a criterion is crossed.
+    """``result`` with its plausibility report and design checks attached (:func:`weftsim.design_checks.block`),
+    failed if a criterion is crossed.
 
     Applied by both engines to every run, so a criterion crossed without the step-by-step
     checks seeing it still fails the run: :func:`result_breach`, then the defects of
@@ -281,11 +282,11 @@ def vet_result(result: RunResult) -> RunResult:
     get the report only.  The channels are kept whole (the run did finish); the message
     names the first step concerned.
     """
+    from weftsim.design_checks import block
     from weftsim.plausibility import assess
 
     report = assess(result)
-    if report is not None:
-        result = replace(result, plausibility=report.as_dict())
+    result = replace(result, plausibility=block(result, {} if report is None else report.as_dict()))
     if not result.ok:
         return result
     found = result_breach(result)

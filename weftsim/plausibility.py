@@ -31,11 +31,15 @@ correct integration of the model produces.
 **Validity warnings** (the run stands; :attr:`Plausibility.warnings`):
 
 - restitution outside the law's ``valid_restitution`` (the range its xi(ce) was derived for);
-- largest penetration above :data:`PENETRATION_WARNING_RATIO` of the clearance: the laws build
-  on Hertz's contact of two cylinders, which assumes a contact width small against the radii.
-  Two conforming cylinders at approach delta overlap over a half-width of about
-  R_j sqrt(2 delta / c) (the gap x^2 / (2 R*) with R* = R_j R_b / c closes there); at
-  delta = c / 10 that is 0.45 R_j, an arc of +-25 deg: no longer small;
+- largest penetration above the law's ``valid_penetration_ratio`` of the clearance
+  (:mod:`weftsim.contact`).  The Hertz-based laws (``lankarani_nikravesh``, ``flores``,
+  ``hunt_crossley``, ``gonthier``: :data:`PENETRATION_WARNING_RATIO`) build on Hertz's contact of two
+  cylinders, which assumes a contact width small against the radii.  Two conforming cylinders at
+  approach delta overlap over a half-width of about R_j sqrt(2 delta / c) (the gap x^2 / (2 R*) with
+  R* = R_j R_b / c closes there); at delta = c / 10 that is 0.45 R_j, an arc of +-25 deg: no longer
+  small.  The conformal laws (``variable_kd``, ``elastic_foundation``) are Liu's elastic foundation,
+  written for exactly that wide arc (small clearance, large load: a 30 kN load presses a 30 mm steel
+  pin about 40 um into a bushing of 20 um clearance): the clearance sets them no bound;
 - peak contact pressure above the first-yield pressure of the weaker material, when a scene
   gives ``yield_strength_mpa``: the Hertz line-contact pressure of a cylinder in a conforming
   bore (Johnson, *Contact Mechanics*, 1985, section 4.3),
@@ -50,7 +54,7 @@ from __future__ import annotations
 
 import math
 import sys
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, fields
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -60,7 +64,7 @@ if TYPE_CHECKING:
     from weftsim.params import ClearanceJoint, Scene
     from weftsim.results import RunResult
 
-PENETRATION_WARNING_RATIO = 0.1  # delta_max / c; reason in the module docstring
+PENETRATION_WARNING_RATIO = 0.1  # delta_max / c of the Hertz-based laws (contact._Law.valid_penetration_ratio)
 TRESCA_LINE_CONTACT_YIELD = 1.67  # p0 / Y at first yield under a Hertz line contact (Johnson 1985, 6.2)
 # delta = |e| - c with e a sum of four link-length terms (L_OG + L_FG cos a - L_EF cos psi - L_OE cos q):
 # each rounds to within eps * L, hypot and the subtraction add a few eps more.  64 ulps of the summed
@@ -249,14 +253,16 @@ def validity_warnings(scene: Scene, law: _Law, max_penetration_ratio: float, pea
                    f"'{law.name}' law's damping was derived for: its restitution is not what the scene asks; "
                    "choose a law valid there (e.g. 'flores' for any ce)")
     at = "" if table == "joint_e" else " at F"
-    if max_penetration_ratio > PENETRATION_WARNING_RATIO:
-        out.append(f"the largest penetration{at} is {max_penetration_ratio:.3g} of the clearance (above "
-                   f"{PENETRATION_WARNING_RATIO:g}): the contact is no longer narrow against the radii that the "
-                   "Hertz-based laws assume; read peak forces as estimates")
+    bound = law.valid_penetration_ratio
+    if bound is not None and max_penetration_ratio > bound:
+        out.append(f"the largest penetration{at} is {max_penetration_ratio:.3g} of the clearance (above {bound:g}, "
+                   f"the range of the '{law.name}' law: {law.penetration_basis}); read peak forces as estimates, "
+                   f"or choose a conformal-contact law ({table}.law = \"variable_kd\" or \"elastic_foundation\")")
     if yield_pressure is not None and peak_pressure > yield_pressure:
         out.append(f"the peak Hertz contact pressure{at} {peak_pressure / 1e6:.4g} MPa exceeds first yield "
-                   f"{yield_pressure / 1e6:.4g} MPa (1.67 x the smaller yield_strength_mpa): the joint would "
-                   "deform plastically, which no law here models")
+                   f"{yield_pressure / 1e6:.4g} MPa (1.67 x the smaller {table}.*_material.yield_strength_mpa): the joint "
+                   f"would deform plastically, which no law here models; a larger pin or a smaller clearance "
+                   f"({table}.journal_radius_mm, {table}.bearing_length_mm, {table}.clearance_mm)")
     return out
 
 
@@ -370,12 +376,17 @@ def first_defect_row(result: RunResult, report: Plausibility) -> int:
 
 
 def format_lines(result: RunResult) -> list[str]:
-    """The counts line and one ``warning:`` line per validity warning of a result's report (stderr)."""
+    """The counts line and one ``warning:`` line per validity warning and per after-run design-check warning
+    of a result's report (stderr; :mod:`weftsim.design_checks`)."""
     block = result.plausibility
     if not block:
         return []
-    report = Plausibility(**{k: v if k != "warnings" else tuple(v) for k, v in block.items() if k != "defects"})
-    return [report.summary_line()] + [f"warning: {text}" for text in report.warnings]
+    lines = []
+    if "onsets" in block:  # a mechanism with a clearance joint: the contact-history counts
+        names = {f.name for f in fields(Plausibility)}
+        report = Plausibility(**{k: v if k != "warnings" else tuple(v) for k, v in block.items() if k in names})
+        lines.append(report.summary_line())
+    return lines + [f"warning: {text}" for text in block.get("warnings", [])]
 
 
 def report_lines(result: RunResult, label: str) -> None:
