@@ -1,0 +1,125 @@
+"""The bundled `loom` mechanism (models/loom.toml; docs/physics.md, "The loom mechanism").
+
+The design targets of its synthesis (scripts/loom_synthesis.py) are checked on the scene as loaded:
+closure of the four-bar, the stroke the reed width and the selvedge timing ask for, the transmission
+angles, the ideal pin loads against the bushing's limits; then a run at the defaults against the ideal
+loads, both engines against each other over the start-up impact, and no plausibility warning.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+import weftsim
+from weftsim import kinematics as kin
+from weftsim.design_checks import after_run, before_run, running
+from weftsim.pin_loads import ideal_pin_loads
+
+# Targets of the synthesis (docs/physics.md, "The loom mechanism").
+REED_WIDTH = 1.90  # m
+SELVEDGE_ANGLE = math.radians(60.0)  # out of the shed for a third of the cycle
+MAX_RAPIER_ACCELERATION = 3000.0  # m/s2 (limits.max_rapier_acceleration_m_s2)
+GRID = np.radians(np.arange(0.0, 360.0, 0.25))
+
+
+@pytest.fixture(scope="module")
+def loom():
+    return weftsim.load_scene("loom")
+
+
+def test_the_loom_is_a_bundled_scene():
+    from weftsim.scene import bundled_scenes
+
+    assert "loom" in bundled_scenes() and "reference" in bundled_scenes()
+
+
+def test_four_bar_closes_and_is_the_parallelogram_of_the_synthesis(loom):
+    g = loom.geometry
+    st = kin.linkage_state(GRID, g, loom.inertia.rocker_com)
+    # Loop O-E-F-G: |F - E| = L_EF at every crank angle (round-off of lengths of 0.3 m: 1e-15 m).
+    rod = np.hypot(*(st.point_f - st.point_e).T)
+    assert np.max(np.abs(rod - g.l_ef)) < 1e-12
+    # A parallelogram turns the sector as the rocker: theta_FG = theta_OE, the rod keeps its direction.
+    assert np.max(np.abs(st.theta_fg - st.theta_oe)) < 1e-12
+    assert np.max(np.abs(st.d_theta_ef)) < 1e-12
+    assert kin.assembly_problem(g) is None
+
+
+def test_stroke_and_selvedge_timing_meet_the_reed_width(loom):
+    g = loom.geometry
+    beta = g.crank_inclination
+    st = kin.linkage_state(np.array([SELVEDGE_ANGLE, math.pi]), g)
+    stroke, selvedge = st.rapier_displacement[1], st.rapier_displacement[0]
+    # Closed form of the parallelogram: s = (d5 d7 / d6) (phi(theta) - phi(0)), phi = -atan(tan beta cos theta).
+    assert stroke == pytest.approx(g.rapier_ratio * 2.0 * beta, rel=1e-12)
+    phi60 = -math.atan(math.tan(beta) * math.cos(SELVEDGE_ANGLE))
+    assert selvedge == pytest.approx(g.rapier_ratio * (phi60 + beta), rel=1e-12)
+    # From the selvedge (60 deg) to 180 deg the head crosses half the reed; the sector's teeth are rounded
+    # up, so it reaches at most one tooth's worth of stroke further (module 3 mm: d7 / d6 x 1.5 mm x 2 beta).
+    reach = stroke - selvedge
+    one_tooth = 2.0 * beta * g.rapier_gear_pitch_radius / g.pinion_pitch_radius * 1.5e-3 * (1.0 - selvedge / stroke)
+    assert REED_WIDTH / 2.0 <= reach <= REED_WIDTH / 2.0 + one_tooth
+    # Symmetric: the head leaves the shed at 300 deg where it entered at 60 deg.
+    back = kin.linkage_state(np.array([2.0 * math.pi - SELVEDGE_ANGLE]), g).rapier_displacement[0]
+    assert back == pytest.approx(selvedge, rel=1e-12)
+
+
+def test_transmission_angles_and_peak_acceleration(loom):
+    g = loom.geometry
+    st = kin.linkage_state(GRID, g)
+    mu = np.degrees(st.transmission_angle)
+    beta = math.degrees(g.crank_inclination)
+    # The parallelogram's transmission angle at F is theta_OE: 90 -/+ beta, inside 40..140 deg.
+    assert mu.min() == pytest.approx(90.0 - beta, abs=1e-6) and mu.max() == pytest.approx(90.0 + beta, abs=1e-6)
+    assert 40.0 <= mu.min() and mu.max() <= 140.0
+    peak = np.max(np.abs(st.dd_rapier_displacement)) * loom.drive.speed**2
+    assert peak < MAX_RAPIER_ACCELERATION
+
+
+def test_ideal_pin_loads_are_within_the_bushing_limits_at_the_nominal_speed(loom):
+    loads = ideal_pin_loads(loom, "e")
+    joint = loom.joint
+    area = 2.0 * joint.journal_radius * joint.bearing_length
+    assert np.max(loads.force) / area < joint.bearing_material.max_pressure
+    assert not [c.message for c in before_run(loom) if c.verdict == "warning"]
+
+
+@pytest.fixture(scope="module")
+def default_run(loom):
+    return weftsim.simulate(loom, engine="exudyn")
+
+
+def test_run_at_the_defaults_carries_the_ideal_mean_load_and_warns_nothing(loom, default_run):
+    assert default_run.ok, default_run.message
+    s = default_run.samples
+    rev2 = (s["time_s"] >= loom.drive.period) & (s["time_s"] < 2.0 * loom.drive.period)
+    ideal = ideal_pin_loads(loom, "e")
+    # At 20 um the pin bears on its bushing all through revolution 2: its mean force is the ideal joint's
+    # (Newton-Euler of the chain behind E), to the impacts' share: measured 0.4 %.
+    assert float(np.mean(s["contact_force_N"][rev2])) == pytest.approx(float(np.mean(ideal.force)), rel=0.02)
+    assert not [c.message for c in after_run(default_run) if c.verdict == "warning"]
+
+
+def test_design_checks_after_a_run_read_revolution_two_on(default_run):
+    settled = running(default_run)
+    period = default_run.scene.drive.period
+    assert settled.steps["time_s"].min() >= period
+    # Revolution 1's start-up impact (the journal starts centred) is the run's largest force; it is not judged.
+    first = default_run.steps["time_s"] < period
+    assert default_run.steps["contact_force_N"][first].max() > 2.0 * settled.steps["contact_force_N"].max()
+    pressure = [c for c in after_run(default_run) if c.name == "pin_pressure"][0]
+    area = 2.0 * default_run.scene.joint.journal_radius * default_run.scene.joint.bearing_length
+    assert pressure.value == pytest.approx(settled.steps["contact_force_N"].max() / area, rel=1e-12)
+
+
+def test_both_engines_agree_over_the_start_up_impact(loom):
+    """First contact and the start-up impact's maxima (the reproducible quantities, docs/physics.md section 6)."""
+    scene = weftsim.load_scene("loom", revolutions=0.05)  # 18 deg: the impact is over by 5 deg
+    ref = weftsim.simulate(scene, engine="reference")
+    exu = weftsim.simulate(scene, engine="exudyn")
+    assert ref.ok and exu.ok, (ref.message, exu.message)
+    assert abs(ref.first_contact_angle_deg - exu.first_contact_angle_deg) < math.degrees(loom.compare.first_contact_angle)
+    for name in ("contact_force_N", "rapier_acceleration_m_s2", "driving_torque_Nm"):
+        a, b = (np.max(np.abs(r.steps[name])) for r in (ref, exu))
+        assert a == pytest.approx(b, rel=loom.compare.first_revolution_peaks), name
