@@ -3,7 +3,7 @@
 Reproducible: ``PYTHONPATH=. python scripts/loom_synthesis.py`` prints every figure the docs quote and
 checks that models/loom.toml holds the values this synthesis chooses.  Ideal joints throughout
 (weftsim.kinematics); the joint force at E is the Newton-Euler force of the rod and the sector chain
-(:func:`ideal_joint_forces`), which a run at the design clearance reproduces in the mean.
+(weftsim.pin_loads), which a run at the design clearance reproduces in the mean (tests/test_loom.py).
 
 Steps:
 1. Timing and stroke.  The rapier is out of the shed for a third of the cycle, the giver's head passes
@@ -31,6 +31,7 @@ import numpy as np
 
 from weftsim import kinematics as kin
 from weftsim.params import Geometry, Inertia
+from weftsim.pin_loads import ideal_pin_loads
 from weftsim.reference.ideal import ideal_torque, sector_chain_inertia
 from weftsim.scene import load_scene
 
@@ -80,33 +81,6 @@ def with_stroke(geometry: Geometry) -> Geometry:
     return replace(geometry, sector_pitch_radius=geometry.sector_pitch_radius * scale)
 
 
-def _cross(p, q):
-    return p[..., 0] * q[..., 1] - p[..., 1] * q[..., 0]
-
-
-def ideal_joint_forces(theta, omega: float, geometry: Geometry, inertia: Inertia):
-    """Forces at E and F of the ideal-joint mechanism at constant crank speed, N (vectors (Y, Z)).
-
-    Newton-Euler of the rod 4 (mass m4 at mid EF, J4) and the sector chain 5-8 about G (J_FG):
-    with P the force of the rod on the sector at F and F_E the force of the rocker on the rod at E,
-
-        (F - G) x P = J_FG theta_FG'',   F_E - P = m4 (a_4 - g),
-        (E - C4) x F_E - (F - C4) x P = J4 theta_EF''.
-    """
-    st = kin.linkage_state(theta, geometry, inertia.rocker_com)
-    j_fg = (inertia.sector_inertia + inertia.pinion_gear_inertia * geometry.pinion_ratio**2
-            + inertia.rapier_mass * geometry.rapier_ratio**2)
-    e, f, c = st.point_e, st.point_f, st.rod_com
-    rod = inertia.rod_mass * (omega**2 * st.dd_rod_com - np.array([0.0, -inertia.gravity]))
-    arm = f - np.array([geometry.l_og, 0.0])
-    moment = inertia.rod_inertia * omega**2 * st.dd_theta_ef - _cross(e - c, rod)
-    lever = e - f
-    matrix = np.stack([np.stack([-arm[:, 1], arm[:, 0]], -1), np.stack([-lever[:, 1], lever[:, 0]], -1)], -2)
-    rhs = np.stack([j_fg * omega**2 * st.dd_theta_fg, moment], -1)[..., None]
-    force_f = np.linalg.solve(matrix, rhs)[..., 0]
-    return rod + force_f, force_f
-
-
 # --- member shapes (step 6) -------------------------------------------------------------------------------
 def tube(outer, wall, length, density):
     """Mass of a tube, kg."""
@@ -141,18 +115,20 @@ def member_inertias(geometry: Geometry) -> dict:
 
 
 def loads(geometry: Geometry, inertia: Inertia, rpm: float) -> dict:
-    """Ideal-joint figures at ``rpm``: force at E, pin pressure, p x v, rapier acceleration, torque."""
+    """Ideal-joint figures at ``rpm``: force at E (weftsim.pin_loads, Newton-Euler of the chain behind E),
+    pin pressure, p x v, rapier acceleration, driving torque."""
     omega = rpm * math.pi / 30.0
-    force_e, _ = ideal_joint_forces(GRID, omega, geometry, inertia)
-    magnitude = np.hypot(force_e[:, 0], force_e[:, 1])
-    st = kin.linkage_state(GRID, geometry, inertia.rocker_com)
-    sliding = np.abs(st.d_theta_ef - st.d_theta_oe) * omega * PIN_DIAMETER / 2
-    pressure = magnitude / (PIN_DIAMETER * PIN_LENGTH)
-    scene = replace(load_scene("reference"), geometry=geometry, inertia=inertia)
-    torque = ideal_torque(GRID, replace(scene, drive=replace(scene.drive, speed=omega)))
-    return dict(force_peak=magnitude.max(), force_mean=magnitude.mean(), pressure_peak=pressure.max(),
-                pressure_mean=pressure.mean(), pv_mean=(pressure * sliding).mean(), sliding_peak=sliding.max(),
-                acceleration=np.abs(omega**2 * st.dd_rapier_displacement).max(), torque=np.abs(torque).max())
+    base = load_scene("reference")
+    scene = replace(base, geometry=geometry, inertia=inertia, drive=replace(base.drive, speed=omega),
+                    joint=replace(base.joint, journal_radius=PIN_DIAMETER / 2, bearing_length=PIN_LENGTH))
+    pin = ideal_pin_loads(scene, "e")
+    pressure = pin.force / (PIN_DIAMETER * PIN_LENGTH)
+    st = kin.linkage_state(pin.theta, geometry, inertia.rocker_com)
+    torque = ideal_torque(pin.theta, scene)
+    return dict(force_peak=pin.force.max(), force_mean=pin.force.mean(), pressure_peak=pressure.max(),
+                pressure_mean=pressure.mean(), pv_mean=(pressure * pin.sliding_speed).mean(),
+                sliding_peak=pin.sliding_speed.max(), acceleration=np.abs(omega**2 * st.dd_rapier_displacement).max(),
+                torque=np.abs(torque).max(), reflected_mass=pin.reflected_mass.max())
 
 
 def main() -> int:
@@ -225,7 +201,8 @@ def main() -> int:
         print(f"  {rpm:4.0f} rpm: F_E peak {r['force_peak'] / 1e3:6.2f} kN, mean {r['force_mean'] / 1e3:6.2f} kN, "
               f"p peak {r['pressure_peak'] / 1e6:5.2f} MPa, mean {r['pressure_mean'] / 1e6:5.2f} MPa, "
               f"mean p x v {r['pv_mean'] / 1e6:5.2f} MPa m/s, peak sliding {r['sliding_peak']:.3f} m/s, "
-              f"peak acceleration {r['acceleration']:7.1f} m/s2, peak torque {r['torque']:7.1f} N m")
+              f"peak acceleration {r['acceleration']:7.1f} m/s2, peak torque {r['torque']:7.1f} N m, "
+              f"reflected mass at E up to {r['reflected_mass']:.1f} kg")
     return check_scene(geometry, inertia)
 
 
