@@ -37,3 +37,19 @@ def weftsim_figures(block, block_vars, gallery_conf):
     return figure_rst(paths, gallery_conf["src_dir"])
 
 
+
+
+class LoomFirstSortKey:
+    """The gallery's order (``within_subsection_order`` in ``docs/conf.py``): the loom's run first, the
+    showcase of the bundled ``loom`` scene, then the other examples by file name."""
+
+    FIRST = "plot_loom_run.py"
+
+    def __init__(self, src_dir):
+        self.src_dir = src_dir
+
+    def __call__(self, filename):
+        return (filename != self.FIRST, filename)
+
+    def __repr__(self):
+        return f"<{type(self).__name__}>"

@@ -58,7 +58,7 @@ sphinx_gallery_conf = {
     "abort_on_example_error": True,
     "download_all_examples": True,
     "remove_config_comments": True,
-    "within_subsection_order": "FileNameSortKey",
+    "within_subsection_order": "_gallery.LoomFirstSortKey",  # the loom run first, then by file name
     "show_memory": False,
     "matplotlib_animations": True,
     "image_scrapers": ("matplotlib", "_gallery.weftsim_figures"),
