@@ -83,19 +83,19 @@ def fmt(value, digits):
     return f"{value:.{digits}f}" if isinstance(value, float) and math.isfinite(value) else str(value)
 
 
-def markdown(rows: list[dict]) -> str:
+def markdown(rows: list[dict], speeds=SPEEDS_RPM) -> str:
     """The docs table: loom and reference side by side per speed and clearance."""
-    by = {(r["scene"], r["speed_rpm"], r["clearance_mm"]): r for r in rows}
+    by = {(r["scene"], float(r["speed_rpm"]), float(r["clearance_mm"])): r for r in rows}
     head = ("| rpm | c mm | F peak kN | F mean kN | p mean MPa | p v MPa m/s | Hertz MPa | a peak m/s2 | T peak N m |\n"
             "|---|---|---|---|---|---|---|---|---|")
     lines = [head]
-    for rpm in SPEEDS_RPM:
+    for rpm in speeds:
         for c in CLEARANCES_MM:
             cells = []
             for key, digits in (("force_peak_kN", 1), ("force_mean_kN", 2), ("pressure_mean_MPa", 1),
                                 ("pv_mean_MPa_m_s", 2), ("hertz_peak_MPa", 0), ("acceleration_peak_m_s2", 0),
                                 ("torque_peak_Nm", 0)):
-                pair = [by.get((name, rpm, c), {}).get(key, float("nan")) for name in SCENES]
+                pair = [float(by.get((name, rpm, c), {}).get(key, "nan")) for name in SCENES]
                 cells.append(" / ".join(fmt(v, digits) for v in pair))
             lines.append(f"| {rpm:g} | {c:g} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
@@ -106,7 +106,13 @@ def main(argv=None) -> int:
     parser.add_argument("--engine", default="auto")
     parser.add_argument("--out", default=str(ROOT / "docs" / "data" / "loom-loads.csv"))
     parser.add_argument("--scenes", nargs="*", default=list(SCENES))
+    parser.add_argument("--table-only", action="store_true", help="print the tables of an existing CSV")
     args = parser.parse_args(argv)
+    if args.table_only:
+        with Path(args.out).open() as handle:
+            rows = list(csv.DictReader(handle))
+        print(markdown(rows, (600.0,)), markdown(rows), sep="\n\n")
+        return 0
     rows = []
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)

@@ -40,9 +40,10 @@ def _block(readme: str, language: str, after: str) -> str:
 
 
 def test_the_quick_start_runs_a_bundled_scene():
+    """The README's main job is the bundled loom (issue 21); the paper comparison stays on `reference`."""
     readme = (ROOT / "README.md").read_text()
     command = _block(readme, "bash", "## Quick start")
-    assert command.strip().endswith(".venv/bin/weftsim run reference")
+    assert command.strip().endswith(".venv/bin/weftsim run loom")
 
 
 def test_the_readme_script_simulates_both_engines_into_pandas_tables(capsys):
