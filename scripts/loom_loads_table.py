@@ -14,7 +14,9 @@ mechanism, one draw of its impact sequence: docs/physics.md section 6):
   1/R* = 1/R_j - 1/R_b (Johnson, Contact Mechanics, 1985, section 4.3);
 - peak |rapier acceleration| and peak |driving torque|.
 
-The CSV also holds revolution 1's peaks, the largest penetration and the wall time of each run.
+The CSV also holds revolution 1's peaks, the largest penetration, the wall time of each run and the
+plausibility checks that warned (weftsim.design_checks; before = on the ideal mechanism, after = on the
+run from revolution 2 on).
 """
 
 from __future__ import annotations
@@ -24,12 +26,14 @@ import csv
 import math
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
 
 import weftsim
 from weftsim import kinematics as kin
+from weftsim.design_checks import after_run, before_run
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ("loom", "reference")
@@ -38,7 +42,7 @@ CLEARANCES_MM = (0.02, 0.05, 0.1, 0.25)
 COLUMNS = ("scene", "speed_rpm", "clearance_mm", "status", "force_peak_kN", "force_mean_kN", "pressure_mean_MPa",
            "pv_mean_MPa_m_s", "hertz_peak_MPa", "acceleration_peak_m_s2", "torque_peak_Nm",
            "force_peak_rev1_kN", "acceleration_peak_rev1_m_s2", "torque_peak_rev1_Nm", "penetration_peak_um",
-           "wall_time_s")
+           "wall_time_s", "warnings")
 
 
 def hertz_pressure(force, joint) -> float:
@@ -50,8 +54,11 @@ def hertz_pressure(force, joint) -> float:
 def row(scene_name: str, rpm: float, clearance_mm: float, engine: str) -> dict:
     scene = weftsim.load_scene(scene_name, speed_rpm=rpm, clearance_mm=clearance_mm, revolutions=2.0)
     started = time.perf_counter()
-    result = weftsim.simulate(scene, engine=engine)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", weftsim.PlausibilityWarning)  # collected below from the checks
+        result = weftsim.simulate(scene, engine=engine)
     wall = time.perf_counter() - started
+    warned = sorted({f"{c.stage}:{c.name}" for c in before_run(scene) + after_run(result) if c.verdict == "warning"})
     s = result.samples
     angle = s["crank_angle_deg"]
     rev1, rev2 = angle < 360.0, (angle >= 360.0) & (angle < 720.0)
@@ -75,7 +82,7 @@ def row(scene_name: str, rpm: float, clearance_mm: float, engine: str) -> dict:
         force_peak_rev1_kN=peak("contact_force_N", rev1) / 1e3,
         acceleration_peak_rev1_m_s2=peak("rapier_acceleration_m_s2", rev1),
         torque_peak_rev1_Nm=peak("driving_torque_Nm", rev1),
-        penetration_peak_um=float(np.max(s["penetration_m"])) * 1e6, wall_time_s=wall,
+        penetration_peak_um=float(np.max(s["penetration_m"])) * 1e6, wall_time_s=wall, warnings=" ".join(warned),
     )
 
 
