@@ -30,7 +30,7 @@ def same_scene(a, b):
 def test_every_scene_file_of_models_is_bundled_under_its_path_name():
     names = weftsim.bundled_scenes()
     assert names == sorted(p.relative_to(MODELS).with_suffix("").as_posix() for p in MODELS.rglob("*.toml"))
-    assert {"reference", "ideal", *PAPER_CASES} <= set(names)
+    assert {"reference", "loom", "ideal", *PAPER_CASES} <= set(names)
     for name in names:
         assert same_scene(weftsim.load_scene(name), weftsim.load_scene(MODELS / f"{name}.toml"))
 

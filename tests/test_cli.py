@@ -90,6 +90,7 @@ def test_scenes_lists_the_bundled_scenes_with_their_descriptions():
     assert "reference" in lines and "paper/clearance_0p50mm_400rpm" in lines
     assert "Reference weft insertion mechanism, c = 0.25 mm at E, 400 rpm" in lines["reference"]
     assert "c = 0.50 mm at E, 400 rpm" in lines["paper/clearance_0p50mm_400rpm"]
+    assert "Rapier loom, 190 cm reed, 600 rpm" in lines["loom"]
 
 
 def test_runs_of_the_two_engines_go_to_their_own_directories(tmp_path):
