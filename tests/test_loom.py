@@ -7,6 +7,7 @@ loads, both engines against each other over the start-up impact, and no plausibi
 """
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -95,8 +96,9 @@ def test_run_at_the_defaults_carries_the_ideal_mean_load_and_warns_nothing(loom,
     s = default_run.samples
     rev2 = (s["time_s"] >= loom.drive.period) & (s["time_s"] < 2.0 * loom.drive.period)
     ideal = ideal_pin_loads(loom, "e")
-    # At 20 um the pin bears on its bushing all through revolution 2: its mean force is the ideal joint's
-    # (Newton-Euler of the chain behind E), to the impacts' share: measured 0.4 %.
+    # At 20 um the pin bears on its bushing all through revolution 2 but near the two force reversals: its
+    # mean force is the ideal joint's (Newton-Euler of the chain behind E) plus the impacts' share, measured
+    # 0.4 % (9197 N against 9160 N); 2 % is five times that.
     assert float(np.mean(s["contact_force_N"][rev2])) == pytest.approx(float(np.mean(ideal.force)), rel=0.02)
     assert not [c.message for c in after_run(default_run) if c.verdict == "warning"]
 
@@ -113,13 +115,22 @@ def test_design_checks_after_a_run_read_revolution_two_on(default_run):
     assert pressure.value == pytest.approx(settled.steps["contact_force_N"].max() / area, rel=1e-12)
 
 
-def test_both_engines_agree_over_the_start_up_impact(loom):
-    """First contact and the start-up impact's maxima (the reproducible quantities, docs/physics.md section 6)."""
-    scene = weftsim.load_scene("loom", revolutions=0.05)  # 18 deg: the impact is over by 5 deg
-    ref = weftsim.simulate(scene, engine="reference")
-    exu = weftsim.simulate(scene, engine="exudyn")
+@pytest.mark.parametrize("clearance_mm", [0.02, 0.25])
+def test_both_engines_agree_on_the_first_revolution(clearance_mm):
+    """`weftsim compare loom` over one revolution, new and worn joint: the first contact and the first
+    revolution's maxima (the reproducible quantities, docs/physics.md section 6) within the scene's
+    [compare] tolerances.  Measured at 600 rpm: 2.6e-5 deg and <= 4.9e-3 (0.02 mm), 3.5e-6 deg and
+    <= 6.7e-3 (0.25 mm)."""
+    from weftsim.compare import agreement_checks
+
+    scene = weftsim.load_scene("loom", clearance_mm=clearance_mm, revolutions=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", weftsim.PlausibilityWarning)  # the worn joint warns; judged elsewhere
+        ref = weftsim.simulate(scene, engine="reference")
+        exu = weftsim.simulate(scene, engine="exudyn")
     assert ref.ok and exu.ok, (ref.message, exu.message)
-    assert abs(ref.first_contact_angle_deg - exu.first_contact_angle_deg) < math.degrees(loom.compare.first_contact_angle)
-    for name in ("contact_force_N", "rapier_acceleration_m_s2", "driving_torque_Nm"):
-        a, b = (np.max(np.abs(r.steps[name])) for r in (ref, exu))
-        assert a == pytest.approx(b, rel=loom.compare.first_revolution_peaks), name
+    checks = agreement_checks(exu, ref)
+    assert sum("first revolution" in c["name"] for c in checks) == 3
+    assert any("first contact" in c["name"] for c in checks)
+    failed = [c for c in checks if not c["passed"]]
+    assert not failed, failed
