@@ -192,10 +192,34 @@ def before_run(scene: Scene) -> list[Check]:
     return out
 
 
+def running(result: RunResult) -> RunResult:
+    """``result`` from its second revolution on, when it covers at least two; else all of it.
+
+    Revolution 1 starts from the centred journal with the ideal mechanism's velocities: the journal
+    crosses the clearance freely and strikes the bearing (the start-up impact, docs/physics.md section 6),
+    which a running machine, whose pin already bears on its bushing, does not see.  On the loom at
+    600 rpm and c = 0.02 mm that impact reaches 35 kN against 11.7 kN in revolution 2.  The run's
+    printed peaks are revolution 2's; the loads are judged on the same revolutions.
+    """
+    import dataclasses
+
+    period = result.scene.drive.period
+    if result.steps["time_s"].size == 0 or result.steps["time_s"][-1] < 2.0 * period * (1.0 - 1e-9):
+        return result
+
+    def after(channels):
+        keep = np.asarray(channels["time_s"]) >= period
+        return {name: np.asarray(values)[keep] for name, values in channels.items()}
+
+    return dataclasses.replace(result, steps=after(result.steps), samples=after(result.samples))
+
+
 def after_run(result: RunResult) -> list[Check]:
-    """The checks of a finished run's channels (nothing for a run without steps)."""
+    """The checks of a finished run's channels (nothing for a run without steps), from revolution 2 on
+    when the run has two or more (:func:`running`)."""
     from weftsim.contact import make_law
 
+    result = running(result)
     scene = result.scene
     out: list[Check] = []
     if result.steps["time_s"].size == 0:
