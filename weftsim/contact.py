@@ -60,6 +60,10 @@ hunt_c.     +0.416   +0.281   +0.163   +0.068   +0.033   +0.009
 gonthier    +0.001   +0.004   -0.012   -0.030   -0.032   -0.024
 ==========  =======  =======  =======  =======  =======  =======
 
+Each law also declares ``valid_penetration_ratio``, the largest delta / c its elastic force is
+derived for, and ``penetration_basis``, why: 0.1 for the Hertz-based laws (a narrow contact),
+None for the conformal ``variable_kd`` and ``elastic_foundation`` (docs/plausibility.md).
+
 Sources: Lankarani & Nikravesh, J. Mech. Des. 112 (1990); Hunt & Crossley,
 J. Appl. Mech. 42 (1975); Gonthier et al., Multibody Syst. Dyn. 11 (2004); Flores
 et al., Mech. Mach. Theory 46 (2011); Bai & Zhao, Int. J. Non-Linear Mech. 48

@@ -18,7 +18,10 @@ check                  value                                        limit (scene
 *Before the run* (:func:`before_run`) the loads come from the ideal mechanism at the scene's speed
 (:func:`weftsim.pin_loads.ideal_pin_loads`): no simulation.  *After the run* (:func:`after_run`) they
 come from the run's contact force channels (peaks over every solver step, means over the output grid,
-which is uniform in time) and the sliding speed of the ideal kinematics at the same crank angle.
+which is uniform in time) and the sliding speed of the ideal kinematics at the same crank angle, from
+revolution 2 on when the run has two (:func:`running`: revolution 1 holds the start-up impact of the
+centred journal, which a running machine does not see); the law's range (penetration, Hertz) is judged
+over the whole run, as :mod:`weftsim.plausibility` judges it.
 Joint checks are made at each joint with a clearance (E, and F when it has one).  A check whose
 limit the scene does not give has the verdict ``"no_limit"``; the reflected mass is always
 ``"info"``.  The ``hertz_pressure`` and ``penetration`` warnings after the run are
@@ -105,8 +108,12 @@ def _pin(table: str, joint) -> str:
 
 
 def pressure_checks(stage: str, table: str, joint, force_peak: float, force_mean: float, pv_mean: float,
-                    pv_peak: float, speed_peak: float) -> list[Check]:
-    """``pin_pressure``, ``pv`` and (before the run) ``hertz_pressure`` of one pin's loads."""
+                    pv_peak: float, speed_peak: float, hertz_force: float | None = None,
+                    numbers: dict | None = None) -> list[Check]:
+    """``pin_pressure``, ``pv`` and ``hertz_pressure`` of one pin's loads (the Hertz pressure of
+    ``hertz_force``, default ``force_peak``); ``numbers`` are added to the first two checks' numbers."""
+    numbers = numbers or {}
+    hertz_force = force_peak if hertz_force is None else hertz_force
     area = 2.0 * joint.journal_radius * joint.bearing_length
     p_peak, p_mean = force_peak / area, force_mean / area
     out = []
@@ -118,7 +125,7 @@ def pressure_checks(stage: str, table: str, joint, force_peak: float, force_mean
         f"pressure F/(d B) (peak force {force_peak / 1e3:.4g} kN), above the bushing's {key} = "
         f"{material.max_pressure / 1e6:g}: a larger pin or a lighter chain behind it")
     out.append(Check("pin_pressure", stage, table, p_peak, material.max_pressure, "Pa", key, verdict,
-                     {"mean_pa": p_mean, "peak_force_n": force_peak, "mean_force_n": force_mean}, message))
+                     {"mean_pa": p_mean, "peak_force_n": force_peak, "mean_force_n": force_mean, **numbers}, message))
     key = f"{table}.bearing_material.max_pv_mpa_m_s"
     verdict = _judge(pv_mean, material.max_pv)
     message = "" if verdict != "warning" else (
@@ -127,17 +134,17 @@ def pressure_checks(stage: str, table: str, joint, force_peak: float, force_mean
         f"{material.max_pv / 1e6:g}: a larger pin ({table}.bearing_length_mm), a slower drive (drive.speed_rpm) "
         "or a bushing rated higher")
     out.append(Check("pv", stage, table, pv_mean, material.max_pv, "Pa m/s", key, verdict,
-                     {"peak_pa_m_s": pv_peak, "peak_sliding_speed_m_s": speed_peak}, message))
+                     {"peak_pa_m_s": pv_peak, "peak_sliding_speed_m_s": speed_peak, **numbers}, message))
     strength = _yield_strength(joint)
     yield_pressure = None if strength is None else TRESCA_LINE_CONTACT_YIELD * strength
-    hertz = line_contact_pressure(force_peak, joint)
+    hertz = line_contact_pressure(hertz_force, joint)
     verdict = _judge(hertz, yield_pressure)
     message = "" if verdict != "warning" or stage == "after" else (  # after: validity_warnings says it
-        f"{table}: the ideal mechanism's peak pin force {force_peak / 1e3:.4g} kN gives a Hertz contact pressure "
+        f"{table}: the ideal mechanism's peak pin force {hertz_force / 1e3:.4g} kN gives a Hertz contact pressure "
         f"of {hertz / 1e6:.4g} MPa (before the run), above first yield {yield_pressure / 1e6:.4g} MPa (1.67 x the "
         f"smaller {table}.*_material.yield_strength_mpa): a larger pin or a smaller clearance ({table}.clearance_mm)")
     out.append(Check("hertz_pressure", stage, table, hertz, yield_pressure, "Pa",
-                     f"{table}.bearing_material.yield_strength_mpa", verdict, {}, message))
+                     f"{table}.bearing_material.yield_strength_mpa", verdict, {"peak_force_n": hertz_force}, message))
     return out
 
 
@@ -166,7 +173,7 @@ def joint_checks_before(scene: Scene, joint_name: str) -> list[Check]:
     return out
 
 
-def rapier_check(scene: Scene, stage: str, peak: float) -> Check:
+def rapier_check(scene: Scene, stage: str, peak: float, numbers: dict | None = None) -> Check:
     """``rapier_acceleration``: ``peak`` |a| (m/s^2) against ``limits.max_rapier_acceleration_m_s2``."""
     limit = scene.limits.max_rapier_acceleration
     key = "limits.max_rapier_acceleration_m_s2"
@@ -175,7 +182,7 @@ def rapier_check(scene: Scene, stage: str, peak: float) -> Check:
         f"the rapier's acceleration in {_when(stage)} peaks at {peak:.4g} m/s2, above what rapier heads are built "
         f"for ({key} = {limit:g}): a lower drive.speed_rpm, a longer insertion (mechanism) " + (
             "or a smaller clearance (the impacts' spikes)" if stage == "after" else "or a rapier head rated higher"))
-    return Check("rapier_acceleration", stage, None, peak, limit, "m/s2", key, verdict, {}, message)
+    return Check("rapier_acceleration", stage, None, peak, limit, "m/s2", key, verdict, dict(numbers or {}), message)
 
 
 def before_run(scene: Scene) -> list[Check]:
@@ -215,20 +222,28 @@ def running(result: RunResult) -> RunResult:
 
 
 def after_run(result: RunResult) -> list[Check]:
-    """The checks of a finished run's channels (nothing for a run without steps), from revolution 2 on
-    when the run has two or more (:func:`running`)."""
+    """The checks of a finished run's channels (nothing for a run without steps).
+
+    The machine's loads (pin pressure, p x v, rapier acceleration) are judged from revolution 2 on
+    when the run has two or more (:func:`running`; ``numbers["from_time_s"]`` says where); the
+    contact law's range (penetration, Hertz pressure) over the whole run, as
+    :func:`weftsim.plausibility.validity_warnings` judges and words it.
+    """
     from weftsim.contact import make_law
 
-    result = running(result)
+    full = result
+    result = running(full)
     scene = result.scene
     out: list[Check] = []
     if result.steps["time_s"].size == 0:
         return out
+    window = {"from_time_s": float(result.steps["time_s"][0])}
     for name in scene.loose_joints:
         table = f"joint_{name}"
         joint_scene, steps = joint_view(result, name)
         joint = joint_scene.joint
         _, samples = joint_view(replace_steps(result), name)
+        _, whole = joint_view(full, name)
         area = 2.0 * joint.journal_radius * joint.bearing_length
         force_steps = np.asarray(steps["contact_force_N"])
         force_samples = np.asarray(samples["contact_force_N"]) if samples["time_s"].size else force_steps
@@ -238,14 +253,15 @@ def after_run(result: RunResult) -> list[Check]:
         v_samples = sliding_speed(theta_samples, scene, name, joint.journal_radius)
         out += pressure_checks("after", table, joint, float(force_steps.max()), float(force_samples.mean()),
                                float(np.mean(force_samples * v_samples)) / area,
-                               float(np.max(force_steps * v_steps)) / area, float(v_steps.max()))
+                               float(np.max(force_steps * v_steps)) / area, float(v_steps.max()),
+                               hertz_force=float(np.max(whole["contact_force_N"])), numbers=window)
         law = make_law(joint)
-        ratio = max(float(np.max(steps["penetration_m"])), 0.0) / joint.clearance
+        ratio = max(float(np.max(whole["penetration_m"])), 0.0) / joint.clearance
         bound = law.valid_penetration_ratio
         out.append(Check("penetration", "after", table, ratio, bound, "1", f"{table}.law", _judge(ratio, bound),
                          {}, ""))
     peak = float(np.max(np.abs(result.steps["rapier_acceleration_m_s2"])))
-    out.append(rapier_check(scene, "after", peak))
+    out.append(rapier_check(scene, "after", peak, window))
     return out
 
 

@@ -390,7 +390,10 @@ class Limits:
     max_penetration : float
         Largest penetration delta allowed, as a fraction of the journal radius R_j.
         Beyond about a tenth of R_j the rigid bodies with a local contact compliance are
-        no model of the joint any more (the journal would be flattened by R_j / 10).
+        no model of the joint any more (the journal would be flattened by R_j / 10).  The bound
+        is the same for every law: it does not depend on the clearance, so a conformal law's
+        delta of twice a small clearance (40 um at 20 um, a 30 mm pin under 30 kN: 0.003 R_j) is
+        far inside it; the law's own range of delta / c is a warning (docs/plausibility.md).
     min_step : float
         Step-size collapse, s: the reference engine fails on an accepted step shorter
         than this; the Exudyn engine uses it as the floor of its step reduction after
