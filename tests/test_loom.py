@@ -115,22 +115,46 @@ def test_design_checks_after_a_run_read_revolution_two_on(default_run):
     assert pressure.value == pytest.approx(settled.steps["contact_force_N"].max() / area, rel=1e-12)
 
 
-@pytest.mark.parametrize("clearance_mm", [0.02, 0.25])
-def test_both_engines_agree_on_the_first_revolution(clearance_mm):
-    """`weftsim compare loom` over one revolution, new and worn joint: the first contact and the first
-    revolution's maxima (the reproducible quantities, docs/physics.md section 6) within the scene's
-    [compare] tolerances.  Measured at 600 rpm: 2.6e-5 deg and <= 4.9e-3 (0.02 mm), 3.5e-6 deg and
-    <= 6.7e-3 (0.25 mm)."""
+@pytest.mark.parametrize("speed_rpm, clearance_mm", [(600, 0.02), (300, 0.1), (600, 0.05), (800, 0.25)])
+def test_both_engines_agree_on_the_start_up_impact(speed_rpm, clearance_mm):
+    """`weftsim compare loom` over one revolution: the first contact and the start-up impact's maxima of
+    contact force and rapier acceleration (the reproducible quantities, docs/physics.md section 6) within
+    the scene's [compare] tolerances.  Measured over 300/600/800 rpm x 0.02..0.25 mm: first contact within
+    5.1e-5 deg, maxima within 3.5e-3.
+
+    The driving torque's first-revolution maximum is not among them on the loom: the start-up impact
+    (crank angle 3-6 deg) falls where the spherical crank is near its dead point (phi' = 0.02-0.05, 4-8 %
+    of its largest), so it hardly reaches the crank, and the torque's maximum comes from later impacts
+    (35-56 deg), one draw of the chaotic sequence: 10 of the 12 settings agree within 8e-3, 600 rpm at
+    0.05 mm by 1.6e-2 and 300 rpm at 0.1 mm by 9.9e-2 (docs/physics.md, "The loom mechanism")."""
     from weftsim.compare import agreement_checks
 
-    scene = weftsim.load_scene("loom", clearance_mm=clearance_mm, revolutions=1)
+    scene = weftsim.load_scene("loom", speed_rpm=speed_rpm, clearance_mm=clearance_mm, revolutions=1)
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", weftsim.PlausibilityWarning)  # the worn joint warns; judged elsewhere
+        warnings.simplefilter("ignore", weftsim.PlausibilityWarning)  # worn joints warn; judged elsewhere
         ref = weftsim.simulate(scene, engine="reference")
         exu = weftsim.simulate(scene, engine="exudyn")
     assert ref.ok and exu.ok, (ref.message, exu.message)
+    checks = {c["name"]: c for c in agreement_checks(exu, ref)}
+    wanted = ["first contact crank angle [deg]", "contact_force_N: first revolution max",
+              "rapier_acceleration_m_s2: first revolution max"]
+    failed = [checks[name] for name in wanted if not checks[name]["passed"]]
+    assert not failed, failed
+    # The start-up impact is the first revolution's largest force, near the crank's dead point at 0 deg: the
+    # free flight across the clearance takes 1-5 deg (the larger the clearance, the longer), the impact 1-2.
+    for result in (ref, exu):
+        at = result.steps["crank_angle_deg"][np.argmax(result.steps["contact_force_N"])]
+        assert at < 10.0
+
+
+def test_compare_at_the_defaults_agrees_on_every_check():
+    """`weftsim compare loom` as it runs (2 revolutions, 600 rpm, c = 0.02 mm): every check, the torque's
+    too (measured 4.9e-3 against 0.01)."""
+    from weftsim.compare import agreement_checks
+
+    scene = weftsim.load_scene("loom")
+    ref, exu = weftsim.simulate(scene, engine="reference"), weftsim.simulate(scene, engine="exudyn")
     checks = agreement_checks(exu, ref)
     assert sum("first revolution" in c["name"] for c in checks) == 3
-    assert any("first contact" in c["name"] for c in checks)
     failed = [c for c in checks if not c["passed"]]
     assert not failed, failed
