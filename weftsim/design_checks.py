@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.pin_loads import ideal_pin_loads, sliding_speed
+from weftsim.pin_loads import SAMPLES, ideal_pin_loads, sliding_speed
 from weftsim.plausibility import TRESCA_LINE_CONTACT_YIELD, _yield_strength, joint_view, line_contact_pressure
 
 if TYPE_CHECKING:
@@ -192,7 +192,7 @@ def before_run(scene: Scene) -> list[Check]:
     out = []
     for name in scene.loose_joints:
         out += joint_checks_before(scene, name)
-    theta = np.arange(1440) * (2.0 * np.pi / 1440)  # 0.25 deg, as weftsim.pin_loads.SAMPLES
+    theta = np.arange(SAMPLES) * (2.0 * np.pi / SAMPLES)
     st = linkage_state(theta, scene.geometry, scene.inertia.rocker_com)
     peak = float(np.max(np.abs(st.dd_rapier_displacement))) * scene.drive.speed**2
     out.append(rapier_check(scene, "before", peak))
@@ -289,5 +289,47 @@ def block(result: RunResult, report: dict) -> dict:
 
 
 def before_run_lines(scene: Scene) -> list[str]:
-    """``warning: ...`` per before-run warning of ``scene`` (the command line prints them before the run)."""
-    return [f"warning: {text}" for text in warnings_of(before_run(scene))]
+    """The before-run numbers in one line, then ``warning: ...`` per before-run warning of ``scene`` (the
+    command line prints them before the run)."""
+    checks = before_run(scene)
+    return [summary_line([c.as_dict() for c in checks], "before")] + [f"warning: {t}" for t in warnings_of(checks)]
+
+
+def _limit(check: dict, scale: float, unit: str) -> str:
+    limit = check["limit"]
+    return f" (limit {limit / scale:.4g}{unit})" if limit is not None else " (no limit given)"
+
+
+def _short(check: dict) -> str:
+    """One check's numbers in a few words."""
+    name, value, numbers = check["name"], check["value"], check["numbers"]
+    if name == "reflected_mass":
+        return f"reflected mass {value:.4g} kg peak, {numbers['mean_kg']:.4g} mean"
+    if name == "clearance_ratio":
+        low, high = check["limit"]
+        return f"c/d {1e3 * value:.3g} per mille (design {1e3 * low:g}-{1e3 * high:g})"
+    if name == "pin_pressure":
+        return f"pin pressure {value / 1e6:.4g} MPa peak, {numbers['mean_pa'] / 1e6:.4g} mean" + _limit(check, 1e6, "")
+    if name == "pv":
+        return f"p x v {value / 1e6:.4g} MPa m/s mean" + _limit(check, 1e6, "")
+    if name == "hertz_pressure":
+        limit = check["limit"]
+        return f"Hertz {value / 1e6:.4g} MPa" + (f" (first yield {limit / 1e6:.4g})" if limit is not None
+                                                 else " (no yield strength given)")
+    if name == "penetration":
+        limit = check["limit"]
+        return f"delta/c {value:.3g}" + (f" (law's range {limit:g})" if limit is not None else " (law: no bound)")
+    return f"rapier acceleration {value:.4g} m/s2 peak" + _limit(check, 1.0, "")
+
+
+def summary_line(checks: list[dict], stage: str) -> str:
+    """The numbers of one stage's checks (dicts of :meth:`Check.as_dict`) in one line, grouped by joint."""
+    groups: dict = {}
+    for check in checks:
+        if check["stage"] == stage:
+            groups.setdefault(check["table"], []).append(_short(check))
+    parts = [(f"{table}: " if table else "") + ", ".join(texts) for table, texts in groups.items()]
+    start = max((c["numbers"].get("from_time_s", 0.0) for c in checks if c["stage"] == stage), default=0.0)
+    when = ("before the run (ideal mechanism)" if stage == "before" else
+            f"of the run from t = {start:.4g} s (revolution 2 on)" if start > 0.0 else "of the run")
+    return f"design checks {when}: " + "; ".join(parts)

@@ -42,8 +42,8 @@ import numpy as np
 from weftsim.kinematics import _cross, _normal, _unit, fourbar, linkage_state
 from weftsim.params import Scene
 
-# Crank angles of one revolution the ideal loads are evaluated at: 0.25 deg, where the ideal pin force
-# of the reference mechanism changes by less than 0.1 % between neighbours (its peak converges to 4 digits).
+# Crank angles of one revolution the ideal loads are evaluated at: 0.25 deg apart.  Measured against 0.025 deg:
+# the peak pin force at E within 1e-6 and its mean within 5e-7, on the reference and the loom mechanisms.
 SAMPLES = 1440
 
 
