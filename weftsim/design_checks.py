@@ -3,17 +3,17 @@
 Each check compares one number with a limit and names the scene key to change (docs/plausibility.md
 gives every formula, default and source):
 
-=====================  ===========================================  ==========================================
-check                  value                                        limit (scene key)
-=====================  ===========================================  ==========================================
-``reflected_mass``     m_eff of the chain behind the pin (peak)     none: reported (:mod:`weftsim.pin_loads`)
-``clearance_ratio``    c / d, radial clearance over pin diameter    ``joint_*.design_clearance_per_mille``
-``pin_pressure``       peak projected pressure F / (d L_b)          ``joint_*.bearing_material.max_pressure_mpa``
-``pv``                 cycle mean of p x v, v = R_j |omega_rel|     ``joint_*.bearing_material.max_pv_mpa_m_s``
-``hertz_pressure``     Hertz line-contact pressure at peak force    1.67 x the smaller ``yield_strength_mpa``
-``penetration``        largest delta / c (after the run only)       the law's range (:mod:`weftsim.contact`)
-``rapier_acceleration``  peak |rapier acceleration|                 ``limits.max_rapier_acceleration_m_s2``
-=====================  ===========================================  ==========================================
+=======================  ===========================================  ============================================
+check                    value                                        limit (scene key)
+=======================  ===========================================  ============================================
+``reflected_mass``       m_eff of the chain behind the pin (peak)     none: reported (:mod:`weftsim.pin_loads`)
+``clearance_ratio``      c / d, radial clearance over pin diameter    ``joint_*.design_clearance_per_mille``
+``pin_pressure``         peak projected pressure F / (d L_b)          ``joint_*.bearing_material.max_pressure_mpa``
+``pv``                   cycle mean of p x v, v = R_j abs(omega_rel)  ``joint_*.bearing_material.max_pv_mpa_m_s``
+``hertz_pressure``       Hertz line-contact pressure at peak force    1.67 x the smaller ``yield_strength_mpa``
+``penetration``          largest delta / c (after the run only)       the law's range (:mod:`weftsim.contact`)
+``rapier_acceleration``  peak of abs(rapier acceleration)             ``limits.max_rapier_acceleration_m_s2``
+=======================  ===========================================  ============================================
 
 *Before the run* (:func:`before_run`) the loads come from the ideal mechanism at the scene's speed
 (:func:`weftsim.pin_loads.ideal_pin_loads`): no simulation.  *After the run* (:func:`after_run`) they
@@ -174,7 +174,7 @@ def joint_checks_before(scene: Scene, joint_name: str) -> list[Check]:
 
 
 def rapier_check(scene: Scene, stage: str, peak: float, numbers: dict | None = None) -> Check:
-    """``rapier_acceleration``: ``peak`` |a| (m/s^2) against ``limits.max_rapier_acceleration_m_s2``."""
+    """``rapier_acceleration``: ``peak`` abs(a) (m/s^2) against ``limits.max_rapier_acceleration_m_s2``."""
     limit = scene.limits.max_rapier_acceleration
     key = "limits.max_rapier_acceleration_m_s2"
     verdict = _judge(peak, limit)
