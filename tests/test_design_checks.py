@@ -207,7 +207,11 @@ def test_simulate_reports_the_before_run_warnings_before_it_starts():
         weftsim.simulate(in_range, "reference")
     checks = weftsim.plausibility_checks(scene)
     assert [c["name"] for c in checks] == [c["name"] for c in result.plausibility["checks"] if c["stage"] == "before"]
-    assert before_run_lines(scene) == [f"warning: {c['message']}" for c in checks if c["verdict"] == "warning"]
+    summary, *warned = before_run_lines(scene)
+    assert warned == [f"warning: {c['message']}" for c in checks if c["verdict"] == "warning"]
+    # One line of numbers first: the reflected mass, which no limit judges, is on stderr too.
+    assert summary.startswith("design checks before the run") and "reflected mass 548.6 kg peak" in summary
+    assert "rapier acceleration 1142 m/s2 peak (limit 1000)" in summary
 
 
 # --- Checks after the run --------------------------------------------------------------------

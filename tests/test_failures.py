@@ -384,10 +384,11 @@ def run_cli(*args, cwd=None):
 def _error_lines(stderr: str) -> list[str]:
     """stderr without the progress lines, which any run longer than 2 s prints (weftsim.progress): a
     loaded machine, or numba's start-up when the process first loads a compiled kernel, gets there; and
-    without the plausibility warnings (the reference scene's 0.25 mm clearance on a 20 mm pin is outside
-    a new bushed pin's design range, weftsim.design_checks)."""
+    without the design checks' numbers and the plausibility warnings (the reference scene's 0.25 mm
+    clearance on a 20 mm pin is outside a new bushed pin's design range, weftsim.design_checks)."""
     return [line for line in stderr.strip().splitlines()
-            if not re.search(r"\d%\s+elapsed", line) and not line.startswith("weftsim run: warning: ")]
+            if not re.search(r"\d%\s+elapsed", line) and not line.startswith(("weftsim run: warning: ",
+                                                                                "weftsim run: design checks "))]
 
 
 def write_scene(path: Path, body: str) -> Path:

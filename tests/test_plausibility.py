@@ -249,8 +249,8 @@ def test_run_fails_with_exit_3_on_a_plausibility_defect_and_keeps_its_results(tm
     """limits.max_damping_ratio = 0.5 < 1: every impact's onset (delta_dot = v_imp) crosses it."""
     done, written = run_reference(tmp_path, "[drive]\nrevolutions = 0.05\n[limits]\nmax_damping_ratio = 0.5\n")
     assert done.returncode == 3, done.stderr
-    errors = [line for line in done.stderr.splitlines()
-              if line.startswith("weftsim run:") and not line.startswith("weftsim run: warning:")]
+    errors = [line for line in done.stderr.splitlines() if line.startswith("weftsim run:")
+              and not line.startswith(("weftsim run: warning:", "weftsim run: design checks "))]
     assert len(errors) == 1 and "limits.max_damping_ratio = 0.5" in errors[0] and "crank angle" in errors[0]
     assert written["status"] == "failed" and written["plausibility"]["damping_steps"] > 0
     assert written["simulated_time_s"] == pytest.approx(0.05 * 60.0 / 400.0)

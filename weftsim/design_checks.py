@@ -3,17 +3,17 @@
 Each check compares one number with a limit and names the scene key to change (docs/plausibility.md
 gives every formula, default and source):
 
-=====================  ===========================================  ==========================================
-check                  value                                        limit (scene key)
-=====================  ===========================================  ==========================================
-``reflected_mass``     m_eff of the chain behind the pin (peak)     none: reported (:mod:`weftsim.pin_loads`)
-``clearance_ratio``    c / d, radial clearance over pin diameter    ``joint_*.design_clearance_per_mille``
-``pin_pressure``       peak projected pressure F / (d L_b)          ``joint_*.bearing_material.max_pressure_mpa``
-``pv``                 cycle mean of p x v, v = R_j |omega_rel|     ``joint_*.bearing_material.max_pv_mpa_m_s``
-``hertz_pressure``     Hertz line-contact pressure at peak force    1.67 x the smaller ``yield_strength_mpa``
-``penetration``        largest delta / c (after the run only)       the law's range (:mod:`weftsim.contact`)
-``rapier_acceleration``  peak |rapier acceleration|                 ``limits.max_rapier_acceleration_m_s2``
-=====================  ===========================================  ==========================================
+=======================  ===========================================  ============================================
+check                    value                                        limit (scene key)
+=======================  ===========================================  ============================================
+``reflected_mass``       m_eff of the chain behind the pin (peak)     none: reported (:mod:`weftsim.pin_loads`)
+``clearance_ratio``      c / d, radial clearance over pin diameter    ``joint_*.design_clearance_per_mille``
+``pin_pressure``         peak projected pressure F / (d L_b)          ``joint_*.bearing_material.max_pressure_mpa``
+``pv``                   cycle mean of p x v, v = R_j abs(omega_rel)  ``joint_*.bearing_material.max_pv_mpa_m_s``
+``hertz_pressure``       Hertz line-contact pressure at peak force    1.67 x the smaller ``yield_strength_mpa``
+``penetration``          largest delta / c (after the run only)       the law's range (:mod:`weftsim.contact`)
+``rapier_acceleration``  peak of abs(rapier acceleration)             ``limits.max_rapier_acceleration_m_s2``
+=======================  ===========================================  ============================================
 
 *Before the run* (:func:`before_run`) the loads come from the ideal mechanism at the scene's speed
 (:func:`weftsim.pin_loads.ideal_pin_loads`): no simulation.  *After the run* (:func:`after_run`) they
@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.pin_loads import ideal_pin_loads, sliding_speed
+from weftsim.pin_loads import SAMPLES, ideal_pin_loads, sliding_speed
 from weftsim.plausibility import TRESCA_LINE_CONTACT_YIELD, _yield_strength, joint_view, line_contact_pressure
 
 if TYPE_CHECKING:
@@ -174,7 +174,7 @@ def joint_checks_before(scene: Scene, joint_name: str) -> list[Check]:
 
 
 def rapier_check(scene: Scene, stage: str, peak: float, numbers: dict | None = None) -> Check:
-    """``rapier_acceleration``: ``peak`` |a| (m/s^2) against ``limits.max_rapier_acceleration_m_s2``."""
+    """``rapier_acceleration``: ``peak`` abs(a) (m/s^2) against ``limits.max_rapier_acceleration_m_s2``."""
     limit = scene.limits.max_rapier_acceleration
     key = "limits.max_rapier_acceleration_m_s2"
     verdict = _judge(peak, limit)
@@ -192,7 +192,7 @@ def before_run(scene: Scene) -> list[Check]:
     out = []
     for name in scene.loose_joints:
         out += joint_checks_before(scene, name)
-    theta = np.arange(1440) * (2.0 * np.pi / 1440)  # 0.25 deg, as weftsim.pin_loads.SAMPLES
+    theta = np.arange(SAMPLES) * (2.0 * np.pi / SAMPLES)
     st = linkage_state(theta, scene.geometry, scene.inertia.rocker_com)
     peak = float(np.max(np.abs(st.dd_rapier_displacement))) * scene.drive.speed**2
     out.append(rapier_check(scene, "before", peak))
@@ -289,5 +289,47 @@ def block(result: RunResult, report: dict) -> dict:
 
 
 def before_run_lines(scene: Scene) -> list[str]:
-    """``warning: ...`` per before-run warning of ``scene`` (the command line prints them before the run)."""
-    return [f"warning: {text}" for text in warnings_of(before_run(scene))]
+    """The before-run numbers in one line, then ``warning: ...`` per before-run warning of ``scene`` (the
+    command line prints them before the run)."""
+    checks = before_run(scene)
+    return [summary_line([c.as_dict() for c in checks], "before")] + [f"warning: {t}" for t in warnings_of(checks)]
+
+
+def _limit(check: dict, scale: float, unit: str) -> str:
+    limit = check["limit"]
+    return f" (limit {limit / scale:.4g}{unit})" if limit is not None else " (no limit given)"
+
+
+def _short(check: dict) -> str:
+    """One check's numbers in a few words."""
+    name, value, numbers = check["name"], check["value"], check["numbers"]
+    if name == "reflected_mass":
+        return f"reflected mass {value:.4g} kg peak, {numbers['mean_kg']:.4g} mean"
+    if name == "clearance_ratio":
+        low, high = check["limit"]
+        return f"c/d {1e3 * value:.3g} per mille (design {1e3 * low:g}-{1e3 * high:g})"
+    if name == "pin_pressure":
+        return f"pin pressure {value / 1e6:.4g} MPa peak, {numbers['mean_pa'] / 1e6:.4g} mean" + _limit(check, 1e6, "")
+    if name == "pv":
+        return f"p x v {value / 1e6:.4g} MPa m/s mean" + _limit(check, 1e6, "")
+    if name == "hertz_pressure":
+        limit = check["limit"]
+        return f"Hertz {value / 1e6:.4g} MPa" + (f" (first yield {limit / 1e6:.4g})" if limit is not None
+                                                 else " (no yield strength given)")
+    if name == "penetration":
+        limit = check["limit"]
+        return f"delta/c {value:.3g}" + (f" (law's range {limit:g})" if limit is not None else " (law: no bound)")
+    return f"rapier acceleration {value:.4g} m/s2 peak" + _limit(check, 1.0, "")
+
+
+def summary_line(checks: list[dict], stage: str) -> str:
+    """The numbers of one stage's checks (dicts of :meth:`Check.as_dict`) in one line, grouped by joint."""
+    groups: dict = {}
+    for check in checks:
+        if check["stage"] == stage:
+            groups.setdefault(check["table"], []).append(_short(check))
+    parts = [(f"{table}: " if table else "") + ", ".join(texts) for table, texts in groups.items()]
+    start = max((c["numbers"].get("from_time_s", 0.0) for c in checks if c["stage"] == stage), default=0.0)
+    when = ("before the run (ideal mechanism)" if stage == "before" else
+            f"of the run from t = {start:.4g} s (revolution 2 on)" if start > 0.0 else "of the run")
+    return f"design checks {when}: " + "; ".join(parts)

@@ -29,7 +29,7 @@ With d = F - E and the force F_s of the rod on the sector, F_s = F_t n(theta_FG)
 
 Power balance F_E . v_E = dT/dt + m4 g v_C4,z holds exactly (tests/test_design_checks.py).
 
-**Sliding speed.**  The pin surface slides at R_j |omega_rel|: at E the rod turns against the
+**Sliding speed.**  The pin surface slides at R_j abs(omega_rel): at E the rod turns against the
 rocker (omega_EF - omega_OE), at F against the sector (omega_EF - omega_FG).
 """
 
@@ -42,8 +42,8 @@ import numpy as np
 from weftsim.kinematics import _cross, _normal, _unit, fourbar, linkage_state
 from weftsim.params import Scene
 
-# Crank angles of one revolution the ideal loads are evaluated at: 0.25 deg, where the ideal pin force
-# of the reference mechanism changes by less than 0.1 % between neighbours (its peak converges to 4 digits).
+# Crank angles of one revolution the ideal loads are evaluated at: 0.25 deg apart.  Measured against 0.025 deg:
+# the peak pin force at E within 1e-6 and its mean within 5e-7, on the reference and the loom mechanisms.
 SAMPLES = 1440
 
 
@@ -80,7 +80,7 @@ class PinLoads:
     force : ndarray
         Magnitude of the pin force, N.
     sliding_speed : ndarray
-        R_j |omega_rel| at the pin surface, m/s.
+        R_j abs(omega_rel) at the pin surface, m/s.
     reflected_mass : ndarray
         m_eff of the chain behind the pin, kg.
     """
@@ -124,7 +124,7 @@ def ideal_pin_loads(scene: Scene, joint: str, samples: int = SAMPLES) -> PinLoad
 
 
 def sliding_speed(theta: np.ndarray, scene: Scene, joint: str, radius: float) -> np.ndarray:
-    """R_j |omega_rel| of the ideal mechanism at crank angles ``theta``, m/s: rod against rocker at E,
+    """R_j abs(omega_rel) of the ideal mechanism at crank angles ``theta``, m/s: rod against rocker at E,
     rod against sector at F."""
     st = linkage_state(theta, scene.geometry, scene.inertia.rocker_com)
     other = st.d_phi if joint == "e" else st.d_theta_fg

@@ -376,8 +376,8 @@ def first_defect_row(result: RunResult, report: Plausibility) -> int:
 
 
 def format_lines(result: RunResult) -> list[str]:
-    """The counts line and one ``warning:`` line per validity warning and per after-run design-check warning
-    of a result's report (stderr; :mod:`weftsim.design_checks`)."""
+    """The counts line, the after-run design checks' numbers (:mod:`weftsim.design_checks`), and one
+    ``warning:`` line per validity warning and per after-run design-check warning (stderr)."""
     block = result.plausibility
     if not block:
         return []
@@ -386,6 +386,10 @@ def format_lines(result: RunResult) -> list[str]:
         names = {f.name for f in fields(Plausibility)}
         report = Plausibility(**{k: v if k != "warnings" else tuple(v) for k, v in block.items() if k in names})
         lines.append(report.summary_line())
+    if block.get("checks"):
+        from weftsim.design_checks import summary_line
+
+        lines.append(summary_line(block["checks"], "after"))
     return lines + [f"warning: {text}" for text in block.get("warnings", [])]
 
 
