@@ -276,3 +276,10 @@ def test_a_run_of_two_revolutions_is_judged_on_its_second_and_the_law_on_the_who
     assert hertz.numbers["peak_force_n"] == run.steps["contact_force_N"].max()
     assert hertz.value == run.plausibility["peak_pressure_pa"]  # the same number plausibility.assess judges
     assert checks[("joint_e", "penetration")].value == run.plausibility["max_penetration_ratio"]
+
+
+def test_a_warning_of_a_run_shorter_than_two_revolutions_says_the_start_up_impact_counts(run):
+    """The tenth of a revolution holds the start-up impact only: the warning says so and names drive.revolutions."""
+    (check,) = [c for c in after_run(with_scene(run, {"limits.max_rapier_acceleration_m_s2": 3000.0}))
+                if c.name == "rapier_acceleration"]
+    assert check.verdict == "warning" and "start-up impact" in check.message and "drive.revolutions" in check.message

@@ -109,7 +109,7 @@ def _pin(table: str, joint) -> str:
 
 def pressure_checks(stage: str, table: str, joint, force_peak: float, force_mean: float, pv_mean: float,
                     pv_peak: float, speed_peak: float, hertz_force: float | None = None,
-                    numbers: dict | None = None) -> list[Check]:
+                    numbers: dict | None = None, note: str = "") -> list[Check]:
     """``pin_pressure``, ``pv`` and ``hertz_pressure`` of one pin's loads (the Hertz pressure of
     ``hertz_force``, default ``force_peak``); ``numbers`` are added to the first two checks' numbers."""
     numbers = numbers or {}
@@ -123,7 +123,7 @@ def pressure_checks(stage: str, table: str, joint, force_peak: float, force_mean
     message = "" if verdict != "warning" else (
         f"{table}: {_when(stage)} presses {_pin(table, joint)} with up to {p_peak / 1e6:.4g} MPa of projected "
         f"pressure F/(d B) (peak force {force_peak / 1e3:.4g} kN), above the bushing's {key} = "
-        f"{material.max_pressure / 1e6:g}: a larger pin or a lighter chain behind it")
+        f"{material.max_pressure / 1e6:g}: a larger pin or a lighter chain behind it{note}")
     out.append(Check("pin_pressure", stage, table, p_peak, material.max_pressure, "Pa", key, verdict,
                      {"mean_pa": p_mean, "peak_force_n": force_peak, "mean_force_n": force_mean, **numbers}, message))
     key = f"{table}.bearing_material.max_pv_mpa_m_s"
@@ -132,7 +132,7 @@ def pressure_checks(stage: str, table: str, joint, force_peak: float, force_mean
         f"{table}: in {_when(stage)} the pin's p x v averages {pv_mean / 1e6:.4g} MPa m/s over a revolution (peak "
         f"{pv_peak / 1e6:.4g}, sliding speed up to {speed_peak:.3g} m/s), above the bushing's {key} = "
         f"{material.max_pv / 1e6:g}: a larger pin ({table}.bearing_length_mm), a slower drive (drive.speed_rpm) "
-        "or a bushing rated higher")
+        f"or a bushing rated higher{note}")
     out.append(Check("pv", stage, table, pv_mean, material.max_pv, "Pa m/s", key, verdict,
                      {"peak_pa_m_s": pv_peak, "peak_sliding_speed_m_s": speed_peak, **numbers}, message))
     strength = _yield_strength(joint)
@@ -173,7 +173,7 @@ def joint_checks_before(scene: Scene, joint_name: str) -> list[Check]:
     return out
 
 
-def rapier_check(scene: Scene, stage: str, peak: float, numbers: dict | None = None) -> Check:
+def rapier_check(scene: Scene, stage: str, peak: float, numbers: dict | None = None, note: str = "") -> Check:
     """``rapier_acceleration``: ``peak`` abs(a) (m/s^2) against ``limits.max_rapier_acceleration_m_s2``."""
     limit = scene.limits.max_rapier_acceleration
     key = "limits.max_rapier_acceleration_m_s2"
@@ -181,7 +181,8 @@ def rapier_check(scene: Scene, stage: str, peak: float, numbers: dict | None = N
     message = "" if verdict != "warning" else (
         f"the rapier's acceleration in {_when(stage)} peaks at {peak:.4g} m/s2, above what rapier heads are built "
         f"for ({key} = {limit:g}): a lower drive.speed_rpm, a longer insertion (mechanism) " + (
-            "or a smaller clearance (the impacts' spikes)" if stage == "after" else "or a rapier head rated higher"))
+            "or a smaller clearance (the impacts' spikes)" if stage == "after" else "or a rapier head rated higher")
+        + note)
     return Check("rapier_acceleration", stage, None, peak, limit, "m/s2", key, verdict, dict(numbers or {}), message)
 
 
@@ -197,6 +198,11 @@ def before_run(scene: Scene) -> list[Check]:
     peak = float(np.max(np.abs(st.dd_rapier_displacement))) * scene.drive.speed**2
     out.append(rapier_check(scene, "before", peak))
     return out
+
+
+# Said after an after-run warning of a run shorter than two revolutions, whose loads include the start-up.
+STARTUP_NOTE = ("; the run is shorter than two revolutions, so the start-up impact of the centred journal in "
+                "revolution 1 counts (drive.revolutions = 2 or more judges the running machine)")
 
 
 def running(result: RunResult) -> RunResult:
@@ -238,6 +244,7 @@ def after_run(result: RunResult) -> list[Check]:
     if result.steps["time_s"].size == 0:
         return out
     window = {"from_time_s": float(result.steps["time_s"][0])}
+    note = "" if result is not full or not scene.loose_joints else STARTUP_NOTE
     for name in scene.loose_joints:
         table = f"joint_{name}"
         joint_scene, steps = joint_view(result, name)
@@ -254,14 +261,14 @@ def after_run(result: RunResult) -> list[Check]:
         out += pressure_checks("after", table, joint, float(force_steps.max()), float(force_samples.mean()),
                                float(np.mean(force_samples * v_samples)) / area,
                                float(np.max(force_steps * v_steps)) / area, float(v_steps.max()),
-                               hertz_force=float(np.max(whole["contact_force_N"])), numbers=window)
+                               hertz_force=float(np.max(whole["contact_force_N"])), numbers=window, note=note)
         law = make_law(joint)
         ratio = max(float(np.max(whole["penetration_m"])), 0.0) / joint.clearance
         bound = law.valid_penetration_ratio
         out.append(Check("penetration", "after", table, ratio, bound, "1", f"{table}.law", _judge(ratio, bound),
                          {}, ""))
     peak = float(np.max(np.abs(result.steps["rapier_acceleration_m_s2"])))
-    out.append(rapier_check(scene, "after", peak, window))
+    out.append(rapier_check(scene, "after", peak, window, note))
     return out
 
 
