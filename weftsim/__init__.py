@@ -33,9 +33,8 @@ Example::
         table = weftsim.simulate(scene, engine).to_pandas()
 """
 
-__version__ = "0.1.0"
-
-from weftsim.api import (  # noqa: E402 (after __version__, which submodules read)
+from weftsim.version import __version__
+from weftsim.api import (
     DEFAULT_ENGINE,
     ENGINE_NAMES,
     bundled_scenes,

@@ -357,7 +357,7 @@ def _interrupted_line(result, outdir: Path, signum: int) -> str:
 def cmd_run(args: argparse.Namespace) -> int:
     from weftsim.api import resolve_engine
     from weftsim.output import prepare_directory, write_run
-    from weftsim.plausibility import report_lines
+    from weftsim.design_checks import report_lines
 
     scene = scene_from_args(args)
     engine = resolve_engine(args.engine)

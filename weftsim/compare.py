@@ -206,7 +206,7 @@ def run_compare(scene: Scene, outdir: str | Path, solve: Callable[[Scene, str], 
     Returns the report (:func:`compare_results`), the exit status and the line saying why it is
     not 0 (:func:`verdict`); the caller prints them.
     """
-    from weftsim.plausibility import report_lines
+    from weftsim.design_checks import report_lines
     from weftsim.output import prepare_directory, write_files, write_json, write_run
 
     outdir = prepare_directory(outdir, force)

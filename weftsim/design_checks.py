@@ -30,13 +30,20 @@ limit the scene does not give has the verdict ``"no_limit"``; the reflected mass
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import sys
+from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from weftsim.pin_loads import SAMPLES, ideal_pin_loads, sliding_speed
-from weftsim.plausibility import TRESCA_LINE_CONTACT_YIELD, _yield_strength, joint_view, line_contact_pressure
+from weftsim.plausibility import (
+    TRESCA_LINE_CONTACT_YIELD,
+    Plausibility,
+    _yield_strength,
+    joint_view,
+    line_contact_pressure,
+)
 
 if TYPE_CHECKING:
     from weftsim.params import Scene
@@ -340,3 +347,30 @@ def summary_line(checks: list[dict], stage: str) -> str:
     when = ("before the run (ideal mechanism)" if stage == "before" else
             f"of the run from t = {start:.4g} s (revolution 2 on)" if start > 0.0 else "of the run")
     return f"design checks {when}: " + "; ".join(parts)
+
+
+def format_lines(result: RunResult) -> list[str]:
+    """The counts line, the after-run design checks' numbers (:mod:`weftsim.design_checks`), and one
+    ``warning:`` line per validity warning and per after-run design-check warning (stderr)."""
+    block = result.plausibility
+    if not block:
+        return []
+    lines = []
+    if "onsets" in block:  # a mechanism with a clearance joint: the contact-history counts
+        names = {f.name for f in fields(Plausibility)}
+        report = Plausibility(**{k: v if k != "warnings" else tuple(v) for k, v in block.items() if k in names})
+        lines.append(report.summary_line())
+    if block.get("checks"):
+        lines.append(summary_line(block["checks"], "after"))
+    return lines + [f"warning: {text}" for text in block.get("warnings", [])]
+
+
+def report_lines(result: RunResult, label: str) -> None:
+    """The plausibility counts (:mod:`weftsim.plausibility`), the after-run design checks' numbers and each
+    warning of a finished run, one line each on stderr (``weftsim <label>: ...``; once per run, where its
+    results are written).  A failed run says
+    only why it failed (its summary.json still holds the block)."""
+    if not result.ok:
+        return
+    for line in format_lines(result):
+        print(f"weftsim {label}: {line}", file=sys.stderr)

@@ -12,12 +12,9 @@ package), so code written against those keeps working.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from weftsim.exitcodes import EXIT_FAILED, EXIT_USAGE
-
-if TYPE_CHECKING:
-    from weftsim.results import RunResult
 
 
 class WeftsimError(Exception):
@@ -46,11 +43,16 @@ class WriteFailed(OutputError):
 
 
 class RunFailed(WeftsimError, RuntimeError):
-    """A simulation ended with ``status = "failed"``; :attr:`result` keeps what it computed."""
+    """A simulation ended with ``status = "failed"``; :attr:`result` keeps what it computed (a
+    :class:`weftsim.results.RunResult`, or None).
+
+    The attribute is typed loosely on purpose: this module is the bottom of weftsim's imports (every
+    module raises these errors, :mod:`weftsim.results` among them), so it names no module above it.
+    """
 
     exit_status = EXIT_FAILED
 
-    def __init__(self, message: str, result: RunResult | None = None) -> None:
+    def __init__(self, message: str, result: Any = None) -> None:
         super().__init__(message)
         self.result = result
 

@@ -53,8 +53,7 @@ correct integration of the model produces.
 from __future__ import annotations
 
 import math
-import sys
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -373,31 +372,3 @@ def first_defect_row(result: RunResult, report: Plausibility) -> int:
         negative = np.flatnonzero(mode & (np.asarray(steps["penetration_m"]) < -report.roundoff_m))
         rows.extend(negative[:1].tolist())
     return min(rows) if rows else 0
-
-
-def format_lines(result: RunResult) -> list[str]:
-    """The counts line, the after-run design checks' numbers (:mod:`weftsim.design_checks`), and one
-    ``warning:`` line per validity warning and per after-run design-check warning (stderr)."""
-    block = result.plausibility
-    if not block:
-        return []
-    lines = []
-    if "onsets" in block:  # a mechanism with a clearance joint: the contact-history counts
-        names = {f.name for f in fields(Plausibility)}
-        report = Plausibility(**{k: v if k != "warnings" else tuple(v) for k, v in block.items() if k in names})
-        lines.append(report.summary_line())
-    if block.get("checks"):
-        from weftsim.design_checks import summary_line
-
-        lines.append(summary_line(block["checks"], "after"))
-    return lines + [f"warning: {text}" for text in block.get("warnings", [])]
-
-
-def report_lines(result: RunResult, label: str) -> None:
-    """The plausibility counts and each validity warning of a finished run, one line each on stderr
-    (``weftsim <label>: ...``; once per run, where its results are written).  A failed run says
-    only why it failed (its summary.json still holds the block)."""
-    if not result.ok:
-        return
-    for line in format_lines(result):
-        print(f"weftsim {label}: {line}", file=sys.stderr)

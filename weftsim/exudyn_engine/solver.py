@@ -24,7 +24,14 @@ import exudyn as exu
 from weftsim.exudyn_engine.callbacks import route_error
 from weftsim.exudyn_engine.clearance_joint import register_post_step
 from weftsim.exudyn_engine.mechanism import build_mechanism
-from weftsim.exudyn_engine.selection import select_model, select_path
+from weftsim.exudyn_engine.selection import (  # noqa: F401 (IDEAL_JOINT_STEP_ANGLE, requested_step: re-exported)
+    IDEAL_JOINT_STEP_ANGLE,
+    adaptive,
+    requested_step,
+    select_model,
+    select_path,
+    step_plan,
+)
 from weftsim.exudyn_engine.step_control import StepController
 from weftsim.exudyn_engine.sensors import add_sensors, first_nonfinite_row, sample_channels, silence, step_channels
 from weftsim.guards import RunGuard, failure_message, non_finite_breach, vet_result
@@ -41,16 +48,6 @@ MODELS = ("auto", "rigid_body", "kinematic_tree")  # auto: selection.py; kinemat
 # at the same tolerance (2: 2.97 iterations but 4x the Jacobians, slower).
 MODIFIED_NEWTON_ITERATIONS = 3
 _PROGRESS_CALLS = 1000  # every 0.1 % of the run: a long run shows its first line soon (issue 16)
-# Step of the ideal joint, as crank angle.  The ideal mechanism has no free coordinate: its motion
-# is a function of theta = omega t alone, so the error of the ideal curves against the closed form
-# (largest difference at a sample / peak, reference mechanism, 2 revolutions) depends on the crank
-# angle of the step and not on the speed; measured identical at 400 and 800 rpm: 0.8-1.0e-6 at
-# 0.05 deg, 1.5-1.7e-6 at 0.1 deg, 1.0e-5 at 0.25 deg, 6.3e-5 at 0.5 deg (rapier acceleration; the
-# torque 4.0e-6 and 1.6e-5).  Truncation of the second-order method grows as ~(omega h)^2.7 here;
-# below 0.05 deg the round-off of the constraint reactions (~1/h^2) takes over.  0.5 deg, the
-# largest output spacing (a step must end on every sample), stays within the compare tolerance of
-# 1e-4 but only by 1.6x; 0.25 deg keeps 10x below it at 5x fewer steps than 0.05 deg.
-IDEAL_JOINT_STEP_ANGLE = math.radians(0.25)
 
 
 def check_settings(scene: Scene) -> str | None:
@@ -97,29 +94,6 @@ def check_settings(scene: Scene) -> str | None:
     return None
 
 
-def requested_step(scene: Scene) -> float:
-    """The fixed step to aim for, s: the scene's, or with the ideal joint :data:`IDEAL_JOINT_STEP_ANGLE`.
-
-    A scene's step is chosen to resolve impacts (about 2e-6 s).  With an ideal joint there is none,
-    and such a step only adds round-off: the constraint reactions of generalized-alpha carry an error
-    growing as 1/h^2, 9e-5 of the peak driving torque at 2e-6 s against 1e-5 at the ideal step.
-    Under ``step_control = "fixed"`` the scene's step is taken as it is, ideal joint or not.
-    """
-    step = scene.exudyn_solver.step_size
-    if scene.is_ideal and scene.exudyn_solver.step_control == "adaptive":
-        step = max(step, IDEAL_JOINT_STEP_ANGLE / scene.drive.speed)
-    return step
-
-
-def step_plan(scene: Scene) -> tuple[float, int]:
-    """(step size, number of steps): :func:`requested_step` shortened to divide the sample period."""
-    omega, t_end = scene.drive.speed, scene.drive.end_time
-    sample_dt = scene.output.sample_angle / omega
-    per_sample = max(1, math.ceil(sample_dt / requested_step(scene) * (1.0 - 1e-12)))
-    n_steps = max(1, round(t_end / (sample_dt / per_sample)))
-    return t_end / n_steps, n_steps
-
-
 def simulation_settings(scene: Scene, n_steps: int) -> exu.SimulationSettings:
     """Exudyn settings: generalized-alpha from ``scene.exudyn_solver``, no files, no console output."""
     s = scene.exudyn_solver
@@ -153,13 +127,6 @@ def simulation_settings(scene: Scene, n_steps: int) -> exu.SimulationSettings:
         ti.adaptiveStepRecoverySteps = 2**30
     silence(ss)
     return ss
-
-
-def adaptive(scene: Scene) -> bool:
-    """True when the step is error-controlled (:mod:`.step_control`): a clearance joint under
-    ``step_control = "adaptive"``.  The ideal joint always takes the fixed step of :func:`step_plan`
-    (nothing but the prescribed kinematics to follow; :data:`IDEAL_JOINT_STEP_ANGLE`)."""
-    return scene.exudyn_solver.step_control == "adaptive" and not scene.is_ideal
 
 
 def _failed(scene: Scene, message: str, wall: float) -> RunResult:

@@ -26,7 +26,7 @@ from pathlib import Path
 from typing import Any
 from typing import TYPE_CHECKING
 
-from weftsim import __version__
+from weftsim.version import __version__
 
 if TYPE_CHECKING:
     from weftsim.results import RunResult

@@ -24,7 +24,7 @@ import json
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from weftsim import __version__
+from weftsim.version import __version__
 from weftsim.sweep.cell import METRIC_CHANNELS, finite_or_none, read_record
 from weftsim.sweep.grid import Axis, SweepError, format_value
 from weftsim.sweep.lock import LOCK_FILE
