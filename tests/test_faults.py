@@ -151,7 +151,7 @@ def test_disk_full_on_a_real_tmpfs_keeps_what_was_computed(tmp_path):
     assert int((tmp_path / "rc.txt").read_text()) == EXIT_FAILED
     last = error_line((tmp_path / "stderr.txt").read_text())
     assert "cannot write channels.png, orbit.png, result.npz" in last and "No space left on device" in last, last
-    assert "channels.csv, summary.json written there" in last and "kept in" in last, last
+    assert "channels.csv, scene.toml, summary.json written there" in last and "kept in" in last, last
     manifest = json.loads((copy / MANIFEST).read_text())
     assert manifest["state"] == "incomplete" and manifest["files"] == ["channels.csv", "summary.json"]
     assert manifest["missing"] == {"channels.png": "No space left on device", "orbit.png": "No space left on device",
@@ -185,8 +185,8 @@ class FullDisk:
 
 
 @pytest.mark.parametrize("command, files", [
-    ("run", ["channels.csv", "channels.png", "orbit.png", "result.npz", "summary.json"]),
-    ("kinematics", ["kinematics.csv", "kinematics.png"]),
+    ("run", ["channels.csv", "channels.png", "orbit.png", "result.npz", "scene.toml", "summary.json"]),
+    ("kinematics", ["kinematics.csv", "kinematics.png", "scene.toml"]),
 ])  # fmt: skip
 def test_disk_full_rescues_every_file_and_marks_the_manifest(tmp_path, monkeypatch, capsys, command, files):
     """The disk is full right after the manifest was opened: not even the manifest's last update

@@ -17,7 +17,6 @@ message is the line the command line prints.
 
 from __future__ import annotations
 
-import difflib
 import os
 import warnings
 from collections.abc import Mapping
@@ -25,7 +24,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import TYPE_CHECKING, Any, Callable
 
-from weftsim.errors import EngineError, PlausibilityWarning, RunFailed, SceneError
+from weftsim.errors import EngineError, PlausibilityWarning, RunFailed, SceneError, closest
 from weftsim.params import Scene
 from weftsim.results import RunResult
 
@@ -58,8 +57,8 @@ def scene_overrides(overrides: Mapping[str, Any] | None = None, where: str = "ov
     for flag, value in flags.items():
         key = SCENE_FLAGS.get(flag)
         if key is None:
-            near = difflib.get_close_matches(flag, list(SCENE_FLAGS), n=1)
-            mean = f"did you mean {near[0]}? " if near else ""
+            near = closest(flag, SCENE_FLAGS)
+            mean = f"did you mean {near}? " if near else ""
             raise SceneError(f"{where}: unknown scene flag {flag!r}; {mean}the flags are {', '.join(SCENE_FLAGS)}; "
                              "set any other key with overrides={'section.key': value}")
         if value is None:
@@ -121,7 +120,9 @@ def resolve_engine(engine: str) -> str:
     if engine == "auto":
         return DEFAULT_ENGINE
     if engine not in ENGINE_NAMES:
-        raise EngineError(f"engine must be one of {', '.join(ENGINE_NAMES)}, got {engine!r}")
+        near = closest(engine, ENGINE_NAMES) if isinstance(engine, str) else None
+        raise EngineError(f"engine must be one of {', '.join(ENGINE_NAMES)}, got {engine!r}"
+                          + (f"; did you mean {near}?" if near else ""))
     return engine
 
 

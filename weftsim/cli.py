@@ -41,6 +41,7 @@ from weftsim.cli_grammar import (  # noqa: F401 (CliError, add_scene_flags, scen
     shorthand_values,
 )
 from weftsim.errors import WeftsimError
+from weftsim.record import set_command
 from weftsim.exitcodes import EXIT_DISAGREE, EXIT_FAILED, EXIT_USAGE  # noqa: F401 (re-exported)
 
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a command stopped by Ctrl-C
@@ -80,6 +81,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="animation file, .gif (or .mp4 with ffmpeg) (default: out/<scene name>/<engine>/animation.gif)")
     p.add_argument("--engine", default="auto", choices=ENGINE_CHOICES, help="as for run")
     p.add_argument("--frames", type=positive(int), default=72, help="frames over the revolution (default 72)")
+    p.add_argument("--force", action="store_true",
+                   help="write the animation into a directory that holds the results of another scene")
     p.add_argument("--viewer", action="store_true",
                    help="instead of the GIF, replay the run in Exudyn's own viewer (needs a display): the rigid-body "
                    "model is solved over the scene's revolutions, its coordinates stored in a solution file "
@@ -115,10 +118,15 @@ def build_parser() -> argparse.ArgumentParser:
                        "speed (Fig. 13, with the acceleration spectrum), engines (Fig. 16), or all of them.  "
                        "Each study sets its own scenes; --set and the shorthands apply to every run of it, "
                        "except what the study sets itself (the clearance of 'clearance', the speed of 'speed', "
-                       "the speed and clearance of 'contact-law': refused).")
+                       "the speed and clearance of 'contact-law': refused).  With SCENE each case runs on that "
+                       "scene (e.g. 'weftsim study clearance loom': the loom at c = 0 (ideal), 0.01, 0.25, 0.50 mm).")
     p.add_argument("name", help="contact-law, clearance, speed, engines or all")
+    p.add_argument("scene", nargs="?", default=None,
+                   help="the scene to run the study's cases on: a scene file (TOML) or the name of a bundled scene "
+                   "(default: the paper's reference scene and its cases in models/paper)")
     p.add_argument("-o", "--output", default=None,
-                   help="output directory (default: out/study-NAME; with 'all': parent of one directory per study)")
+                   help="output directory (default: out/study-NAME, with SCENE out/<scene name>/study-NAME; with "
+                   "'all': parent of one directory per study)")
     p.add_argument("--models", default=None,
                    help="directory of the scene files (default: the bundled scenes, 'weftsim scenes')")
     add_scene_flags(p, positional=False)
@@ -266,7 +274,7 @@ def cmd_kinematics(args: argparse.Namespace) -> int:
     check_output_fits(rows, len(KINEMATICS_COLUMNS), outdir,
                       f"output.sample_deg = {math.degrees(step):g} over one revolution",
                       fix="a coarser output.sample_deg (any value up to 0.5 deg)")
-    outdir = prepare_directory(outdir, args.force)
+    outdir = prepare_directory(outdir, args.force, scene)
     theta = np.linspace(0.0, 2.0 * math.pi, rows)
     state = linkage_state(theta, scene.geometry, scene.inertia.rocker_com)
     w = scene.drive.speed
@@ -288,7 +296,7 @@ def cmd_kinematics(args: argparse.Namespace) -> int:
         "png": ("kinematics.png", lambda target: write_figure(target, plot_kinematics(
             columns["crank_angle_deg"], columns["rapier_displacement_m"], columns["rapier_velocity_m_s"],
             columns["rapier_acceleration_m_s2"], title))),
-    })
+    }, scene=scene)
     csv, png = written["csv"], written["png"]
     s, v, a = columns["rapier_displacement_m"], columns["rapier_velocity_m_s"], columns["rapier_acceleration_m_s2"]
     print(f"scene {scene.name}: {rpm:g} rpm, ideal joints")
@@ -363,7 +371,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     engine = resolve_engine(args.engine)
     outdir = output_directory(args, scene, engine)
     _check_fits(scene, outdir)
-    outdir = prepare_directory(outdir, args.force)
+    outdir = prepare_directory(outdir, args.force, scene)
     _announce_run_time(scene, (engine,), "run")
     _announce_checks(scene, "run")
     with _stop_on_interrupt("run") as stop:
@@ -380,8 +388,9 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def cmd_animate(args: argparse.Namespace) -> int:
-    from weftsim.animate import check_format, write_animation
+    from weftsim.animate import animated_window, check_format, write_animation
     from weftsim.api import resolve_engine
+    from weftsim.record import check_same_scene
 
     scene = scene_from_args(args)
     engine = resolve_engine(args.engine)
@@ -395,6 +404,7 @@ def cmd_animate(args: argparse.Namespace) -> int:
     except ValueError as exc:
         raise CliError(str(exc)) from None
     _check_fits(scene, target.parent)
+    check_same_scene(target.parent, scene, args.force)  # beside the results of another scene: refused
     _announce_run_time(scene, (engine,), "animate")
     with _stop_on_interrupt("animate"):
         result = _solve(scene, engine, announce=True)
@@ -406,8 +416,11 @@ def cmd_animate(args: argparse.Namespace) -> int:
     except OSError as exc:
         raise CliError(f"cannot write {target}: {exc.strerror or exc}") from None
     closure = float(abs(frames.rod_length - scene.geometry.l_ef).max())
-    print(f"wrote {target}: {args.frames} frames over crank angles {frames.crank_angle_deg[0]:.1f}.."
-          f"{frames.crank_angle_deg[-1]:.1f} deg; "
+    t0, t1 = animated_window(result)  # the last whole revolution, or the run when shorter
+    turn = math.degrees(scene.drive.speed * (t1 - t0))
+    window = f"revolution {round(t0 / scene.drive.period) + 1}" if turn > 359.999 else "the run"
+    print(f"wrote {target}: {args.frames} frames of {window}, crank angles 0.0..{turn * (1 - 1 / args.frames):.1f} "
+          "deg (each the solver step nearest); "
           f"drawn rod EF within {closure:.1e} m of L_EF = {scene.geometry.l_ef:g} m")
     return 0
 
@@ -444,7 +457,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
     scene = scene_from_args(args)
     outdir = output_directory(args, scene, "compare")
     _check_fits(scene, outdir, runs=2)
-    prepare_directory(outdir, args.force)  # refused before the estimate is shown
+    prepare_directory(outdir, args.force, scene)  # refused before the estimate is shown
     with _stdout_to_stderr() if args.json else contextlib.nullcontext():  # the estimate imports Exudyn
         _announce_run_time(scene, ("reference", "exudyn"), "compare")
         _announce_checks(scene, "compare")
@@ -502,6 +515,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 def cmd_study(args: argparse.Namespace) -> int:
     from weftsim.api import scene_overrides
     from weftsim.studies import STUDIES, check_overrides, format_study, run_study
+    from weftsim.studies.common import wrote_lines
 
     names = list(STUDIES) if args.name == "all" else [args.name]
     overrides = scene_overrides(set_overrides(args), where="command line", **shorthand_values(args))
@@ -509,10 +523,17 @@ def cmd_study(args: argparse.Namespace) -> int:
     for name in names:  # every refusal before the first study runs
         check_overrides(name, overrides, revolutions)
     models = models_directory(args)
+    parent = Path("out")
+    if args.scene is not None:  # a bad scene or override refused before the first study runs
+        from weftsim.scene import load_scene
+
+        parent = output_directory(argparse.Namespace(output=None), load_scene(args.scene, overrides))
     for name in names:
-        outdir = Path(args.output) / name if args.output and args.name == "all" else args.output
-        report = run_study(name, outdir, models, revolutions, args.force, overrides=overrides)
+        outdir = (Path(args.output) / name if args.name == "all" else Path(args.output)) if args.output \
+            else parent / f"study-{name}"
+        report = run_study(name, outdir, models, revolutions, args.force, overrides=overrides, scene=args.scene)
         print(format_study(name, report))
+        print("\n".join(wrote_lines(outdir, report)))
     return 0
 
 
@@ -564,6 +585,7 @@ def _one_line(text: str) -> str:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    set_command(sys.argv[1:] if argv is None else argv)  # recorded in every output directory (weftsim.record)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(name)s: %(message)s")
     try:

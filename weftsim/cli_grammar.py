@@ -11,7 +11,6 @@ errors with the closest spelling of a mistyped flag or command.
 from __future__ import annotations
 
 import argparse
-import difflib
 import math
 import os
 import re
@@ -19,7 +18,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, NoReturn
 
-from weftsim.errors import WeftsimError
+from weftsim.errors import WeftsimError, closest
 from weftsim.exitcodes import EXIT_USAGE
 
 if TYPE_CHECKING:
@@ -84,8 +83,8 @@ class Parser(argparse.ArgumentParser):
         choice = re.search(r"invalid choice: '(.*?)' \(choose from (.*)\)", message)
         if choice:
             options = re.findall(r"'([^']*)'", choice.group(2))
-            near = difflib.get_close_matches(choice.group(1), options, n=1)
-            return f"; did you mean {near[0]}?" if near else ""
+            near = closest(choice.group(1), options)
+            return f"; did you mean {near}?" if near else ""
         unknown = re.search(r"unrecognized arguments: (.*)", message)
         if not unknown:
             return ""
@@ -93,9 +92,9 @@ class Parser(argparse.ArgumentParser):
         hints = []
         for word in unknown.group(1).split():
             if word.startswith("--"):
-                near = difflib.get_close_matches(word.partition("=")[0], flags, n=1, cutoff=0.6)
+                near = closest(word.partition("=")[0], flags)
                 if near:
-                    hints.append(f"did you mean {near[0]} for {word.partition('=')[0]}?")
+                    hints.append(f"did you mean {near} for {word.partition('=')[0]}?")
         return "; " + "; ".join(hints) if hints else ""
 
 

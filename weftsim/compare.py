@@ -209,7 +209,7 @@ def run_compare(scene: Scene, outdir: str | Path, solve: Callable[[Scene, str], 
     from weftsim.design_checks import report_lines
     from weftsim.output import prepare_directory, write_files, write_json, write_run
 
-    outdir = prepare_directory(outdir, force)
+    outdir = prepare_directory(outdir, force, scene)
     results = {engine: solve(scene, engine) for engine in ("reference", "exudyn")}
     for engine, result in results.items():
         write_run(result, outdir / engine, figure=False, force=force)
@@ -218,7 +218,7 @@ def run_compare(scene: Scene, outdir: str | Path, solve: Callable[[Scene, str], 
     write_files(outdir, {"kind": "compare", "scene": scene.name, "agree": report["agree"]}, {
         "json": ("compare.json", lambda target: write_json(target, report)),
         "figure": ("compare.png", lambda target: _overlay_figure(target, results, scene.name)),
-    })
+    }, scene=scene)
     status, problem = verdict(report, outdir)
     return report, status, problem
 

@@ -12,7 +12,8 @@ package), so code written against those keeps working.
 
 from __future__ import annotations
 
-from typing import Any
+import difflib
+from typing import Any, Iterable
 
 from weftsim.exitcodes import EXIT_FAILED, EXIT_USAGE
 
@@ -77,6 +78,16 @@ class WearError(WeftsimError, ValueError):
 
 class MissingExtra(WeftsimError, ImportError):
     """An optional package is not installed; the message names the extra that installs it."""
+
+
+def closest(word: str, choices: Iterable[str], cutoff: float = 0.6) -> str | None:
+    """The choice closest in spelling to a mistyped ``word`` (for "did you mean ...?"), or None.
+
+    The one suggestion helper of weftsim: the command line's parser and the Python interface both use it,
+    so ``weftsim run --engine exudin`` and ``weftsim.simulate(scene, "exudin")`` suggest the same name.
+    """
+    near = difflib.get_close_matches(word, list(choices), n=1, cutoff=cutoff)
+    return near[0] if near else None
 
 
 def require(module: str, extra: str, purpose: str) -> Any:

@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from weftsim.errors import OutputError, WriteFailed
+from weftsim.record import MANIFEST, SCENE_FILE, check_same_scene, provenance, scene_toml
 from weftsim.results import RunResult
 
 if TYPE_CHECKING:
@@ -37,11 +38,12 @@ if TYPE_CHECKING:
     from weftsim.params import Scene
 
 
-MANIFEST = ".weftsim-output.json"
 # Bytes the manifest reserves on disk when a directory is opened (JSON allows trailing blanks):
-# its final state (a few hundred bytes for the files of a run) is then written over blocks the
-# file already holds, which needs no free space.
+# its final state (a few hundred bytes for the files of a run, more than its opening state) is then
+# written over blocks the file already holds, which needs no free space.  A manifest recording a
+# resolved scene (~5 kB) reserves whole multiples of it with at least MANIFEST_ROOM to spare.
 MANIFEST_RESERVE = 4096
+MANIFEST_ROOM = 2048
 # Characters per value in channels.csv: "%.10g" gives at most 17 ("-1.234567891e-100") and a comma.
 CSV_BYTES_PER_VALUE = 18
 # Bytes of memory per output value while a run is held: 8 for the sample, and at least as many for
@@ -49,11 +51,13 @@ CSV_BYTES_PER_VALUE = 18
 MEMORY_BYTES_PER_VALUE = 24
 
 
-def prepare_directory(path: str | Path, force: bool = False) -> Path:
+def prepare_directory(path: str | Path, force: bool = False, scene: Scene | None = None) -> Path:
     """Create ``path`` (and parents) and check it is a writable directory of ours.
 
     A directory that already holds files but no weftsim manifest was not written by
     weftsim: it is refused (unless ``force``) so a run never mixes its files with others.
+    With ``scene``, a directory holding the results of another resolved scene is refused too
+    (unless ``force``; :func:`weftsim.record.check_same_scene`), before anything is written.
     """
     path = Path(path)
     if path.is_dir() and not force and not (path / MANIFEST).exists() and any(path.iterdir()):
@@ -61,6 +65,8 @@ def prepare_directory(path: str | Path, force: bool = False) -> Path:
             f"output directory {path} is not empty and was not written by weftsim; "
             "choose another directory with -o, or pass --force to write into it anyway"
         )
+    if scene is not None:
+        check_same_scene(path, scene, force)
     try:
         path.mkdir(parents=True, exist_ok=True)
     except FileExistsError:
@@ -173,8 +179,9 @@ def _overwrite_in_place(target: Path, text: str) -> None:
 def _set_manifest(outdir: Path, data: dict, reserve: bool = False) -> None:
     """Write the manifest atomically; on a full disk over its reserved room instead."""
     text = to_json(data)
+    room = MANIFEST_RESERVE * math.ceil((len(text) + MANIFEST_ROOM) / MANIFEST_RESERVE)
     try:
-        write_text(outdir / MANIFEST, text.ljust(MANIFEST_RESERVE) if reserve else text)
+        write_text(outdir / MANIFEST, text.ljust(room) if reserve else text)
     except OSError:
         if reserve or not (outdir / MANIFEST).exists():
             raise
@@ -224,7 +231,8 @@ def _rescue(failed: dict[str, tuple[str, Callable[[Path], Path]]]) -> tuple[Path
     return rescue, errors
 
 
-def write_files(outdir: Path, what: dict, files: dict[str, tuple[str, Callable[[Path], Path]]]) -> dict[str, Path]:
+def write_files(outdir: Path, what: dict, files: dict[str, tuple[str, Callable[[Path], Path]]],
+                scene: Scene | None = None) -> dict[str, Path]:
     """Write a set of files into ``outdir`` under its manifest; keep what fails elsewhere.
 
     Parameters
@@ -236,6 +244,9 @@ def write_files(outdir: Path, what: dict, files: dict[str, tuple[str, Callable[[
     files : dict
         kind -> (file name, ``write(target) -> Path``), written in this order; after a failure
         the later ones are still attempted (a small summary may fit where a large CSV did not).
+    scene : Scene, optional
+        The scene of these results: the manifest records it resolved and the command line
+        (:func:`weftsim.record.provenance`), and ``scene.toml`` holds it as a scene file.
 
     Returns
     -------
@@ -248,6 +259,9 @@ def write_files(outdir: Path, what: dict, files: dict[str, tuple[str, Callable[[
         A file could not be written.  Every other file was still attempted, the failed ones
         went to a rescue directory where possible, and the manifest says ``"incomplete"``.
     """
+    if scene is not None:
+        what = {**what, **provenance(scene)}
+        files = {**files, "scene": (SCENE_FILE, lambda target: write_text(target, scene_toml(scene)))}
     begin_directory(outdir, what)
     written, failed, reasons = {}, {}, {}
     for kind, (name, write) in files.items():
@@ -358,7 +372,7 @@ def write_run(result: RunResult, outdir: str | Path, figure: bool = True, force:
     from weftsim.plots import plot_channels, plot_orbit
     from weftsim.results import save_npz
 
-    outdir = prepare_directory(outdir, force)
+    outdir = prepare_directory(outdir, force, result.scene)
     what = {"kind": "run", "engine": result.engine, "scene": result.scene.name, "status": result.status}
     files = {
         "channels": ("channels.csv", lambda target: write_csv(target, {n: result.samples[n] for n in result.channel_names})),
@@ -370,4 +384,4 @@ def write_run(result: RunResult, outdir: str | Path, figure: bool = True, force:
         files["figure"] = ("channels.png", lambda target: write_figure(target, plot_channels([result])))
         if result.scene.joint.clearance > 0.0:
             files["orbit"] = ("orbit.png", lambda target: write_figure(target, plot_orbit(result)))
-    return write_files(outdir, what, files)
+    return write_files(outdir, what, files, scene=result.scene)

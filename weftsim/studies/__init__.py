@@ -11,7 +11,8 @@ name             what                                                           
 
 Each writes into its output directory PNG figures named ``study-*.png``, CSV files of
 the plotted curves and a JSON file of every number it prints (``<name>.json``).
-Scenes come from ``models/`` (``models/paper/`` for the paper's cases).  ``overrides`` (scene keys in
+Scenes come from ``models/`` (``models/paper/`` for the paper's cases), or each case is run on a scene
+given (``weftsim study clearance loom``): that scene with the keys the case sets.  ``overrides`` (scene keys in
 file units) apply to every run of a study, except the keys the study sets itself (its ``SETS``: the
 clearance of the clearance study, the speed of the speed study, the paper's case of the contact-law study).
 """
@@ -50,11 +51,15 @@ def check_overrides(name: str, overrides: dict | None = None, revolutions: float
 
 def run_study(name: str, outdir: str | Path | None = None, models: str | Path = "models",
               revolutions: float | None = None, force: bool = False, progress: bool = True,
-              overrides: dict | None = None) -> dict:
+              overrides: dict | None = None, scene: str | Path | None = None) -> dict:
     """Run one study by name into ``outdir`` (default ``out/study-<name>``); returns its report (JSON content).
 
     ``overrides``: scene keys in file units (e.g. ``{"joint_e.restitution": 0.8}``) applied to every
     run of the study; a key the study sets itself is refused (:func:`check_overrides`).
+    ``scene``: a scene file or bundled name to run the study's cases on (default: the paper's reference
+    scene and its case files in ``models``): each case is that scene with the keys the case sets
+    (the clearance of the clearance study, ...).  The report records the scene, the overrides and the
+    command line (``base_scene``, ``overrides``, ``command``); the directory holds ``scene.toml``.
 
     Raises
     ------
@@ -67,7 +72,7 @@ def run_study(name: str, outdir: str | Path | None = None, models: str | Path = 
         raise StudyError(f"unknown study {name!r}; choose one of {', '.join(STUDIES)} (or all)")
     run, _ = STUDIES[name]
     return run(Path(outdir) if outdir is not None else Path("out") / f"study-{name}", models=models,
-               revolutions=revolutions, force=force, progress=progress, overrides=overrides)
+               revolutions=revolutions, force=force, progress=progress, overrides=overrides, scene=scene)
 
 
 def format_study(name: str, report: dict) -> str:

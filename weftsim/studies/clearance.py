@@ -126,19 +126,24 @@ def trend_row(metrics: dict, ideal: dict) -> dict:
 
 
 def run(outdir: str | Path, models: str | Path = "models", revolutions: float | None = None,
-        force: bool = False, progress: bool = True, overrides: dict | None = None) -> dict:
+        force: bool = False, progress: bool = True, overrides: dict | None = None,
+        scene: str | Path | None = None) -> dict:
     """Run the clearance study into ``outdir``; returns what ``clearance.json`` holds.
 
     ``overrides``: scene keys (file units) applied to every run, except the clearance (:data:`SETS`).
+    ``scene``: the scene file or bundled name its cases run on (default: the paper's reference, ``models/``).
     """
-    from weftsim.output import finish_directory, prepare_directory, write_figure, write_json
+    from weftsim.output import write_figure, write_json
     from weftsim.studies.figures import channel_panels, deviation_panel, trend_panels
 
     overrides = common.study_overrides("clearance", SETS, revolutions, REVOLUTIONS, overrides)
-    outdir = prepare_directory(outdir, force)
-    ideal_result = common.solve(common.load(models, IDEAL_SCENE, overrides), progress=progress)
+    base = common.base_scene(models, scene, overrides)
+    outdir = common.open_directory(outdir, force, base)
+    note = common.title_note(base, overrides)
+    ideal_result = common.solve(common.load(models, IDEAL_SCENE, overrides, scene), progress=progress)
     ideal = common.run_metrics(ideal_result)
-    results = {c: common.solve(common.load(models, name, overrides), progress=progress) for c, name in SCENES.items()}
+    results = {c: common.solve(common.load(models, name, overrides, scene), progress=progress)
+               for c, name in SCENES.items()}
     metrics = {c: common.run_metrics(r) for c, r in results.items()}
     written, curves, deviations = {}, [], []
     last = max(ideal["revolutions"] - 1, 0)
@@ -164,7 +169,7 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
     rpm = common.speed_rpm(ideal_result.scene)
     written["figure"] = write_figure(outdir / "study-clearance.png", channel_panels(
         curves, f"clearance study at {rpm:g} rpm, reference engine, last of "
-                f"{metrics[0.25]['revolutions']} revolutions (cf. paper Fig. 12)"))
+                f"{metrics[0.25]['revolutions']} revolutions (cf. paper Fig. 12)" + note))
     rows = [trend_row(metrics[c], ideal) for c in SCENES]
     x = list(SCENES)
     def lines(*pairs):
@@ -180,16 +185,17 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
         ("contact force at E [N]", lines(("max, revolution 1", "first_revolution_contact_force_max_N"),
                                          ("99th percentile, rev. 2..N", "contact_force_p99_N"),
                                          ("mean, rev. 2..N", "contact_force_mean_N"))),
-    ], f"clearance trend at {rpm:g} rpm (reproducible quantities; reference engine)", x_ticks=x))
+    ], f"clearance trend at {rpm:g} rpm (reproducible quantities; reference engine)" + note, x_ticks=x))
     markers = [("ideal a extremes", features["acceleration_max_deg"] + features["acceleration_min_deg"],
                 {"color": "k", "ls": "-", "lw": 0.8}),
                ("ideal v extremes", features["velocity_extremes_deg"], {"color": "0.4", "ls": "--", "lw": 0.8}),
                ("ideal v = 0", features["velocity_zeros_deg"], {"color": "0.4", "ls": ":", "lw": 1.0})]
     written["deviation"] = write_figure(outdir / "study-clearance-deviation.png", deviation_panel(
         np.arange(BIN_DEG / 2, 360.0, BIN_DEG), deviations, markers,
-        f"where the clearance acceleration departs from the ideal one ({rpm:g} rpm, revolutions 2..N)"))
+        f"where the clearance acceleration departs from the ideal one ({rpm:g} rpm, revolutions 2..N)" + note))
     report = {
         "study": "clearance",
+        **common.record(base, overrides),
         "speed_rpm": rpm,
         "revolutions": metrics[0.25]["revolutions"],
         "ideal": ideal,
@@ -200,7 +206,7 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
         "files": sorted(p.name for p in written.values()) + ["clearance.json"],
     }
     written["json"] = write_json(outdir / "clearance.json", report)
-    finish_directory(outdir, written, {"kind": "study", "study": "clearance"})
+    common.finish(outdir, written, "clearance", base)
     return report
 
 

@@ -40,11 +40,84 @@ def scene_path(models: str | Path, name: str) -> Path:
     return path
 
 
-def load(models: str | Path, name: str, overrides: dict | None = None) -> Scene:
-    """Load ``models/<name>`` with file-unit overrides (e.g. ``{"drive.revolutions": 10}``)."""
+REFERENCE = "reference.toml"  # the scene every study's files extend (models/paper/*.toml, ideal.toml)
+# The keys a study's scene file sets on the reference scene, shown in the names of its runs on another scene.
+NAMED_KEYS = {"joint_e.clearance_mm": "c{:g}mm", "drive.speed_rpm": "{:g}rpm"}
+
+
+def own_keys(path: Path) -> dict:
+    """The keys a scene file gives itself (not those of the scene it extends), ``extends``, ``name`` and
+    ``description`` left out: what a study's case changes on the scene it is run on."""
+    from weftsim.scene import TOP_LEVEL, _flatten, _read_toml
+
+    return {k: v for k, v in _flatten(_read_toml(path), str(path)).items() if k not in TOP_LEVEL}
+
+
+def load(models: str | Path, name: str, overrides: dict | None = None, base: str | Path | None = None) -> Scene:
+    """Load ``models/<name>`` with file-unit overrides (e.g. ``{"drive.revolutions": 10}``).
+
+    With ``base`` (a scene file or bundled name: ``weftsim study NAME SCENE``) the case runs on that scene
+    instead: ``base`` with the keys ``models/<name>`` sets itself (:func:`own_keys`: the clearance of a
+    clearance case, the speed of a speed case), then ``overrides``; it is named after ``base`` and those keys.
+    """
     from weftsim.scene import load_scene
 
-    return load_scene(scene_path(models, name), overrides)
+    path = scene_path(models, name)
+    if base is None:
+        return load_scene(path, overrides)
+    case = own_keys(path)
+    base_name = load_scene(base).name
+    suffix = "_".join(form.format(case[key]) for key, form in NAMED_KEYS.items() if key in case)
+    return load_scene(base, {**case, "name": f"{base_name}_{suffix}" if suffix else base_name, **(overrides or {})})
+
+
+def base_scene(models: str | Path, base: str | Path | None, overrides: dict) -> Scene:
+    """The scene a study runs its cases on, resolved with ``overrides`` (``models/reference.toml`` by default):
+    what its output directory records (:mod:`weftsim.record`) and refuses to mix with another."""
+    from weftsim.scene import load_scene
+
+    return load_scene(scene_path(models, REFERENCE) if base is None else base, overrides)
+
+
+def open_directory(outdir: Path, force: bool, scene: Scene) -> Path:
+    """:func:`weftsim.output.prepare_directory` for a study of ``scene`` (a directory holding a study of
+    another scene or other overrides is refused unless ``force``)."""
+    from weftsim.output import prepare_directory
+
+    return prepare_directory(outdir, force, scene)
+
+
+def record(scene: Scene, overrides: dict) -> dict:
+    """What a study's JSON records of how it was made: the scene its cases run on, the overrides given
+    (``--set`` and the shorthands, file units, the revolutions included) and the command line."""
+    from weftsim.record import command_line
+
+    return {"base_scene": scene.name, "overrides": dict(overrides), "command": command_line()}
+
+
+def title_note(scene: Scene, overrides: dict) -> str:
+    """A second title line naming the scene and the overrides when they are not the paper's reference."""
+    shown = [f"{key} = {value:g}" if isinstance(value, float) else f"{key} = {value}"
+             for key, value in overrides.items() if key != "drive.revolutions"]
+    if scene.name == "reference" and not shown:
+        return ""
+    return "\n(scene " + scene.name + ("; " + ", ".join(shown) if shown else "") + ")"
+
+
+def finish(outdir: Path, written: dict, study: str, scene: Scene) -> None:
+    """Write ``scene.toml`` (the resolved scene the cases run on) and the manifest, last."""
+    from weftsim.output import finish_directory, write_text
+    from weftsim.record import SCENE_FILE, provenance, scene_toml
+
+    written["scene"] = write_text(outdir / SCENE_FILE, scene_toml(scene))
+    finish_directory(outdir, written, {"kind": "study", "study": study, **provenance(scene)})
+
+
+def wrote_lines(outdir: Path, report: dict) -> list[str]:
+    """``  wrote <path>`` per file of a study, as ``weftsim run`` reports its files."""
+    from weftsim.record import SCENE_FILE
+
+    return [f"  wrote {Path(outdir) / name}" for name in sorted(set(report.get("files", [])) | {SCENE_FILE})]
 
 
 def solve(scene: Scene, engine: str = "reference", label: str | None = None, progress: bool = True) -> RunResult:

@@ -101,19 +101,22 @@ def contact_steps(result: RunResult, revolution: int) -> dict[str, np.ndarray]:
 
 
 def run(outdir: str | Path, models: str | Path = "models", revolutions: float | None = None,
-        force: bool = False, progress: bool = True, overrides: dict | None = None) -> dict:
+        force: bool = False, progress: bool = True, overrides: dict | None = None,
+        scene: str | Path | None = None) -> dict:
     """Run the contact-law study into ``outdir``; returns what ``contact-law.json`` holds.
 
     ``overrides``: scene keys (file units) applied to its run, except its speed and clearance (:data:`SETS`).
+    ``scene``: the scene file or bundled name its cases run on (default: the paper's reference, ``models/``).
     """
     from weftsim.contact import make_law
-    from weftsim.output import finish_directory, prepare_directory, write_csv, write_figure, write_json
+    from weftsim.output import write_csv, write_figure, write_json
     from weftsim.studies.figures import contact_law_panels
 
     overrides = common.study_overrides("contact-law", SETS, revolutions, REVOLUTIONS, overrides)
-    outdir = prepare_directory(outdir, force)
+    source, base = scene, common.base_scene(models, scene, overrides)
+    outdir = common.open_directory(outdir, force, base)
     scene = common.load(models, SCENE, {"drive.speed_rpm": SPEED_RPM, "name": "contact_law_0p01mm_500rpm",
-                                        **overrides})
+                                        **overrides}, source)
     curve = stiffness_curve(scene.joint)
     result = common.solve(scene, "reference", progress=progress)
     from weftsim.analysis import complete_revolutions
@@ -142,7 +145,7 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
             law_lines.append((f"law at v_imp = {v:.3g} m/s ({what})", delta, law.damping(delta * 1e-3, v)))
     rpm = common.speed_rpm(scene)
     title = (f"contact law {law.name}, c = {curve['clearance_mm']:g} mm, {rpm:g} rpm "
-             f"(revolution {revolution + 1} of {n}, reference engine)")
+             f"(revolution {revolution + 1} of {n}, reference engine)" + common.title_note(base, overrides))
     written["figure"] = write_figure(outdir / "study-contact-law.png",
                                      contact_law_panels(curve, steps, law_lines, title))
     in_contact = {}
@@ -165,6 +168,7 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
         }
     report = {
         "study": "contact-law",
+        **common.record(base, overrides),
         "scene": scene.name,
         "clearance_mm": curve["clearance_mm"],
         "speed_rpm": rpm,
@@ -179,7 +183,7 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
         "files": sorted(p.name for p in written.values()),
     }
     written["json"] = write_json(outdir / "contact-law.json", report)
-    finish_directory(outdir, written, {"kind": "study", "study": "contact-law"})
+    common.finish(outdir, written, "contact-law", base)
     return report
 
 

@@ -45,18 +45,21 @@ def peak_ratios(reference: dict, exudyn: dict) -> dict:
 
 
 def run(outdir: str | Path, models: str | Path = "models", revolutions: float | None = None,
-        force: bool = False, progress: bool = True, overrides: dict | None = None) -> dict:
+        force: bool = False, progress: bool = True, overrides: dict | None = None,
+        scene: str | Path | None = None) -> dict:
     """Run the engine comparison into ``outdir``; returns what ``engines.json`` holds.
 
     ``overrides``: scene keys (file units) applied to the scene both engines run.
+    ``scene``: the scene file or bundled name its cases run on (default: the paper's reference, ``models/``).
     """
     from weftsim.compare import compare_results
-    from weftsim.output import finish_directory, prepare_directory, write_figure, write_json
+    from weftsim.output import write_figure, write_json
     from weftsim.studies.figures import channel_panels
 
     overrides = common.study_overrides("engines", SETS, revolutions, REVOLUTIONS, overrides)
-    outdir = prepare_directory(outdir, force)
-    scene = common.load(models, SCENE, overrides)
+    source, base = scene, common.base_scene(models, scene, overrides)
+    outdir = common.open_directory(outdir, force, base)
+    scene = common.load(models, SCENE, overrides, source)
     results = {engine: common.solve(scene, engine, progress=progress) for engine in ENGINES}
     metrics = {engine: common.run_metrics(r) for engine, r in results.items()}
     comparison = compare_results(results["exudyn"], results["reference"])
@@ -74,10 +77,11 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
         note = "where the engines must agree" if which == "first" else "an illustration: impacts not reproducible"
         written[f"figure-{which}"] = write_figure(outdir / name, channel_panels(
             curves, f"c = {scene.joint.clearance * 1e3:g} mm, {rpm:g} rpm: revolution {revolution + 1} of {n} "
-                    f"({note}; cf. paper Fig. 16)"))
+                    f"({note}; cf. paper Fig. 16)" + common.title_note(base, overrides)))
     ratios = peak_ratios(metrics["reference"], metrics["exudyn"])
     report = {
         "study": "engines",
+        **common.record(base, overrides),
         "scene": scene.name,
         "clearance_mm": common.clearance_mm(scene),
         "speed_rpm": rpm,
@@ -89,7 +93,7 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
         "files": sorted(p.name for p in written.values()) + ["engines.json"],
     }
     written["json"] = write_json(outdir / "engines.json", report)
-    finish_directory(outdir, written, {"kind": "study", "study": "engines"})
+    common.finish(outdir, written, "engines", base)
     return report
 
 

@@ -71,22 +71,27 @@ def spectrum_summary(spectrum: Spectrum, speed_rpm: float) -> dict:
 
 
 def run(outdir: str | Path, models: str | Path = "models", revolutions: float | None = None,
-        force: bool = False, progress: bool = True, overrides: dict | None = None) -> dict:
+        force: bool = False, progress: bool = True, overrides: dict | None = None,
+        scene: str | Path | None = None) -> dict:
     """Run the speed study into ``outdir``; returns what ``speed.json`` holds.
 
     ``overrides``: scene keys (file units) applied to every run, except the speed (:data:`SETS`).
+    ``scene``: the scene file or bundled name its cases run on (default: the paper's reference, ``models/``).
     """
-    from weftsim.output import finish_directory, prepare_directory, write_csv, write_figure, write_json
+    from weftsim.output import write_csv, write_figure, write_json
     from weftsim.studies.figures import channel_panels, spectrum_panels, trend_panels
 
     overrides = common.study_overrides("speed", SETS, revolutions, REVOLUTIONS, overrides)
-    outdir = prepare_directory(outdir, force)
+    base = common.base_scene(models, scene, overrides)
+    outdir = common.open_directory(outdir, force, base)
+    note = common.title_note(base, overrides)
     results, ideals = {}, {}
     for rpm, name in SCENES.items():
         ideals[rpm] = common.solve(common.load(models, IDEAL_SCENE, {**overrides, "drive.speed_rpm": rpm,
-                                                                    "name": f"ideal_{rpm:g}rpm"}),
+                                                                    "name": f"ideal_{rpm:g}rpm"}, scene),
                                    progress=progress)
-        results[rpm] = common.solve(common.load(models, name, overrides), progress=progress)
+        results[rpm] = common.solve(common.load(models, name, overrides, scene), progress=progress)
+    c = f"c = {common.clearance_mm(results[500.0].scene):g} mm"  # the paper's 0.25 mm, or the scene's
     metrics = {rpm: common.run_metrics(r) for rpm, r in results.items()}
     ideal_metrics = {rpm: common.run_metrics(r) for rpm, r in ideals.items()}
     written, curves, spectra, spectrum_rows, table = {}, [], [], {}, {}
@@ -94,7 +99,7 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
         n = metrics[rpm]["revolutions"]
         data = common.revolution_steps(result, max(n - 1, 0))
         written[f"curves-{rpm:g}"] = common.write_curves(outdir, f"speed-curves-{rpm:g}rpm", data)
-        curves.append((f"{rpm:g} rpm, c = 0.25 mm", data, {"color": COLOURS[rpm]}))
+        curves.append((f"{rpm:g} rpm, {c}", data, {"color": COLOURS[rpm]}))
         ideal_data = common.revolution_steps(ideals[rpm], max(n - 1, 0))
         curves.append((f"{rpm:g} rpm, ideal joint", ideal_data, {"color": COLOURS[rpm], "ls": "--", "lw": 0.7}))
         table[f"{rpm:g}"] = {kind: {"clearance": amplitude_measures(metrics[rpm], channel),
@@ -103,7 +108,7 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
         if n >= 2:
             spectrum = acceleration_spectrum(result)
             ideal_spectrum = acceleration_spectrum(ideals[rpm])
-            spectra.append((f"{rpm:g} rpm, c = 0.25 mm", spectrum, {"color": COLOURS[rpm]}))
+            spectra.append((f"{rpm:g} rpm, {c}", spectrum, {"color": COLOURS[rpm]}))
             spectrum_rows[f"{rpm:g}"] = {"clearance": spectrum_summary(spectrum, rpm),
                                          "ideal": spectrum_summary(ideal_spectrum, rpm)}
             written[f"spectrum-{rpm:g}"] = write_csv(outdir / f"speed-spectrum-{rpm:g}rpm.csv", {
@@ -123,24 +128,25 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
                                                                  sb["clearance"]["max_amplitude_m_s2"])
     n = metrics[500.0]["revolutions"]
     written["figure"] = write_figure(outdir / "study-speed.png", channel_panels(
-        curves, f"speed study at c = 0.25 mm, reference engine, last of {n} revolutions (cf. paper Fig. 13)"))
+        curves, f"speed study at {c}, reference engine, last of {n} revolutions (cf. paper Fig. 13)" + note))
     speeds = list(SCENES)
     panels = []
     for kind, unit in (("acceleration", "rapier acceleration [m/s²]"), ("torque", "driving torque [N·m]")):
         rows = [table[f"{rpm:g}"][kind] for rpm in speeds]
         panels.append((unit, [("ideal joint, peak", [r["ideal_peak"] for r in rows]),
-                              ("c = 0.25 mm, max revolution 1",
+                              (f"{c}, max revolution 1",
                                [r["clearance"]["first_revolution_peak"] for r in rows]),
-                              ("c = 0.25 mm, 99th pct |.|, rev. 2..N", [r["clearance"]["p99_abs"] for r in rows]),
-                              ("c = 0.25 mm, RMS, rev. 2..N", [r["clearance"]["rms"] for r in rows])]))
+                              (f"{c}, 99th pct |.|, rev. 2..N", [r["clearance"]["p99_abs"] for r in rows]),
+                              (f"{c}, RMS, rev. 2..N", [r["clearance"]["rms"] for r in rows])]))
     written["trend"] = write_figure(outdir / "study-speed-trend.png", trend_panels(
-        speeds, "crank speed [rpm]", panels, "amplitude against crank speed (reproducible quantities)", speeds))
+        speeds, "crank speed [rpm]", panels, "amplitude against crank speed (reproducible quantities)" + note, speeds))
     if spectra:
         written["spectrum"] = write_figure(outdir / "study-speed-spectrum.png", spectrum_panels(
-            spectra, f"rapier acceleration spectrum, c = 0.25 mm, revolutions 2..{n} "
-                     "(single-sided amplitude 2|X|/N)"))
+            spectra, f"rapier acceleration spectrum, {c}, revolutions 2..{n} "
+                     "(single-sided amplitude 2|X|/N)" + note))
     report = {
         "study": "speed",
+        **common.record(base, overrides),
         "clearance_mm": metrics[500.0]["clearance_mm"],
         "revolutions": n,
         "runs": {f"{rpm:g}": metrics[rpm] for rpm in speeds},
@@ -154,7 +160,7 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
         "files": sorted(p.name for p in written.values()) + ["speed.json"],
     }
     written["json"] = write_json(outdir / "speed.json", report)
-    finish_directory(outdir, written, {"kind": "study", "study": "speed"})
+    common.finish(outdir, written, "speed", base)
     return report
 
 

@@ -9,11 +9,13 @@ working directory, on another machine, without a shared file system.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import math
 import os
 import sys
 import time
 from typing import Callable
 
+from weftsim.progress import RateEstimate
 from weftsim.sweep.grid import SweepError
 
 CONNECT_TIMEOUT_S = 20.0  # how long to keep trying to reach a Dask scheduler (it may be starting up)
@@ -66,24 +68,36 @@ def _dask_executor(scheduler: str):
 class SweepProgress:
     """Cells done, failed and time left on stderr: one refreshed line on a terminal, else every ``interval`` s."""
 
-    def __init__(self, total: int, skipped: int, stream=None, interval: float = 1.0):
+    def __init__(self, total: int, skipped: int, stream=None, interval: float = 1.0,
+                 clock: Callable[[], float] = time.perf_counter):
         self.total, self.skipped = total, skipped
         self.stream = stream if stream is not None else sys.stderr
         self.tty = hasattr(self.stream, "isatty") and self.stream.isatty()
         self.interval = interval if self.tty else max(interval, 10.0)
-        self.start = time.perf_counter()
+        self.clock = clock
+        self.start = clock()
+        # The first cells carry the workers' start-up (a process, the imports, numba's compilation):
+        # the rate is measured from the first cell done on (settle 0: a cell marks the end of it).
+        self.rate = RateEstimate(self.start, settle=0.0)
+        self.rate_started = False
         self.last = float("-inf")
 
     def update(self, done: int, failed: int, final: bool = False) -> None:
-        now = time.perf_counter()
+        now = self.clock()
+        run = self.total - self.skipped
+        if done and not self.rate_started:  # the first cell done: the start-up is behind
+            self.rate = RateEstimate(now, settle=0.0)
+            self.rate_started = True
+        if self.rate_started:
+            self.rate.add(now, done / max(run, 1))
         if not final and now - self.last < self.interval:
             return
         self.last = now
         elapsed = now - self.start
-        run = self.total - self.skipped
-        left = elapsed * (run - done) / done if done else float("nan")
+        left = self.rate.left(now, done / max(run, 1)) if self.rate_started else float("nan")
+        shown = f", left ~{left:.0f} s" if math.isfinite(left) else ", left: measuring"
         text = (f"sweep: {done}/{run} cells done, {failed} failed"
                 + (f", {self.skipped} already finished" if self.skipped else "")
-                + f", elapsed {elapsed:.0f} s" + ("" if final else f", left ~{left:.0f} s"))
+                + f", elapsed {elapsed:.0f} s" + ("" if final else shown))
         self.stream.write(("\r" + text + ("\n" if final else "")) if self.tty else text + "\n")
         self.stream.flush()

@@ -92,11 +92,12 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
         The summary (``wear.json``) with ``"files"``: kind -> path written.
     """
     from weftsim.output import begin_directory, write_figure, write_files, write_json
+    from weftsim.record import provenance
     from weftsim.wear import store
 
     check_request(scene, hours, engine, limit)
     outdir = Path(outdir)
-    what = {"kind": "wear", "scene": scene.name}
+    what = {"kind": "wear", "scene": scene.name, **provenance(scene)}  # recorded from the first update on
     begin_directory(outdir, what)  # ours from the first update on: an interrupted prediction resumes here
     wall0 = time.perf_counter()
     done = store.load_state(outdir, scene)
@@ -125,6 +126,6 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
         title = f"{scene.name}: wear at E"
         files["profile_figure"] = ("wear_profile.png", lambda p: write_figure(p, profile_figure(scene, updates, title)))
         files["growth_figure"] = ("wear_growth.png", lambda p: write_figure(p, growth_figure(columns, title)))
-    written = write_files(outdir, what, files)
+    written = write_files(outdir, what, files, scene=scene)
     data["files"] = {k: str(v) for k, v in written.items()}
     return data

@@ -38,11 +38,15 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
 
     limit = None if args.limit_clearance_mm is None else args.limit_clearance_mm * 1e-3
     check_request(scene, args.hours, args.engine, limit)  # a WearError is one line, exit 2
-    outdir = prepare_directory(outdir, args.force)
+    outdir = prepare_directory(outdir, args.force, scene)
+    resumed = _stored_updates(outdir, scene, args.force)
     print(f"scene {scene.name}, wear at E over {args.hours:g} h on the reference engine; each update simulates "
           f"{scene.joint.wear.settle_revolutions} + {scene.joint.wear.revolutions_per_update} revolutions "
           f"(~0.1 s), the update interval grows the clearance by at most "
           f"{100 * scene.joint.wear.max_clearance_change:g} %", file=sys.stderr, flush=True)
+    if resumed:
+        print(f"resuming the prediction stored in {outdir}: {len(resumed)} updates kept, up to "
+              f"{resumed[-1].hours:.6g} h", file=sys.stderr, flush=True)
     progress = Progress(f"wear {scene.name}")
     with stop_on_interrupt("wear") as state:
         try:
@@ -68,3 +72,18 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
         raise CliError(f"stopped after {data['hours_reached']:.6g} h; the state is in {outdir}: run the same "
                         "command again to resume", 130)
     return 0
+
+
+def _stored_updates(outdir: Path, scene: Scene, force: bool) -> list:
+    """The updates a previous run stored in ``outdir`` (resumed); with ``force`` a state of another
+    scene is deleted (the prediction starts over), without it that is refused (one line)."""
+    from weftsim.cli_grammar import CliError
+    from weftsim.wear import store
+
+    try:
+        return store.load_state(outdir, scene)
+    except store.StateMismatch as exc:
+        if not force:
+            raise CliError(str(exc)) from None
+        (outdir / store.STATE).unlink(missing_ok=True)
+        return []

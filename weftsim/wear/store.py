@@ -66,7 +66,7 @@ def load_state(outdir: Path, scene: Scene) -> list[Update]:
     with np.load(path, allow_pickle=False) as data:
         if str(data["scene"]) != scene_identity(scene):
             raise StateMismatch(f"{path} holds a wear prediction of another scene or other [joint_e.wear] "
-                                "settings; choose another output directory with -o, or delete it to start over")
+                                "settings; choose another output directory with -o, or pass --force to start over")
         return [Update(float(data["hours"][i]), float(data["revolutions"][i]), data["bearing"][i].copy(),
                        data["journal"][i].copy(), float(data["step_revolutions"][i]), data["rate_bearing"][i].copy(),
                        data["rate_journal"][i].copy(), float(data["volume_rate"][i]),
