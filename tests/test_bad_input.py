@@ -264,13 +264,16 @@ def test_rerun_replaces_the_previous_run_and_drops_its_stale_files(tmp_path):
     first = cli("run", REFERENCE, "-o", out, "--revolutions", "0.01")
     assert first.returncode == 0, first.stderr
     assert (out / "channels.png").exists()
-    second = cli("run", REFERENCE, "-o", out, "--revolutions", "0.02", "--no-plot")
+    # Another scene (0.02 revolutions) into the same directory: refused unless --force (issue 25).
+    refused = cli("run", REFERENCE, "-o", out, "--revolutions", "0.02", "--no-plot")
+    assert refused.returncode == 2 and "drive.revolutions 0.01 -> 0.02" in refused.stderr
+    second = cli("run", REFERENCE, "-o", out, "--revolutions", "0.02", "--no-plot", "--force")
     assert second.returncode == 0, second.stderr
     # The figure of the first run would describe other data: it is gone, and the manifest lists
     # exactly this run's files.
     assert not (out / "channels.png").exists()
     manifest = json.loads((out / ".weftsim-output.json").read_text())
-    assert manifest["files"] == ["channels.csv", "result.npz", "summary.json"]
+    assert manifest["files"] == ["channels.csv", "result.npz", "scene.toml", "summary.json"]
     summary = json.loads((out / "summary.json").read_text())
     assert summary["scene"]["drive.revolutions"] == 0.02
 
@@ -301,7 +304,7 @@ def test_sigkill_while_writing_leaves_the_previous_complete_files(tmp_path):
     before = {p.name: p.read_bytes() for p in out.iterdir()}
     ready = tmp_path / "ready"
     child = subprocess.Popen([sys.executable, "-c", _SLOW_WRITER, str(ready), "run", str(REFERENCE), "-o", str(out),
-                              "--revolutions", "0.05", "--no-plot"], stdout=subprocess.DEVNULL,
+                              "--revolutions", "0.05", "--no-plot", "--force"], stdout=subprocess.DEVNULL,
                              stderr=subprocess.DEVNULL)  # fmt: skip
     try:
         deadline = time.monotonic() + 120
@@ -326,7 +329,7 @@ def test_sigkill_while_writing_leaves_the_previous_complete_files(tmp_path):
     partial = [name for name in after if name not in before]
     assert partial and all(name.startswith(".channels.csv.") and name.endswith(".part") for name in partial)
     # The next run into the directory works and leaves its own complete files.
-    again = cli("run", REFERENCE, "-o", out, "--revolutions", "0.03", "--no-plot")
+    again = cli("run", REFERENCE, "-o", out, "--revolutions", "0.03", "--no-plot", "--force")
     assert again.returncode == 0, again.stderr
     assert json.loads((out / "summary.json").read_text())["scene"]["drive.revolutions"] == 0.03
     assert json.loads((out / MANIFEST).read_text())["state"] == "complete"

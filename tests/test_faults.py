@@ -153,7 +153,7 @@ def test_disk_full_on_a_real_tmpfs_keeps_what_was_computed(tmp_path):
     assert "cannot write channels.png, orbit.png, result.npz" in last and "No space left on device" in last, last
     assert "channels.csv, scene.toml, summary.json written there" in last and "kept in" in last, last
     manifest = json.loads((copy / MANIFEST).read_text())
-    assert manifest["state"] == "incomplete" and manifest["files"] == ["channels.csv", "summary.json"]
+    assert manifest["state"] == "incomplete" and manifest["files"] == ["channels.csv", "scene.toml", "summary.json"]
     assert manifest["missing"] == {"channels.png": "No space left on device", "orbit.png": "No space left on device",
                                    "result.npz": "No space left on device"}
     (kept,) = rescue.glob("weftsim-rescue-*/channels.png")

@@ -59,12 +59,21 @@ def _value(row: dict, channel: str, which: str) -> float:
     return _number(row.get(f"{channel}_{which}_peak")) if row.get("status") == "success" else math.nan
 
 
-def _edges(centres: np.ndarray) -> np.ndarray:
-    """Cell edges half-way between centres (ends mirrored), so uneven grids draw honestly."""
+def _edges(centres: np.ndarray, numeric: bool = False) -> np.ndarray:
+    """Cell edges half-way between centres (ends mirrored), so uneven grids draw honestly.
+
+    For ``numeric`` values that are all >= 0 (a clearance, a speed) no cell reaches below 0: a mirrored
+    first edge would put the axis at -0.1 mm for clearances 0.01, 0.25, 0.5 mm, a value no run had.
+    """
     if centres.size == 1:
-        return np.array([centres[0] - 0.5, centres[0] + 0.5])
-    mid = 0.5 * (centres[1:] + centres[:-1])
-    return np.concatenate([[2 * centres[0] - mid[0]], mid, [2 * centres[-1] - mid[-1]]])
+        half = 0.5 if not numeric or centres[0] == 0 else 0.5 * abs(centres[0])
+        edges = np.array([centres[0] - half, centres[0] + half])
+    else:
+        mid = 0.5 * (centres[1:] + centres[:-1])
+        edges = np.concatenate([[2 * centres[0] - mid[0]], mid, [2 * centres[-1] - mid[-1]]])
+    if numeric and centres.min() >= 0.0:
+        edges[0] = max(edges[0], 0.0)
+    return edges
 
 
 def windows(rows: list[dict]) -> list[tuple[str, str]]:
@@ -75,18 +84,21 @@ def windows(rows: list[dict]) -> list[tuple[str, str]]:
     return first + [("last", f"last revolution ({last})" if last > 1 else "last revolution")] if last > 1 else first
 
 
-def _grid_panel(fig, ax, grid, xc, yc, channel, annotate):
+def _grid_panel(fig, ax, grid, xc, yc, channel, annotate, numeric=(False, False)):
     ax.set_facecolor("0.85")  # failed or missing cells show as grey
     scale = SCALES.get(channel, 1.0)
-    mesh = ax.pcolormesh(_edges(xc), _edges(yc), np.ma.masked_invalid(grid * scale), cmap="viridis",
-                         shading="flat")
+    xe, ye = _edges(xc, numeric[0]), _edges(yc, numeric[1])
+    mesh = ax.pcolormesh(xe, ye, np.ma.masked_invalid(grid * scale), cmap="viridis", shading="flat")
+    ax.set_xlim(xe[0], xe[-1])  # the axes span the cells, no more (limits from the data)
+    ax.set_ylim(ye[0], ye[-1])
+    xt, yt = 0.5 * (xe[1:] + xe[:-1]), 0.5 * (ye[1:] + ye[:-1])  # labels in the middle of their cells
     fig.colorbar(mesh, ax=ax, label=PANEL_LABELS[channel])
     if annotate and np.isfinite(grid).any():
         top = np.nanmax(grid)
         for i in range(grid.shape[0]):
             for j in range(grid.shape[1]):
                 if np.isfinite(grid[i, j]):
-                    ax.text(xc[j], yc[i], _short(grid[i, j] * scale), ha="center", va="center", fontsize=7,
+                    ax.text(xt[j], yt[i], _short(grid[i, j] * scale), ha="center", va="center", fontsize=7,
                             color="white" if grid[i, j] < 0.6 * top else "black")
 
 
@@ -138,14 +150,19 @@ def plot_sweep_2d(rows: list[dict], x_name: str, y_name: str, title: str = "") -
                 for j, xv in enumerate(xs):
                     if (xv, yv) in index:
                         grid[i, j] = _value(index[(xv, yv)], channel, which)
-            _grid_panel(fig, ax, grid, xc, yc, channel, annotate=len(xs) * len(ys) <= 80)
+            _grid_panel(fig, ax, grid, xc, yc, channel, annotate=len(xs) * len(ys) <= 80,
+                        numeric=(x_numeric, y_numeric))
             ax.set_title(label, fontsize=10)
             ax.set_xlabel(axis_label(x_name))
             ax.set_ylabel(axis_label(y_name))
             if not x_numeric:
                 ax.set_xticks(xc, [str(v) for v in xs], rotation=30)
+            elif len(xs) <= 12:  # a tick at each value run
+                ax.set_xticks(xc, [f"{v:g}" for v in xs])
             if not y_numeric:
                 ax.set_yticks(yc, [str(v) for v in ys])
+            elif len(ys) <= 12:
+                ax.set_yticks(yc, [f"{v:g}" for v in ys])
     fig.suptitle(title)
     return fig
 

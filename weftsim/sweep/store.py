@@ -24,6 +24,7 @@ import json
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from weftsim.record import command_line
 from weftsim.version import __version__
 from weftsim.sweep.cell import METRIC_CHANNELS, finite_or_none, read_record
 from weftsim.sweep.grid import Axis, SweepError, format_value
@@ -54,6 +55,7 @@ def manifest(scene_path: str, base_keys: dict, fixed: dict, engine: str, axes: l
         "engine": engine,
         "axes": [{"name": a.name, "key": a.key, "values": list(a.values)} for a in axes],
         "weftsim_version": __version__,
+        "command": command_line(),  # the command line that made (or last extended) the sweep
     }
 
 

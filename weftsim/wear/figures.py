@@ -26,22 +26,40 @@ def _chosen(updates, count: int = 6):
 
 def profile_figure(scene: Scene, updates: Sequence[Update], title: str = "") -> Figure:
     """Bearing clearance c0 + h_b(psi) (mm) and journal wear, polar, at several updates."""
+    from matplotlib.ticker import MaxNLocator
+
     fig = figure(figsize=(10, 5))
     c0 = scene.joint.clearance * 1e3
     n = updates[0].bearing.size
     psi = np.append(np.arange(n), 0) * (2.0 * np.pi / n)
     for k, which in enumerate(("bearing", "journal")):
         ax = fig.add_subplot(1, 2, k + 1, projection="polar")
+        radii = []
         for u in _chosen(updates):
             h = np.append(getattr(u, which), getattr(u, which)[0]) * 1e3
-            ax.plot(psi, (c0 if which == "bearing" else 0.0) + h, label=f"{u.hours:.4g} h")
+            radii.append((c0 if which == "bearing" else 0.0) + h)
+            ax.plot(psi, radii[-1], label=f"{u.hours:.4g} h")
         ax.set_title(("bearing: c0 + h_b(psi) [mm], rocker frame" if which == "bearing"
-                      else "journal: h_j(psi) [mm], rod frame"), fontsize=9)
-    fig.axes[0].legend(loc="lower left", bbox_to_anchor=(-0.25, -0.15), fontsize=8)
+                      else "journal: h_j(psi) [mm], rod frame"), fontsize=9, pad=14)
+        ax.set_rlabel_position(label_angle(psi, np.max(radii, axis=0)))
+        ax.yaxis.set_major_locator(MaxNLocator(4))
+        ax.tick_params(labelsize=7)
+    # One legend for both panels, below them, inside the figure (drawn beside a polar axes it was clipped).
+    handles, labels = fig.axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=min(len(labels), 6), fontsize=8, frameon=False,
+               title="operating hours", title_fontsize=8)
     if title:
         fig.suptitle(title)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0.0, 0.1, 1.0, 1.0))
     return fig
+
+
+def label_angle(psi: np.ndarray, radius: np.ndarray) -> float:
+    """Angle, deg, for a polar panel's radial labels: where the curves stay closest to the centre (the labels
+    then sit on empty ground, not on a lobe of the profile)."""
+    candidates = np.arange(22.5, 360.0, 45.0)  # between the angle labels at every 45 deg
+    reach = [np.max(radius[np.abs((np.degrees(psi) - a + 180.0) % 360.0 - 180.0) <= 22.5]) for a in candidates]
+    return float(candidates[int(np.argmin(reach))])
 
 
 def statistic_label(name: str) -> str:
