@@ -59,13 +59,150 @@ eps < 1: at e >= c the asperity and dry contact take over), and are compiled wit
 
 from __future__ import annotations
 
+import hashlib
 import math
+from pathlib import Path
 
+import numpy as np
 from numba import njit
 
 MODEL_FINITE, MODEL_SHORT, MODEL_LONG = 0, 1, 2
 
 TWO_PI = 2.0 * math.pi
+
+# Grid of the finite-bearing table (scripts/make_film_table.py solves Reynolds' equation on it).
+# eps = 1 - (1 - u)^2 with u uniform on [0, U_MAX] (nodes crowd towards eps = 1: eps_max = 0.99);
+# xi uniform on [0, pi] (the mirror image about e gives [-pi, 0]); B/D geometric on [WIDTH_MIN, WIDTH_MAX].
+N_U, U_MAX = 29, 0.9
+N_XI = 49
+N_WIDTH, WIDTH_MIN, WIDTH_MAX = 9, 0.25, 4.0
+LOG_WIDTH_STEP = math.log(WIDTH_MAX / WIDTH_MIN) / (N_WIDTH - 1)
+# First 16 hex digits of the SHA-256 of the stored table (scripts/make_film_table.py writes this
+# line).  numba freezes the table into the compiled code and keys its cache by this file, so a new
+# table must change this file; a table that does not match is not used (NaN forces).
+TABLE_DIGEST = "724a82af844b3486"
+
+
+def table_eccentricities() -> np.ndarray:
+    """The table's eccentricity ratios."""
+    u = np.linspace(0.0, U_MAX, N_U)
+    return 1.0 - (1.0 - u) ** 2
+
+
+def table_angles() -> np.ndarray:
+    """The table's squeeze-velocity angles xi, rad."""
+    return np.linspace(0.0, math.pi, N_XI)
+
+
+def table_widths() -> np.ndarray:
+    """The table's B/D."""
+    return WIDTH_MIN * np.exp(LOG_WIDTH_STEP * np.arange(N_WIDTH))
+
+
+@njit(cache=True, error_model="numpy")
+def table_scale(eps: float, width: float) -> float:
+    """The table stores f (1 - eps^2)^1.5 (1 + (B/D)^2) / (B/D)^3: bounded and smooth on the grid.
+
+    (1 - eps^2)^-1.5 is the growth of the long bearing's squeeze force as eps -> 1; the width factor
+    takes out the short bearing's (B/D)^3 and the long bearing's B/D.
+    """
+    return (1.0 - eps * eps) ** 1.5 * (1.0 + width * width) / (width * width * width)
+
+
+def table_digest(table: np.ndarray) -> str:
+    """First 16 hex digits of the SHA-256 of the table's float64 bytes."""
+    return hashlib.sha256(np.ascontiguousarray(table, dtype=np.float64).tobytes()).hexdigest()[:16]
+
+
+def _padded_table() -> np.ndarray:
+    """The stored table with one ghost node on each side of each axis (Catmull-Rom needs four nodes).
+
+    xi: mirror images (the component along e is even in xi about 0 and pi, the one ahead odd);
+    eps and B/D: linear extrapolation.  NaN if the stored table is missing or is not the one of
+    ``TABLE_DIGEST`` (while scripts/make_film_table.py builds it).
+    """
+    path = Path(__file__).with_name("film_table.npz")
+    shape = (N_WIDTH, N_U, N_XI, 2)
+    if not path.exists():
+        return np.full((N_WIDTH + 2, N_U + 2, N_XI + 2, 2), np.nan)
+    with np.load(path) as data:
+        core = np.asarray(data["force"], dtype=np.float64)
+    if core.shape != shape or table_digest(core) != TABLE_DIGEST:
+        return np.full((N_WIDTH + 2, N_U + 2, N_XI + 2, 2), np.nan)
+    out = np.empty((N_WIDTH + 2, N_U + 2, N_XI + 2, 2))
+    out[1:-1, 1:-1, 1:-1] = core
+    mirror = np.array([1.0, -1.0])
+    out[1:-1, 1:-1, 0] = core[:, :, 1] * mirror
+    out[1:-1, 1:-1, -1] = core[:, :, -2] * mirror
+    out[1:-1, 0] = 2.0 * out[1:-1, 1] - out[1:-1, 2]
+    out[1:-1, -1] = 2.0 * out[1:-1, -2] - out[1:-1, -3]
+    out[0] = 2.0 * out[1] - out[2]
+    out[-1] = 2.0 * out[-2] - out[-3]
+    return out
+
+
+FINITE_TABLE = _padded_table()
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _catmull_rom(t: float):
+    """Weights of the four nodes i-1, i, i+1, i+2 at the fraction t in [0, 1] of the interval (i, i+1)."""
+    t2 = t * t
+    t3 = t2 * t
+    return (0.5 * (-t3 + 2.0 * t2 - t), 0.5 * (3.0 * t3 - 5.0 * t2 + 2.0), 0.5 * (-3.0 * t3 + 4.0 * t2 + t),
+            0.5 * (t3 - t2))
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _cell(x: float, n: int):
+    """Interval index i in [0, n-2] and fraction t (clamped to [0, 1]) of the node coordinate x."""
+    if x <= 0.0:
+        return 0, 0.0
+    i = int(x)
+    if i >= n - 1:
+        return n - 2, 1.0
+    return i, x - i
+
+
+@njit(cache=True, error_model="numpy")
+def finite_force(eps: float, xi: float, width: float):
+    """Dimensionless film force (f_along_e, f_ahead) of the finite bearing: the table, tricubic.
+
+    Catmull-Rom in u = 1 - sqrt(1 - eps), in xi and in log(B/D).  Past eps = 0.99 the scaled force
+    of eps = 0.99 is kept (f grows as (1 - eps^2)^-1.5); below B/D = 1/4 the force scales as the short
+    bearing's (B/D)^3, above B/D = 4 as the long bearing's B/D.
+    """
+    factor = 1.0
+    w = width
+    if w < WIDTH_MIN:
+        factor = (w / WIDTH_MIN) ** 3
+        w = WIDTH_MIN
+    elif w > WIDTH_MAX:
+        factor = w / WIDTH_MAX
+        w = WIDTH_MAX
+    sign = 1.0
+    x = xi
+    if x < 0.0:
+        x = -x
+        sign = -1.0
+    u = 1.0 - math.sqrt(1.0 - eps)
+    iu, tu = _cell(u / U_MAX * (N_U - 1), N_U)
+    ix, tx = _cell(x / math.pi * (N_XI - 1), N_XI)
+    iw, tw = _cell(math.log(w / WIDTH_MIN) / LOG_WIDTH_STEP, N_WIDTH)
+    wu = _catmull_rom(tu)
+    wx = _catmull_rom(tx)
+    ww = _catmull_rom(tw)
+    g0 = 0.0
+    g1 = 0.0
+    for a in range(4):
+        for b in range(4):
+            wab = ww[a] * wu[b]
+            for d in range(4):
+                weight = wab * wx[d]
+                g0 += weight * FINITE_TABLE[iw + a, iu + b, ix + d, 0]
+                g1 += weight * FINITE_TABLE[iw + a, iu + b, ix + d, 1]
+    scale = factor / table_scale(eps, w)
+    return g0 * scale, sign * g1 * scale
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -113,6 +250,80 @@ def short_force(eps: float, xi: float, half_width: float):
     return -(cx * j_cc + sx * j_cs), -(cx * j_cs + sx * j_ss)
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _long_pressure(psi: float, eps: float, xi: float) -> float:
+    """Full-Sommerfeld pressure of the long bearing at Sommerfeld angle psi, zero at the thickest film.
+
+    H^3 dP/dphi = -12 sin(phi - xi) + C with C = -36 eps sin(xi) / (2 + eps^2) (periodic P), integrated
+    from phi = psi = pi through Sommerfeld's substitution (a trigonometric polynomial in psi).
+    """
+    k = 1.0 - eps * eps
+    root = math.sqrt(k)
+    c0 = -36.0 * eps * math.sin(xi) / (2.0 + eps * eps)
+
+    def primitive(p):
+        a0 = p + 2.0 * eps * math.sin(p) + eps * eps * (0.5 * p + 0.25 * math.sin(2.0 * p))
+        a_s = -math.cos(p) + 0.5 * eps * math.sin(p) ** 2
+        a_c = (1.0 + eps * eps) * math.sin(p) + 1.5 * eps * p + 0.25 * eps * math.sin(2.0 * p)
+        return (-12.0 * (math.cos(xi) * a_s * root - math.sin(xi) * a_c) + c0 * a0) / (k * k * root)
+
+    return primitive(psi) - primitive(math.pi)
+
+
+LONG_SAMPLES = 48  # sign changes of the (degree-2 trigonometric) pressure are found on this many intervals
+LONG_BISECTIONS = 48
+_GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(24)
+
+
+@njit(cache=True, error_model="numpy")
+def long_force(eps: float, xi: float, half_width: float):
+    """Dimensionless film force (f_along_e, f_ahead) of the long bearing, Gumbel cavitation.
+
+    The full-Sommerfeld pressure (:func:`_long_pressure`) where positive, times the length 2 B/D,
+    integrated over each positive interval of psi by 24-point Gauss-Legendre.
+    """
+    step = TWO_PI / LONG_SAMPLES
+    f0 = 0.0
+    f1 = 0.0
+    root = math.sqrt(1.0 - eps * eps)
+    start = -math.pi
+    inside = False
+    p_prev = _long_pressure(-math.pi + 0.5 * step, eps, xi)
+    inside = p_prev > 0.0
+    lo = -math.pi
+    for n in range(LONG_SAMPLES + 1):
+        psi = -math.pi + (n + 0.5) * step if n < LONG_SAMPLES else math.pi
+        p = _long_pressure(psi, eps, xi) if n < LONG_SAMPLES else 0.0
+        positive = p > 0.0
+        if positive != inside or n == LONG_SAMPLES:
+            a = psi - step if n < LONG_SAMPLES else psi - 0.5 * step
+            b = psi
+            if n < LONG_SAMPLES:
+                for _ in range(LONG_BISECTIONS):
+                    m = 0.5 * (a + b)
+                    if (_long_pressure(m, eps, xi) > 0.0) == inside:
+                        a = m
+                    else:
+                        b = m
+                edge = 0.5 * (a + b)
+            else:
+                edge = math.pi
+            if inside:
+                start = lo
+                half = 0.5 * (edge - start)
+                mid = 0.5 * (edge + start)
+                for g in range(_GAUSS_X.size):
+                    q = mid + half * _GAUSS_X[g]
+                    d = 1.0 + eps * math.cos(q)
+                    pressure = _long_pressure(q, eps, xi)
+                    jac = half * _GAUSS_W[g] * root / d
+                    f0 += pressure * jac * (math.cos(q) + eps) / d
+                    f1 += pressure * jac * root * math.sin(q) / d
+            lo = edge
+            inside = positive
+    return -2.0 * half_width * f0, -2.0 * half_width * f1
+
+
 @njit(cache=True, error_model="numpy")
 def film_force(ey: float, ez: float, vy: float, vz: float, omega_j: float, omega_b: float, c: float,
                radius: float, length: float, viscosity: float, model: int):
@@ -158,7 +369,12 @@ def film_force(ey: float, ez: float, vy: float, vz: float, omega_j: float, omega
             nz = sz / speed
         xi = math.atan2(ny * sz - nz * sy, ny * sy + nz * sz)
         half_width = 0.5 * length / radius
-        f_along, f_ahead = short_force(eps, xi, half_width)
+        if model == MODEL_FINITE:
+            f_along, f_ahead = finite_force(eps, xi, half_width)
+        elif model == MODEL_LONG:
+            f_along, f_ahead = long_force(eps, xi, half_width)
+        else:
+            f_along, f_ahead = short_force(eps, xi, half_width)
         ratio = radius / c
         scale = viscosity * radius * radius * ratio * ratio * speed / c
         fy = scale * (f_along * ny - f_ahead * nz)
