@@ -270,8 +270,8 @@ def _long_pressure(psi: float, eps: float, xi: float) -> float:
     return primitive(psi) - primitive(math.pi)
 
 
-LONG_SAMPLES = 48  # sign changes of the (degree-2 trigonometric) pressure are found on this many intervals
-LONG_BISECTIONS = 48
+LONG_SAMPLES = 32  # sign changes of the (degree-2 trigonometric) pressure are found on this many intervals
+LONG_BISECTIONS = 36  # each located to 2 pi / 32 / 2^36 ~ 3e-12 rad
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(24)
 
 
