@@ -251,23 +251,40 @@ def short_force(eps: float, xi: float, half_width: float):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def _long_coefficients(eps: float, xi: float):
+    """Coefficients (a1, b1, a2, d) of the long bearing's pressure, see :func:`_long_pressure`."""
+    k = 1.0 - eps * eps
+    root = math.sqrt(k)
+    scale = 1.0 / (k * k * root)
+    sx = math.sin(xi)
+    cx = math.cos(xi)
+    c0 = -36.0 * eps * sx / (2.0 + eps * eps)
+    a1 = (12.0 * sx * (1.0 + eps * eps) + 2.0 * eps * c0) * scale
+    b1 = 12.0 * cx * root * scale
+    a2 = (3.0 * eps * sx + 0.25 * eps * eps * c0) * scale
+    d = -6.0 * eps * cx * root * scale
+    return a1, b1, a2, d
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _long_pressure_at(psi: float, a1: float, b1: float, a2: float, d: float) -> float:
+    s = math.sin(psi)
+    c = math.cos(psi)
+    return a1 * s + b1 * (c + 1.0) + 2.0 * a2 * s * c + d * s * s
+
+
+@njit(cache=True, error_model="numpy")
 def _long_pressure(psi: float, eps: float, xi: float) -> float:
     """Full-Sommerfeld pressure of the long bearing at Sommerfeld angle psi, zero at the thickest film.
 
     H^3 dP/dphi = -12 sin(phi - xi) + C with C = -36 eps sin(xi) / (2 + eps^2) (periodic P), integrated
-    from phi = psi = pi through Sommerfeld's substitution (a trigonometric polynomial in psi).
+    from phi = psi = pi through Sommerfeld's substitution: the terms linear in psi cancel, leaving
+    P = (a1 sin psi + b1 (cos psi + 1) + a2 sin 2psi + d sin^2 psi) with
+    a1 = 12 sin xi (1 + eps^2) + 2 eps C, b1 = 12 cos xi sqrt(1 - eps^2), a2 = 3 eps sin xi + eps^2 C / 4,
+    d = -6 eps cos xi sqrt(1 - eps^2), all over (1 - eps^2)^2.5.
     """
-    k = 1.0 - eps * eps
-    root = math.sqrt(k)
-    c0 = -36.0 * eps * math.sin(xi) / (2.0 + eps * eps)
-
-    def primitive(p):
-        a0 = p + 2.0 * eps * math.sin(p) + eps * eps * (0.5 * p + 0.25 * math.sin(2.0 * p))
-        a_s = -math.cos(p) + 0.5 * eps * math.sin(p) ** 2
-        a_c = (1.0 + eps * eps) * math.sin(p) + 1.5 * eps * p + 0.25 * eps * math.sin(2.0 * p)
-        return (-12.0 * (math.cos(xi) * a_s * root - math.sin(xi) * a_c) + c0 * a0) / (k * k * root)
-
-    return primitive(psi) - primitive(math.pi)
+    a1, b1, a2, d = _long_coefficients(eps, xi)
+    return _long_pressure_at(psi, a1, b1, a2, d)
 
 
 LONG_SAMPLES = 32  # sign changes of the (degree-2 trigonometric) pressure are found on this many intervals
@@ -283,17 +300,18 @@ def long_force(eps: float, xi: float, half_width: float):
     integrated over each positive interval of psi by 24-point Gauss-Legendre.
     """
     step = TWO_PI / LONG_SAMPLES
+    a1, b1, a2, d2 = _long_coefficients(eps, xi)
     f0 = 0.0
     f1 = 0.0
     root = math.sqrt(1.0 - eps * eps)
     start = -math.pi
     inside = False
-    p_prev = _long_pressure(-math.pi + 0.5 * step, eps, xi)
+    p_prev = _long_pressure_at(-math.pi + 0.5 * step, a1, b1, a2, d2)
     inside = p_prev > 0.0
     lo = -math.pi
     for n in range(LONG_SAMPLES + 1):
         psi = -math.pi + (n + 0.5) * step if n < LONG_SAMPLES else math.pi
-        p = _long_pressure(psi, eps, xi) if n < LONG_SAMPLES else 0.0
+        p = _long_pressure_at(psi, a1, b1, a2, d2) if n < LONG_SAMPLES else 0.0
         positive = p > 0.0
         if positive != inside or n == LONG_SAMPLES:
             a = psi - step if n < LONG_SAMPLES else psi - 0.5 * step
@@ -301,7 +319,7 @@ def long_force(eps: float, xi: float, half_width: float):
             if n < LONG_SAMPLES:
                 for _ in range(LONG_BISECTIONS):
                     m = 0.5 * (a + b)
-                    if (_long_pressure(m, eps, xi) > 0.0) == inside:
+                    if (_long_pressure_at(m, a1, b1, a2, d2) > 0.0) == inside:
                         a = m
                     else:
                         b = m
@@ -315,7 +333,7 @@ def long_force(eps: float, xi: float, half_width: float):
                 for g in range(_GAUSS_X.size):
                     q = mid + half * _GAUSS_X[g]
                     d = 1.0 + eps * math.cos(q)
-                    pressure = _long_pressure(q, eps, xi)
+                    pressure = _long_pressure_at(q, a1, b1, a2, d2)
                     jac = half * _GAUSS_W[g] * root / d
                     f0 += pressure * jac * (math.cos(q) + eps) / d
                     f1 += pressure * jac * root * math.sin(q) / d
