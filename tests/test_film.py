@@ -6,8 +6,8 @@ import pytest
 from scipy.integrate import quad
 
 from weftsim import reynolds
-from weftsim.kernel.film import (MODEL_FINITE, MODEL_LONG, MODEL_SHORT, _long_pressure, film_force, finite_force,
-                                 long_force, short_force, sommerfeld_angle)
+from weftsim.kernel.film import (MODEL_FINITE, MODEL_LONG, MODEL_SHORT, MODEL_SHORT_HALF, _long_pressure, film_force,
+                                 finite_force, long_force, short_force, sommerfeld_angle)
 from weftsim.reynolds import RAIMONDI_BOYD, equilibrium, steady_load
 
 VISCOSITY, RADIUS, LENGTH, CLEARANCE = 0.1, 0.01, 0.02, 2e-5  # Pa s, m, m, m: a pin of B/D = 1
@@ -39,6 +39,26 @@ def test_short_bearing_squeeze_both_directions_with_cavitation(eps, sign):
     expected = -VISCOSITY * LENGTH**3 * RADIUS * rate / CLEARANCE**3 * integral
     assert fy == pytest.approx(expected, rel=1e-9)  # closed form vs adaptive quadrature: round-off
     assert abs(fz) <= 1e-12 * abs(fy)  # symmetric film: no force across the line of motion
+
+
+@pytest.mark.parametrize("eps", [0.0, 0.3, 0.8])
+@pytest.mark.parametrize("rate", [1e-4, -1e-4])
+@pytest.mark.parametrize("omega", [0.0, 100.0, -100.0])
+def test_short_half_film_is_the_multibody_papers_closed_form(eps, rate, omega):
+    """MODEL_SHORT_HALF: Flores, Ambrosio, Claro, Lankarani (2006) short-bearing forces, wedge + squeeze on the
+    fixed half film: F_r = -(eta R L^3 / (2 c^2)) (2 eps^2 |w| / (1-eps^2)^2 + pi (1+2 eps^2) deps / (1-eps^2)^2.5),
+    F_t = (eta R L^3 / (2 c^2)) (pi eps w / (2 (1-eps^2)^1.5) + 4 eps deps sign(w) / (1-eps^2)^2), w = omega."""
+    e = eps * CLEARANCE
+    fy, fz, _, _ = film_force(e, 0.0, rate, 0.0, omega, 0.0, CLEARANCE, RADIUS, LENGTH, VISCOSITY, MODEL_SHORT_HALF)
+    deps = rate / CLEARANCE
+    side = 1.0 if omega >= 0.0 else -1.0  # the half film of the wedge flips with the sense of rotation
+    k = 1 - eps**2
+    base = VISCOSITY * RADIUS * LENGTH**3 / (2 * CLEARANCE**2)
+    radial = -base * (2 * eps**2 * abs(omega) / k**2 + math.pi * (1 + 2 * eps**2) * deps / k**2.5)
+    ahead = base * (math.pi * eps * omega / (2 * k**1.5) + side * 4 * eps * deps / k**2)
+    scale = base * (abs(omega) + abs(deps)) / k**2.5
+    assert fy == pytest.approx(radial, abs=1e-12 * scale)  # closed form by another route: round-off
+    assert fz == pytest.approx(ahead, abs=1e-12 * scale)
 
 
 def test_zero_viscosity_gives_no_force_and_no_torque():
@@ -159,7 +179,7 @@ def test_finite_table_reproduces_fresh_solves_between_its_nodes(eps, xi, width):
     assert math.hypot(got[0] - exact[0], got[1] - exact[1]) < 0.01 * math.hypot(*exact)
 
 
-@pytest.mark.parametrize("model", [MODEL_FINITE, MODEL_SHORT, MODEL_LONG])
+@pytest.mark.parametrize("model", [MODEL_FINITE, MODEL_SHORT, MODEL_LONG, MODEL_SHORT_HALF])
 def test_every_model_is_finite_near_the_centre_and_silent_without_oil(model):
     """At the centre the film is the one of a journal leaving it along its squeeze velocity V."""
     args = (1e-4, 2e-4, 30.0, -5.0, CLEARANCE, RADIUS, LENGTH)
@@ -171,7 +191,7 @@ def test_every_model_is_finite_near_the_centre_and_silent_without_oil(model):
     assert all(math.isfinite(v) for v in film_force(0.999 * CLEARANCE, 0.0, *args, VISCOSITY, model))
 
 
-@pytest.mark.parametrize("model", [MODEL_FINITE, MODEL_SHORT, MODEL_LONG])
+@pytest.mark.parametrize("model", [MODEL_FINITE, MODEL_SHORT, MODEL_LONG, MODEL_SHORT_HALF])
 def test_petroff_torque_of_the_centred_journal(model):
     """Centred journal: no pressure torque, the shear torque is Petroff's 2 pi eta R^3 L omega / c."""
     omega = 50.0

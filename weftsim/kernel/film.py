@@ -37,8 +37,12 @@ any mix of rotation and squeeze, exact in both directions of the squeeze.  ``mod
     d/dphi(H^3 dP/dphi) alone (B/D -> infinity), periodic pressure zero at the thickest film,
     negative part discarded (Gumbel).
 ``MODEL_FINITE``
-    the finite bearing.  [First commit: evaluates the short bearing; the finite-length solution
-    replaces it.]
+    the finite bearing: Reynolds' equation with Reynolds' cavitation condition solved on a grid
+    (:mod:`weftsim.reynolds`) and tabulated over eps, xi and B/D (``film_table.npz``,
+    interpolated by :func:`finite_force`).
+``MODEL_SHORT_HALF``
+    the short bearing as the multibody papers write it: wedge and squeeze pressure over the fixed
+    half film of the wedge (:func:`short_half_force`).
 
 Film friction: the shear stress of the film on each surface (Couette part over the full film,
 Petroff's term with the eccentricity factor 1/sqrt(1 - eps^2); pressure-gradient part from the
@@ -66,7 +70,7 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-MODEL_FINITE, MODEL_SHORT, MODEL_LONG = 0, 1, 2
+MODEL_FINITE, MODEL_SHORT, MODEL_LONG, MODEL_SHORT_HALF = 0, 1, 2, 3
 
 TWO_PI = 2.0 * math.pi
 
@@ -230,15 +234,11 @@ def _short_antiderivatives(psi: float, eps: float):
     return cc, cs, ss
 
 
-@njit(cache=True, error_model="numpy")
-def short_force(eps: float, xi: float, half_width: float):
-    """Dimensionless film force f = (f_along_e, f_ahead) of the short bearing, Gumbel cavitation.
-
-    ``half_width`` = B/D (zeta runs over [-B/D, B/D]).  The axially integrated pressure is
-    8 (B/D)^3 cos(phi - xi) / H^3, kept over the half circle |phi - xi| < pi/2 where it is positive.
-    """
-    a = sommerfeld_angle(xi - 0.5 * math.pi, eps)
-    b = sommerfeld_angle(xi + 0.5 * math.pi, eps)
+@njit(cache=True, error_model="numpy", inline="always")
+def _short_integrals(eps: float, xi: float, half_width: float, lo: float, hi: float):
+    """f of the axially integrated short-bearing pressure 8 (B/D)^3 cos(phi - xi) / H^3 over phi in [lo, hi]."""
+    a = sommerfeld_angle(lo, eps)
+    b = sommerfeld_angle(hi, eps)
     cc_a, cs_a, ss_a = _short_antiderivatives(a, eps)
     cc_b, cs_b, ss_b = _short_antiderivatives(b, eps)
     scale = 8.0 * half_width * half_width * half_width / (1.0 - eps * eps) ** 2.5
@@ -248,6 +248,33 @@ def short_force(eps: float, xi: float, half_width: float):
     cx = math.cos(xi)
     sx = math.sin(xi)
     return -(cx * j_cc + sx * j_cs), -(cx * j_cs + sx * j_ss)
+
+
+@njit(cache=True, error_model="numpy")
+def short_force(eps: float, xi: float, half_width: float):
+    """Dimensionless film force f = (f_along_e, f_ahead) of the short bearing, Gumbel cavitation.
+
+    ``half_width`` = B/D (zeta runs over [-B/D, B/D]).  The axially integrated pressure is
+    8 (B/D)^3 cos(phi - xi) / H^3, kept over the half circle |phi - xi| < pi/2 where it is positive.
+    """
+    return _short_integrals(eps, xi, half_width, xi - 0.5 * math.pi, xi + 0.5 * math.pi)
+
+
+@njit(cache=True, error_model="numpy")
+def short_half_force(eps: float, xi: float, half_width: float):
+    """The short bearing of the multibody papers (``MODEL_SHORT_HALF``): (f_along_e, f_ahead).
+
+    Flores, Ambrosio, Claro and Lankarani integrate the wedge and the squeeze pressure over one
+    fixed half of the film, the half where the wedge's pressure is positive (phi in [-pi, 0] for
+    omega_j + omega_b - 2 dgamma/dt >= 0, i.e. sin xi <= 0; [0, pi] otherwise), without clipping the
+    squeeze pressure.  Their closed forms follow: with w the effective speed,
+    F_r = -(eta R B^3 / (2 c^2)) (2 eps^2 |w| / (1-eps^2)^2 + pi (1 + 2 eps^2) deps/dt / (1-eps^2)^2.5),
+    F_t = (eta R B^3 / (2 c^2)) (pi eps w / (2 (1-eps^2)^1.5) + 4 eps deps/dt / (1-eps^2)^2) for w >= 0;
+    a journal leaving the wall is pulled back by a pressure below ambient.
+    """
+    if math.sin(xi) <= 1e-9:  # no wedge (sin xi = 1e-16 at xi = pi from atan2): the half of w > 0
+        return _short_integrals(eps, xi, half_width, -math.pi, 0.0)
+    return _short_integrals(eps, xi, half_width, 0.0, math.pi)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -360,7 +387,7 @@ def film_force(ey: float, ez: float, vy: float, vz: float, omega_j: float, omega
     viscosity : float
         Dynamic viscosity, Pa s.
     model : int
-        ``MODEL_FINITE``, ``MODEL_SHORT`` or ``MODEL_LONG``.
+        ``MODEL_FINITE``, ``MODEL_SHORT``, ``MODEL_LONG`` or ``MODEL_SHORT_HALF`` (any other: short).
 
     Returns
     -------
@@ -391,6 +418,8 @@ def film_force(ey: float, ez: float, vy: float, vz: float, omega_j: float, omega
             f_along, f_ahead = finite_force(eps, xi, half_width)
         elif model == MODEL_LONG:
             f_along, f_ahead = long_force(eps, xi, half_width)
+        elif model == MODEL_SHORT_HALF:
+            f_along, f_ahead = short_half_force(eps, xi, half_width)
         else:
             f_along, f_ahead = short_force(eps, xi, half_width)
         ratio = radius / c
