@@ -2,6 +2,7 @@
 
 import math
 
+import numpy as np
 import pytest
 from scipy.integrate import quad
 
@@ -212,3 +213,22 @@ def test_finite_force_is_the_same_film_for_any_frame():
     # omega_m x e = 20 * (0, e): the same squeeze velocity with the journal still and moving instead.
     still = film_force(e, 0.0, 1e-3, 2e-3 - 20.0 * e, 0.0, 0.0, CLEARANCE, RADIUS, LENGTH, VISCOSITY, MODEL_FINITE)
     assert still[:2] == pytest.approx(base[:2], rel=1e-12)
+
+
+@pytest.mark.parametrize("model", [MODEL_FINITE, MODEL_SHORT, MODEL_LONG, MODEL_SHORT_HALF])
+def test_the_film_only_dissipates(model):
+    """Power into journal and bearing, F . e_dot + torque_j omega_j + torque_b omega_b, is never positive.
+
+    It equals F . V (V Booker's squeeze velocity) minus the Couette shear's eta R^3 B (omega_j - omega_b)^2
+    2 pi / (c sqrt(1 - eps^2)); F . V = -(1/12 eta) integral h^3 |grad p|^2 for a film that solves
+    Reynolds' equation where it carries pressure.
+    """
+    rng = np.random.default_rng(3)
+    for _ in range(500):
+        eps, angle = rng.uniform(0.0, 0.98), rng.uniform(-math.pi, math.pi)
+        ey, ez = eps * CLEARANCE * math.cos(angle), eps * CLEARANCE * math.sin(angle)
+        vy, vz = rng.normal(0.0, 1e-3, 2)
+        omega_j, omega_b = rng.normal(0.0, 50.0, 2)
+        fy, fz, tj, tb = film_force(ey, ez, vy, vz, omega_j, omega_b, CLEARANCE, RADIUS, LENGTH, VISCOSITY, model)
+        power = fy * vy + fz * vz + tj * omega_j + tb * omega_b
+        assert power < 0.0
