@@ -67,11 +67,11 @@ def operator(eps: float, half_width: float, n_phi: int, n_zeta: int):
     rows, cols, vals = [], [], []
     # Circumferential fluxes: conductance H^3 / gap times the cell height in zeta.
     g_phi = (face_h3 / gap)[:, None] * dzeta[None, :]
-    right = np.roll(index, -1, axis=0)
-    for a, b in ((index, right),):
-        rows += [a.ravel(), b.ravel(), a.ravel(), b.ravel()]
-        cols += [a.ravel(), b.ravel(), b.ravel(), a.ravel()]
-        vals += [g_phi.ravel(), g_phi.ravel(), -g_phi.ravel(), -g_phi.ravel()]
+    here = index.ravel()
+    right = np.roll(index, -1, axis=0).ravel()
+    rows += [here, right, here, right]
+    cols += [here, right, right, here]
+    vals += [g_phi.ravel(), g_phi.ravel(), -g_phi.ravel(), -g_phi.ravel()]
     # Axial fluxes between j and j+1 (conductance H^3 / dz times the cell width in phi).
     g_z = np.repeat((node_h3 * width / dz)[:, None], n_zeta, axis=1)
     up = index[:, 1:]

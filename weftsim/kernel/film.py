@@ -55,10 +55,13 @@ torque_j + torque_b + (e x F)_x = 0:
 Sources: Ocvirk (NACA TN 2808, 1952) and Sommerfeld (1904) for the limits; Gumbel's half-Sommerfeld
 condition and the multibody use of both (Flores, Ambrosio, Claro, Lankarani, Mech. Mach. Theory 41,
 2006; Nonlinear Dyn. 56, 2009); Booker's mobility/impedance view of the squeeze velocity
-(J. Lubr. Technol. 87, 1965; Childs, Moes, van der Bosch, J. Lubr. Technol. 99, 1977).
+(J. Basic Eng. 87, 1965; Childs, Moes, van der Bosch, J. Lubr. Technol. 99, 1977).
 
-The functions take floats and return floats, never check their arguments (the caller keeps
-eps < 1: at e >= c the asperity and dry contact take over), and are compiled with numba.
+The functions take floats and return floats, never check their arguments, and are compiled with
+numba.  The caller keeps eps < 1 (at e >= c the result is NaN; the asperity and dry contact take
+over before the wall).  The force grows without bound towards the wall (the squeeze film as
+(1 - eps^2)^-1.5, its stiffness one power of (1 - eps) faster), which sets the step of explicit
+integrators near the wall.
 """
 
 from __future__ import annotations
