@@ -17,7 +17,7 @@ has a right-hand side that depends on the motion only through one vector (Booker
 ``omega_m dh/dtheta + dh/dt = -V . n`` with ``V = e_dot - omega_m x e``.  A journal spinning in a
 bearing therefore makes the same film as a journal translating with V in a still bearing, and the
 rotation (wedge) term carries the effective speed omega_j + omega_b - 2 dgamma/dt (gamma the
-direction of e) of the multibody literature.  With h = c H, p = eta (R/c)^2 (|V|/c) P, the axial
+direction of e) of the multibody literature.  With h = c H, p = eta (R/c)^2 (abs(V)/c) P, the axial
 coordinate z = R zeta and the angle phi from e, the dimensionless problem is
 
     div(H^3 grad P) = -12 cos(phi - xi),   H = 1 - eps cos phi,   zeta in [-B/D, B/D],
@@ -25,7 +25,7 @@ coordinate z = R zeta and the angle phi from e, the dimensionless problem is
 with xi the angle of V from e, P = 0 at the bearing's ends and P >= 0 (cavitation: the film
 ruptures where the pressure would fall below ambient).  Its force is
 
-    F = eta R^2 (R/c)^2 (|V|/c) f(eps, xi, B/D),   f = -integral P n dphi dzeta,
+    F = eta R^2 (R/c)^2 (abs(V)/c) f(eps, xi, B/D),   f = -integral P n dphi dzeta,
 
 one dimensionless vector (component along e, component 90 deg ahead of e) of three numbers, for
 any mix of rotation and squeeze, exact in both directions of the squeeze.  ``model`` picks f:
@@ -258,7 +258,7 @@ def short_force(eps: float, xi: float, half_width: float):
     """Dimensionless film force f = (f_along_e, f_ahead) of the short bearing, Gumbel cavitation.
 
     ``half_width`` = B/D (zeta runs over [-B/D, B/D]).  The axially integrated pressure is
-    8 (B/D)^3 cos(phi - xi) / H^3, kept over the half circle |phi - xi| < pi/2 where it is positive.
+    8 (B/D)^3 cos(phi - xi) / H^3, kept over the half circle abs(phi - xi) < pi/2 where it is positive.
     """
     return _short_integrals(eps, xi, half_width, xi - 0.5 * math.pi, xi + 0.5 * math.pi)
 
@@ -271,7 +271,7 @@ def short_half_force(eps: float, xi: float, half_width: float):
     fixed half of the film, the half where the wedge's pressure is positive (phi in [-pi, 0] for
     omega_j + omega_b - 2 dgamma/dt >= 0, i.e. sin xi <= 0; [0, pi] otherwise), without clipping the
     squeeze pressure.  Their closed forms follow: with w the effective speed,
-    F_r = -(eta R B^3 / (2 c^2)) (2 eps^2 |w| / (1-eps^2)^2 + pi (1 + 2 eps^2) deps/dt / (1-eps^2)^2.5),
+    F_r = -(eta R B^3 / (2 c^2)) (2 eps^2 abs(w) / (1-eps^2)^2 + pi (1 + 2 eps^2) deps/dt / (1-eps^2)^2.5),
     F_t = (eta R B^3 / (2 c^2)) (pi eps w / (2 (1-eps^2)^1.5) + 4 eps deps/dt / (1-eps^2)^2) for w >= 0;
     a journal leaving the wall is pulled back by a pressure below ambient.
     """
@@ -380,7 +380,7 @@ def film_force(ey: float, ez: float, vy: float, vz: float, omega_j: float, omega
     Parameters
     ----------
     ey, ez : float
-        Eccentricity, journal centre - bearing centre, m (|e| < c).
+        Eccentricity, journal centre - bearing centre, m (abs(e) < c).
     vy, vz : float
         Its rate, m/s.
     omega_j, omega_b : float
