@@ -232,3 +232,15 @@ def test_the_film_only_dissipates(model):
         fy, fz, tj, tb = film_force(ey, ez, vy, vz, omega_j, omega_b, CLEARANCE, RADIUS, LENGTH, VISCOSITY, model)
         power = fy * vy + fz * vz + tj * omega_j + tb * omega_b
         assert power < 0.0
+
+
+@pytest.mark.parametrize(("k", "i", "j"), [(4, 10, 0), (4, 20, 24), (2, 27, 48), (7, 5, 30)])
+def test_stored_table_is_the_solver_of_this_code_at_its_nodes(k, i, j):
+    """The shipped film_table.npz is what weftsim.reynolds gives today (rebuild it after changing the solver)."""
+    from weftsim.kernel import film
+
+    eps, xi, width = film.table_eccentricities()[i], film.table_angles()[j], film.table_widths()[k]
+    stored = film.FINITE_TABLE[k + 1, i + 1, j + 1] / film.table_scale(eps, width)
+    fresh = reynolds.film(float(eps), float(xi), float(width))
+    # The same computation (sparse direct solves): round-off only.
+    assert stored == pytest.approx(fresh, rel=1e-9, abs=1e-12 * math.hypot(*fresh))
