@@ -469,6 +469,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         plan = plan_sweep(args.scene, args.vary, fixed, engine, allow_large=args.yes,
                           allow_cwd_engine=args.allow_cwd_engine,
                           announce=lambda line: print(line, file=sys.stderr, flush=True))
+        for note in plan.notes:
+            print(f"weftsim sweep: {note}", file=sys.stderr, flush=True)
         outdir = output_directory(args, plan.base, "sweep-" + engine.replace(":", "."))
         report = run_sweep(plan, outdir, jobs=args.jobs, scheduler=args.scheduler, cell_figures=args.cell_figures)
     except _SweepTerminated as exc:

@@ -181,8 +181,9 @@ class RunGuard:
             return Breach(
                 "step_size",
                 f"the step size collapsed to {step_size:.3g} s (below limits.min_step_s = {self.min_step:.3g} s)",
-                "the equations became too stiff or discontinuous for the method: try another method ('Radau' "
-                "or 'LSODA' for stiff contact), a looser rtol/atol, or check the joint's stiffness and the contact law",
+                "the equations became too stiff or discontinuous for the method: try another method "
+                "(solver.reference.method = 'Radau' or 'LSODA' for stiff contact), a looser tolerance, or check "
+                "the joint's stiffness and the contact law",
             )  # fmt: skip
         if self.max_steps is not None and self.steps > self.max_steps:
             return Breach(
