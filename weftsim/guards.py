@@ -60,6 +60,11 @@ def request_stop(reason: str) -> None:
     _STOP_REQUEST[:] = [reason]
 
 
+def stop_requested() -> str | None:
+    """The reason given to :func:`request_stop` while a stop is asked for, else None."""
+    return _STOP_REQUEST[0] if _STOP_REQUEST else None
+
+
 def clear_stop() -> None:
     """Withdraw :func:`request_stop` (before the next run)."""
     _STOP_REQUEST.clear()

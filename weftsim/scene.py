@@ -68,11 +68,14 @@ MM, DEG, GPA, MPA, RPM = 1e-3, math.pi / 180.0, 1e9, 1e6, 2.0 * math.pi / 60.0
 def WEAR_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 - a constant-like key factory
     """The ``[<table>.wear]`` keys of a clearance joint (weftsim wear; docs/wear.md), all optional."""
     return (
-        Key(f"{table}.wear.wear_coefficient", f"{joint}.wear.wear_coefficient", "float", 1, 0, 1, True, False,
-            doc="Archard's dimensionless wear coefficient k (default 1e-7, mild lubricated steel)"),
-        Key(f"{table}.wear.bearing_hardness_mpa", f"{joint}.wear.bearing_hardness", "float", MPA, 0,
+        # k spans 1e-2 (severe, dry) to below 1e-6 (Archard 1953; Rabinowicz 1995); hardness from soft
+        # polymer bushings (~10 MPa) to ceramics and diamond (~1e5 MPa).  Beyond these the wear per update
+        # dwarfs the clearance and the cycle extrapolation cannot follow it (issue 24).
+        Key(f"{table}.wear.wear_coefficient", f"{joint}.wear.wear_coefficient", "float", 1, 0, 1e-2, True, False,
+            doc="Archard's dimensionless wear coefficient k (default 1e-7, mild lubricated steel; 1e-2 severe dry wear)"),
+        Key(f"{table}.wear.bearing_hardness_mpa", f"{joint}.wear.bearing_hardness", "float", MPA, 1, 1e5, False,
             doc="hardness H of the bearing surface (default 2000 MPa, hardened steel)"),
-        Key(f"{table}.wear.journal_hardness_mpa", f"{joint}.wear.journal_hardness", "float", MPA, 0,
+        Key(f"{table}.wear.journal_hardness_mpa", f"{joint}.wear.journal_hardness", "float", MPA, 1, 1e5, False,
             doc="hardness H of the journal surface (default 2000 MPa)"),
         Key(f"{table}.wear.max_clearance_change", f"{joint}.wear.max_clearance_change", "float", 1, 0, 0.5, True,
             False, doc="update criterion: largest growth of the effective clearance per update, as a fraction"),
