@@ -112,6 +112,20 @@ def test_a_key_of_an_ideal_joint_is_refused_alike_by_run_and_sweep(capsys, tmp_p
     assert not (tmp_path / "sweep").exists() and not (tmp_path / "run").exists()
 
 
+@pytest.mark.parametrize("command", [["run", "reference", "--set"], ["sweep", "reference", "--vary"]])
+def test_a_wear_key_outside_weftsim_wear_is_refused(capsys, tmp_path, command):
+    """Further round: [joint_e.wear] keys change nothing a run computes; a sweep of them made identical cells."""
+    value = "1e-7,1e-6" if command[0] == "sweep" else "1e-6"
+    status, _, err = run(capsys, *command, f"joint_e.wear.wear_coefficient={value}", "--revolutions", 0.05,
+                         "-o", tmp_path / "x")
+    assert status == 2 and "is read by `weftsim wear` only" in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_wear_limit_beyond_the_journal_radius_is_refused(capsys, tmp_path):
+    status, _, err = run(capsys, "wear", "reference", "--hours", 1, "--limit-clearance-mm", 100, "-o", tmp_path / "w")
+    assert status == 2 and "must be smaller than the journal radius 10 mm" in err
+
+
 def test_a_key_that_matters_in_some_cells_of_a_sweep_is_kept():
     from weftsim.sweep import plan_sweep
 

@@ -220,7 +220,11 @@ def test_engine_study_writes_both_engines_and_agrees_on_the_start(reduced):
     for name in report["files"]:
         assert (outdir / name).is_file(), name
     assert set(report["runs"]) == {"reference", "exudyn"}
-    assert report["compare"]["agree"], report["compare"]["checks"]
+    # The reduced run is shorter than a revolution: the start (first contact) agrees, the peaks are not
+    # compared, and that is a partial comparison, not an agreement (issue 24).
+    compare = report["compare"]
+    assert all(c["passed"] for c in compare["checks"]), compare["checks"]
+    assert compare["status"] == "partial" and not compare["agree"]
 
 
 def test_unknown_study_and_missing_scenes_are_errors(tmp_path):

@@ -103,6 +103,19 @@ def ideal_key_message(key: str, where: str = "command line") -> str:
             f"{table}.{CLEARANCE} > 0 as well (e.g. --set {table}.{CLEARANCE}=0.25) or leave the key out")
 
 
+def wear_only_keys(keys) -> list[str]:
+    """The keys among ``keys`` of a ``[joint_*.wear]`` table: read by ``weftsim wear`` alone."""
+    return [key for key in keys if ".wear." in str(key) and joint_table(str(key)) is not None]
+
+
+def wear_only_message(key: str, command: str) -> str:
+    """The one line refusing a wear key where it would change nothing (any command but ``weftsim wear``)."""
+    from weftsim.scene import shown
+
+    return (f"key '{shown(key)}' is read by `weftsim wear` only: `weftsim {command}` does not depend on it, so it "
+            "would change nothing (every cell of a sweep would be the same run); leave it out or run `weftsim wear`")
+
+
 def inheritance_note(scene: Scene) -> str | None:
     """One line saying which keys joint F took from joint E, when F has a clearance and took any; else None."""
     if scene.joint_f.is_ideal or not scene.joint_f_inherits:

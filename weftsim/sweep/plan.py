@@ -90,11 +90,15 @@ def plan_sweep(scene_path: str | Path, vary: list[str], fixed: list[str] | tuple
     weftsim.scene.SceneError
         The base scene itself is invalid.
     """
-    from weftsim.joint_keys import ideal_joint_keys, ideal_key_message, inheritance_note
+    from weftsim.joint_keys import (ideal_joint_keys, ideal_key_message, inheritance_note, wear_only_keys,
+                                    wear_only_message)
     from weftsim.scene import SceneError, apply_overrides, load_scene, to_file_keys
 
     axes = tuple(parse_vary(text) for text in vary)
     fixed_overrides = dict(parse_set(text) for text in fixed)
+    idle = wear_only_keys([axis.key for axis in axes] + list(fixed_overrides))
+    if idle:
+        raise SweepError(wear_only_message(idle[0], "sweep"))
     size = grid_size(axes)
     if size > LARGE_GRID_CELLS and not allow_large:
         raise SweepError(f"the grid has {size:,} cells, more than {LARGE_GRID_CELLS:,}: check the --vary counts, "

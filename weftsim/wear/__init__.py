@@ -61,11 +61,15 @@ def check_request(scene: Scene, hours: float, engine: str, limit: float | None) 
     if limit is not None and not (limit > scene.joint.clearance and math.isfinite(limit)):
         raise WearError(f"--limit-clearance-mm must be larger than the scene's clearance "
                         f"{scene.joint.clearance * 1e3:g} mm, got {limit * 1e3:g}")
-    if scene.joint.is_ideal:
-        raise WearError("joint_e.clearance_mm is 0 (ideal joint): there is no contact to wear; give a clearance > 0")
-    if not scene.joint_f.is_ideal:
+    if limit is not None and limit >= scene.joint.journal_radius:
+        raise WearError(f"--limit-clearance-mm must be smaller than the journal radius "
+                        f"{scene.joint.journal_radius * 1e3:g} mm (the prediction ends before the clearance "
+                        f"reaches it, docs/wear.md), got {limit * 1e3:g}")
+    if not scene.joint_f.is_ideal:  # first: a scene with F alone loose is refused for F, not for E's 0
         raise WearError("the scene gives a clearance at F: the wear prediction covers joint E with F ideal so far "
                         "(docs/wear.md); set joint_f.clearance_mm = 0 or leave out [joint_f]")
+    if scene.joint.is_ideal:
+        raise WearError("joint_e.clearance_mm is 0 (ideal joint): there is no contact to wear; give a clearance > 0")
 
 
 def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine: str = "reference",
