@@ -256,6 +256,7 @@ def test_wear_prediction_stops_at_the_limit_and_resumes_to_the_same_end(tmp_path
     ("joint_e.wear.wear_coefficient", 0.9, "<= 0.01"),
     ("joint_e.wear.bearing_hardness_mpa", 1e-310, ">= 1"),
     ("joint_e.wear.journal_hardness_mpa", 1e9, "<= 100000"),
+    ("joint_e.wear.profile_points", 8, ">= 180"),  # further round: 8-120 points broke the worn contact
 ])
 def test_wear_inputs_beyond_physics_are_refused_up_front(capsys, tmp_path, key, value, allowed):
     status, _, err = run(capsys, "wear", "reference", "--set", f"{key}={value}", "--hours", 1, "-o", tmp_path / "w")
