@@ -210,6 +210,24 @@ def test_animation_of_a_clearance_at_f_draws_and_captions_f():
     assert any("clearance at F" in t for t in texts) and any("journal at F" in t for t in texts)
 
 
+def test_orbit_figure_has_a_panel_per_clearance_joint(tmp_path):
+    """Further round: orbit.png showed joint E alone (and nothing for a clearance at F alone)."""
+    from weftsim import reference
+    from weftsim.output import write_run
+    from weftsim.plots import plot_orbit
+
+    only_f = reference.solve(load_scene(CLEARANCE_F, {"drive.revolutions": 0.3}))
+    figure = plot_orbit(only_f)
+    panels = [ax for ax in figure.axes if ax.get_title()]
+    assert len(panels) == 1 and "orbit at F" in panels[0].get_title()
+    orbit = panels[0].lines[1]  # the rod's pin in the sector's eye, every solver step, in mm
+    assert np.array_equal(orbit.get_xdata(), only_f.steps["eccentricity_f_y_m"] * 1e3)
+    assert "orbit" in write_run(only_f, tmp_path / "f")
+    both = reference.solve(load_scene(MODELS / "clearance_ef.toml", {"drive.revolutions": 0.3}))
+    titles = [ax.get_title() for ax in plot_orbit(both).axes if ax.get_title()]
+    assert ["orbit at E" in titles[0], "orbit at F" in titles[1]] == [True, True]
+
+
 # --- wear: geometric limits, bad inputs, failures mid-way, interrupts ------------------------------
 
 
