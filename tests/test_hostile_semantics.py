@@ -359,3 +359,13 @@ def test_the_exudyn_model_message_names_the_scene_key(capsys, tmp_path):
     status, _, err = run(capsys, "run", "clearance_f", "--engine", "exudyn", "--set",
                          "solver.exudyn.model=kinematic_tree", "--revolutions", 0.05, "-o", tmp_path / "x")
     assert status in (2, 3) and "solver.exudyn.model" in err and "exudyn_solver" not in err
+
+
+def test_a_law_range_warning_names_the_scene_key_once(capsys, tmp_path):
+    """Further round: the Exudyn engine also printed the reusable joint's Python warning (a file path and
+    `restitution`) beside the scene's own line naming joint_f.restitution."""
+    status, _, err = run(capsys, "run", "clearance_f", "--set", "joint_f.restitution=0.3", "--engine", "exudyn",
+                         "--revolutions", 0.05, "-o", tmp_path / "x")
+    assert status == 0, err
+    assert "joint_f.restitution = 0.3 is outside" in err
+    assert "UserWarning" not in err and "`restitution`" not in err
