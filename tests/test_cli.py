@@ -100,12 +100,17 @@ def test_runs_of_the_two_engines_go_to_their_own_directories(tmp_path):
     first = subprocess.run([sys.executable, "-m", "weftsim.cli", *run, "--engine", "reference"], cwd=tmp_path,
                            capture_output=True, text=True)
     assert first.returncode == 0, first.stderr
-    reference = tmp_path / "out" / "clearance_0p50mm_400rpm" / "reference"
+    # Overrides on the command line: the scene's directory is named after them (issue 25).
+    from weftsim.cli_grammar import overrides_tag
+
+    name = "clearance_0p50mm_400rpm-" + overrides_tag({"drive.revolutions": 0.25, "joint_e.restitution": 0.8})
+    assert name.startswith("clearance_0p50mm_400rpm-0.25rev-set")
+    reference = tmp_path / "out" / name / "reference"
     kept = {name: (reference / name).read_bytes() for name in ("channels.csv", "summary.json", "result.npz")}
     second = subprocess.run([sys.executable, "-m", "weftsim.cli", *run], cwd=tmp_path, capture_output=True, text=True)
     assert second.returncode == 0, second.stderr
     assert "engine exudyn" in second.stdout.splitlines()[0]  # --engine auto is the Exudyn engine
-    exudyn = tmp_path / "out" / "clearance_0p50mm_400rpm" / "exudyn"
+    exudyn = tmp_path / "out" / name / "exudyn"
     assert (exudyn / "channels.csv").exists() and (exudyn / "result.npz").exists()
     assert {name: (reference / name).read_bytes() for name in kept} == kept  # the first run is untouched
     summary = json.loads((exudyn / "summary.json").read_text())

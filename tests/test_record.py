@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -62,36 +63,57 @@ def test_differences_name_each_changed_key_old_and_new():
     assert differences(a, a) == []
 
 
-def test_a_run_of_another_scene_is_refused_before_it_runs_and_force_replaces(tmp_path, capsys, monkeypatch):
-    """The issue's case: the defaults, then --clearance-mm 0.5 --speed-rpm 600 into the same out/reference/<engine>."""
+def test_runs_with_other_settings_go_to_their_own_directory(tmp_path, capsys, monkeypatch):
+    """The issue's case: the defaults, then --clearance-mm 0.5 --speed-rpm 600.  The second run's directory
+    is named after its overrides; the first run's files are untouched."""
     monkeypatch.chdir(tmp_path)
-    status, out, err = main(capsys, "run", "reference", "--engine", "reference", *SHORT, "--no-plot")
+    status, out, err = main(capsys, "run", "reference", "--engine", "reference", "--no-plot")
     assert status == 0, err
     first = Path("out", "reference", "reference")  # relative, as the command names it
-    before = (first / "summary.json").read_text()
+    before = {p.name: p.read_bytes() for p in first.iterdir()}
     record = manifest(first)
-    assert record["command"] == "weftsim run reference --engine reference --revolutions 0.05 --no-plot"
+    assert record["command"] == "weftsim run reference --engine reference --no-plot"
     assert record["resolved_scene"]["joint_e.clearance_mm"] == 0.25
     assert "scene.toml" in record["files"] and f"wrote {first / 'scene.toml'}" in out
 
-    status, out, err = main(capsys, "run", "reference", "--engine", "reference", *SHORT, "--no-plot",
+    status, out, err = main(capsys, "run", "reference", "--engine", "reference", "--no-plot",
                             "--clearance-mm", "0.5", "--speed-rpm", "600")
-    assert status == 2
-    assert err.strip().splitlines() == [
-        f"weftsim run: error: {first} holds the results of another scene (drive.speed_rpm 400.0 -> 600.0, "
-        "joint_e.clearance_mm 0.25 -> 0.5); choose another directory with -o, or pass --force to replace them"]
-    assert out == ""  # nothing ran
-    assert (first / "summary.json").read_text() == before
-
-    status, _, err = main(capsys, "run", "reference", "--engine", "reference", *SHORT, "--no-plot")
-    assert status == 0, err  # the same scene again replaces its own results
-
-    status, _, err = main(capsys, "run", "reference", "--engine", "reference", *SHORT, "--no-plot",
-                          "--clearance-mm", "0.5", "--speed-rpm", "600", "--force")
     assert status == 0, err
-    assert json.loads((first / "summary.json").read_text())["scene"]["joint_e.clearance_mm"] == 0.5
-    assert same(load_scene(first / "scene.toml"), load_scene("reference", {"joint_e.clearance_mm": 0.5, "drive.speed_rpm": 600,
-                                                                 "drive.revolutions": 0.05}))
+    second = Path("out", "reference-c0.5mm-600rpm", "reference")
+    assert f"wrote {second / 'summary.json'}" in out
+    assert {p.name: p.read_bytes() for p in first.iterdir()} == before
+    assert same(load_scene(second / "scene.toml"),
+                load_scene("reference", {"joint_e.clearance_mm": 0.5, "drive.speed_rpm": 600}))
+    # Other keys (--set) are told apart by a digest of their values.
+    status, out, err = main(capsys, "run", "reference", "--engine", "reference", "--no-plot", "--revolutions", "0.05",
+                            "--set", "restitution=0.8")
+    assert status == 0, err
+    assert re.search(r"wrote out/reference-0\.05rev-set[0-9a-f]{8}/reference/summary\.json", out), out
+
+
+def test_an_edited_scene_file_is_refused_in_its_old_directory_and_force_replaces(tmp_path, capsys, monkeypatch):
+    """A scene file changed between two runs writes to the same default directory: refused before the run,
+    naming the key; the same scene again replaces its own results; --force replaces the other's."""
+    monkeypatch.chdir(tmp_path)
+    scene = tmp_path / "mine.toml"
+    scene.write_text('extends = "%s"\nname = "mine"\n\n[drive]\nrevolutions = 0.05\n' % (MODELS / "reference.toml"))
+    args = ("run", scene, "--engine", "reference", "--no-plot")
+    status, _, err = main(capsys, *args)
+    assert status == 0, err
+    target = Path("out", "mine", "reference")
+    before = (target / "summary.json").read_text()
+    status, _, err = main(capsys, *args)
+    assert status == 0, err  # the same scene again
+    scene.write_text(scene.read_text() + "\n[joint_e]\nclearance_mm = 0.5\n")
+    status, out, err = main(capsys, *args)
+    assert status == 2 and out == ""  # nothing ran
+    assert err.strip().splitlines() == [
+        f"weftsim run: error: {target} holds the results of another scene (joint_e.clearance_mm 0.25 -> 0.5); "
+        "choose another directory with -o, or pass --force to replace them"]
+    assert json.loads((target / "summary.json").read_text())["scene"] == json.loads(before)["scene"]
+    status, _, err = main(capsys, *args, "--force")
+    assert status == 0, err
+    assert json.loads((target / "summary.json").read_text())["scene"]["joint_e.clearance_mm"] == 0.5
 
 
 @pytest.mark.parametrize("command", [

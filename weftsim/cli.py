@@ -33,8 +33,10 @@ from weftsim.cli_grammar import (  # noqa: F401 (CliError, add_scene_flags, scen
     VersionAction,
     add_output_flags,
     add_scene_flags,
+    command_overrides,
     models_directory,
     output_directory,
+    overrides_tag,
     positive,
     scene_from_args,
     set_overrides,
@@ -528,14 +530,16 @@ def cmd_study(args: argparse.Namespace) -> int:
     for name in names:  # every refusal before the first study runs
         check_overrides(name, overrides, revolutions)
     models = models_directory(args)
-    parent = Path("out")
+    parent, tag = Path("out"), overrides_tag(command_overrides(args))
     if args.scene is not None:  # a bad scene or override refused before the first study runs
         from weftsim.scene import load_scene
 
-        parent = output_directory(argparse.Namespace(output=None), load_scene(args.scene, overrides))
+        parent = output_directory(argparse.Namespace(**{**vars(args), "output": None}),
+                                  load_scene(args.scene, {**overrides, "drive.revolutions": revolutions}))
+        tag = ""  # in the scene's directory's name
     for name in names:
         outdir = (Path(args.output) / name if args.name == "all" else Path(args.output)) if args.output \
-            else parent / f"study-{name}"
+            else parent / (f"study-{name}-{tag}" if tag else f"study-{name}")
         report = run_study(name, outdir, models, revolutions, args.force, overrides=overrides, scene=args.scene)
         print(format_study(name, report))
         print("\n".join(wrote_lines(outdir, report)))

@@ -219,9 +219,39 @@ def models_directory(args: argparse.Namespace) -> Path:
     return directory
 
 
+# How the shorthand flags show in the name of a default output directory (out/loom-c0.25mm-800rpm/exudyn/).
+DIRECTORY_LABELS = {"joint_e.clearance_mm": "c{}mm", "drive.speed_rpm": "{}rpm", "drive.revolutions": "{}rev",
+                    "joint_e.law": "{}"}
+
+
+def overrides_tag(overrides: dict[str, Any]) -> str:
+    """What tells a default output directory of a scene with ``overrides`` from the scene's own: the shorthand
+    values (``c0.25mm-800rpm-3rev``), and ``set`` with 8 hex digits of the other keys' values (``--set``);
+    empty without overrides (``name`` names the directory itself)."""
+    import hashlib
+    import json
+
+    given = {k: v for k, v in overrides.items() if v is not None and k != "name"}
+    parts = [form.format(f"{given.pop(key):g}" if isinstance(given[key], float) else given.pop(key))
+             for key, form in DIRECTORY_LABELS.items() if key in given]
+    if given:
+        digest = hashlib.sha1(json.dumps(given, sort_keys=True, default=str).encode()).hexdigest()[:8]
+        parts.append(f"set{digest}")
+    return "-".join(parts)
+
+
+def command_overrides(args: argparse.Namespace) -> dict[str, Any]:
+    """The overrides the command line gives (``--set`` and the shorthand flags) as dotted keys."""
+    from weftsim.api import SCENE_FLAGS
+
+    return {**set_overrides(args), **{SCENE_FLAGS[flag]: value for flag, value in shorthand_values(args).items()}}
+
+
 def output_directory(args: argparse.Namespace, scene: Scene, *parts: str) -> Path:
     """``-o``, or ``out/<scene name>/<parts>`` (``parts``: the engine, ``"compare"``, ...): every command's
-    results of one scene under one directory, each in its own.  A name that would leave ``out/`` is refused."""
+    results of one scene under one directory, each in its own.  With overrides on the command line the
+    scene's directory is ``out/<scene name>-<tag>`` (:func:`overrides_tag`: ``out/loom-c0.25mm/exudyn``), so a
+    run with other settings never lands on another's results.  A name that would leave ``out/`` is refused."""
     if args.output:
         return Path(args.output)
     name = scene.name
@@ -229,4 +259,5 @@ def output_directory(args: argparse.Namespace, scene: Scene, *parts: str) -> Pat
         raise CliError(f"the scene's key 'name' = {name!r} cannot name the default output directory "
                        "out/<name>: it must be one plain file name (no '/' or '\\', not '.' or '..'); "
                        "change it or choose the output directory with -o")
-    return Path("out", name, *parts)
+    tag = overrides_tag(command_overrides(args))
+    return Path("out", f"{name}-{tag}" if tag else name, *parts)
