@@ -33,7 +33,7 @@ Example::
         table = weftsim.simulate(scene, engine).to_pandas()
 """
 
-from weftsim.version import __version__
+from weftsim.version import __version__  # noqa: F401 (weftsim.__version__)
 from weftsim.api import (
     DEFAULT_ENGINE,
     ENGINE_NAMES,
