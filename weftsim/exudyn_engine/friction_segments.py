@@ -42,7 +42,9 @@ NAMES = ("dead", "ramp", "slide")
 # moves at < 1 m/s relative to the bearing), so the frozen RAMP is the ramp's line at every speed reached.
 FAR = 1.0e3
 # Switches of the frozen piece within one step before the step counts as failed (Exudyn then halves it).
-# Measured on the loom (c = 0.5 mm, mu = 0.15, one revolution): most switching steps need 1, none more than 3.
+# Measured on the loom (mu = 0.15, one revolution, c = 0.25 / 0.5 mm): of 13 790 / 10 129 accepted steps
+# 96 / 98 % needed none, 495 / 182 one, 18 / 20 two or three; 61 / 11 met the limit (the pieces cycled)
+# and were halved.
 MAX_SWITCHES = 8
 
 
