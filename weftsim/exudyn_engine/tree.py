@@ -28,7 +28,8 @@ contact point when ``joint.friction_coefficient`` > 0 (its tangential velocity f
 rocker's rotation rates, its moments about both centres), and returns the joint torques of the
 contact force and moment by virtual work.  No constraints remain, so an error-controlled
 explicit solver (DOPRI5 with automatic step size) integrates it; there is no Jacobian and no
-Newton iteration.
+Newton iteration.  With friction the friction ramp makes it stiff, and generalized-alpha with an
+error-controlled step integrates it instead (:mod:`.tree_implicit`).
 
 The driving torque comes from the contact force in closed form, with the crank-side
 terms of :mod:`weftsim.reference.ideal` (docs/physics.md section 4, docs/reference-solver.md):

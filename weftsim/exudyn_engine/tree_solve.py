@@ -1,6 +1,8 @@
-"""``solve`` of the kinematic-tree model (:mod:`.tree`): explicit solver, channels, failures.
+"""``solve`` of the kinematic-tree model (:mod:`.tree`): explicit or implicit solver, channels, failures.
 
-Solver: Exudyn's explicit ``exudyn_solver.explicit_method`` (DOPRI5 or ODE23) with
+Solver (:func:`tree_solver`): with friction in the joint generalized-alpha with error control and
+friction segments (:mod:`.tree_implicit`); otherwise, or under ``solver.exudyn.tree_solver = "explicit"``,
+Exudyn's explicit ``exudyn_solver.explicit_method`` (DOPRI5 or ODE23) with
 automatic step size, ``relative_tolerance`` (at most :data:`FRICTION_RELATIVE_TOLERANCE` with
 friction) and ``absolute_tolerance`` (on the joint
 angles, rad, and rates, rad/s), end-of-step accelerations on (else the rapier acceleration
@@ -288,12 +290,13 @@ def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, ca
         return True
 
     implicit = tree_solver(scene) == "implicit"
-    register_post_step(mbs, post_step)
     if implicit:
+        register_post_step(mbs, post_step)  # first: the step controller's hook plans the next step after it
         solver = exu.MainSolverImplicitSecondOrder()
         stepper = ImplicitTree(mbs, solver, model, scene)
         stepper.install()
     else:
+        mbs.SetPostStepUserFunction(post_step)  # the one hook, without register_post_step's dispatcher
         solver = exu.MainSolverExplicit()
     mbs.Assemble()
     if progress is not None:
