@@ -37,9 +37,8 @@ from __future__ import annotations
 from weftsim.kernel.joint import MU, V0, V1
 
 DEAD, RAMP, SLIDE = 0, 1, 2
-NAMES = ("dead", "ramp", "slide")
-# The frozen ramp's saturation speed, m/s: far beyond any sliding speed in the loom (the journal's surface
-# moves at < 1 m/s relative to the bearing), so the frozen RAMP is the ramp's line at every speed reached.
+# The frozen ramp's saturation speed, m/s.  The frozen RAMP equals the law on v0 < |v_T| < v1 for any FAR > v1;
+# FAR only has to lie beyond the speeds Newton's iterates reach, so that the frozen piece is a line there.
 FAR = 1.0e3
 # Switches of the frozen piece within one step before the step counts as failed (Exudyn then halves it).
 # Measured on the loom (mu = 0.15, one revolution, c = 0.25 / 0.5 mm): of 13 790 / 10 129 accepted steps
@@ -98,7 +97,3 @@ class FrictionSegments:
         self.freeze(true)
         self.switches += 1
         return False
-
-    def release(self) -> None:
-        """The true law again (the callback's original parameters)."""
-        self._set(self.prm, self.mu, self.v0, self.v1)
