@@ -258,3 +258,47 @@ def test_the_rigid_body_model_with_friction_agrees_with_the_reference_engine():
     assert exu.path["model"] == "rigid_body"
     problems = _span_disagreements(exu, ref)
     assert not problems, problems
+
+
+def test_each_frozen_friction_piece_is_the_law_on_its_own_speed_range():
+    """exudyn_engine/friction_segments.py: Newton runs on one piece of the friction law at a time, made from the
+    kernel's own law by setting its parameters.  A step is accepted only on its own piece, so each frozen piece
+    must equal the law (to round-off) at every sliding speed of that piece, and the piece of a speed must be
+    the law's (its inequalities at v0 and v1)."""
+    from weftsim.exudyn_engine.friction_segments import DEAD, RAMP, SLIDE, FrictionSegments
+    from weftsim.kernel.joint import friction_force
+    from weftsim.reference.dynamics import pack_parameters
+
+    scene = _scene(0.15, "0p50")
+    law = pack_parameters(scene)
+    v0, v1 = scene.joint.friction_velocities
+
+    class Callback:  # what FrictionSegments reads of the tree's callback: its parameter copy
+        prm = law.copy()
+
+    pieces = FrictionSegments(Callback)
+    f_n = 1.0e5
+    ranges = {DEAD: np.linspace(-v0, v0, 41), RAMP: np.concatenate([np.linspace(v0, v1, 41)[1:-1], -np.linspace(v0, v1, 41)[1:-1]]),
+              SLIDE: np.concatenate([np.geomspace(v1, 10.0, 41), -np.geomspace(v1, 10.0, 41)])}  # fmt: skip
+    for piece, speeds in ranges.items():
+        pieces.freeze(piece)
+        for v in speeds:
+            assert pieces.segment_of(v) == piece, (piece, v)
+            # The frozen RAMP is the ramp's line rescaled to a saturation at 1e3 m/s: equal to round-off (1e-12).
+            assert friction_force(pieces.prm, f_n, v) == pytest.approx(friction_force(law, f_n, v), rel=1e-12, abs=1e-9)
+    # Off its range a piece is not the law (else there would be nothing to switch): the ramp's line beyond v1.
+    pieces.freeze(RAMP)
+    assert abs(friction_force(pieces.prm, f_n, 2 * v1)) > 1.5 * abs(friction_force(law, f_n, 2 * v1))
+
+
+def test_the_implicit_tree_gives_the_same_run_on_both_callback_routes():
+    """The friction pieces write into the callback's parameters: a numpy array on the numba route, a list on the
+    python route.  Both runs take the same steps and the same peaks (measured 1.3e-14 apart: round-off)."""
+    from weftsim import exudyn_engine
+
+    scene = _scene(0.15, "0p50", revolutions=0.05)
+    runs = [exudyn_engine.solve(scene, callback=route) for route in ("numba", "python")]
+    assert all(r.ok for r in runs), [r.message for r in runs]
+    assert runs[0].solver_stats["steps"] == runs[1].solver_stats["steps"]
+    for name in PEAK_CHANNELS:
+        assert np.abs(runs[0].steps[name]).max() == pytest.approx(np.abs(runs[1].steps[name]).max(), rel=1e-10)
