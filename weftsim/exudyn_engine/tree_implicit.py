@@ -66,7 +66,7 @@ _REPEAT = 2.0
 class TreeStepController(StepController):
     """:class:`StepController` that does not lengthen the step for :data:`HOLD_STEPS` steps after Newton
     failed and Exudyn halved it (the error estimate alone would double it again at once, into the same
-    failure: measured on the loom with friction, heavy creeping contacts failed Newton every second step)."""
+    failure: measured on the loom with friction, heavy creeping contacts then failed Newton step after step)."""
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
