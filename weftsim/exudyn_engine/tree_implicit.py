@@ -73,7 +73,7 @@ class TreeStepController(StepController):
         super().__init__(*args, **kwargs)
         self.planned = self.next_step
         self.hold = 0
-        self.newton_failures = 0
+        self.newton_cut_steps = 0  # accepted steps that Exudyn had cut (once or more) after Newton failed
 
     def post_newton(self, mbs: exu.MainSystem, t: float) -> list[float]:
         out = super().post_newton(mbs, t)
@@ -84,7 +84,7 @@ class TreeStepController(StepController):
     def post_step(self, mbs: exu.MainSystem, t: float) -> bool:
         h = self.it.currentStepSize
         if t > 0.0 and h < self.planned * (1.0 - 1e-9):  # Exudyn cut the planned step: Newton failed
-            self.newton_failures += 1
+            self.newton_cut_steps += 1
             self.hold = HOLD_STEPS
         go = super().post_step(mbs, t)
         if t > 0.0 and self.hold > 0:
@@ -167,8 +167,9 @@ class ImplicitTree:
         ti.minimumStepSize = scene.limits.min_step
 
     def counters(self) -> dict:
-        """Solver statistics of the run: the controller's, Newton failures, friction piece switches."""
-        out = {**self.control.counters(), "newton_failures": self.control.newton_failures}
+        """Solver statistics of the run: the controller's, the steps cut after Newton failed (a step may have
+        failed more than once before it was accepted), friction piece switches."""
+        out = {**self.control.counters(), "newton_cut_steps": self.control.newton_cut_steps}
         if self.segments is not None:
             out["friction_switches"] = self.segments.switches
         return out
