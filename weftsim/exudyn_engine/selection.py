@@ -6,7 +6,10 @@
   the clearance joint at E is the only free joint.  Then the crank, coupler and rocker move in
   closed form with the crank angle, and only the two coordinates of the chain 4-8 behind the
   clearance are integrated, by an explicit error-controlled solver (DOPRI5) that takes large steps
-  in free flight and short ones through the impacts.  Every scene weftsim describes today with a
+  in free flight and short ones through the impacts; with friction in the joint by generalized-alpha
+  with an error-controlled step (``solver.exudyn.tree_solver``,
+  :func:`weftsim.exudyn_engine.tree_solve.tree_solver`): the friction ramp holds an explicit solver
+  at ~1e-9 s steps while the journal creeps.  Every scene weftsim describes today with a
   clearance at E is of this kind.
 - **rigid-body model** (:mod:`.mechanism`, generalized-alpha) when the scene needs bodies and joints
   for members 1-3.  What forces it (:func:`rigid_body_needs`):
@@ -58,10 +61,14 @@ def select_path(scene: Scene) -> dict:
     model, reason = select_model(scene)
     if model == "kinematic_tree":
         from weftsim.exudyn_engine.callbacks import resolve_route
-        from weftsim.exudyn_engine.tree_solve import tree_relative_tolerance
+        from weftsim.exudyn_engine.tree_solve import tree_relative_tolerance, tree_solver
 
+        route = resolve_route(s.callback)
+        if tree_solver(scene) == "implicit":
+            return {"model": model, "reason": reason,
+                    "method": f"generalized-alpha, adaptive step (local error {s.local_error:g} m at E), {route} callback"}
         return {"model": model, "reason": reason,
-                "method": f"{s.explicit_method} rtol {tree_relative_tolerance(scene):g}, {resolve_route(s.callback)} callback"}
+                "method": f"{s.explicit_method} rtol {tree_relative_tolerance(scene):g}, {route} callback"}
     from weftsim.exudyn_engine.solver import adaptive, step_plan
 
     if adaptive(scene):
