@@ -182,3 +182,16 @@ def test_automatic_choice_names_the_stiff_joint_and_keeps_explicit_paths_selecta
     assert path["method"].startswith("numba_DOP853_RODAS4 rtol 1e-06")
     assert "friction at E" in path["reason"]
     assert select_path(_scene(mu=0.15, method="numba_DOP853"))["method"].startswith("numba_DOP853 rtol 1e-05")
+
+
+def test_run_time_and_record_estimates_know_friction():
+    from weftsim.progress import EXPLICIT_STIFF_FACTOR, estimate_run_time, estimate_step_bytes
+
+    dry, rough = _scene(degrees=360.0), _scene(mu=0.15, degrees=360.0)
+    explicit = _scene(mu=0.15, degrees=360.0, method="numba_DOP853")
+    # The implicit path with friction: measured 2.3-3.1x the dry default in one process.
+    assert 2.0 <= estimate_run_time(rough, "reference") / estimate_run_time(dry, "reference") <= 4.0
+    # numba_DOP853 on friction: measured 1661x the dry run (issue 23), and a record of millions of rows.
+    assert estimate_run_time(explicit, "reference") == pytest.approx(EXPLICIT_STIFF_FACTOR
+                                                                     * estimate_run_time(dry, "reference"))
+    assert estimate_step_bytes(explicit, "reference") > 1e9 > 1e7 > estimate_step_bytes(rough, "reference")
