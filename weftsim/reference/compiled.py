@@ -225,7 +225,7 @@ def advance(prm: np.ndarray, method: int, rtol: float, atol: float, max_step: fl
         h_abs = min(max(fst[H_ABS], min_step), max_step)
         rejected = False
         if m == RODAS4:  # one Jacobian per step, kept through rejected attempts from the same (t, y)
-            ros.jacobian(prm, t, y, contact, impact, ist, J, f_t, plus, minus, tmp)
+            ros.jacobian(prm, t, y, f, contact, impact, ist, J, f_t, plus, minus, tmp)
             ist[JACOBIANS] += 1
         while True:
             if h_abs < min_step:
@@ -320,7 +320,11 @@ def advance(prm: np.ndarray, method: int, rtol: float, atol: float, max_step: fl
             _record(smp_t, smp_y, smp_c, smp_i, k, sample_times[k], tmp, contact, impact)
             k += 1
         ist[NEXT_SAMPLE] = k
-        if contact != 0 and _CONTACT_SUBSTEPS > 0:
+        if contact != 0 and m == RODAS4:  # its steps are 3-5x shorter than DOP853's: the midpoint only
+            t_sub = 0.5 * (t + t_stop)
+            _dense_any(m, F, t, h, y, t_sub, tmp)
+            n_rows = _record(stp_t, stp_y, stp_c, stp_i, n_rows, t_sub, tmp, contact, impact)
+        elif contact != 0 and _CONTACT_SUBSTEPS > 0:
             for i in range(_CONTACT_SUBSTEPS):
                 t_sub = t + (t_stop - t) * _SUBSTEPS[i]
                 _dense_any(m, F, t, h, y, t_sub, tmp)

@@ -17,12 +17,14 @@ Each step solves 6 linear systems with one LU decomposition of E, so its step si
 accuracy, not by the stiffness of a lasting contact or of the friction ramp (the explicit DOP853
 steps at ~1e-9 s where the journal sticks: the ramp's slope mu F_N / (v1 - v0) ~ 1e7-1e8 N s/m).
 
-The Jacobian J = df/dy and df/dt come from the one kernel (:func:`weftsim.kernel.chain_f.rhs_any`) by
-central differences with fixed, small perturbations (:data:`JAC_STEP_Q`, :data:`JAC_STEP_V`,
-:data:`JAC_STEP_T`); the quadrature states W3 and D are not read by the right-hand side, so their
-columns are zero and are not perturbed.  Their accuracy is measured in ``tests/test_rosenbrock.py``
-(against a Richardson-extrapolated difference: relative error below 1e-6 in contact with friction)
-and discussed in docs/reference-solver.md section 3, "Linearly implicit path".
+The Jacobian J = df/dy and df/dt come from the one kernel (:func:`weftsim.kernel.chain_f.rhs_any`) by forward
+differences with fixed, small perturbations (:data:`JAC_STEP_Q`, :data:`JAC_STEP_V`, :data:`JAC_STEP_T`) from
+f(t, y), which the step needs anyway: n - 1 evaluations (5 for the 2-DOF chain).  The quadrature states W3 and
+D are not read by the right-hand side, so their columns are zero and are not perturbed.  Accuracy, measured in
+``tests/test_rosenbrock.py`` against an extrapolated central difference: relative error 5e-8-7e-6 inside a
+contact with friction (central differences: 2e-8-8e-7, at twice the evaluations and no measurable gain in
+steps or peaks; docs/reference-solver.md section 3, "Linearly implicit path").  At delta = 0 and at the kinks
+of the friction ramp no difference is a derivative; the step's error control rejects what that spoils.
 
 Every function is module-level ``@njit(cache=True, error_model="numpy")``;
 :mod:`weftsim.reference.compiled` drives them in its event-driven loop.
@@ -39,10 +41,11 @@ from weftsim.reference.compiled_rk import _f
 
 RODAS4 = 2  # method code next to compiled_rk.DOP853 (0) and RK45 (1)
 ORDER = 4  # of the solution; the error estimate k_6 is O(h^4), so the step-size exponent is 1/4
-# Perturbations of the central differences: coordinates (rad, or m for the free rod's centre) and their
+# Perturbations of the forward differences: coordinates (rad, or m for the free rod's centre) and their
 # rates (rad/s, m/s), and time (s).  1e-9 rad moves the journal by ~0.3 nm, against penetrations of
 # 1e-7-1e-5 m (truncation ~ (0.3 nm / delta)^2, < 1e-5); the rates by ~0.3 nm/s, far inside the
-# friction ramp of 1e-4 m/s.  Round-off ~ eps |f| / 1e-9 ~ 1e-3 rad/s^2 against derivatives of 1e3-1e9.
+# friction ramp of 1e-4 m/s.  Round-off ~ eps |f| / 1e-9 ~ 1e-3 rad/s^2 against derivatives of 1e3-1e9;
+# truncation ~ (0.3 nm / delta), 1e-5 at delta = 30 um.
 JAC_STEP_Q = 1e-9
 JAC_STEP_V = 1e-9
 JAC_STEP_T = 1e-10
@@ -73,10 +76,10 @@ SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 6.0
 
 
 @njit(cache=True, error_model="numpy")
-def jacobian(prm, t, y, contact, impact, ist, J, f_t, plus, minus, tmp):
-    """J = df/dy (n, n) and f_t = df/dt (n,) at (t, y) by central differences of the kernel.
+def jacobian(prm, t, y, f0, contact, impact, ist, J, f_t, plus, minus, tmp):
+    """J = df/dy (n, n) and f_t = df/dt (n,) at (t, y) by forward differences of the kernel from f0 = f(t, y).
 
-    Columns of W3 and D stay zero (the right-hand side does not read them).  2 (n - 2) + 2 evaluations.
+    Columns of W3 and D stay zero (the right-hand side does not read them).  n - 1 evaluations.
     """
     n = y.size
     n_mech = n - N_QUADRATURES
@@ -87,16 +90,13 @@ def jacobian(prm, t, y, contact, impact, ist, J, f_t, plus, minus, tmp):
         step = JAC_STEP_Q if j < half else JAC_STEP_V
         tmp[j] = y[j] + step
         _f(prm, t, tmp, contact, impact, plus, ist)
-        tmp[j] = y[j] - step
-        _f(prm, t, tmp, contact, impact, minus, ist)
         tmp[j] = y[j]
-        inv = 0.5 / step
+        inv = 1.0 / step
         for i in range(n):
-            J[i, j] = (plus[i] - minus[i]) * inv
+            J[i, j] = (plus[i] - f0[i]) * inv
     _f(prm, t + JAC_STEP_T, y, contact, impact, plus, ist)
-    _f(prm, t - JAC_STEP_T, y, contact, impact, minus, ist)
     for i in range(n):
-        f_t[i] = (plus[i] - minus[i]) * (0.5 / JAC_STEP_T)
+        f_t[i] = (plus[i] - f0[i]) * (1.0 / JAC_STEP_T)
 
 
 @njit(cache=True, error_model="numpy")
