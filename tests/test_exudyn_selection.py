@@ -52,6 +52,23 @@ def test_auto_takes_the_rigid_body_model_where_the_scene_needs_it():
     assert select_path(friction)["model"] == "kinematic_tree" and select_path(friction)["reason"].startswith("auto")
 
 
+def test_auto_runs_the_tree_implicitly_with_friction_and_explicitly_without():
+    """Issue 23: with friction the explicit tree steps at the friction ramp's ~1e-9 s stability limit, the
+    implicit one does not (tests/test_friction_agreement.py); without friction DOPRI5 is the faster
+    (docs/performance.md).  Both stay choices by ``solver.exudyn.tree_solver``."""
+    base = load_scene(MODELS / "reference.toml")
+    friction = load_scene(MODELS / "reference.toml", {"joint_e.friction_coefficient": 0.15})
+    path = select_path(friction)
+    assert path["model"] == "kinematic_tree"
+    assert path["method"] == "generalized-alpha, adaptive step (local error 3e-10 m at E), numba callback"
+    assert select_path(base)["method"].startswith("DOPRI5")
+    assert select_path(_with(friction, tree_solver="explicit"))["method"].startswith("DOPRI5 rtol 1e-08")
+    assert select_path(_with(base, tree_solver="implicit"))["method"].startswith("generalized-alpha")
+    with pytest.raises(SceneError) as err:
+        load_scene(MODELS / "reference.toml", {"solver.exudyn.tree_solver": "radau"})
+    assert "solver.exudyn.tree_solver" in str(err.value) and "'implicit'" in str(err.value)
+
+
 def test_explicit_models_stay_choices():
     base = load_scene(MODELS / "reference.toml")
     for model in ("rigid_body", "kinematic_tree"):
@@ -64,6 +81,7 @@ def test_explicit_models_stay_choices():
 
 @pytest.mark.parametrize("overrides, model, method", [
     ({}, "kinematic_tree", "DOPRI5"),
+    ({"joint_e.friction_coefficient": 0.15}, "kinematic_tree", "generalized_alpha"),
     ({"solver.exudyn.model": "rigid_body", "drive.revolutions": 0.03}, "rigid_body", "generalized_alpha"),
     ({"joint_e.clearance_mm": 0.0}, "rigid_body", "generalized_alpha"),
 ])  # fmt: skip
@@ -102,3 +120,26 @@ def test_the_default_path_meets_the_issue_targets_on_the_reference_scene():
     err = errors(quantities(r), ref)
     assert err["peak_max"] < scene.compare.first_revolution_peaks, err["peak"]
     assert err["stats_max"] < scene.compare.rms, (err["rms"], err["mean"])
+
+
+def test_the_default_path_runs_a_slow_drive_that_the_other_paths_run():
+    """Issue 24: at 1 rpm the tree's largest step was half an output sample, 0.042 s, and its first step
+    from the centred journal ended 99.7 mm deep in the wall (gravity: the journal falls through the
+    clearance in 7 ms), "joint too soft".  The step is now also at most 0.1 of that fall time
+    (tree_solve.largest_step): the default path runs, and as at any speed it agrees with the reference
+    engine, here on the journal resting on the bearing (0.003 revolution, 0.18 s: it falls, bounces and
+    settles)."""
+    from weftsim import reference
+    from weftsim.exudyn_engine.tree_solve import largest_step
+
+    scene = load_scene(MODELS / "reference.toml", {"drive.speed_rpm": 1.0, "drive.revolutions": 0.003})
+    assert largest_step(scene) == pytest.approx(0.1 * (2 * scene.joint.clearance / scene.inertia.gravity) ** 0.5)
+    fast = load_scene(MODELS / "reference.toml")  # 400 rpm: the half sample is the bound, steps unchanged
+    assert largest_step(fast) == fast.output.sample_angle / fast.drive.speed / 2
+    exu, ref = exudyn_engine.solve(scene), reference.solve(scene)
+    assert exu.ok and ref.ok, (exu.message, ref.message)
+    assert exu.path["model"] == "kinematic_tree" and exu.path["method"].startswith("DOPRI5")
+    # At rest the journal carries its static load (3.136 N in both engines): the settled state of two
+    # integrations to their tolerances, measured to agree within 1e-4.
+    assert exu.steps["contact_force_N"][-1] == pytest.approx(ref.steps["contact_force_N"][-1], rel=1e-3)
+    assert exu.steps["penetration_m"][-1] > 0.0

@@ -334,7 +334,9 @@ class ExudynSolver:
     to ``local_error`` under ``step_control = "adaptive"``, or ``step_size`` under ``"fixed"``) or
     "kinematic_tree" (members 1-3 prescribed, 4-8 in minimal coordinates, explicit
     ``explicit_method`` with automatic step size to ``relative_tolerance`` /
-    ``absolute_tolerance``; docs/performance.md).
+    ``absolute_tolerance``, or ``tree_solver = "implicit"``: generalized-alpha with the rigid-body
+    model's error control to ``local_error``; "auto": implicit with friction in the joint, explicit
+    without; docs/performance.md).
     """
 
     model: str = "auto"
@@ -346,6 +348,7 @@ class ExudynSolver:
     newton_relative_tolerance: float = 1e-8
     newton_max_iterations: int = 25
     callback: str = "auto"
+    tree_solver: str = "auto"  # kinematic_tree: "explicit" (explicit_method), "implicit" (generalized-alpha), auto
     explicit_method: str = "DOPRI5"  # kinematic_tree only
     relative_tolerance: float = 1e-6  # kinematic_tree: error control of the explicit solver
     absolute_tolerance: float = 1e-9  # kinematic_tree: on joint angles (rad) and rates (rad/s)

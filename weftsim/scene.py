@@ -27,9 +27,11 @@ from typing import Any
 from weftsim import params
 from weftsim.errors import SceneError
 
-INTEGRATORS = ("auto", "DOP853", "RK45", "RK23", "Radau", "LSODA", "BDF", "numba_DOP853", "numba_RK45")
+INTEGRATORS = ("auto", "DOP853", "RK45", "RK23", "Radau", "LSODA", "BDF", "numba_DOP853", "numba_RK45", "numba_RODAS4",
+               "numba_DOP853_RODAS4")
 EXUDYN_MODELS = ("auto", "rigid_body", "kinematic_tree")
 EXPLICIT_METHODS = ("DOPRI5", "ODE23")
+TREE_SOLVERS = ("auto", "explicit", "implicit")
 STEP_CONTROLS = ("adaptive", "fixed")
 CALLBACK_ROUTES = ("auto", "python", "symbolic", "numba")
 BRANCHES = {"+": 1, "-": -1}
@@ -152,8 +154,9 @@ SCHEMA: tuple[Key, ...] = (
     Key("drive.speed_rpm", "drive.speed", "float", RPM, 0, 5000, doc="constant crank speed"),
     Key("drive.revolutions", "drive.revolutions", "float", 1, 0, 1000, doc="crank revolutions to simulate"),
     Key("solver.reference.method", "reference_solver.method", "str", choices=INTEGRATORS,
-        doc="method of the reference engine: scipy's, or numba_* (compiled, docs/performance.md); "
-            "auto = numba_DOP853 (the fastest path meeting the accuracy targets)"),
+        doc="method of the reference engine: scipy's, or numba_* (compiled, docs/performance.md; numba_RODAS4 "
+            "linearly implicit, numba_DOP853_RODAS4 implicit in contact); auto = numba_DOP853, or with friction "
+            "numba_DOP853_RODAS4 at rtol <= 1e-6 (the fastest paths meeting the accuracy targets)"),
     Key("solver.reference.rtol", "reference_solver.rtol", "float", 1, 0, 1e-2, doc="relative tolerance"),
     Key("solver.reference.atol", "reference_solver.atol", "float", 1, 0, 1e-2, doc="absolute tolerance"),
     Key("solver.reference.max_step_deg", "reference_solver.max_step", "float", DEG, 0, 90,
@@ -165,17 +168,23 @@ SCHEMA: tuple[Key, ...] = (
         doc="rigid_body model: adaptive (step from a local error estimate: large in free flight, small "
             "through impacts) or fixed (step_size_s)"),
     Key("solver.exudyn.local_error_m", "exudyn_solver.local_error", "float", 1, 0, 1e-3,
-        doc="rigid_body model, adaptive: tolerance of the local error estimate of the journal centre at E per step"),
+        doc="rigid_body model, adaptive, and kinematic_tree, implicit: tolerance of the local error estimate "
+            "of the journal centre at E per step"),
     Key("solver.exudyn.step_size_s", "exudyn_solver.step_size", "float", 1, 0, 1e-2,
         doc="generalized-alpha step when fixed (adaptive: unused; an ideal joint then steps 0.25 deg of "
             "crank, nothing to resolve)"),
     Key("solver.exudyn.spectral_radius", "exudyn_solver.spectral_radius", "float", 1, 0, 1, False, False,
-        doc="generalized-alpha spectral radius (<= 0.9 for smooth constraint torques)"),
+        doc="rigid_body model: generalized-alpha spectral radius (<= 0.9 for smooth constraint torques; the "
+            "kinematic tree's implicit solver takes 1, it has no constraints)"),
     Key("solver.exudyn.modified_newton", "exudyn_solver.modified_newton", "bool", doc="modified Newton"),
     Key("solver.exudyn.newton_relative_tolerance", "exudyn_solver.newton_relative_tolerance", "float", 1, 0, 1e-2),
     Key("solver.exudyn.newton_max_iterations", "exudyn_solver.newton_max_iterations", "int", 1, 0, 1000),
     Key("solver.exudyn.callback", "exudyn_solver.callback", "str", choices=CALLBACK_ROUTES,
         doc="contact callback route; auto = fastest measured"),
+    Key("solver.exudyn.tree_solver", "exudyn_solver.tree_solver", "str", choices=TREE_SOLVERS,
+        doc="kinematic_tree model: explicit (explicit_method, automatic step size) or implicit "
+            "(generalized-alpha, step error-controlled to local_error_m); auto = implicit with friction "
+            "in the joint, explicit without (the faster of the two for each, docs/performance.md)"),
     Key("solver.exudyn.explicit_method", "exudyn_solver.explicit_method", "str", choices=EXPLICIT_METHODS,
         doc="kinematic_tree model: explicit solver with automatic step size"),
     Key("solver.exudyn.relative_tolerance", "exudyn_solver.relative_tolerance", "float", 1, 0, 1e-2,

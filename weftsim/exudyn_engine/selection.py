@@ -6,7 +6,10 @@
   the clearance joint at E is the only free joint.  Then the crank, coupler and rocker move in
   closed form with the crank angle, and only the two coordinates of the chain 4-8 behind the
   clearance are integrated, by an explicit error-controlled solver (DOPRI5) that takes large steps
-  in free flight and short ones through the impacts.  Every scene weftsim describes today with a
+  in free flight and short ones through the impacts; with friction in the joint by generalized-alpha
+  with an error-controlled step (``solver.exudyn.tree_solver``,
+  :func:`tree_solver`): the friction ramp holds an explicit solver
+  at ~1e-9 s steps while the journal creeps.  Every scene weftsim describes today with a
   clearance at E is of this kind.
 - **rigid-body model** (:mod:`.mechanism`, generalized-alpha) when the scene needs bodies and joints
   for members 1-3.  What forces it (:func:`rigid_body_needs`):
@@ -41,6 +44,27 @@ AUTO = "auto"
 # largest output spacing (a step must end on every sample), stays within the compare tolerance of
 # 1e-4 but only by 1.6x; 0.25 deg keeps 10x below it at 5x fewer steps than 0.05 deg.
 IDEAL_JOINT_STEP_ANGLE = math.radians(0.25)
+# Largest step of the kinematic tree (explicit and implicit): the output sample period / STEPS_PER_SAMPLE (Exudyn's maximum step is endTime /
+# numberOfSteps).  With one step per sample (0.5 deg) a light impact could begin and turn back inside one
+# free-flight step: the next step end holds a penetration with delta_dot <= 0 and the run fails the
+# plausibility guard (2 of 32 ten-revolution runs of four scenes at 400-800 rpm, c = 0.1-0.5 mm, with the
+# tolerance perturbed at round-off).  Two per sample: 0 of 64 such runs, 3 % more steps on the reference
+# scene (43 067 against 41 846 for 10 revolutions); five per sample also 0 of 32.
+STEPS_PER_SAMPLE = 2
+# ... and at most this fraction of the time a journal released at rest needs to fall through the clearance
+# under gravity, sqrt(2 c / g): in one free-flight step it then falls at most 1 % of c.  At low crank speed
+# the half sample is long (0.042 s at 1 rpm) and gravity moves the journal most: a first step of 0.042 s
+# from the centred journal ends 99.7 mm deep in the wall; its error estimate (~1e55) asks for a step below
+# limits.min_step_s, and Exudyn's DOPRI5 then accepts the rejected step instead (issue 24).  At 300 rpm and
+# above the half sample is the smaller bound for every clearance down to 0.01 mm (1.39e-4 s against 1.4e-4 s):
+# the loom's scenes take exactly the steps they took before.
+GRAVITY_STEP_FRACTION = 0.1
+# Largest relative tolerance of the tree with friction.  The friction ramp sticks the journal in phases
+# where DOPRI5 steps at its stability limit, and at rtol 1e-6 the error left there broke the energy balance
+# (4.5 J, 8e-3 of the largest kinetic energy, in one revolution at mu = 0.15, c = 0.5 mm) and the torque
+# maximum (1.1 % off the reference engine); at 1e-8: 0.02 J and 6e-5, and no more steps than at 1e-6
+# (the stick phases' steps are set by stability, not accuracy).  A tighter scene value is kept.
+FRICTION_RELATIVE_TOLERANCE = 1e-8
 
 
 def rigid_body_needs(scene: Scene) -> list[str]:
@@ -72,10 +96,13 @@ def select_path(scene: Scene) -> dict:
     model, reason = select_model(scene)
     if model == "kinematic_tree":
         from weftsim.exudyn_engine.callbacks import resolve_route
-        from weftsim.exudyn_engine.tree_solve import tree_relative_tolerance
 
+        route = resolve_route(s.callback)
+        if tree_solver(scene) == "implicit":
+            return {"model": model, "reason": reason,
+                    "method": f"generalized-alpha, adaptive step (local error {s.local_error:g} m at E), {route} callback"}
         return {"model": model, "reason": reason,
-                "method": f"{s.explicit_method} rtol {tree_relative_tolerance(scene):g}, {resolve_route(s.callback)} callback"}
+                "method": f"{s.explicit_method} rtol {tree_relative_tolerance(scene):g}, {route} callback"}
     if adaptive(scene):
         where = " and ".join(name.upper() for name in scene.loose_joints)  # the rod's pins with a clearance
         method = f"generalized-alpha, adaptive step (local error {s.local_error:g} m at {where})"
@@ -112,3 +139,30 @@ def step_plan(scene: Scene) -> tuple[float, int]:
     per_sample = max(1, math.ceil(sample_dt / requested_step(scene) * (1.0 - 1e-12)))
     n_steps = max(1, round(t_end / (sample_dt / per_sample)))
     return t_end / n_steps, n_steps
+
+
+def largest_step(scene: Scene) -> float:
+    """Largest step of the tree, s: half an output sample, and at most :data:`GRAVITY_STEP_FRACTION` of
+    the fall time through the clearance sqrt(2 c / g)."""
+    h = scene.output.sample_angle / scene.drive.speed / STEPS_PER_SAMPLE
+    g = scene.inertia.gravity
+    if g > 0.0:
+        h = min(h, GRAVITY_STEP_FRACTION * math.sqrt(2.0 * scene.joint.clearance / g))
+    return h
+
+
+def tree_solver(scene: Scene) -> str:
+    """"explicit" or "implicit": the scene key ``solver.exudyn.tree_solver``, or under "auto" implicit
+    with friction in the joint (the explicit solver steps at ~1e-9 s while the journal creeps on the
+    friction ramp; :mod:`.tree_implicit`) and explicit without (faster there, docs/performance.md)."""
+    choice = scene.exudyn_solver.tree_solver
+    if choice != "auto":
+        return choice
+    return "implicit" if scene.joint.friction_coefficient > 0.0 else "explicit"
+
+
+def tree_relative_tolerance(scene: Scene) -> float:
+    """The explicit solver's relative tolerance: the scene's, at most :data:`FRICTION_RELATIVE_TOLERANCE`
+    with friction in the joint."""
+    rtol = scene.exudyn_solver.relative_tolerance
+    return min(rtol, FRICTION_RELATIVE_TOLERANCE) if scene.joint.friction_coefficient > 0.0 else rtol

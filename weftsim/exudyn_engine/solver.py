@@ -32,7 +32,7 @@ from weftsim.exudyn_engine.selection import (  # noqa: F401 (IDEAL_JOINT_STEP_AN
     select_path,
     step_plan,
 )
-from weftsim.exudyn_engine.step_control import StepController
+from weftsim.exudyn_engine.step_control import StepController, failure_reason
 from weftsim.exudyn_engine.sensors import add_sensors, first_nonfinite_row, sample_channels, silence, step_channels
 from weftsim.guards import RunGuard, failure_message, non_finite_breach, vet_result
 from weftsim.params import Scene
@@ -147,24 +147,6 @@ def _what_to_try(scene: Scene, h: float) -> str:
             f"(now {s.newton_max_iterations})")  # fmt: skip
 
 
-def _failure_reason(solver, scene: Scene) -> tuple[str, str]:
-    """(failure kind, reason) from Exudyn's convergence flags after SolveSystem returned False."""
-    conv = solver.conv
-    if not math.isfinite(conv.residual):
-        # Exudyn reports a NaN force (e.g. from a user function) as Newton non-convergence.
-        return "non_finite", (f"the Newton residual is {conv.residual}: a force or the state became NaN or inf, "
-                              f"and cutting the step down to limits.min_step_s = {scene.limits.min_step:.3g} s "
-                              "did not help")  # fmt: skip
-    if conv.massMatrixNotInvertible or conv.linearSolverFailed:
-        return "singular", f"singular system matrix (equation {conv.linearSolverCausingRow})"
-    if conv.newtonSolutionDiverged:
-        return "newton", "Newton diverged"
-    if conv.stepReductionFailed:
-        return "newton", (f"Newton did not converge, even with the step cut down to limits.min_step_s = "
-                          f"{scene.limits.min_step:.3g} s (step-size collapse)")  # fmt: skip
-    return "newton", "Newton did not converge"
-
-
 def solve(scene: Scene, progress: Callable[[float], None] | None = None, callback: str | None = None) -> RunResult:
     """Simulate a scene with Exudyn.
 
@@ -243,7 +225,7 @@ def _solve_model(scene: Scene, model: str, progress, callback: str | None, wall0
     try:
         if not solver.SolveSystem(mbs, simulation_settings(scene, n_steps)):
             status = "failed"
-            kind, message = _failure_reason(solver, scene)
+            kind, message = failure_reason(solver, scene)
     except exu.ExudynError as exc:  # NaN (SolverError), user-function exception (ModelError), ...
         text = str(exc).strip().splitlines()
         last = text[-1].split(" [Python file ")[0] if text else ""  # Exudyn appends where it was called from

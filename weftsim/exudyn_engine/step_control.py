@@ -83,10 +83,14 @@ class StepController:
         Output sample spacing, s: every sample time is a step end.
     newmark_beta : float
         beta of the generalized-alpha method in use.
+    jump : callable, optional
+        ``jump(a0, a1)``: bound of the change of the journal centre's acceleration, m/s^2, between two
+        outputs ``Coordinates_tt`` of ``node``; default: the rigid-body node's (:meth:`error`).  The
+        kinematic tree passes its own (:mod:`.tree_implicit`).
     """
 
     def __init__(self, mbs, solver, node, arm: float, tolerance: float, min_step: float, max_step: float,
-                 sample_period: float, newmark_beta: float):
+                 sample_period: float, newmark_beta: float, jump=None):
         self.mbs = mbs
         self.it = solver.it  # the solver's step data (a live reference: writes reach the solver)
         self.node = node
@@ -96,6 +100,7 @@ class StepController:
         self.max_step = min(max_step, sample_period)
         self.sample_period = sample_period
         self.factor = abs(newmark_beta - 1.0 / 6.0)
+        self.jump = jump
         self.accel_start = None  # relative acceleration at the last accepted state
         self.accel_trial = None
         self.error_trial = 0.0
@@ -128,6 +133,8 @@ class StepController:
         term within a step is far smaller).
         """
         a0 = self.accel_start
+        if self.jump is not None:
+            return self.factor * h * h * self.jump(a0, a1)
         jump = math.hypot(a1[0] - a0[0], a1[1] - a0[1]) + self.arm * abs(a1[2] - a0[2])
         return self.factor * h * h * jump
 
@@ -205,3 +212,21 @@ def to_sample_grid(t: float, h: float, period: float) -> float:
         return 0.5 * remaining
     return h
 
+
+def failure_reason(solver, scene: Scene) -> tuple[str, str]:
+    """(failure kind, reason) from Exudyn's convergence flags after SolveSystem returned False (the
+    generalized-alpha solver of the rigid-body model and of the implicit tree alike)."""
+    conv = solver.conv
+    if not math.isfinite(conv.residual):
+        # Exudyn reports a NaN force (e.g. from a user function) as Newton non-convergence.
+        return "non_finite", (f"the Newton residual is {conv.residual}: a force or the state became NaN or inf, "
+                              f"and cutting the step down to limits.min_step_s = {scene.limits.min_step:.3g} s "
+                              "did not help")  # fmt: skip
+    if conv.massMatrixNotInvertible or conv.linearSolverFailed:
+        return "singular", f"singular system matrix (equation {conv.linearSolverCausingRow})"
+    if conv.newtonSolutionDiverged:
+        return "newton", "Newton diverged"
+    if conv.stepReductionFailed:
+        return "newton", (f"Newton did not converge, even with the step cut down to limits.min_step_s = "
+                          f"{scene.limits.min_step:.3g} s (step-size collapse)")  # fmt: skip
+    return "newton", "Newton did not converge"

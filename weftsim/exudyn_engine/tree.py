@@ -28,7 +28,8 @@ contact point when ``joint.friction_coefficient`` > 0 (its tangential velocity f
 rocker's rotation rates, its moments about both centres), and returns the joint torques of the
 contact force and moment by virtual work.  No constraints remain, so an error-controlled
 explicit solver (DOPRI5 with automatic step size) integrates it; there is no Jacobian and no
-Newton iteration.
+Newton iteration.  With friction the friction ramp makes it stiff, and generalized-alpha with an
+error-controlled step integrates it instead (:mod:`.tree_implicit`).
 
 The driving torque comes from the contact force in closed form, with the crank-side
 terms of :mod:`weftsim.reference.ideal` (docs/physics.md section 4, docs/reference-solver.md):
@@ -70,7 +71,7 @@ class TreeModel:
     tracker: OnsetTracker
     route: str
     memory: list  # [v_held, delta0, rate0] read by the force callback
-    stash: list  # [t, delta, delta_dot, F_b,x, F_b,y, F_N, M_b, F_T v_T] of the last callback
+    stash: list  # [t, delta, delta_dot, F_b,x, F_b,y, F_N, M_b, F_T v_T, v_T] of the last callback
     callback_calls: list = field(default_factory=lambda: [0])  # [count]
     # [t, F_b,x, F_b,y, F_N, M_b, F_T v_T] per accepted state (tree_joint_force's contact on the bearing)
     bearing_force: list = field(default_factory=list)
@@ -81,7 +82,7 @@ class TreeModel:
             q = mbs.GetNodeOutput(self.node, exu.OutputVariableType.Coordinates)
             q_t = mbs.GetNodeOutput(self.node, exu.OutputVariableType.Coordinates_t)
             self.force(mbs, t, self.tree, q, q_t)
-        _, delta, rate, fx, fy, f_n, m_b, power = self.stash
+        _, delta, rate, fx, fy, f_n, m_b, power = self.stash[:8]
         tracker = self.tracker
         tracker.accept(t, delta, rate)
         self.memory[0], self.memory[1], self.memory[2] = tracker.held, delta, rate
@@ -105,7 +106,7 @@ def build_tree(mbs: exu.MainSystem, scene: Scene, callback: str = "auto") -> Tre
     calls = [0]
     tracker = OnsetTracker(joint.clearance, joint.min_impact_velocity, rule=joint.impact_velocity_rule)
     memory = list(tracker.callback_state)
-    stash = [math.nan] + [0.0] * 7
+    stash = [math.nan] + [0.0] * 8
     force = callbacks.make_tree_force(pack_parameters(scene), memory, stash, route, calls)
     node = mbs.AddNode(NodeGenericODE2(
         referenceCoordinates=[0.0, 0.0], initialCoordinates=[a0, psi0 + math.pi - a0],

@@ -1,6 +1,8 @@
-"""``solve`` of the kinematic-tree model (:mod:`.tree`): explicit solver, channels, failures.
+"""``solve`` of the kinematic-tree model (:mod:`.tree`): explicit or implicit solver, channels, failures.
 
-Solver: Exudyn's explicit ``solver.exudyn.explicit_method`` (DOPRI5 or ODE23) with
+Solver (:func:`tree_solver`): with friction in the joint generalized-alpha with error control and
+friction segments (:mod:`.tree_implicit`); otherwise, or under ``solver.exudyn.tree_solver = "explicit"``,
+Exudyn's explicit ``solver.exudyn.explicit_method`` (DOPRI5 or ODE23) with
 automatic step size, ``relative_tolerance`` (at most :data:`FRICTION_RELATIVE_TOLERANCE` with
 friction) and ``absolute_tolerance`` (on the joint
 angles, rad, and rates, rad/s), end-of-step accelerations on (else the rapier acceleration
@@ -37,7 +39,18 @@ from exudyn.itemInterface import SensorNode
 from weftsim.contact import make_law
 from weftsim.exudyn_engine.sensors import first_nonfinite_row, sample_channels, silence
 from weftsim.exudyn_engine import callbacks
+from weftsim.exudyn_engine.clearance_joint import register_post_step
 from weftsim.exudyn_engine.tree import TreeModel, build_tree
+from weftsim.exudyn_engine.selection import (  # noqa: F401 (re-exported: the tree's plan lives in selection)
+    FRICTION_RELATIVE_TOLERANCE,
+    GRAVITY_STEP_FRACTION,
+    STEPS_PER_SAMPLE,
+    largest_step,
+    tree_relative_tolerance,
+    tree_solver,
+)
+from weftsim.exudyn_engine.tree_implicit import ImplicitTree
+from weftsim.exudyn_engine.step_control import failure_reason as implicit_failure
 from weftsim.guards import RunGuard, failure_message, non_finite_breach, vet_result
 from weftsim.params import Scene
 from weftsim.reference.dynamics import NUMPY, ChainConstants, chain_energy, eccentricity, initial_state
@@ -49,28 +62,8 @@ if TYPE_CHECKING:
 
 OVT = exu.OutputVariableType
 EXPLICIT_METHODS = {"DOPRI5": exu.DynamicSolverType.DOPRI5, "ODE23": exu.DynamicSolverType.ODE23}
-# Largest step: the output sample period / STEPS_PER_SAMPLE (Exudyn's maximum step is endTime /
-# numberOfSteps).  With one step per sample (0.5 deg) a light impact could begin and turn back inside one
-# free-flight step: the next step end holds a penetration with delta_dot <= 0 and the run fails the
-# plausibility guard (2 of 32 ten-revolution runs of four scenes at 400-800 rpm, c = 0.1-0.5 mm, with the
-# tolerance perturbed at round-off).  Two per sample: 0 of 64 such runs, 3 % more steps on the reference
-# scene (43 067 against 41 846 for 10 revolutions); five per sample also 0 of 32.
-STEPS_PER_SAMPLE = 2
 _PROGRESS_EVERY = 0.001  # every 0.1 % of the run: a long run shows its first line soon (issue 16)
 END_OF_STEP_ACCELERATIONS = False
-# Largest relative tolerance of the tree with friction.  The friction ramp sticks the journal in phases
-# where DOPRI5 steps at its stability limit, and at rtol 1e-6 the error left there broke the energy balance
-# (4.5 J, 8e-3 of the largest kinetic energy, in one revolution at mu = 0.15, c = 0.5 mm) and the torque
-# maximum (1.1 % off the reference engine); at 1e-8: 0.02 J and 6e-5, and no more steps than at 1e-6
-# (the stick phases' steps are set by stability, not accuracy).  A tighter scene value is kept.
-FRICTION_RELATIVE_TOLERANCE = 1e-8
-
-
-def tree_relative_tolerance(scene: Scene) -> float:
-    """The explicit solver's relative tolerance: the scene's, at most :data:`FRICTION_RELATIVE_TOLERANCE`
-    with friction in the joint."""
-    rtol = scene.exudyn_solver.relative_tolerance
-    return min(rtol, FRICTION_RELATIVE_TOLERANCE) if scene.joint.friction_coefficient > 0.0 else rtol
 
 
 def check_tree_settings(scene: Scene) -> str | None:
@@ -86,6 +79,8 @@ def check_tree_settings(scene: Scene) -> str | None:
     if s.callback not in routes:
         return (f"the 'kinematic_tree' Exudyn model has the callback routes {routes}, got {s.callback!r}; "
                 "use `solver.exudyn.model` = 'rigid_body' for it")  # fmt: skip
+    if s.tree_solver not in ("auto", "explicit", "implicit"):
+        return f"`solver.exudyn.tree_solver` must be one of 'auto', 'explicit', 'implicit', got {s.tree_solver!r}"
     if s.explicit_method not in EXPLICIT_METHODS:
         return f"`solver.exudyn.explicit_method` must be one of {tuple(EXPLICIT_METHODS)}, got {s.explicit_method!r}"
     for name in ("relative_tolerance", "absolute_tolerance"):
@@ -153,6 +148,7 @@ def tree_settings(scene: Scene) -> exu.SimulationSettings:
     ti.solverType = EXPLICIT_METHODS[s.explicit_method]
     ti.endTime = t_end
     ti.numberOfSteps = STEPS_PER_SAMPLE * max(1, math.ceil(t_end / (scene.output.sample_angle / omega) * (1.0 - 1e-12)))
+    ti.numberOfSteps = max(ti.numberOfSteps, math.ceil(t_end / largest_step(scene) * (1.0 - 1e-12)))
     ti.automaticStepSize = True
     ti.relativeTolerance = tree_relative_tolerance(scene)
     ti.absoluteTolerance = s.absolute_tolerance
@@ -253,16 +249,30 @@ def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, ca
             return False
         return True
 
-    mbs.SetPostStepUserFunction(post_step)
+    implicit = tree_solver(scene) == "implicit"
+    if implicit:
+        register_post_step(mbs, post_step)  # first: the step controller's hook plans the next step after it
+        solver = exu.MainSolverImplicitSecondOrder()
+        stepper = ImplicitTree(mbs, solver, model, scene)
+        stepper.install()
+    else:
+        mbs.SetPostStepUserFunction(post_step)  # the one hook, without register_post_step's dispatcher
+        solver = exu.MainSolverExplicit()
     mbs.Assemble()
     if progress is not None:
         progress(0.0)
-    solver = exu.MainSolverExplicit()
+    settings = tree_settings(scene)
+    if implicit:
+        stepper.settings(settings)
     status, message, kind = "success", "", None
     wall_solve = _time.perf_counter()
     try:
-        if not solver.SolveSystem(mbs, tree_settings(scene)):
-            status, kind, message = "failed", "solver", solver.GetErrorString() or "the explicit solver stopped"
+        if not solver.SolveSystem(mbs, settings):
+            if implicit:
+                status = "failed"
+                kind, message = implicit_failure(solver, scene)
+            else:
+                status, kind, message = "failed", "solver", solver.GetErrorString() or "the explicit solver stopped"
     except exu.ExudynError as exc:
         text = str(exc).strip().splitlines()
         last = text[-1].split(" [Python file ")[0] if text else ""
@@ -279,7 +289,11 @@ def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, ca
             found = non_finite_breach("non-finite values (NaN or inf) in the results (explicit solvers do not stop on NaN)")
             status, message, kind = "failed", found.what, found.kind
     t_last = float(steps["time_s"][-1]) if len(steps["time_s"]) else 0.0
-    hint = ("try a tighter `solver.exudyn.relative_tolerance`, the 'rigid_body' model, or the reference engine")
+    if implicit:
+        hint = ("try a smaller `solver.exudyn.local_error_m`, `solver.exudyn.tree_solver` = 'explicit', "
+                "or the reference engine")  # fmt: skip
+    else:
+        hint = ("try a tighter `solver.exudyn.relative_tolerance`, the 'rigid_body' model, or the reference engine")
     if breach and (status == "success" or kind is None):
         status, kind = "failed", breach[0].kind
         message = failure_message("Exudyn engine (kinematic_tree)", t_last, omega, breach[0].what, breach[0].hint)
@@ -291,12 +305,17 @@ def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, ca
     samples = sample_channels(steps, angle_grid(t_end, omega, scene.output.sample_angle))
     it = solver.it
     n_done = max(len(steps["time_s"]) - 1, 0)
+    if implicit:
+        method = {"method": "generalized_alpha", "local_error_m": scene.exudyn_solver.local_error,
+                  "rejected_steps": int(it.rejectedModifiedNewtonSteps), "newton_iterations": int(it.newtonStepsCount),
+                  "jacobian_evaluations": int(it.newtonJacobiCount), **stepper.counters()}  # fmt: skip
+    else:
+        method = {"method": scene.exudyn_solver.explicit_method, "relative_tolerance": tree_relative_tolerance(scene),
+                  "rejected_steps": int(it.rejectedAutomaticStepSizeSteps)}  # fmt: skip
     stats = {
-        "method": scene.exudyn_solver.explicit_method,
+        **method,
         "model": "kinematic_tree",
-        "relative_tolerance": tree_relative_tolerance(scene),
         "steps": n_done,
-        "rejected_steps": int(it.rejectedAutomaticStepSizeSteps),
         "min_step_s": state["min_step"],
         "callback": model.route,
         "callback_calls": int(model.callback_calls[0]),

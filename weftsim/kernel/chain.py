@@ -196,8 +196,9 @@ def tree_joint_force(prm: np.ndarray, t: float, a: float, q1: float, da: float, 
         Q1 = -F_b . dP_j/dq1 + M_j = L_EF (F_bx sin b - F_by cos b) + M_j,
         Q0 = L_FG (F_bx sin a - F_by cos a) + Q1.
 
-    Returns (Q0, Q1, delta, delta_dot, F_bx, F_by, F_N, M_b, F_T v_T): N m, N m, m, m/s, N, N, N,
-    N m, W (the friction power on the pair, <= 0; 0 without friction).
+    Returns (Q0, Q1, delta, delta_dot, F_bx, F_by, F_N, M_b, F_T v_T, v_T): N m, N m, m, m/s, N, N, N,
+    N m, W (the friction power on the pair, <= 0; 0 without friction), m/s (the sliding speed of the
+    contact points, 0 out of contact; the implicit tree's friction segments read it).
     """
     l_fg, l_ef = prm[L_FG], prm[L_EF]
     b = a + q1
@@ -213,4 +214,4 @@ def tree_joint_force(prm: np.ndarray, t: float, a: float, q1: float, da: float, 
     fx, fy, delta, rate, f_n, f_t, m_j, m_b, v_t = connector_friction_force(
         prm, px - b_y, py - b_z, vx - omega * db_y, vy - omega * db_z, held, delta0, rate0, db, omega * dphi)
     g1 = l_ef * (fx * sb - fy * cb) + m_j
-    return l_fg * (fx * sa - fy * ca) + g1, g1, delta, rate, fx, fy, f_n, m_b, f_t * v_t
+    return l_fg * (fx * sa - fy * ca) + g1, g1, delta, rate, fx, fy, f_n, m_b, f_t * v_t, v_t
