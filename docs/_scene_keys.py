@@ -35,33 +35,33 @@ UNITS: tuple[tuple[str, str, float], ...] = (
 # first matching prefix wins, so the specific ones come first. Anchors are myst's heading slugs: a
 # wrong one fails the build (warnings are errors).
 SECTIONS: tuple[tuple[str, str, str], ...] = (
-    ("mechanism.", "physics.md#1-the-mechanism-paper-fig-1-fig-10", "physics 1, the mechanism"),
-    ("inertia.", "physics.md#reference-mechanism", "physics 1, reference mechanism; 4, dynamics"),
-    ("joint_e.wear.", "wear.md#5-parameters-and-their-sources", "wear 5, parameters"),
+    ("mechanism.", "physics.md#1-the-mechanism-paper-fig-1-fig-10", "physics §1"),
+    ("inertia.", "physics.md#reference-mechanism", "physics §1, §4"),
+    ("joint_e.wear.", "wear.md#5-parameters-and-their-sources", "wear §5"),
     ("joint_*.lubrication.", "lubrication.md", "lubrication"),
     ("joint_*.bearing_material.yield_strength", "plausibility.md#the-checks-their-limits-and-their-sources",
-     "plausibility: Hertz pressure"),
+     "plausibility: Hertz"),
     ("joint_*.journal_material.yield_strength", "plausibility.md#the-checks-their-limits-and-their-sources",
-     "plausibility: Hertz pressure"),
+     "plausibility: Hertz"),
     ("joint_*.bearing_material.max_", "plausibility.md#the-checks-their-limits-and-their-sources",
-     "plausibility: pin pressure, p x v"),
+     "plausibility: p, p x v"),
     ("joint_*.design_clearance", "plausibility.md#the-checks-their-limits-and-their-sources",
-     "plausibility: clearance ratio"),
-    ("joint_*.journal_material.", "physics.md#3-contact-force-laws", "physics 3, contact laws"),
-    ("joint_*.bearing_material.", "physics.md#3-contact-force-laws", "physics 3, contact laws"),
-    ("joint_*.law", "physics.md#3-contact-force-laws", "physics 3, contact laws"),
-    ("joint_*.restitution", "physics.md#3-contact-force-laws", "physics 3, contact laws"),
-    ("joint_*.", "physics.md#2-clearance-joint-at-e-flores-ambrósio-formulation", "physics 2, clearance joint"),
-    ("drive.", "physics.md#4-dynamics", "physics 4, dynamics"),
-    ("solver.reference.", "reference-solver.md#3-integration", "reference solver 3, integration"),
+     "plausibility: c/d"),
+    ("joint_*.journal_material.", "physics.md#3-contact-force-laws", "physics §3"),
+    ("joint_*.bearing_material.", "physics.md#3-contact-force-laws", "physics §3"),
+    ("joint_*.law", "physics.md#3-contact-force-laws", "physics §3"),
+    ("joint_*.restitution", "physics.md#3-contact-force-laws", "physics §3"),
+    ("joint_*.", "physics.md#2-clearance-joint-at-e-flores-ambrósio-formulation", "physics §2"),
+    ("drive.", "physics.md#4-dynamics", "physics §4"),
+    ("solver.reference.", "reference-solver.md#3-integration", "reference solver §3"),
     ("solver.exudyn.", "clearance-joint.md#the-loom-in-exudyn-mechanism-py", "Exudyn engine"),
-    ("output.", "physics.md#4-dynamics", "physics 4, outputs"),
-    ("compare.", "physics.md#6-what-is-reproducible", "physics 6, what is reproducible"),
+    ("output.", "physics.md#4-dynamics", "physics §4"),
+    ("compare.", "physics.md#6-what-is-reproducible", "physics §6"),
     ("limits.max_rapier_acceleration", "plausibility.md#the-checks-their-limits-and-their-sources",
-     "plausibility: rapier acceleration"),
+     "plausibility: rapier"),
     ("limits.max_damping_ratio", "physics.md#2-clearance-joint-at-e-flores-ambrósio-formulation",
-     "physics 2, held impact velocity"),
-    ("limits.", "hard-cases.md#2-failure-detection", "hard cases 2, failure detection"),
+     "physics §2"),
+    ("limits.", "hard-cases.md#2-failure-detection", "hard cases §2"),
 )
 
 # One paragraph per table of the scene file, in the order of the schema.
@@ -137,9 +137,11 @@ def page(docs: Path) -> str:
         "Every key a scene file (or `--set KEY=VALUE`, or `weftsim.load_scene(..., overrides=...)`) accepts, "
         "generated from the schema the loader checks against (`weftsim.scene.SCHEMA`) when the site is built. "
         "Units are part of the key names; the loader converts to SI. **Required** keys are part of the "
-        "machine: a scene gives them itself or through `extends`; the column *reference / loom* gives the "
-        "values of the two bundled mechanisms, a starting point for your own "
-        "([How-to: your own mechanism](howto-own-mechanism.md)). Other keys fall back to the default shown.",
+        "machine: a scene gives them itself or through `extends`; for them the column *default* gives the "
+        "values of the two bundled mechanisms, reference / loom, a starting point for your own "
+        "([How-to: your own mechanism](howto-own-mechanism.md)). Other keys fall back to the default shown. "
+        "The sections are the tables of a scene file: `max_pressure_mpa` under `[joint_e.bearing_material]` is "
+        "written `--set joint_e.bearing_material.max_pressure_mpa=27.6` on the command line.",
         "",
     ]
     groups: dict[str, list] = {}
@@ -149,7 +151,7 @@ def page(docs: Path) -> str:
         lines += [f"## `[{table}]`", ""]
         if table in TABLES:
             lines += [TABLES[table], ""]
-        lines += ["| key | unit | default or reference / loom | allowed | meaning | physics |",
+        lines += [f"| key in `[{table}]` | unit | default (reference / loom) | allowed | meaning | physics |",
                   "|---|---|---|---|---|---|"]
         for key in keys:
             shown_unit, _ = unit(key.path)
@@ -160,7 +162,7 @@ def page(docs: Path) -> str:
             target, title = section(key.path)
             page_name = target.partition("#")[0]
             physics = f"[{title}]({target})" if (docs / page_name).exists() else title
-            lines.append(f"| `{key.path}` | {shown_unit or '-'} | {_cell(value)} | {_cell(key.allowed())} | "
+            lines.append(f"| `{key.path.rpartition('.')[2]}` | {shown_unit or '-'} | {_cell(value)} | {_cell(key.allowed())} | "
                          f"{_cell(key.doc)} | {physics} |")
         lines.append("")
     lines += ["The same keys as one table, for the command line's `--set`: the README's scene reference "

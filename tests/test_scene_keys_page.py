@@ -21,11 +21,14 @@ def page() -> str:
 
 
 def _rows(page: str) -> dict[str, list[str]]:
-    rows = {}
+    """Each table row by its dotted key: the section's table (a ``## `[table]``` heading) and the row's key."""
+    rows, table = {}, None
     for line in page.splitlines():
-        if line.startswith("| `"):
+        if line.startswith("## `["):
+            table = line.removeprefix("## `[").removesuffix("]`")
+        elif line.startswith("| `"):
             cells = [cell.strip() for cell in line.strip("|").split(" | ")]
-            rows[cells[0].strip("`")] = cells
+            rows[f"{table}.{cells[0].strip('`')}"] = cells
     return rows
 
 
