@@ -125,3 +125,20 @@ def test_build_docs_falls_back_to_python3_and_obeys_PYTHON(tmp_path):
     _run_build_docs(tmp_path / "env", str(chosen), with_venv=True)
     assert len((tmp_path / "chosen.log").read_text().splitlines()) == 2
     assert not (tmp_path / "env" / "calls.log").read_text()  # neither .venv's nor PATH's python ran
+
+
+def test_the_docs_extra_covers_what_the_gallery_needs():
+    """The README's docs command installs '.[docs]' only: every optional package an example reaches (through
+    weftsim.load_sweep or RunResult.to_pandas) must be in that extra, or the gallery stops on a fresh clone
+    (it did: plot_sweep_grid.py needs xarray)."""
+    import re
+    import tomllib
+
+    extras = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["optional-dependencies"]
+    docs = {re.split(r"[<>=\[ ]", requirement, maxsplit=1)[0] for requirement in extras["docs"]}
+    needs = {"load_sweep": {"xarray"}, "to_pandas": {"pandas"}, "import dask": {"dask"}}
+    for example in sorted((ROOT / "examples").glob("plot_*.py")):
+        text = example.read_text()
+        for call, packages in needs.items():
+            if call in text:
+                assert packages <= docs, f"{example.name} uses {call}: the docs extra lacks {packages - docs}"
