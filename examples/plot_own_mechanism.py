@@ -91,4 +91,5 @@ for line in messages + results["variant, c = 0.1 mm"].plausibility["warnings"]:
 # worn pin's impacts near 90 and 270 deg, where the force at E reverses.
 from weftsim.plots import plot_channels
 
-channels = plot_channels(list(results.values()), labels=list(results))
+channels = plot_channels(list(results.values()), labels=list(results),
+                         title="the loom, its 150 cm variant and the variant with a worn pin (last revolution)")
