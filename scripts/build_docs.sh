@@ -26,4 +26,10 @@ fi
 export EXUDYN_SUPPRESS_UI_WINDOW_OPEN=1 MPLBACKEND=Agg
 start=$(date +%s)
 "$python" -m sphinx -W --keep-going -b html docs docs/_build/html "$@"
+# Sphinx does not check the #anchors of its own links (the source pages link back to the API pages).
+"$python" scripts/check_anchors.py docs/_build/html || {
+    echo "build_docs: links to missing anchors (above); after moving pages, stale pages of an earlier build can" \
+         "cause this: rm -rf docs/_build and build again" >&2
+    exit 1
+}
 echo "build_docs: docs/_build/html/index.html built with $python in $(( $(date +%s) - start )) s" >&2

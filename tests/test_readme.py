@@ -111,19 +111,20 @@ def test_build_docs_uses_the_checkout_venv_that_the_readme_command_makes(tmp_pat
     """The README's command installs the docs extra into .venv: the script must build with that Python
     (issue 25: it ran python3 and stopped), checking the extra and running sphinx-build, arguments passed on."""
     calls = _run_build_docs(tmp_path, None, with_venv=True)
-    assert len(calls) == 2 and all(call.startswith("python ") for call in calls), calls
+    assert len(calls) == 3 and all(call.startswith("python ") for call in calls), calls
     assert "import sphinx" in calls[0]
     assert calls[1].startswith("python -m sphinx -W") and calls[1].endswith("-D plot_gallery=0")
+    assert calls[2] == "python scripts/check_anchors.py docs/_build/html"
 
 
 def test_build_docs_falls_back_to_python3_and_obeys_PYTHON(tmp_path):
     calls = _run_build_docs(tmp_path / "bare", None, with_venv=False)
-    assert [call.split()[0] for call in calls] == ["python3", "python3"]
+    assert [call.split()[0] for call in calls] == ["python3"] * 3
     chosen = tmp_path / "chosen" / "python"
     _fake_python(chosen, tmp_path / "chosen.log")
     (tmp_path / "chosen.log").touch()
     _run_build_docs(tmp_path / "env", str(chosen), with_venv=True)
-    assert len((tmp_path / "chosen.log").read_text().splitlines()) == 2
+    assert len((tmp_path / "chosen.log").read_text().splitlines()) == 3
     assert not (tmp_path / "env" / "calls.log").read_text()  # neither .venv's nor PATH's python ran
 
 
@@ -142,3 +143,20 @@ def test_the_docs_extra_covers_what_the_gallery_needs():
         for call, packages in needs.items():
             if call in text:
                 assert packages <= docs, f"{example.name} uses {call}: the docs extra lacks {packages - docs}"
+
+
+def test_check_anchors_finds_a_link_to_a_missing_id(tmp_path):
+    """scripts/check_anchors.py (run by build_docs.sh): a link to an id its page lacks fails the build."""
+    import subprocess
+    import sys
+
+    (tmp_path / "api").mkdir()
+    (tmp_path / "api" / "simulate.html").write_text('<h1 id="weftsim.simulate">simulate</h1><a href="#top">x</a>')
+    (tmp_path / "index.html").write_text('<p id="top"></p><a href="api/simulate.html#weftsim.simulate">ok</a>'
+                                         '<a href="https://numpy.org/doc/#external">not ours</a>')
+    script = ROOT / "scripts" / "check_anchors.py"
+    ok = subprocess.run([sys.executable, str(script), str(tmp_path)], capture_output=True, text=True)
+    assert ok.returncode == 1 and "api/simulate.html: link to a missing anchor: #top" in ok.stderr
+    (tmp_path / "api" / "simulate.html").write_text('<h1 id="weftsim.simulate">simulate</h1><a href="../index.html#top">x</a>')
+    ok = subprocess.run([sys.executable, str(script), str(tmp_path)], capture_output=True, text=True)
+    assert ok.returncode == 0, ok.stderr
