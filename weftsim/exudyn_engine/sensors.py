@@ -31,7 +31,7 @@ import numpy as np
 from exudyn.itemInterface import SensorBody, SensorNode, SensorObject
 
 from weftsim.exudyn_engine.mechanism import CRANK_COORDINATE, ROTATION_2D, MechanismModel
-from weftsim.results import CHANNELS, CONTACT_CHANNELS, JOINT_E_NAME, JOINT_F_CHANNELS
+from weftsim.results import CHANNELS, CONTACT_CHANNELS, JOINT_E_NAME, JOINT_F_CHANNELS, optional_channels
 
 OVT = exu.OutputVariableType
 
@@ -157,7 +157,7 @@ def sample_channels(steps: dict[str, np.ndarray], times: np.ndarray) -> dict[str
     (a failed run) are dropped.
     """
     t = steps["time_s"]
-    names = [k for k in CHANNELS + JOINT_F_CHANNELS if k in steps]
+    names = [k for k in CHANNELS + optional_channels(steps) if k in steps]
     if len(t) == 0:
         return {k: np.zeros(0) for k in names}
     # Exudyn accumulates t += h: the last step may fall short of the end time by round-off.
