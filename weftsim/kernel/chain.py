@@ -226,7 +226,7 @@ def tree_joint_force(prm: np.ndarray, t: float, a: float, q1: float, da: float, 
     lub_power = asperity_energy = 0.0
     if is_lubricated(prm):
         fx, fy, delta, rate, f_n, f_t, m_j, m_b, v_t, lub_power, asperity_energy = connector_lubricated_force(
-            prm, px - b_y, py - b_z, vx - omega * db_y, vy - omega * db_z, held, delta0, rate0, db, omega * dphi)
+            prm, px - b_y, py - b_z, vx - omega * db_y, vy - omega * db_z, held, delta0, rate0, db, omega * dphi)[:11]
     else:
         fx, fy, delta, rate, f_n, f_t, m_j, m_b, v_t = connector_friction_force(
             prm, px - b_y, py - b_z, vx - omega * db_y, vy - omega * db_z, held, delta0, rate0, db, omega * dphi)

@@ -122,10 +122,11 @@ def connector_lubricated_force(prm, ex: float, ey: float, vx: float, vy: float, 
 
     Returns the same nine values (the force on the bearing, now - f_journal of :func:`lubricated_force`
     added; M_j, M_b including the film's torques and the boundary friction), then the lubricated part's
-    dissipated power D' (W) and the asperity potential U_a (J).
+    dissipated power D' (W), the asperity potential U_a (J), the film force's magnitude (N), the
+    asperity load F_a (N) and the film's shear torque on the journal T_j (N m).
     """
     fx, fy, delta, rate, f_n, f_t, m_j, m_b, v_t = connector_friction_force(prm, ex, ey, vx, vy, held, delta0,
                                                                             rate0, omega_j, omega_b)  # fmt: skip
     lub = lubricated_force(prm, prm[CLEARANCE], ex, ey, vx, vy, omega_j, omega_b)
     return (fx - lub[L_FX], fy - lub[L_FY], delta, rate, f_n, f_t, m_j + lub[L_MJ], m_b + lub[L_MB], v_t,
-            lub[L_DISSIPATED], lub[L_ASPERITY_ENERGY])  # fmt: skip
+            lub[L_DISSIPATED], lub[L_ASPERITY_ENERGY], lub[L_FILM], lub[L_ASPERITY], lub[L_FILM_TORQUE])  # fmt: skip
