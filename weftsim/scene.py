@@ -661,10 +661,8 @@ def to_file_keys(scene: params.Scene) -> dict[str, Any]:
         obj: Any = scene
         for part in key.target.split("."):
             obj = getattr(obj, part)
-            if obj is None and part == "lubrication":
-                break  # a dry joint: no lubrication keys (the summaries of dry scenes are unchanged)
-        if obj is None and ".lubrication." in key.path:
-            continue
+            if obj is None:
+                break  # a dry joint's lubrication keys: None, as any unset optional key
         if obj is None:  # an optional key the scene does not give
             pass
         elif key.path == "mechanism.fourbar_branch":
