@@ -165,11 +165,11 @@ def cmd_wear(args: argparse.Namespace) -> int:
 def _check_fits(scene, outdir: Path, runs: int = 1) -> None:
     """Refuse a run whose output grid cannot be held or written (before anything is created)."""
     from weftsim.output import check_output_fits, output_rows
-    from weftsim.results import CHANNELS, JOINT_F_CHANNELS
+    from weftsim.results import scene_channels
 
     what = (f"output.sample_deg = {math.degrees(scene.output.sample_angle):g} over "
             f"drive.revolutions = {scene.drive.revolutions:g}")
-    columns = len(CHANNELS) + (0 if scene.joint_f.is_ideal else len(JOINT_F_CHANNELS))
+    columns = len(scene_channels(scene))
     check_output_fits(output_rows(scene), columns, outdir, what, runs)
 
 
