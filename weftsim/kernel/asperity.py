@@ -99,3 +99,14 @@ def asperity_load(coef: float, sigma: float, clearance: float, ecc: float, radiu
     if ecc > clearance:
         energy += force * (ecc - clearance)
     return force, energy
+
+
+@njit(cache=True, error_model="numpy")
+def asperity_half_angle(sigma: float, clearance: float, ecc: float) -> float:
+    """theta_max = acos((c - 4 sigma) / |e|): half the arc where the asperities touch (h < 4 sigma), rad;
+    0 while h_min >= 4 sigma (|e| held at c beyond c, as the load)."""
+    e = ecc if ecc < clearance else clearance
+    if e <= 0.0 or clearance - e >= H_CUTOFF * sigma:
+        return 0.0
+    cos_max = (clearance - H_CUTOFF * sigma) / e
+    return math.acos(cos_max if cos_max > -1.0 else -1.0)
