@@ -175,9 +175,18 @@ def _check_fits(scene, outdir: Path, runs: int = 1) -> None:
 
 def _announce_run_time(scene, engines: tuple[str, ...], command: str) -> None:
     """One line on stderr with the estimated run time of a long run (a warning above LONG_RUN_S)."""
-    from weftsim.progress import LONG_RUN_S, SHOW_ESTIMATE_S, estimate_run_time, format_duration
+    from weftsim.output import _size
+    from weftsim.progress import (
+        LARGE_FILE_BYTES, LONG_RUN_S, SHOW_ESTIMATE_S, estimate_run_time, estimate_step_bytes, format_duration,
+    )  # fmt: skip
 
     estimate = sum(estimate_run_time(scene, engine) for engine in engines)
+    size = max(estimate_step_bytes(scene, engine) for engine in engines) if command == "run" else 0.0
+    if size > LARGE_FILE_BYTES:
+        print(f"weftsim {command}: warning: the per-step record will be ~{_size(size)} (held in memory, written "
+              "compressed to result.npz): an explicit solver steps at ~1e-9 s on the friction or film of the "
+              "joint (solver.reference.method = 'auto' integrates it implicitly); or shorten drive.revolutions",
+              file=sys.stderr, flush=True)
     if estimate < SHOW_ESTIMATE_S:
         return
     prefix = "warning: " if estimate > LONG_RUN_S else ""

@@ -27,7 +27,8 @@ from typing import Any
 from weftsim import params
 from weftsim.errors import SceneError
 
-INTEGRATORS = ("auto", "DOP853", "RK45", "RK23", "Radau", "LSODA", "BDF", "numba_DOP853", "numba_RK45")
+INTEGRATORS = ("auto", "DOP853", "RK45", "RK23", "Radau", "LSODA", "BDF", "numba_DOP853", "numba_RK45", "numba_RODAS4",
+               "numba_DOP853_RODAS4")
 EXUDYN_MODELS = ("auto", "rigid_body", "kinematic_tree")
 EXPLICIT_METHODS = ("DOPRI5", "ODE23")
 STEP_CONTROLS = ("adaptive", "fixed")
