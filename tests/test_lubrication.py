@@ -28,6 +28,7 @@ from weftsim.scene import SceneError, load_scene
 
 OIL = {"joint_e.lubrication.viscosity_mpa_s": 80.0}  # ISO VG 220 near 60 C
 SHORT_RUN = {"drive.revolutions": 0.1}  # the first impact at E and its rebound (~20 deg of crank)
+EXPLICIT = {"solver.reference.method": "numba_DOP853"}  # the dry runs' integrator
 
 
 def _scene(**keys):
@@ -99,7 +100,8 @@ def test_dry_scene_is_bit_for_bit_the_former_joint():
 
 
 def test_no_film_and_no_asperities_is_the_dry_joint_exactly():
-    off = {**OIL, "joint_e.lubrication.viscosity_mpa_s": 0.0, "joint_e.lubrication.asperity_density_radius_roughness": 0.0}
+    off = {**OIL, "joint_e.lubrication.viscosity_mpa_s": 0.0, "joint_e.lubrication.asperity_density_radius_roughness": 0.0,
+           **EXPLICIT}  # the integrator of the dry run ("auto" takes an implicit one for a lubricated joint)
     dry, lubricated = solve(_scene()), solve(_scene(**off))
     for name in ("driving_torque_Nm", "contact_force_N", "eccentricity_y_m", "dissipated_energy_J"):
         np.testing.assert_array_equal(lubricated.steps[name], dry.steps[name])  # the added terms are exact zeros
@@ -183,8 +185,9 @@ def test_film_ratio_and_forces_of_a_lubricated_run(runs):
 def test_energy_balance_includes_the_film_dissipation(runs):
     oil, dry = runs["oil"], runs["dry"]
     # Reference engine: the dissipated work is an integrated state, the balance closes to the solver's
-    # tolerance (measured 2.9e-6 of the largest kinetic energy lubricated, 1.8e-6 dry).
-    assert _energy_residual(oil.steps) < 2e-5
+    # tolerance: RODAS4 at rtol 1e-6 ("auto" with a film) measured 3.4e-5 of the largest kinetic energy here,
+    # 6.3e-5 over a revolution (DOP853 at 1e-5: 2.9e-6); dry 1.8e-6.
+    assert _energy_residual(oil.steps) < 2e-4
     dissipated = oil.steps["dissipated_energy_J"]
     assert np.all(np.diff(dissipated) >= -1e-9 * dissipated[-1])  # the film takes energy out, never gives it back
     assert dissipated[-1] > 0.5 * dry.steps["dissipated_energy_J"][-1]
@@ -195,7 +198,7 @@ def test_vanishing_viscosity_gives_the_dry_joint(runs):
     gaps = []
     for viscosity in (1e-4, 1e-5, 1e-6):  # mPa s; asperities off, so only the film separates it from dry
         keys = {"joint_e.lubrication.viscosity_mpa_s": viscosity,
-                "joint_e.lubrication.asperity_density_radius_roughness": 0.0}
+                "joint_e.lubrication.asperity_density_radius_roughness": 0.0, **EXPLICIT}
         steps = solve(_scene(**keys)).steps
         gaps.append(abs(steps["contact_force_N"].max() - dry["contact_force_N"].max()) / dry["contact_force_N"].max())
     assert gaps[0] > gaps[1] > gaps[2]
