@@ -235,3 +235,29 @@ def test_reusable_exudyn_joint_carries_the_film(runs):
     tolerance = ref.scene.compare.first_revolution_peaks
     for name in ("driving_torque_Nm", "film_force_N"):  # measured 0.27 % and 0.33 %
         assert np.abs(rigid.steps[name]).max() == pytest.approx(np.abs(ref.steps[name]).max(), rel=tolerance), name
+
+
+# --- regime map ----------------------------------------------------------------------------------------
+
+
+def test_regime_limits():
+    from weftsim.studies.regime import regime
+
+    assert [regime(r) for r in (0.5, 1.0, 2.0, 3.0, 3.01, 40.0)] == ["dry", "mixed", "mixed", "mixed",
+                                                                    "hydrodynamic", "hydrodynamic"]
+
+
+def test_regime_study_on_one_cell(tmp_path, monkeypatch):
+    from pathlib import Path
+
+    from weftsim.studies import regime, run_study
+
+    monkeypatch.setattr(regime, "SPEEDS_RPM", (400.0,))
+    monkeypatch.setattr(regime, "CLEARANCES_MM", (0.25,))
+    monkeypatch.setattr(regime, "VISCOSITIES_MPA_S", (80.0,))
+    models = Path(__file__).resolve().parents[1] / "models"
+    report = run_study("regime", tmp_path / "out", models, revolutions=1.1, progress=False)
+    (cell,) = report["cells"]
+    assert cell["regime"] == regime.regime(cell["film_ratio_min"])
+    assert cell["joint_force_max_N"] >= cell["film_force_max_N"] > 0.0
+    assert (tmp_path / "out" / "study-regime.png").is_file() and (tmp_path / "out" / "regime.csv").is_file()
