@@ -13,6 +13,8 @@ Every engine and route evaluates the same definitions:
   right-hand side, eccentricity and penetration, on one parameter array;
 - :mod:`.chain_f`: the chains with a clearance at F (F alone: 2 DOF; E and F: 4 DOF, the rod free),
   and the right-hand side and penetration of any topology (E alone is :mod:`.chain` unchanged);
+- :mod:`.film`: the oil film of a lubricated joint (short, long and finite journal bearing: film
+  force from the eccentricity, its rate and the two spins, with cavitation; film friction torques);
 - :mod:`.roots`: the event search of the reference engine on a step's dense output (Illinois root
   finder, golden-section maximum, first rising crossing, peak of the approach rate);
 - :mod:`.python`: the plain-Python form of any of these (same source, no compilation) and the

@@ -17,7 +17,7 @@ has a right-hand side that depends on the motion only through one vector (Booker
 ``omega_m dh/dtheta + dh/dt = -V . n`` with ``V = e_dot - omega_m x e``.  A journal spinning in a
 bearing therefore makes the same film as a journal translating with V in a still bearing, and the
 rotation (wedge) term carries the effective speed omega_j + omega_b - 2 dgamma/dt (gamma the
-direction of e) of the multibody literature.  With h = c H, p = eta (R/c)^2 (|V|/c) P, the axial
+direction of e) of the multibody literature.  With h = c H, p = eta (R/c)^2 (abs(V)/c) P, the axial
 coordinate z = R zeta and the angle phi from e, the dimensionless problem is
 
     div(H^3 grad P) = -12 cos(phi - xi),   H = 1 - eps cos phi,   zeta in [-B/D, B/D],
@@ -25,7 +25,7 @@ coordinate z = R zeta and the angle phi from e, the dimensionless problem is
 with xi the angle of V from e, P = 0 at the bearing's ends and P >= 0 (cavitation: the film
 ruptures where the pressure would fall below ambient).  Its force is
 
-    F = eta R^2 (R/c)^2 (|V|/c) f(eps, xi, B/D),   f = -integral P n dphi dzeta,
+    F = eta R^2 (R/c)^2 (abs(V)/c) f(eps, xi, B/D),   f = -integral P n dphi dzeta,
 
 one dimensionless vector (component along e, component 90 deg ahead of e) of three numbers, for
 any mix of rotation and squeeze, exact in both directions of the squeeze.  ``model`` picks f:
@@ -37,8 +37,12 @@ any mix of rotation and squeeze, exact in both directions of the squeeze.  ``mod
     d/dphi(H^3 dP/dphi) alone (B/D -> infinity), periodic pressure zero at the thickest film,
     negative part discarded (Gumbel).
 ``MODEL_FINITE``
-    the finite bearing.  [First commit: evaluates the short bearing; the finite-length solution
-    replaces it.]
+    the finite bearing: Reynolds' equation with Reynolds' cavitation condition solved on a grid
+    (:mod:`weftsim.reynolds`) and tabulated over eps, xi and B/D (``film_table.npz``,
+    interpolated by :func:`finite_force`).
+``MODEL_SHORT_HALF``
+    the short bearing as the multibody papers write it: wedge and squeeze pressure over the fixed
+    half film of the wedge (:func:`short_half_force`).
 
 Film friction: the shear stress of the film on each surface (Couette part over the full film,
 Petroff's term with the eccentricity factor 1/sqrt(1 - eps^2); pressure-gradient part from the
@@ -51,21 +55,161 @@ torque_j + torque_b + (e x F)_x = 0:
 Sources: Ocvirk (NACA TN 2808, 1952) and Sommerfeld (1904) for the limits; Gumbel's half-Sommerfeld
 condition and the multibody use of both (Flores, Ambrosio, Claro, Lankarani, Mech. Mach. Theory 41,
 2006; Nonlinear Dyn. 56, 2009); Booker's mobility/impedance view of the squeeze velocity
-(J. Lubr. Technol. 87, 1965; Childs, Moes, van der Bosch, J. Lubr. Technol. 99, 1977).
+(J. Basic Eng. 87, 1965; Childs, Moes, van der Bosch, J. Lubr. Technol. 99, 1977).
 
-The functions take floats and return floats, never check their arguments (the caller keeps
-eps < 1: at e >= c the asperity and dry contact take over), and are compiled with numba.
+The functions take floats and return floats, never check their arguments, and are compiled with
+numba.  The caller keeps eps < 1 (at e >= c the result is NaN; the asperity and dry contact take
+over before the wall).  The force grows without bound towards the wall (the squeeze film as
+(1 - eps^2)^-1.5, its stiffness one power of (1 - eps) faster), which sets the step of explicit
+integrators near the wall.
 """
 
 from __future__ import annotations
 
+import hashlib
 import math
+from pathlib import Path
 
+import numpy as np
 from numba import njit
 
-MODEL_FINITE, MODEL_SHORT, MODEL_LONG = 0, 1, 2
+MODEL_FINITE, MODEL_SHORT, MODEL_LONG, MODEL_SHORT_HALF = 0, 1, 2, 3
 
 TWO_PI = 2.0 * math.pi
+
+# Grid of the finite-bearing table (scripts/make_film_table.py solves Reynolds' equation on it).
+# eps = 1 - (1 - u)^2 with u uniform on [0, U_MAX] (nodes crowd towards eps = 1: eps_max = 0.99);
+# xi uniform on [0, pi] (the mirror image about e gives [-pi, 0]); B/D geometric on [WIDTH_MIN, WIDTH_MAX].
+N_U, U_MAX = 29, 0.9
+N_XI = 49
+N_WIDTH, WIDTH_MIN, WIDTH_MAX = 9, 0.25, 4.0
+LOG_WIDTH_STEP = math.log(WIDTH_MAX / WIDTH_MIN) / (N_WIDTH - 1)
+# First 16 hex digits of the SHA-256 of the stored table (scripts/make_film_table.py writes this
+# line).  numba freezes the table into the compiled code and keys its cache by this file, so a new
+# table must change this file; a table that does not match is not used (NaN forces).
+TABLE_DIGEST = "724a82af844b3486"
+
+
+def table_eccentricities() -> np.ndarray:
+    """The table's eccentricity ratios."""
+    u = np.linspace(0.0, U_MAX, N_U)
+    return 1.0 - (1.0 - u) ** 2
+
+
+def table_angles() -> np.ndarray:
+    """The table's squeeze-velocity angles xi, rad."""
+    return np.linspace(0.0, math.pi, N_XI)
+
+
+def table_widths() -> np.ndarray:
+    """The table's B/D."""
+    return WIDTH_MIN * np.exp(LOG_WIDTH_STEP * np.arange(N_WIDTH))
+
+
+@njit(cache=True, error_model="numpy")
+def table_scale(eps: float, width: float) -> float:
+    """The table stores f (1 - eps^2)^1.5 (1 + (B/D)^2) / (B/D)^3: bounded and smooth on the grid.
+
+    (1 - eps^2)^-1.5 is the growth of the long bearing's squeeze force as eps -> 1; the width factor
+    takes out the short bearing's (B/D)^3 and the long bearing's B/D.
+    """
+    return (1.0 - eps * eps) ** 1.5 * (1.0 + width * width) / (width * width * width)
+
+
+def table_digest(table: np.ndarray) -> str:
+    """First 16 hex digits of the SHA-256 of the table's float64 bytes."""
+    return hashlib.sha256(np.ascontiguousarray(table, dtype=np.float64).tobytes()).hexdigest()[:16]
+
+
+def _padded_table() -> np.ndarray:
+    """The stored table with one ghost node on each side of each axis (Catmull-Rom needs four nodes).
+
+    xi: mirror images (the component along e is even in xi about 0 and pi, the one ahead odd);
+    eps and B/D: linear extrapolation.  NaN if the stored table is missing or is not the one of
+    ``TABLE_DIGEST`` (while scripts/make_film_table.py builds it).
+    """
+    path = Path(__file__).with_name("film_table.npz")
+    shape = (N_WIDTH, N_U, N_XI, 2)
+    if not path.exists():
+        return np.full((N_WIDTH + 2, N_U + 2, N_XI + 2, 2), np.nan)
+    with np.load(path) as data:
+        core = np.asarray(data["force"], dtype=np.float64)
+    if core.shape != shape or table_digest(core) != TABLE_DIGEST:
+        return np.full((N_WIDTH + 2, N_U + 2, N_XI + 2, 2), np.nan)
+    out = np.empty((N_WIDTH + 2, N_U + 2, N_XI + 2, 2))
+    out[1:-1, 1:-1, 1:-1] = core
+    mirror = np.array([1.0, -1.0])
+    out[1:-1, 1:-1, 0] = core[:, :, 1] * mirror
+    out[1:-1, 1:-1, -1] = core[:, :, -2] * mirror
+    out[1:-1, 0] = 2.0 * out[1:-1, 1] - out[1:-1, 2]
+    out[1:-1, -1] = 2.0 * out[1:-1, -2] - out[1:-1, -3]
+    out[0] = 2.0 * out[1] - out[2]
+    out[-1] = 2.0 * out[-2] - out[-3]
+    return out
+
+
+FINITE_TABLE = _padded_table()
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _catmull_rom(t: float):
+    """Weights of the four nodes i-1, i, i+1, i+2 at the fraction t in [0, 1] of the interval (i, i+1)."""
+    t2 = t * t
+    t3 = t2 * t
+    return (0.5 * (-t3 + 2.0 * t2 - t), 0.5 * (3.0 * t3 - 5.0 * t2 + 2.0), 0.5 * (-3.0 * t3 + 4.0 * t2 + t),
+            0.5 * (t3 - t2))
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _cell(x: float, n: int):
+    """Interval index i in [0, n-2] and fraction t (clamped to [0, 1]) of the node coordinate x."""
+    if x <= 0.0:
+        return 0, 0.0
+    i = int(x)
+    if i >= n - 1:
+        return n - 2, 1.0
+    return i, x - i
+
+
+@njit(cache=True, error_model="numpy")
+def finite_force(eps: float, xi: float, width: float):
+    """Dimensionless film force (f_along_e, f_ahead) of the finite bearing: the table, tricubic.
+
+    Catmull-Rom in u = 1 - sqrt(1 - eps), in xi and in log(B/D).  Past eps = 0.99 the scaled force
+    of eps = 0.99 is kept (f grows as (1 - eps^2)^-1.5); below B/D = 1/4 the force scales as the short
+    bearing's (B/D)^3, above B/D = 4 as the long bearing's B/D.
+    """
+    factor = 1.0
+    w = width
+    if w < WIDTH_MIN:
+        factor = (w / WIDTH_MIN) ** 3
+        w = WIDTH_MIN
+    elif w > WIDTH_MAX:
+        factor = w / WIDTH_MAX
+        w = WIDTH_MAX
+    sign = 1.0
+    x = xi
+    if x < 0.0:
+        x = -x
+        sign = -1.0
+    u = 1.0 - math.sqrt(1.0 - eps)
+    iu, tu = _cell(u / U_MAX * (N_U - 1), N_U)
+    ix, tx = _cell(x / math.pi * (N_XI - 1), N_XI)
+    iw, tw = _cell(math.log(w / WIDTH_MIN) / LOG_WIDTH_STEP, N_WIDTH)
+    wu = _catmull_rom(tu)
+    wx = _catmull_rom(tx)
+    ww = _catmull_rom(tw)
+    g0 = 0.0
+    g1 = 0.0
+    for a in range(4):
+        for b in range(4):
+            wab = ww[a] * wu[b]
+            for d in range(4):
+                weight = wab * wx[d]
+                g0 += weight * FINITE_TABLE[iw + a, iu + b, ix + d, 0]
+                g1 += weight * FINITE_TABLE[iw + a, iu + b, ix + d, 1]
+    scale = factor / table_scale(eps, w)
+    return g0 * scale, sign * g1 * scale
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -93,15 +237,11 @@ def _short_antiderivatives(psi: float, eps: float):
     return cc, cs, ss
 
 
-@njit(cache=True, error_model="numpy")
-def short_force(eps: float, xi: float, half_width: float):
-    """Dimensionless film force f = (f_along_e, f_ahead) of the short bearing, Gumbel cavitation.
-
-    ``half_width`` = B/D (zeta runs over [-B/D, B/D]).  The axially integrated pressure is
-    8 (B/D)^3 cos(phi - xi) / H^3, kept over the half circle |phi - xi| < pi/2 where it is positive.
-    """
-    a = sommerfeld_angle(xi - 0.5 * math.pi, eps)
-    b = sommerfeld_angle(xi + 0.5 * math.pi, eps)
+@njit(cache=True, error_model="numpy", inline="always")
+def _short_integrals(eps: float, xi: float, half_width: float, lo: float, hi: float):
+    """f of the axially integrated short-bearing pressure 8 (B/D)^3 cos(phi - xi) / H^3 over phi in [lo, hi]."""
+    a = sommerfeld_angle(lo, eps)
+    b = sommerfeld_angle(hi, eps)
     cc_a, cs_a, ss_a = _short_antiderivatives(a, eps)
     cc_b, cs_b, ss_b = _short_antiderivatives(b, eps)
     scale = 8.0 * half_width * half_width * half_width / (1.0 - eps * eps) ** 2.5
@@ -114,6 +254,125 @@ def short_force(eps: float, xi: float, half_width: float):
 
 
 @njit(cache=True, error_model="numpy")
+def short_force(eps: float, xi: float, half_width: float):
+    """Dimensionless film force f = (f_along_e, f_ahead) of the short bearing, Gumbel cavitation.
+
+    ``half_width`` = B/D (zeta runs over [-B/D, B/D]).  The axially integrated pressure is
+    8 (B/D)^3 cos(phi - xi) / H^3, kept over the half circle abs(phi - xi) < pi/2 where it is positive.
+    """
+    return _short_integrals(eps, xi, half_width, xi - 0.5 * math.pi, xi + 0.5 * math.pi)
+
+
+@njit(cache=True, error_model="numpy")
+def short_half_force(eps: float, xi: float, half_width: float):
+    """The short bearing of the multibody papers (``MODEL_SHORT_HALF``): (f_along_e, f_ahead).
+
+    Flores, Ambrosio, Claro and Lankarani integrate the wedge and the squeeze pressure over one
+    fixed half of the film, the half where the wedge's pressure is positive (phi in [-pi, 0] for
+    omega_j + omega_b - 2 dgamma/dt >= 0, i.e. sin xi <= 0; [0, pi] otherwise), without clipping the
+    squeeze pressure.  Their closed forms follow: with w the effective speed,
+    F_r = -(eta R B^3 / (2 c^2)) (2 eps^2 abs(w) / (1-eps^2)^2 + pi (1 + 2 eps^2) deps/dt / (1-eps^2)^2.5),
+    F_t = (eta R B^3 / (2 c^2)) (pi eps w / (2 (1-eps^2)^1.5) + 4 eps deps/dt / (1-eps^2)^2) for w >= 0;
+    a journal leaving the wall is pulled back by a pressure below ambient.
+    """
+    if math.sin(xi) <= 1e-9:  # no wedge (sin xi = 1e-16 at xi = pi from atan2): the half of w > 0
+        return _short_integrals(eps, xi, half_width, -math.pi, 0.0)
+    return _short_integrals(eps, xi, half_width, 0.0, math.pi)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _long_coefficients(eps: float, xi: float):
+    """Coefficients (a1, b1, a2, d) of the long bearing's pressure, see :func:`_long_pressure`."""
+    k = 1.0 - eps * eps
+    root = math.sqrt(k)
+    scale = 1.0 / (k * k * root)
+    sx = math.sin(xi)
+    cx = math.cos(xi)
+    c0 = -36.0 * eps * sx / (2.0 + eps * eps)
+    a1 = (12.0 * sx * (1.0 + eps * eps) + 2.0 * eps * c0) * scale
+    b1 = 12.0 * cx * root * scale
+    a2 = (3.0 * eps * sx + 0.25 * eps * eps * c0) * scale
+    d = -6.0 * eps * cx * root * scale
+    return a1, b1, a2, d
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _long_pressure_at(psi: float, a1: float, b1: float, a2: float, d: float) -> float:
+    s = math.sin(psi)
+    c = math.cos(psi)
+    return a1 * s + b1 * (c + 1.0) + 2.0 * a2 * s * c + d * s * s
+
+
+@njit(cache=True, error_model="numpy")
+def _long_pressure(psi: float, eps: float, xi: float) -> float:
+    """Full-Sommerfeld pressure of the long bearing at Sommerfeld angle psi, zero at the thickest film.
+
+    H^3 dP/dphi = -12 sin(phi - xi) + C with C = -36 eps sin(xi) / (2 + eps^2) (periodic P), integrated
+    from phi = psi = pi through Sommerfeld's substitution: the terms linear in psi cancel, leaving
+    P = (a1 sin psi + b1 (cos psi + 1) + a2 sin 2psi + d sin^2 psi) with
+    a1 = 12 sin xi (1 + eps^2) + 2 eps C, b1 = 12 cos xi sqrt(1 - eps^2), a2 = 3 eps sin xi + eps^2 C / 4,
+    d = -6 eps cos xi sqrt(1 - eps^2), all over (1 - eps^2)^2.5.
+    """
+    a1, b1, a2, d = _long_coefficients(eps, xi)
+    return _long_pressure_at(psi, a1, b1, a2, d)
+
+
+LONG_SAMPLES = 32  # sign changes of the (degree-2 trigonometric) pressure are found on this many intervals
+LONG_BISECTIONS = 36  # each located to 2 pi / 32 / 2^36 ~ 3e-12 rad
+_GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(24)
+
+
+@njit(cache=True, error_model="numpy")
+def long_force(eps: float, xi: float, half_width: float):
+    """Dimensionless film force (f_along_e, f_ahead) of the long bearing, Gumbel cavitation.
+
+    The full-Sommerfeld pressure (:func:`_long_pressure`) where positive, times the length 2 B/D,
+    integrated over each positive interval of psi by 24-point Gauss-Legendre.
+    """
+    step = TWO_PI / LONG_SAMPLES
+    a1, b1, a2, d2 = _long_coefficients(eps, xi)
+    f0 = 0.0
+    f1 = 0.0
+    root = math.sqrt(1.0 - eps * eps)
+    start = -math.pi
+    inside = False
+    p_prev = _long_pressure_at(-math.pi + 0.5 * step, a1, b1, a2, d2)
+    inside = p_prev > 0.0
+    lo = -math.pi
+    for n in range(LONG_SAMPLES + 1):
+        psi = -math.pi + (n + 0.5) * step if n < LONG_SAMPLES else math.pi
+        p = _long_pressure_at(psi, a1, b1, a2, d2) if n < LONG_SAMPLES else 0.0
+        positive = p > 0.0
+        if positive != inside or n == LONG_SAMPLES:
+            a = psi - step if n < LONG_SAMPLES else psi - 0.5 * step
+            b = psi
+            if n < LONG_SAMPLES:
+                for _ in range(LONG_BISECTIONS):
+                    m = 0.5 * (a + b)
+                    if (_long_pressure_at(m, a1, b1, a2, d2) > 0.0) == inside:
+                        a = m
+                    else:
+                        b = m
+                edge = 0.5 * (a + b)
+            else:
+                edge = math.pi
+            if inside:
+                start = lo
+                half = 0.5 * (edge - start)
+                mid = 0.5 * (edge + start)
+                for g in range(_GAUSS_X.size):
+                    q = mid + half * _GAUSS_X[g]
+                    d = 1.0 + eps * math.cos(q)
+                    pressure = _long_pressure_at(q, a1, b1, a2, d2)
+                    jac = half * _GAUSS_W[g] * root / d
+                    f0 += pressure * jac * (math.cos(q) + eps) / d
+                    f1 += pressure * jac * root * math.sin(q) / d
+            lo = edge
+            inside = positive
+    return -2.0 * half_width * f0, -2.0 * half_width * f1
+
+
+@njit(cache=True, error_model="numpy")
 def film_force(ey: float, ez: float, vy: float, vz: float, omega_j: float, omega_b: float, c: float,
                radius: float, length: float, viscosity: float, model: int):
     """Film force on the journal and film friction torques: (fy, fz, torque_j, torque_b).
@@ -121,7 +380,7 @@ def film_force(ey: float, ez: float, vy: float, vz: float, omega_j: float, omega
     Parameters
     ----------
     ey, ez : float
-        Eccentricity, journal centre - bearing centre, m (|e| < c).
+        Eccentricity, journal centre - bearing centre, m (abs(e) < c).
     vy, vz : float
         Its rate, m/s.
     omega_j, omega_b : float
@@ -131,7 +390,7 @@ def film_force(ey: float, ez: float, vy: float, vz: float, omega_j: float, omega
     viscosity : float
         Dynamic viscosity, Pa s.
     model : int
-        ``MODEL_FINITE``, ``MODEL_SHORT`` or ``MODEL_LONG``.
+        ``MODEL_FINITE``, ``MODEL_SHORT``, ``MODEL_LONG`` or ``MODEL_SHORT_HALF`` (any other: short).
 
     Returns
     -------
@@ -158,7 +417,14 @@ def film_force(ey: float, ez: float, vy: float, vz: float, omega_j: float, omega
             nz = sz / speed
         xi = math.atan2(ny * sz - nz * sy, ny * sy + nz * sz)
         half_width = 0.5 * length / radius
-        f_along, f_ahead = short_force(eps, xi, half_width)
+        if model == MODEL_FINITE:
+            f_along, f_ahead = finite_force(eps, xi, half_width)
+        elif model == MODEL_LONG:
+            f_along, f_ahead = long_force(eps, xi, half_width)
+        elif model == MODEL_SHORT_HALF:
+            f_along, f_ahead = short_half_force(eps, xi, half_width)
+        else:
+            f_along, f_ahead = short_force(eps, xi, half_width)
         ratio = radius / c
         scale = viscosity * radius * radius * ratio * ratio * speed / c
         fy = scale * (f_along * ny - f_ahead * nz)
