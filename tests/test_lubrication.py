@@ -1,4 +1,4 @@
-"""The lubricated clearance joint (issue 22 parts 2-6; docs/lubrication.md).
+"""The lubricated clearance joint (issue 22 parts 2-6; docs/lubricated-joint.md).
 
 Scene keys and their one-line errors; the dry joint unchanged bit for bit; the Greenwood-Tripp asperity
 load (zero for thick films, continuous, its potential); the total radial force continuous where the dry

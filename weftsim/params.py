@@ -145,13 +145,14 @@ class WearModel:
     profile_points: int = 360
 
 
-# Film models of Lubrication.model (the codes of weftsim.kernel.film: MODEL_FINITE, MODEL_SHORT, MODEL_LONG).
-FILM_MODELS = ("finite", "short", "long")
+# Film models of Lubrication.model (the codes of weftsim.kernel.film: MODEL_FINITE, MODEL_SHORT, MODEL_LONG,
+# MODEL_SHORT_HALF, in this order).
+FILM_MODELS = ("finite", "short", "long", "short_half")
 
 
 @dataclass(frozen=True, kw_only=True)
 class Lubrication:
-    """Oil film and asperity contact of a lubricated clearance joint (docs/lubrication.md).
+    """Oil film and asperity contact of a lubricated clearance joint (docs/lubricated-joint.md).
 
     A joint without a ``Lubrication`` (``ClearanceJoint.lubrication = None``) is the dry joint.  With
     one, the film's pressure carries the journal for every eccentricity (no contact needed), the
@@ -164,8 +165,9 @@ class Lubrication:
     viscosity : float
         Dynamic viscosity eta of the oil at operating temperature, Pa s (>= 0; 0 = no film).
     model : str
-        Film model: ``"finite"`` (finite length, default), ``"short"`` (Ocvirk) or ``"long"``
-        (Sommerfeld with Guembel cavitation), :data:`FILM_MODELS`.
+        Film model: ``"finite"`` (finite length, default), ``"short"`` (Ocvirk), ``"long"``
+        (Sommerfeld with Guembel cavitation) or ``"short_half"`` (the short bearing as Flores, Ambrosio,
+        Claro and Lankarani write it), :data:`FILM_MODELS` (docs/lubrication.md).
     roughness : float
         Combined RMS roughness sigma = sqrt(sigma_j^2 + sigma_b^2) of journal and bearing, m.
         Default 0.4 um: two ground surfaces of Rq ~ 0.3 um.

@@ -87,7 +87,7 @@ def WEAR_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 - a cons
 
 
 def LUBRICATION_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 - a constant-like key factory
-    """The ``[<table>.lubrication]`` keys of a clearance joint (docs/lubrication.md).  The table is optional
+    """The ``[<table>.lubrication]`` keys of a clearance joint (docs/lubricated-joint.md).  The table is optional
     (absent: the dry joint); given, it must name ``viscosity_mpa_s``, the other keys default."""
     at = f"{table}.lubrication."
     to = f"{joint}.lubrication."
@@ -95,7 +95,8 @@ def LUBRICATION_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 -
         Key(at + "viscosity_mpa_s", to + "viscosity", "float", 1e-3, 0, None, False,
             doc="dynamic viscosity of the oil at operating temperature (ISO VG 220 at 60 C: ~80 mPa s); 0 = no film"),
         Key(at + "model", to + "model", "str", choices=params.FILM_MODELS,
-            doc="film model: finite (finite-length bearing, default), short (Ocvirk) or long (Sommerfeld)"),
+            doc="film model: finite (finite-length bearing, default), short (Ocvirk), long (Sommerfeld) or "
+                "short_half (Flores et al.'s short bearing)"),
         Key(at + "roughness_um", to + "roughness", "float", 1e-6, 0,
             doc="combined RMS roughness of journal and bearing (default 0.4 um, two ground surfaces)"),
         Key(at + "asperity_density_radius_roughness", to + "asperity_density_radius_roughness", "float", 1, 0, 1,

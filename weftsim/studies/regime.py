@@ -1,5 +1,5 @@
 """Regime map of the lubricated joint at E: minimum film ratio and peak force over crank speed x
-clearance x viscosity (``weftsim study regime``; docs/lubrication.md).
+clearance x viscosity (``weftsim study regime``; docs/lubricated-joint.md).
 
 Each cell is one reference-engine run of :data:`REVOLUTIONS` revolutions of the loom (models/loom.toml; the
 reference mechanism when that scene is not installed, as the report says) with a ``[joint_e.lubrication]``
