@@ -130,7 +130,11 @@ def test_asperity_load_is_continuous_and_its_potential_is_its_integral():
     # Continuous: no step between neighbours larger than the largest slope times the spacing, x 1.01.
     slope = np.max(np.abs(np.gradient(load, ecc)))
     assert np.max(np.abs(np.diff(load))) <= 1.01 * slope * (ecc[1] - ecc[0])
-    assert load[-1] == pytest.approx(asperity_load(COEF, SIGMA, C, C, R, L)[0], rel=1e-15)  # held beyond c
+    # Beyond c: continued with the slope at c (C1): the one-sided difference quotients agree there.
+    at = np.searchsorted(ecc, C)
+    inside = (load[at - 1] - load[at - 2]) / (ecc[1] - ecc[0])
+    beyond = (load[-1] - load[-2]) / (ecc[1] - ecc[0])
+    assert beyond == pytest.approx(inside, rel=1e-2)  # first differences lag by h/2 |F''|: ~1e-3 measured
     # dU/d|e| = F_a: the trapezoid of F_a against U's change; trapezoid error (h^2/12) |F''| ~ 1e-7 relative.
     integral = np.concatenate([[0.0], np.cumsum(0.5 * (load[1:] + load[:-1]) * np.diff(ecc))])
     np.testing.assert_allclose(energy - energy[0], integral, rtol=1e-5, atol=1e-6 * energy[-1])
@@ -177,9 +181,11 @@ def test_film_ratio_and_forces_of_a_lubricated_run(runs):
     oil = runs["oil"]
     assert oil.ok, oil.message
     steps = oil.steps
-    assert np.all(steps["film_ratio"] >= 1.0)  # the film floor: the journal never reaches the dry law here
     np.testing.assert_allclose(steps["film_thickness_m"], steps["film_ratio"] * 0.4e-6, rtol=1e-12)
-    assert np.all(steps["contact_force_N"] == 0.0) and steps["film_force_N"].max() > 1e3
+    # No asperity load under a full film (h_min >= 4 sigma); the dry law only where the film is gone (h_min = 0).
+    assert np.all(steps["asperity_force_N"][steps["film_ratio"] >= H_CUTOFF] == 0.0)
+    assert np.all(steps["film_ratio"][steps["contact_force_N"] > 0.0] == 0.0)
+    assert steps["film_force_N"].max() > 1e3 and steps["asperity_force_N"].max() > 0.0
 
 
 def test_energy_balance_includes_the_film_dissipation(runs):
@@ -228,12 +234,15 @@ def test_reusable_exudyn_joint_carries_the_film(runs):
     from weftsim import exudyn_engine
 
     ref = runs["oil"]
+    # The squeeze film's peak at the floor lasts a few microseconds: the adaptive generalized-alpha step at the
+    # default local error (3e-10 m) cuts it 1.6 % low, at 3e-11 m 0.65 % (the reference engine is converged:
+    # 13 023.2 N m at rtol 1e-5 with RODAS4, 13 024.0 with DOP853 at 1e-8).
     scene = dataclasses.replace(ref.scene, exudyn_solver=dataclasses.replace(ref.scene.exudyn_solver,
-                                                                             model="rigid_body"))  # fmt: skip
+                                                                             model="rigid_body", local_error=3e-11))
     rigid = exudyn_engine.solve(scene)
     assert rigid.ok, rigid.message
     tolerance = ref.scene.compare.first_revolution_peaks
-    for name in ("driving_torque_Nm", "film_force_N"):  # measured 0.27 % and 0.33 %
+    for name in ("driving_torque_Nm", "film_force_N"):
         assert np.abs(rigid.steps[name]).max() == pytest.approx(np.abs(ref.steps[name]).max(), rel=tolerance), name
 
 
