@@ -16,7 +16,8 @@ VISCOSITY, RADIUS, LENGTH, CLEARANCE = 0.1, 0.01, 0.02, 2e-5  # Pa s, m, m, m: a
 
 @pytest.mark.parametrize("eps", [0.05, 0.3, 0.5, 0.9, 0.99])
 def test_short_bearing_rotation_is_ocvirks_closed_form(eps):
-    """Ocvirk (NACA TN 2808): F_r = -eta U L^3 eps^2 / (c^2 (1-eps^2)^2), F_t = eta U L^3 pi eps / (4 c^2 (1-eps^2)^1.5)."""
+    """Ocvirk (NACA TN 2808): F_r = -eta U L^3 eps^2 / (c^2 (1-eps^2)^2),
+    F_t = eta U L^3 pi eps / (4 c^2 (1-eps^2)^1.5)."""
     omega = 100.0
     fy, fz, _, _ = film_force(eps * CLEARANCE, 0.0, 0.0, 0.0, omega, 0.0, CLEARANCE, RADIUS, LENGTH, VISCOSITY,
                               MODEL_SHORT)

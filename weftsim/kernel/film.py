@@ -318,57 +318,83 @@ def _long_pressure(psi: float, eps: float, xi: float) -> float:
 
 
 LONG_SAMPLES = 32  # sign changes of the (degree-2 trigonometric) pressure are found on this many intervals
-LONG_BISECTIONS = 36  # each located to 2 pi / 32 / 2^36 ~ 3e-12 rad
+LONG_ROOT_TOL = 1e-13  # rad: the edges of the pressure lobe (Illinois' regula falsi)
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(24)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _long_edge(a: float, b: float, fa: float, fb: float, a1: float, b1: float, a2: float, d: float) -> float:
+    """Zero of the long bearing's pressure between a and b (signs of fa and fb differ): Illinois."""
+    side = 0
+    for _ in range(60):
+        x = b - fb * (b - a) / (fb - fa)
+        fx = _long_pressure_at(x, a1, b1, a2, d)
+        if (fx > 0.0) == (fb > 0.0):
+            b, fb = x, fx
+            if side == -1:
+                fa *= 0.5
+            side = -1
+        else:
+            a, fa = x, fx
+            if side == 1:
+                fb *= 0.5
+            side = 1
+        if abs(b - a) < LONG_ROOT_TOL or fx == 0.0:
+            return x
+    return 0.5 * (a + b)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _long_lobe(lo: float, hi: float, eps: float, a1: float, b1: float, a2: float, d: float):
+    """Integral of P (cos phi, sin phi) dphi over psi in [lo, hi], 24-point Gauss-Legendre in psi."""
+    root = math.sqrt(1.0 - eps * eps)
+    half = 0.5 * (hi - lo)
+    mid = 0.5 * (hi + lo)
+    f0 = 0.0
+    f1 = 0.0
+    for g in range(_GAUSS_X.size):
+        q = mid + half * _GAUSS_X[g]
+        den = 1.0 + eps * math.cos(q)
+        weight = _long_pressure_at(q, a1, b1, a2, d) * half * _GAUSS_W[g] * root / (den * den)
+        f0 += weight * (math.cos(q) + eps)
+        f1 += weight * root * math.sin(q)
+    return f0, f1
 
 
 @njit(cache=True, error_model="numpy")
 def long_force(eps: float, xi: float, half_width: float):
     """Dimensionless film force (f_along_e, f_ahead) of the long bearing, Gumbel cavitation.
 
-    The full-Sommerfeld pressure (:func:`_long_pressure`) where positive, times the length 2 B/D,
-    integrated over each positive interval of psi by 24-point Gauss-Legendre.
+    The full-Sommerfeld pressure (:func:`_long_pressure`, zero at psi = +-pi) where positive, times
+    the length 2 B/D: its sign changes are bracketed on LONG_SAMPLES intervals of psi, located by
+    Illinois' method, and each positive lobe integrated by Gauss-Legendre (dphi = sqrt(1 - eps^2)
+    dpsi / (1 + eps cos psi), cos phi = (cos psi + eps) / (1 + eps cos psi)).
     """
+    a1, b1, a2, d = _long_coefficients(eps, xi)
     step = TWO_PI / LONG_SAMPLES
-    a1, b1, a2, d2 = _long_coefficients(eps, xi)
     f0 = 0.0
     f1 = 0.0
-    root = math.sqrt(1.0 - eps * eps)
-    start = -math.pi
-    inside = False
-    p_prev = _long_pressure_at(-math.pi + 0.5 * step, a1, b1, a2, d2)
+    prev = -math.pi + 0.5 * step
+    p_prev = _long_pressure_at(prev, a1, b1, a2, d)
     inside = p_prev > 0.0
     lo = -math.pi
-    for n in range(LONG_SAMPLES + 1):
-        psi = -math.pi + (n + 0.5) * step if n < LONG_SAMPLES else math.pi
-        p = _long_pressure_at(psi, a1, b1, a2, d2) if n < LONG_SAMPLES else 0.0
-        positive = p > 0.0
-        if positive != inside or n == LONG_SAMPLES:
-            a = psi - step if n < LONG_SAMPLES else psi - 0.5 * step
-            b = psi
-            if n < LONG_SAMPLES:
-                for _ in range(LONG_BISECTIONS):
-                    m = 0.5 * (a + b)
-                    if (_long_pressure_at(m, a1, b1, a2, d2) > 0.0) == inside:
-                        a = m
-                    else:
-                        b = m
-                edge = 0.5 * (a + b)
-            else:
-                edge = math.pi
+    for n in range(1, LONG_SAMPLES):
+        psi = -math.pi + (n + 0.5) * step
+        p = _long_pressure_at(psi, a1, b1, a2, d)
+        if (p > 0.0) != inside:
+            edge = _long_edge(prev, psi, p_prev, p, a1, b1, a2, d)
             if inside:
-                start = lo
-                half = 0.5 * (edge - start)
-                mid = 0.5 * (edge + start)
-                for g in range(_GAUSS_X.size):
-                    q = mid + half * _GAUSS_X[g]
-                    d = 1.0 + eps * math.cos(q)
-                    pressure = _long_pressure_at(q, a1, b1, a2, d2)
-                    jac = half * _GAUSS_W[g] * root / d
-                    f0 += pressure * jac * (math.cos(q) + eps) / d
-                    f1 += pressure * jac * root * math.sin(q) / d
+                g0, g1 = _long_lobe(lo, edge, eps, a1, b1, a2, d)
+                f0 += g0
+                f1 += g1
             lo = edge
-            inside = positive
+            inside = not inside
+        prev = psi
+        p_prev = p
+    if inside:
+        g0, g1 = _long_lobe(lo, math.pi, eps, a1, b1, a2, d)
+        f0 += g0
+        f1 += g1
     return -2.0 * half_width * f0, -2.0 * half_width * f1
 
 
