@@ -191,8 +191,8 @@ def test_film_ratio_and_forces_of_a_lubricated_run(runs):
 def test_energy_balance_includes_the_film_dissipation(runs):
     oil, dry = runs["oil"], runs["dry"]
     # Reference engine: the dissipated work is an integrated state, the balance closes to the solver's
-    # tolerance: RODAS4 at rtol 1e-6 ("auto" with a film) measured 3.4e-5 of the largest kinetic energy here,
-    # 6.3e-5 over a revolution (DOP853 at 1e-5: 2.9e-6); dry 1.8e-6.
+    # tolerance: RODAS4 at rtol 1e-5 ("auto" with a film) measured 8.5e-7 of the largest kinetic energy here
+    # (6.3e-5 over a revolution at rtol 1e-6 with the short film); dry 3.2e-6.
     assert _energy_residual(oil.steps) < 2e-4
     dissipated = oil.steps["dissipated_energy_J"]
     assert np.all(np.diff(dissipated) >= -1e-9 * dissipated[-1])  # the film takes energy out, never gives it back
@@ -209,8 +209,8 @@ def test_vanishing_viscosity_gives_the_dry_joint(runs):
         gaps.append(abs(steps["contact_force_N"].max() - dry["contact_force_N"].max()) / dry["contact_force_N"].max())
     assert gaps[0] > gaps[1] > gaps[2]
     # The film at its floor is a damper ~ eta: the gap of the impact's peak falls tenfold per decade
-    # (measured 1.1e-2, 1.2e-3, 1.2e-4 with the short-bearing film; the dry run's own solver noise at
-    # rtol 1e-5 is ~4e-4 on the peak torque).
+    # (measured 1.0e-4, 4.2e-6, 4.3e-7 with the finite film, 1.1e-2, 1.2e-3, 1.2e-4 with the short one; the dry
+    # run's own solver noise at rtol 1e-5 is ~4e-4 on the peak torque).
     assert gaps[2] < 1e-3
 
 
@@ -226,7 +226,8 @@ def test_engines_agree_on_a_lubricated_run(runs):
         a, b = np.abs(ref.steps[name]).max(), np.abs(tree.steps[name]).max()
         assert b == pytest.approx(a, rel=tolerance), name
     assert tree.steps["film_ratio"].min() == pytest.approx(ref.steps["film_ratio"].min(), rel=tolerance)
-    # The tree integrates the film's power with trapezoids over its steps: measured 4e-4 of the kinetic energy.
+    # The tree integrates the film's power over its steps with a quadratic rule: measured 1.3e-6 of the kinetic
+    # energy here, 1.7e-4 over a revolution with the short film.
     assert _energy_residual(tree.steps) < 2e-3
 
 
