@@ -100,8 +100,8 @@ def test_dry_scene_is_bit_for_bit_the_former_joint():
 
 
 def test_no_film_and_no_asperities_is_the_dry_joint_exactly():
-    off = {**OIL, "joint_e.lubrication.viscosity_mpa_s": 0.0, "joint_e.lubrication.asperity_density_radius_roughness": 0.0,
-           **EXPLICIT}  # the integrator of the dry run ("auto" takes an implicit one for a lubricated joint)
+    off = {**OIL, "joint_e.lubrication.viscosity_mpa_s": 0.0,
+           "joint_e.lubrication.asperity_density_radius_roughness": 0.0, **EXPLICIT}  # the integrator of the dry run ("auto" takes an implicit one for a lubricated joint)
     dry, lubricated = solve(_scene()), solve(_scene(**off))
     for name in ("driving_torque_Nm", "contact_force_N", "eccentricity_y_m", "dissipated_energy_J"):
         np.testing.assert_array_equal(lubricated.steps[name], dry.steps[name])  # the added terms are exact zeros

@@ -219,7 +219,8 @@ def lubrication_problem(lub: Lubrication) -> str | None:
         return f"`lubrication.roughness` must be > 0 (m, combined RMS of both surfaces), got {lub.roughness!r}"
     eta = lub.asperity_density_radius_roughness
     if not (_number(eta) and 0.0 <= eta <= 1.0):
-        return f"`lubrication.asperity_density_radius_roughness` must be in [0, 1] (0 = no asperity contact), got {eta!r}"
+        return (f"`lubrication.asperity_density_radius_roughness` must be in [0, 1] (0 = no asperity contact), "
+                f"got {eta!r}")
     ratio = lub.roughness_radius_ratio
     if not (_number(ratio) and 0.0 < ratio <= 1.0):
         return f"`lubrication.roughness_radius_ratio` must be in (0, 1] (sigma / beta), got {ratio!r}"

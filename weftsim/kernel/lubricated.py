@@ -37,8 +37,8 @@ from numba import njit
 from weftsim.kernel.asperity import asperity_load
 from weftsim.kernel.film import film_force
 from weftsim.kernel.joint import (
-    ASPERITY_COEF, BEARING_LENGTH, BEARING_RADIUS, BOUNDARY_MU, CLEARANCE, FILM_FLOOR, FILM_MODEL, JOURNAL_RADIUS, LUBRICATED,
-    ROUGHNESS, V0, V1, VISCOSITY, connector_friction_force, tangential_velocity,
+    ASPERITY_COEF, BEARING_LENGTH, BEARING_RADIUS, BOUNDARY_MU, CLEARANCE, FILM_FLOOR, FILM_MODEL, JOURNAL_RADIUS,
+    LUBRICATED, ROUGHNESS, V0, V1, VISCOSITY, connector_friction_force, tangential_velocity,
 )  # fmt: skip
 from weftsim.kernel.laws import friction_factor
 

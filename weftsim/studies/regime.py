@@ -61,7 +61,8 @@ def _cell(scene_name: str, models, overrides: dict, progress: bool) -> dict:
     if "film_ratio" in steps:
         total = steps["film_force_N"] + steps["asperity_force_N"] + joint
         ratio = float(steps["film_ratio"].min())
-        out |= {"film_ratio_min": ratio, "regime": regime(ratio), "film_force_max_N": float(steps["film_force_N"].max()),
+        out |= {"film_ratio_min": ratio, "regime": regime(ratio),
+                "film_force_max_N": float(steps["film_force_N"].max()),
                 "asperity_force_max_N": float(steps["asperity_force_N"].max()), "joint_force_max_N": float(total.max())}
     return out
 
@@ -96,7 +97,8 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
     written = {"csv": write_csv(outdir / "regime.csv", {key: [row[key] for row in rows] for key in rows[0]
                                                         if key != "regime"})}
     written["figure"] = write_figure(outdir / "study-regime.png", regime_figure(rows, scene_name))
-    report = {"study": "regime", "scene": scene_name.removesuffix(".toml"), "revolutions": overrides["drive.revolutions"],
+    report = {"study": "regime", "scene": scene_name.removesuffix(".toml"),
+              "revolutions": overrides["drive.revolutions"],
               "limits": {"hydrodynamic_above": HYDRODYNAMIC, "dry_below": MIXED}, "cells": rows,
               "files": sorted(p.name for p in written.values()) + ["regime.json"]}
     written["json"] = write_json(outdir / "regime.json", report)
