@@ -271,3 +271,25 @@ def test_regime_study_on_one_cell(tmp_path, monkeypatch):
     assert cell["regime"] == regime.regime(cell["film_ratio_min"])
     assert cell["joint_force_max_N"] >= cell["film_force_max_N"] > 0.0
     assert (tmp_path / "out" / "study-regime.png").is_file() and (tmp_path / "out" / "regime.csv").is_file()
+
+
+# --- wear in the mixed regime --------------------------------------------------------------------------
+
+
+def test_wear_load_is_the_asperity_and_dry_load_never_the_film():
+    from weftsim.reference.dynamics import pack_parameters
+    from weftsim.wear.archard import contact_rows
+
+    scene = _oil_scene()
+    kept = {}
+    result = solve(scene, step_states=lambda *rows: kept.update(rows=rows))
+    time, states, contact, impact = kept["rows"]
+    rows = np.zeros((time.size, 5))
+    contact_rows(pack_parameters(scene), time, states, contact, impact, rows)
+    steps = result.steps
+    assert steps["film_force_N"].max() > 1e3  # the film carries load ...
+    solid = steps["asperity_force_N"] + steps["contact_force_N"]
+    np.testing.assert_allclose(rows[:, 0], solid, rtol=1e-12, atol=1e-9)  # ... and wears nothing
+    full_film = steps["film_ratio"] >= H_CUTOFF
+    assert full_film.any() and np.all(rows[full_film, 0] == 0.0)
+    assert np.any(rows[:, 0] > 0.0)  # the mixed and dry parts of the run do wear
