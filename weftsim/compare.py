@@ -154,7 +154,10 @@ def _first_revolution_channels(scene: Scene) -> tuple[str, ...]:
     """The channels whose first-revolution maxima are compared."""
     # A joint without clearance has no contact force to compare (E ideal: both engines write 0).
     names = tuple(name for name in FIRST_REVOLUTION_CHANNELS if name != "contact_force_N" or not scene.joint.is_ideal)
-    return names + (("contact_force_f_N",) if not scene.joint_f.is_ideal else ())
+    names += ("contact_force_f_N",) if not scene.joint_f.is_ideal else ()
+    # A lubricated joint: the film's first-revolution maxima, as the contact force's (same tolerance).
+    names += ("film_force_N",) if not scene.joint.is_ideal and scene.joint.is_lubricated else ()
+    return names + (("film_force_f_N",) if not scene.joint_f.is_ideal and scene.joint_f.is_lubricated else ())
 
 
 def _contact_channel(result: RunResult, name: str) -> str:
