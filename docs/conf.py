@@ -1,8 +1,14 @@
 """Sphinx configuration of the weftsim documentation site (``scripts/build_docs.sh``).
 
-The Markdown pages of ``docs/`` are read as they are (myst-parser), the API reference comes from the
-numpydoc docstrings (autodoc + napoleon), and the gallery runs every ``examples/plot_*.py`` at build
-time (sphinx-gallery), offering each as a Python script and a Jupyter notebook.
+The Markdown pages of ``docs/`` are read as they are (myst-parser, equations in ``$...$`` and
+``$$...$$`` rendered by MathJax), the API reference comes from the numpydoc docstrings (autodoc +
+napoleon, one page per area with autosummary tables), the scene-key reference is written from the
+schema at every build (``docs/_scene_keys.py``), and the gallery runs every ``examples/plot_*.py`` at
+build time (sphinx-gallery), offering each as a Python script and a Jupyter notebook.
+
+Links into the numpy, pandas, xarray, scipy and matplotlib docs (intersphinx) need their inventories
+from the internet: set ``WEFTSIM_DOCS_INTERSPHINX=1`` where the build has network access. Without it
+the build stays offline and those names are shown as plain code.
 """
 
 from __future__ import annotations
@@ -18,6 +24,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))  # _gallery.py, the gal
 os.environ.setdefault("EXUDYN_SUPPRESS_UI_WINDOW_OPEN", "1")
 
 import weftsim  # noqa: E402
+from _scene_keys import write_page  # noqa: E402
+
+# The scene-key reference, from weftsim.scene.SCHEMA (rewritten only when the schema changed).
+write_page(Path(__file__).resolve().parent)
 
 project = "weftsim"
 author = "the weftsim authors"
@@ -27,6 +37,7 @@ version = release
 
 extensions = [
     "sphinx.ext.autodoc",
+    "sphinx.ext.autosummary",
     "sphinx.ext.napoleon",
     "sphinx.ext.mathjax",
     "sphinx.ext.viewcode",
@@ -40,7 +51,8 @@ exclude_patterns = ["_build", "data"]
 
 # Markdown: headings get anchors so that pages can link to sections (physics.md#3-contact-force-laws).
 myst_heading_anchors = 3
-myst_enable_extensions = ["dollarmath"]
+# $...$ inline and $$...$$ display maths (amsmath: align and friends), rendered by MathJax.
+myst_enable_extensions = ["dollarmath", "amsmath"]
 
 # The docstrings are numpydoc; napoleon reads them without demanding numpydoc's full section set.
 napoleon_google_docstring = False
@@ -50,6 +62,22 @@ napoleon_use_ivar = True  # "Attributes" as fields: dataclass fields are not des
 autodoc_default_options = {"members": True, "undoc-members": False, "show-inheritance": False}
 autodoc_member_order = "bysource"
 autodoc_typehints = "description"
+# The API pages' summary tables (autosummary) list what each page documents; the pages themselves are
+# written by hand (docs/api/*.rst), so no stub files are generated.
+autosummary_generate = False
+
+# Offline by default (the build must work without network access); WEFTSIM_DOCS_INTERSPHINX=1 links
+# numpy, pandas, xarray, scipy and matplotlib names to their own documentation.
+if os.environ.get("WEFTSIM_DOCS_INTERSPHINX") == "1":
+    extensions.append("sphinx.ext.intersphinx")
+    intersphinx_mapping = {
+        "python": ("https://docs.python.org/3", None),
+        "numpy": ("https://numpy.org/doc/stable", None),
+        "scipy": ("https://docs.scipy.org/doc/scipy", None),
+        "pandas": ("https://pandas.pydata.org/docs", None),
+        "xarray": ("https://docs.xarray.dev/en/stable", None),
+        "matplotlib": ("https://matplotlib.org/stable", None),
+    }
 
 sphinx_gallery_conf = {
     "examples_dirs": str(ROOT / "examples"),

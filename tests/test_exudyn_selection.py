@@ -14,6 +14,7 @@ from weftsim import exudyn_engine  # noqa: E402
 from weftsim.exudyn_engine.selection import select_path  # noqa: E402
 from weftsim.exudyn_engine.solver import IDEAL_JOINT_STEP_ANGLE  # noqa: E402
 from weftsim.params import Scene  # noqa: E402
+import weftsim  # noqa: E402
 from weftsim.scene import SceneError, load_scene  # noqa: E402
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
@@ -143,3 +144,21 @@ def test_the_default_path_runs_a_slow_drive_that_the_other_paths_run():
     # integrations to their tolerances, measured to agree within 1e-4.
     assert exu.steps["contact_force_N"][-1] == pytest.approx(ref.steps["contact_force_N"][-1], rel=1e-3)
     assert exu.steps["penetration_m"][-1] > 0.0
+
+
+def test_the_run_time_estimate_follows_the_exudyn_trees_solver_with_friction():
+    """The estimate prices friction by the path that integrates it: the implicit tree (the default with
+    friction) at ~5x a dry run as measured in issue 23, the explicit tree at its stability-limited 1400x,
+    and only the explicit one is announced as an explicit solver on a stiff joint."""
+    from weftsim.progress import (
+        EXUDYN_IMPLICIT_STIFF_FACTOR, EXUDYN_STIFF_FACTOR, estimate_run_time, stiff_explicit,
+    )  # fmt: skip
+
+    dry = weftsim.load_scene("reference", clearance_mm=0.5, revolutions=1)
+    rough = weftsim.load_scene("reference", {"joint_e.friction_coefficient": 0.15}, clearance_mm=0.5, revolutions=1)
+    explicit = weftsim.load_scene("reference", {"joint_e.friction_coefficient": 0.15,
+                                               "solver.exudyn.tree_solver": "explicit"}, clearance_mm=0.5, revolutions=1)
+    base = estimate_run_time(dry, "exudyn")
+    assert estimate_run_time(rough, "exudyn") == pytest.approx(EXUDYN_IMPLICIT_STIFF_FACTOR * base)
+    assert estimate_run_time(explicit, "exudyn") == pytest.approx(EXUDYN_STIFF_FACTOR * base)
+    assert not stiff_explicit(rough, ("exudyn",)) and stiff_explicit(explicit, ("exudyn",))

@@ -208,7 +208,7 @@ def test_the_trees_contact_with_friction_is_the_reference_chains():
     out = np.zeros(6)
     q3, f_n, delta, ey, ez, sa, ca, sp, cp, f_y, f_z, m_j, m_b = kc.chain(prm, t, y, True, held, out)
     q0, q1 = a, psi + math.pi - a
-    g0, g1, d2, r2, fbx, fby, fn2, mb2, power, v_t = kc.tree_joint_force(prm, t, q0, q1, da, dpsi - da, held, 1e-6, rate)
+    g0, g1, d2, r2, fbx, fby, fn2, mb2, power, v_t, _, _ = kc.tree_joint_force(prm, t, q0, q1, da, dpsi - da, held, 1e-6, rate)
     assert abs(m_b) > 0.1 * 0.15 * f_n * scene.joint.bearing_radius  # friction is on (full Coulomb here)
     # Same kernel in two coordinate sets (~1e-16 m of a 0.4 m chain); the tree's damping dead zone of
     # 1e-10 m/s changes F_N by xi 1e-10 / v_imp ~ 1e-9 relative.

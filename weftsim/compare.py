@@ -7,7 +7,10 @@ exit status are the reproducible quantities:
 - ideal joint: rapier acceleration and driving torque at every output sample, relative to their peaks;
 - clearance, first revolution: crank angle of the first contact, maxima of contact force, rapier
   acceleration and driving torque; with a clearance at F also its contact force and, when E and F
-  both have one, the crank angle of F's first contact;
+  both have one, the crank angle of F's first contact.  A maximum that the engines reach at crank
+  angles further apart than the first-contact tolerance comes from different impacts of two draws
+  of the impact sequence (:func:`set_by_different_impacts`): the start-up impact's maximum is
+  compared in its place, and the first-revolution one is listed as not compared;
 - clearance, 10 or more revolutions: RMS of rapier acceleration and driving torque and mean contact
   force over revolutions 2..N, and the 99th percentiles of their magnitudes.
 
@@ -94,15 +97,17 @@ def agreement_checks(exudyn: RunResult, reference: RunResult) -> list[dict]:
         a, b = (_joint_first_contact_deg(r, "f") for r in (exudyn, reference))
         checks.append(_check("first contact crank angle at F [deg]", a, b, math.degrees(tol.first_contact_angle),
                              "absolute"))  # fmt: skip
-    # A joint without clearance has no contact force to compare (E ideal: both engines write 0).
-    first_revolution = tuple(name for name in FIRST_REVOLUTION_CHANNELS
-                             if name != "contact_force_N" or not reference.scene.joint.is_ideal)
-    first_revolution += ("contact_force_f_N",) if loose_f else ()
+    first_revolution = _first_revolution_channels(reference.scene)
     if complete_revolutions(exudyn) >= 1 and complete_revolutions(reference) >= 1:
         pe, pr = peaks(exudyn, 0), peaks(reference, 0)
+        different = set(set_by_different_impacts(exudyn, reference, first_revolution))
         for name in first_revolution:
-            checks.append(_check(f"{name}: first revolution max", pe[name]["max"], pr[name]["max"],
-                                 tol.first_revolution_peaks))
+            if name in different:
+                se, sr = (startup_impact_max(r, name) for r in (exudyn, reference))
+                checks.append(_check(f"{name}: start-up impact max", se, sr, tol.first_revolution_peaks))
+            else:
+                checks.append(_check(f"{name}: first revolution max", pe[name]["max"], pr[name]["max"],
+                                     tol.first_revolution_peaks))
     n = min(complete_revolutions(exudyn), complete_revolutions(reference))
     if n >= STATISTICS_MIN_REVOLUTIONS:
         se, sr = statistics(exudyn), statistics(reference)
@@ -132,11 +137,87 @@ def not_compared(exudyn: RunResult, reference: RunResult) -> list[dict]:
     if covered < 1:
         out.append({"what": "first-revolution maxima of contact force, rapier acceleration and driving torque",
                     "why": f"they need one complete crank revolution and the runs cover {ran:.4g}", "core": True})
+    elif different := set_by_different_impacts(exudyn, reference, _first_revolution_channels(reference.scene)):
+        at = ", ".join(f"{r.engine} at {_max_angle_deg(r, different[0]):.1f} deg" for r in (exudyn, reference))
+        out.append({"what": f"first-revolution max of {', '.join(different)}",
+                    "why": f"the engines reach it at different crank angles, in different impacts ({different[0]}: {at}), two draws of the "
+                           "impact sequence that round-off decides (docs/physics.md section 6); the start-up "
+                           "impact's max is compared instead", "core": False})
     if covered < STATISTICS_MIN_REVOLUTIONS:
         out.append({"what": "RMS, mean and 99th percentiles over revolutions 2..N",
                     "why": f"they need {STATISTICS_MIN_REVOLUTIONS} complete revolutions and the runs cover "
                            f"{covered}", "core": False})
     return out
+
+
+def _first_revolution_channels(scene: Scene) -> tuple[str, ...]:
+    """The channels whose first-revolution maxima are compared."""
+    # A joint without clearance has no contact force to compare (E ideal: both engines write 0).
+    names = tuple(name for name in FIRST_REVOLUTION_CHANNELS if name != "contact_force_N" or not scene.joint.is_ideal)
+    names += ("contact_force_f_N",) if not scene.joint_f.is_ideal else ()
+    # A lubricated joint: the film's first-revolution maxima, as the contact force's (same tolerance).
+    names += ("film_force_N",) if not scene.joint.is_ideal and scene.joint.is_lubricated else ()
+    return names + (("film_force_f_N",) if not scene.joint_f.is_ideal and scene.joint_f.is_lubricated else ())
+
+
+def _contact_channel(result: RunResult, name: str) -> str:
+    """The contact flag of the joint whose impacts shape ``name`` (F's for F's force, else E's if loose)."""
+    return "in_contact_f" if name.endswith("_f_N") or result.scene.joint.is_ideal else "in_contact"
+
+
+def _segment(result: RunResult, name: str, index: int) -> tuple[float, float] | None:
+    """Start and end time of the contact that holds step ``index``, or None in free flight."""
+    t, touching = result.steps["time_s"], result.steps[_contact_channel(result, name)] > 0.5
+    if not touching[index]:
+        return None
+    free = np.flatnonzero(~touching)
+    before, after = free[free < index], free[free > index]
+    return (float(t[before[-1] + 1] if before.size else t[0]), float(t[after[0] - 1] if after.size else t[-1]))
+
+
+def _first_revolution_argmax(result: RunResult, name: str) -> int:
+    t = result.steps["time_s"]
+    return int(np.argmax(np.where(t <= result.scene.drive.period + 1e-12, result.steps[name], -np.inf)))
+
+
+def _max_angle_deg(result: RunResult, name: str) -> float:
+    t = result.steps["time_s"][_first_revolution_argmax(result, name)]
+    return math.degrees(result.scene.drive.speed * t)
+
+
+def startup_impact_end(result: RunResult, name: str) -> float:
+    """End of the start-up impact, s: the first separation after the first contact of the joint of ``name``.
+
+    From the centred journal the first contact is the same in every correct integration: its maximum
+    is reproducible (docs/physics.md section 6).  A contact lasting the whole revolution ends it there.
+    """
+    t, touching = result.steps["time_s"], result.steps[_contact_channel(result, name)] > 0.5
+    first = np.flatnonzero(touching)
+    if first.size == 0:
+        return result.scene.drive.period
+    span = _segment(result, name, int(first[0]))
+    return min(span[1], result.scene.drive.period) if span else result.scene.drive.period
+
+
+def startup_impact_max(result: RunResult, name: str) -> float:
+    """Largest value of ``name`` from the start to the end of the start-up impact."""
+    keep = result.steps["time_s"] <= startup_impact_end(result, name) + 1e-12
+    return float(result.steps[name][keep].max())
+
+
+def set_by_different_impacts(exudyn: RunResult, reference: RunResult, names: tuple[str, ...]) -> list[str]:
+    """The channels whose first-revolution maxima the two engines reach at different crank angles.
+
+    After the first impacts the sequence of impacts is one draw among many that round-off decides
+    (docs/physics.md section 6).  Maxima further apart than the first-contact tolerance
+    (``compare.first_contact_angle_deg``) are two different events of two draws, and their values
+    are not comparable: on the loom at 300 rpm and c = 0.1 mm the driving torque's maxima fall at
+    38.6 and 35.0 deg, where on the reference mechanism (49.84 and 49.89 deg) and the loom at its
+    defaults (56.11 and 56.19 deg) they are one event.  The start-up impact's maximum is compared
+    instead, and the report lists the first-revolution maximum as not compared, with both angles.
+    """
+    tolerance = math.degrees(reference.scene.compare.first_contact_angle)
+    return [name for name in names if abs(_max_angle_deg(exudyn, name) - _max_angle_deg(reference, name)) > tolerance]
 
 
 def _revolutions_run(result: RunResult) -> float:

@@ -140,9 +140,14 @@ REFERENCE_RTOL = {"reference scipy": 1e-9, "reference numba": 1e-5, "reference n
 # An explicit method on a stiff joint law (friction's ramp, an oil film) steps at its stability limit, ~1e-9 s
 # where the journal sticks: one revolution of c = 0.5 mm, 400 rpm, mu = 0.15 took 1661x the dry run with
 # numba_DOP853 and 1437x with the kinematic tree's DOPRI5 (issue 23).  Applied to a path that integrates
-# such a joint explicitly; update EXUDYN_STIFF_FACTOR when the Exudyn engine integrates friction implicitly.
+# such a joint explicitly.
 EXPLICIT_STIFF_FACTOR = 1500.0
-EXUDYN_STIFF_FACTOR = 1400.0
+EXUDYN_STIFF_FACTOR = 1400.0  # the kinematic tree under solver.exudyn.tree_solver = "explicit"
+# The Exudyn engine's implicit paths with friction (issue 23, same scene, medians of 3 in one process): the
+# kinematic tree on generalized-alpha with error control 4.3-5.0x its dry run (CPU), the rigid-body model
+# 25x its frictionless span (docs/performance.md, "Exudyn engine with friction").
+EXUDYN_IMPLICIT_STIFF_FACTOR = 5.0
+EXUDYN_RIGID_BODY_STIFF_FACTOR = 25.0
 # Recorded step rows per revolution (each contact step adds 3 dense points): the dry default ~7 100 (71 000
 # for 10 revolutions of the reference scene), the implicit path with friction ~13 000 (3 200 steps), an
 # explicit path with friction ~1e7 (2.5 M steps).  A row of result.npz holds ~20 float64 channels.
@@ -194,11 +199,13 @@ def estimate_run_time(scene: Scene, engine: str) -> float:
     from weftsim.exudyn_engine.selection import select_model
     from weftsim.exudyn_engine.solver import adaptive, step_plan
 
-    stiff = EXUDYN_STIFF_FACTOR if _stiff(scene) else 1.0
+    stiff = _stiff(scene)
     if select_model(scene)[0] == "kinematic_tree":
-        return revolutions * SECONDS_PER_REVOLUTION["exudyn kinematic_tree"] * stiff
+        factor = (EXUDYN_STIFF_FACTOR if _exudyn_tree_explicit(scene) else EXUDYN_IMPLICIT_STIFF_FACTOR) if stiff else 1.0
+        return revolutions * SECONDS_PER_REVOLUTION["exudyn kinematic_tree"] * factor
     if adaptive(scene):
-        return revolutions * SECONDS_PER_REVOLUTION["exudyn rigid_body adaptive"] * stiff
+        factor = EXUDYN_RIGID_BODY_STIFF_FACTOR if stiff else 1.0
+        return revolutions * SECONDS_PER_REVOLUTION["exudyn rigid_body adaptive"] * factor
     return step_plan(scene)[1] * EXUDYN_SECONDS_PER_STEP  # the fixed steps it will take (longer for an ideal joint)
 
 
@@ -206,7 +213,16 @@ def stiff_explicit(scene: Scene, engines: tuple[str, ...]) -> bool:
     """True when one of ``engines`` integrates a stiff joint law of ``scene`` with an explicit method."""
     if not _stiff(scene):
         return False
-    return "exudyn" in engines or ("reference" in engines and not scene.is_ideal and _reference_path(scene)[1])
+    exudyn_explicit = "exudyn" in engines and _exudyn_tree_explicit(scene)
+    return exudyn_explicit or ("reference" in engines and not scene.is_ideal and _reference_path(scene)[1])
+
+
+def _exudyn_tree_explicit(scene: Scene) -> bool:
+    """True when the Exudyn engine runs ``scene`` on the kinematic tree with its explicit solver."""
+    from weftsim.exudyn_engine.selection import select_model
+    from weftsim.exudyn_engine.tree_solve import tree_solver
+
+    return select_model(scene)[0] == "kinematic_tree" and tree_solver(scene) == "explicit"
 
 
 def estimate_step_bytes(scene: Scene, engine: str) -> float:

@@ -93,6 +93,30 @@ def WEAR_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 - a cons
     )
 
 
+def LUBRICATION_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 - a constant-like key factory
+    """The ``[<table>.lubrication]`` keys of a clearance joint (docs/lubricated-joint.md).  The table is optional
+    (absent: the dry joint); given, it must name ``viscosity_mpa_s``, the other keys default."""
+    at = f"{table}.lubrication."
+    to = f"{joint}.lubrication."
+    return (
+        Key(at + "viscosity_mpa_s", to + "viscosity", "float", 1e-3, 0, None, False,
+            doc="dynamic viscosity of the oil at operating temperature (ISO VG 220 at 60 C: ~80 mPa s); 0 = no film"),
+        Key(at + "model", to + "model", "str", choices=params.FILM_MODELS,
+            doc="film model: finite (finite-length bearing, default), short (Ocvirk), long (Sommerfeld) or "
+                "short_half (Flores et al.'s short bearing)"),
+        Key(at + "roughness_um", to + "roughness", "float", 1e-6, 0,
+            doc="combined RMS roughness of journal and bearing (default 0.4 um, two ground surfaces)"),
+        Key(at + "asperity_density_radius_roughness", to + "asperity_density_radius_roughness", "float", 1, 0, 1,
+            False, doc="Greenwood-Tripp eta beta sigma (default 0.04); 0 = no asperity contact"),
+        Key(at + "roughness_radius_ratio", to + "roughness_radius_ratio", "float", 1, 0, 1,
+            doc="Greenwood-Tripp sigma / beta, RMS roughness over asperity summit radius (default 1e-3)"),
+        Key(at + "boundary_friction_coefficient", to + "boundary_friction_coefficient", "float", 1, 0, 2, False,
+            doc="friction coefficient on the asperity load (default 0.1)"),
+        Key(at + "film_floor_ratio", to + "film_floor_ratio", "float", 1, 0, 4,
+            doc="the film force is evaluated no closer than this many RMS roughnesses (default 1)"),
+    )
+
+
 SCHEMA: tuple[Key, ...] = (
     Key("mechanism.crank_inclination_deg", "geometry.crank_inclination", "float", DEG, 0, 90, True, True,
         doc="beta, arc A-B of the spherical 4R"),
@@ -151,12 +175,14 @@ SCHEMA: tuple[Key, ...] = (
         doc="optional; [low, high] design range of the radial clearance over the pin diameter, per mille "
             "(default [0.5, 1.0], a bushed pin in oscillating motion); outside it is warned about"),
     *WEAR_KEYS("joint_e", "joint"),
+    *LUBRICATION_KEYS("joint_e", "joint"),
     Key("drive.speed_rpm", "drive.speed", "float", RPM, 0, 5000, doc="constant crank speed"),
     Key("drive.revolutions", "drive.revolutions", "float", 1, 0, 1000, doc="crank revolutions to simulate"),
     Key("solver.reference.method", "reference_solver.method", "str", choices=INTEGRATORS,
         doc="method of the reference engine: scipy's, or numba_* (compiled, docs/performance.md; numba_RODAS4 "
             "linearly implicit, numba_DOP853_RODAS4 implicit in contact); auto = numba_DOP853, or with friction "
-            "numba_DOP853_RODAS4 at rtol <= 1e-6 (the fastest paths meeting the accuracy targets)"),
+            "numba_DOP853_RODAS4 at rtol <= 1e-6, or with a lubricated joint numba_RODAS4 (the fastest paths "
+            "meeting the accuracy targets)"),
     Key("solver.reference.rtol", "reference_solver.rtol", "float", 1, 0, 1e-2, doc="relative tolerance"),
     Key("solver.reference.atol", "reference_solver.atol", "float", 1, 0, 1e-2, doc="absolute tolerance"),
     Key("solver.reference.max_step_deg", "reference_solver.max_step", "float", DEG, 0, 90,
@@ -239,7 +265,8 @@ REQUIRED_SECTIONS = ("mechanism", "inertia", "joint_e", "drive")
 # Model options inside those sections that are not part of the machine: they default.
 OPTIONAL = ("joint_e.impact_velocity_rule", "joint_e.journal_material.yield_strength_mpa",
             "joint_e.bearing_material.yield_strength_mpa", "joint_e.bearing_material.max_pressure_mpa",
-            "joint_e.bearing_material.max_pv_mpa_m_s", "joint_e.design_clearance_per_mille") + tuple(key.path for key in WEAR_KEYS("joint_e", "joint"))
+            "joint_e.bearing_material.max_pv_mpa_m_s", "joint_e.design_clearance_per_mille") \
+    + tuple(key.path for key in WEAR_KEYS("joint_e", "joint")) + tuple(key.path for key in LUBRICATION_KEYS("joint_e", "joint"))
 # [joint_f] is optional as a whole (absent: the ideal revolute joint at F).  Given a clearance > 0, F takes
 # every key of [joint_e] its table does not give (weftsim.joint_keys).
 REQUIRED = tuple(key.path for key in SCHEMA
@@ -495,7 +522,33 @@ def _set(scene: params.Scene, target: str, value: Any) -> params.Scene:
     head, _, rest = target.partition(".")
     if not rest:
         return replace(scene, **{head: value})
-    return replace(scene, **{head: _set(getattr(scene, head), rest, value)})
+    inner = getattr(scene, head)
+    if inner is None and head == "lubrication":  # the table's first key: the film starts from the defaults
+        inner = params.Lubrication(viscosity=0.0)
+    return replace(scene, **{head: _set(inner, rest, value)})
+
+
+def _set_checked(scene: params.Scene, target: str, value: Any, where: str) -> params.Scene:
+    """:func:`_set`, with a cross-field refusal of the parameter objects (ValueError) as a SceneError."""
+    try:
+        return _set(scene, target, value)
+    except ValueError as exc:
+        raise SceneError(f"{where}: {exc}") from None
+
+
+LUBRICATION_TABLES = (("joint_e", "joint"), ("joint_f", "joint_f"))
+
+
+def _check_lubrication_given(keys, where: str, before: params.Scene | None = None) -> None:
+    """A ``[<joint>.lubrication]`` table must name ``viscosity_mpa_s`` (unless ``before`` already has a film)."""
+    keys = list(keys)
+    for table, attr in LUBRICATION_TABLES:
+        prefix = f"{table}.lubrication."
+        if before is not None and getattr(before, attr).lubrication is not None:
+            continue
+        if any(k.startswith(prefix) for k in keys) and prefix + "viscosity_mpa_s" not in keys:
+            raise SceneError(f"{where}: missing required key '{prefix}viscosity_mpa_s'; a [{table}.lubrication] "
+                             "table must give the oil's viscosity (the other lubrication keys default)")
 
 
 def _check_scene(scene: params.Scene, where: str, origin: dict[str, Path]) -> None:
@@ -565,8 +618,9 @@ def scene_from_keys(flat: dict[str, Any], where: str = "scene", origin: dict[str
         value = _convert(key, value, src)
         if key.path == "mechanism.fourbar_branch":
             value = BRANCHES[value]
-        scene = _set(scene, key.target, value)
+        scene = _set_checked(scene, key.target, value, src)
     scene = replace(scene, joint_f_inherits=inherited)
+    _check_lubrication_given(flat, where)
     _check_scene(scene, where, origin)
     return scene
 
@@ -639,6 +693,8 @@ def to_file_keys(scene: params.Scene) -> dict[str, Any]:
         obj: Any = scene
         for part in key.target.split("."):
             obj = getattr(obj, part)
+            if obj is None:
+                break  # a dry joint's lubrication keys: None, as any unset optional key
         if obj is None:  # an optional key the scene does not give
             pass
         elif key.path == "mechanism.fourbar_branch":
@@ -666,6 +722,7 @@ def apply_overrides(scene: params.Scene, overrides: dict[str, Any], where: str =
     """
     from weftsim.joint_keys import ideal_joint_keys, ideal_key_message, resync_joint_f
 
+    before = scene
     for dotted, value in overrides.items():
         if value is None:
             continue
@@ -678,8 +735,9 @@ def apply_overrides(scene: params.Scene, overrides: dict[str, Any], where: str =
         value = _convert(key, value, where)
         if key.path == "mechanism.fourbar_branch":
             value = BRANCHES[value]
-        scene = _set(scene, key.target, value)
+        scene = _set_checked(scene, key.target, value, where)
     scene = resync_joint_f(scene, {key for key, value in overrides.items() if value is not None})
+    _check_lubrication_given([k for k, v in overrides.items() if v is not None], where, before)
     _check_scene(scene, where, {})
     idle = ideal_joint_keys(scene, [key for key, value in overrides.items() if value is not None])
     if idle and refuse_ideal_keys:

@@ -83,7 +83,7 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
         With ``scene.joint.wear`` (the ``[joint_e.wear]`` keys).
     hours : float
         Operating hours to predict.
-    outdir : path
+    outdir : str or path-like
         A directory checked by :func:`weftsim.output.prepare_directory`; ``wear_state.npz`` in it is
         resumed when it belongs to the same scene (:class:`~.store.StateMismatch` otherwise).
     limit : float, optional
