@@ -24,7 +24,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import TYPE_CHECKING, Any, Callable
 
-from weftsim.errors import EngineError, RunFailed, SceneError
+from weftsim.errors import ArgumentError, EngineError, OutputError, RunFailed, SceneError
 from weftsim.params import Scene
 from weftsim.results import RunResult
 
@@ -182,6 +182,9 @@ def simulate(scene: Scene | str | os.PathLike, engine: str = "auto", *,
         Only with ``raise_on_failure``: the run failed (``exc.result`` holds it).
     """
     module = _engine_module(engine)
+    if progress is not None and not callable(progress):
+        raise ArgumentError(f"simulate: progress must be None or a function called with the completed fraction "
+                            f"(e.g. lambda f: print(f)), got {type(progress).__name__} {progress!r:.40}")
     result = module.solve(_as_scene(scene), progress=progress)
     if raise_on_failure and not result.ok:
         raise RunFailed(f"simulation failed: {result.message}", result)
@@ -197,7 +200,18 @@ def save_result(result: RunResult, path: str | os.PathLike) -> Path:
     """
     from weftsim.results import save_npz
 
-    return save_npz(result, path)
+    if not isinstance(result, RunResult):
+        raise ArgumentError(f"save_result: result must be a RunResult (from weftsim.simulate or load_result), "
+                            f"got {type(result).__name__}")
+    if not isinstance(path, (str, os.PathLike)):
+        raise ArgumentError(f"save_result: path must be a file path, got {type(path).__name__}")
+    from weftsim.output import write_atomic
+
+    try:  # atomic: a run killed while saving leaves the previous file (or none), never a truncated one
+        write_atomic(Path(path), lambda tmp: save_npz(result, tmp))
+        return Path(path)
+    except OSError as exc:
+        raise OutputError(f"cannot write {path}: {exc.strerror or exc}") from None
 
 
 def load_result(path: str | os.PathLike) -> RunResult:
@@ -210,6 +224,8 @@ def load_result(path: str | os.PathLike) -> RunResult:
     """
     from weftsim.results import load_npz
 
+    if not isinstance(path, (str, os.PathLike)):
+        raise ArgumentError(f"load_result: path must be a file path, got {type(path).__name__}")
     return load_npz(path)
 
 
