@@ -4,10 +4,12 @@ A result file may have been damaged by a disk or a copy, or edited by a person, 
 :func:`read_npz` checks it in this order and refuses it with one line
 (:class:`weftsim.errors.OutputError`) at the first problem:
 
+Steps 1-3 are :mod:`weftsim.npz_guard` (shared with the wear state):
+
 1. the path: present, a regular file, not empty, a ZIP archive (a lone ``.npy`` is named as such);
 2. the archive's directory: the members weftsim writes and no others, none twice, none encrypted,
    and the uncompressed size each member declares (the ZIP directory; a member is never read past
-   it) within the memory available and within :data:`MAX_INFLATION` of the file's size;
+   it) within the memory available and not a ZIP bomb;
 3. every array's own header (NumPy format: dtype and shape, a few hundred bytes): a real numeric
    1-D channel, every channel of a table as long as its ``time_s``, the text of ``meta`` a string
    no longer than :data:`MAX_META_BYTES`, and the bytes the header implies equal to the bytes the
@@ -27,11 +29,9 @@ import dataclasses
 import json
 import math
 import os
-import stat
 import types
 import typing
 import zipfile
-import zlib
 from pathlib import Path
 from typing import Any
 
@@ -39,14 +39,8 @@ import numpy as np
 
 from weftsim import params
 from weftsim.errors import OutputError
+from weftsim.npz_guard import DAMAGE, array_headers, fail, open_archive, read_array, size_text
 
-# A float64 channel compresses about 1.4:1 in a real result (measured: 206 kB of arrays in a 152 kB
-# file); a channel that stays 0 (the contact of a run that never touches) compresses far better, but
-# the time and the rapier's channels never do.  Declaring more than this many times the file's size
-# is a ZIP bomb or a damaged directory, not a result.
-MAX_INFLATION = 200.0
-# Below this uncompressed total, the inflation bound is not applied (small files may compress well).
-INFLATION_FLOOR_BYTES = 64 * 2**20
 # The JSON text of meta: scene, statistics, events (a few kB; a worn scene's profiles ~20 kB).
 MAX_META_BYTES = 16 * 2**20
 TABLES = ("samples", "steps")
@@ -76,108 +70,11 @@ FORMAT_1_FIELDS: dict[str, tuple[str, ...]] = {
 }
 
 
+WHAT = "a weftsim result"
+
+
 def _fail(path: Path, text: str) -> OutputError:
-    return OutputError(f"{path}: cannot be read as a weftsim result: {text}")
-
-
-def _size(n: float) -> str:
-    for unit in ("bytes", "kB", "MB", "GB", "TB", "PB"):
-        if n < 1000 or unit == "PB":
-            return f"{n:.3g} {unit}"
-        n /= 1000
-    raise AssertionError("unreachable")
-
-
-def _open_archive(path: Path) -> zipfile.ZipFile:
-    """The archive at ``path``, or an OutputError saying what the path is instead."""
-    try:
-        info = path.stat()
-    except FileNotFoundError:
-        raise OutputError(f"{path}: result file not found") from None
-    except OSError as exc:
-        raise _fail(path, exc.strerror or str(exc)) from None
-    if stat.S_ISDIR(info.st_mode):
-        raise _fail(path, "it is a directory (give the result.npz file in it)")
-    if not stat.S_ISREG(info.st_mode):
-        raise _fail(path, "it is not a regular file")
-    if info.st_size == 0:
-        raise _fail(path, "the file is empty (0 bytes; a run killed while writing it, or a failed copy)")
-    try:
-        with path.open("rb") as handle:
-            head = handle.read(6)
-        if head == b"\x93NUMPY":
-            raise _fail(path, "it is a single NumPy array (.npy), not the NPZ archive that weftsim run or "
-                              "weftsim.save_result writes")
-        return zipfile.ZipFile(path)
-    except OutputError:
-        raise
-    except (zipfile.BadZipFile, zipfile.LargeZipFile, ValueError, EOFError) as exc:
-        raise _fail(path, f"not an NPZ (ZIP) archive, or a truncated one ({exc})") from None
-    except OSError as exc:
-        raise _fail(path, exc.strerror or str(exc)) from None
-
-
-def _array_header(archive: zipfile.ZipFile, member: zipfile.ZipInfo) -> tuple[tuple[int, ...], np.dtype, int]:
-    """(shape, dtype, header bytes) of one ``.npy`` member, read from its first bytes only."""
-    with archive.open(member) as handle:
-        version = np.lib.format.read_magic(handle)
-        if version == (1, 0):
-            shape, fortran, dtype = np.lib.format.read_array_header_1_0(handle)
-        elif version == (2, 0):
-            shape, fortran, dtype = np.lib.format.read_array_header_2_0(handle)
-        else:
-            raise ValueError(f"NumPy format version {version} is not one weftsim writes")
-        return tuple(shape), dtype, handle.tell()
-
-
-def _available_memory() -> int | None:
-    from weftsim.output import _available_memory as available
-
-    return available()
-
-
-def check_members(path: Path, archive: zipfile.ZipFile, expected: set[str]) -> dict[str, tuple[tuple, np.dtype]]:
-    """Steps 2 and 3 of the module docstring: the archive's members and their array headers.
-
-    ``expected``: the member names without ``.npy`` that may occur (all of them at most once).
-    Returns name -> (shape, dtype) of each member present.
-    """
-    infos = archive.infolist()
-    names = [info.filename for info in infos]
-    twice = sorted({n for n in names if names.count(n) > 1})
-    if twice:
-        raise _fail(path, f"the archive holds {', '.join(twice[:3])} more than once (a damaged or crafted file)")
-    unknown = sorted(n for n in names if not n.endswith(".npy") or n[:-4] not in expected)
-    if unknown:
-        shown = ", ".join(repr(n) for n in unknown[:3]) + (f" and {len(unknown) - 3} more" if len(unknown) > 3 else "")
-        raise _fail(path, f"the archive holds {shown}, which weftsim does not write")
-    if any(info.flag_bits & 0x1 for info in infos):
-        raise _fail(path, "the archive is encrypted; weftsim writes none")
-    declared = sum(info.file_size for info in infos)
-    file_size = path.stat().st_size
-    if declared > INFLATION_FLOOR_BYTES and declared > MAX_INFLATION * file_size:
-        raise _fail(path, f"its {_size(file_size)} declare {_size(declared)} of arrays, more than "
-                          f"{MAX_INFLATION:g} times the file (a ZIP bomb or a damaged archive); nothing was read")
-    available = _available_memory()
-    if available is not None and declared > available:
-        raise _fail(path, f"its arrays need {_size(declared)} of memory, more than the {_size(available)} "
-                          "available; nothing was read")
-    headers = {}
-    for info in infos:
-        name = info.filename[:-4]
-        try:
-            shape, dtype, header = _array_header(archive, info)
-        except (ValueError, EOFError, OSError, zipfile.BadZipFile, zlib.error, NotImplementedError,
-                SyntaxError, TypeError) as exc:
-            raise _fail(path, f"array {name!r} has no valid NumPy header ({exc})") from None
-        count = math.prod(shape)
-        if dtype.hasobject or dtype.itemsize == 0 and count:
-            raise _fail(path, f"array {name!r} holds Python objects ({dtype}); weftsim writes numbers and text only")
-        if header + count * dtype.itemsize != info.file_size:
-            raise _fail(path, f"array {name!r} claims shape {shape} of {dtype} ({_size(count * dtype.itemsize)}), "
-                              f"but its member holds {_size(info.file_size - header)} (a damaged or crafted file)")
-        headers[name] = (shape, dtype)
-    return headers
+    return fail(path, WHAT, text)
 
 
 def check_channel_headers(path: Path, headers: dict[str, tuple[tuple, np.dtype]], names: tuple[str, ...]) -> None:
@@ -211,10 +108,9 @@ def read_meta(path: Path, archive: zipfile.ZipFile, headers: dict[str, tuple[tup
     if meta_shape != () or meta_dtype.kind != "U":
         raise _fail(path, f"'meta' is {meta_dtype} of shape {meta_shape}, not the one JSON text weftsim writes")
     if meta_dtype.itemsize > MAX_META_BYTES * 4:  # 4 bytes a character
-        raise _fail(path, f"'meta' is {_size(meta_dtype.itemsize)} long; weftsim's is a few kB (at most "
-                          f"{_size(MAX_META_BYTES)})")
-    with archive.open("meta.npy") as handle:
-        text = str(np.lib.format.read_array(handle, allow_pickle=False)[()])
+        raise _fail(path, f"'meta' is {size_text(meta_dtype.itemsize)} long; weftsim's is a few kB (at most "
+                          f"{size_text(MAX_META_BYTES)})")
+    text = str(read_array(archive, "meta")[()])
     try:
         meta = json.loads(text)
     except RecursionError:
@@ -342,10 +238,10 @@ def read_npz(path: str | os.PathLike):
     path = Path(path)
     all_names = CHANNELS + JOINT_F_CHANNELS
     expected = {"meta"} | {f"{t}/{n}" for t in TABLES for n in all_names}
-    archive = _open_archive(path)
+    archive = open_archive(path, WHAT, "give the result.npz file in it")
     try:
         with archive:
-            headers = check_members(path, archive, expected)
+            headers = array_headers(path, archive, expected, WHAT)
             meta = read_meta(path, archive, headers)
             has_f = any(f"{t}/{n}" in headers for t in TABLES for n in JOINT_F_CHANNELS)
             names = all_names if has_f else CHANNELS
@@ -362,11 +258,10 @@ def read_npz(path: str | os.PathLike):
             for table in TABLES:
                 tables[table] = {}
                 for name in names:
-                    with archive.open(f"{table}/{name}.npy") as handle:
-                        tables[table][name] = np.lib.format.read_array(handle, allow_pickle=False)
+                    tables[table][name] = read_array(archive, f"{table}/{name}")
     except OutputError:
         raise
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile, zlib.error, NotImplementedError, RuntimeError) as exc:
+    except DAMAGE as exc:
         raise _fail(path, f"damaged archive ({type(exc).__name__}: {exc})") from None
     check_times(path, meta, scene, tables)
     try:
