@@ -277,6 +277,9 @@ def check_times(path: Path, meta: dict, scene: params.Scene, tables: dict) -> No
         t = np.asarray(tables[table]["time_s"], dtype=float)
         if t.size and not (np.all(np.isfinite(t)) and np.all(np.diff(t) >= 0.0) and t[0] >= 0.0):
             raise _fail(path, f"{table}/time_s is not a time axis (finite, from >= 0, never decreasing)")
+    first = meta["events"].get("first_contact_time_s")
+    if first is not None and first > scene.drive.end_time * (1.0 + 1e-9):
+        raise _fail(path, f"its first contact at {first:.6g} s is after the run's end, {scene.drive.end_time:.6g} s")
     if meta["status"] == "success":
         t = tables["steps"]["time_s"]
         # The last accepted step lands on the end time (both engines); 1e-9 relative is far above its round-off
