@@ -184,7 +184,14 @@ def _value(hint: Any, value: Any, where: str) -> Any:
     if hint in (float, int, str, bool):
         kind = {float: "a number", int: "a whole number", str: "text", bool: "true or false"}[hint]
         raise ValueError(f"scene field {where} must be {kind}, got {_short(value)}")
-    raise ValueError(f"scene field {where} has a type weftsim cannot check ({hint})")
+    if typing.get_origin(hint) is typing.Literal:
+        if value in typing.get_args(hint):
+            return value
+        raise ValueError(f"scene field {where} must be one of {typing.get_args(hint)}, got {_short(value)}")
+    # Another kind of field (none today): its value is checked with the whole scene (check_scene).
+    if isinstance(value, (str, int, float, bool, list)):
+        return tuple(value) if isinstance(value, list) else value
+    raise ValueError(f"scene field {where} must be a number, text or a list, got {_short(value)}")
 
 
 def rebuild(cls: type, data: Any, where: str = "scene") -> Any:
