@@ -499,5 +499,5 @@ def test_a_table_path_that_is_a_directory_is_refused_before_any_cell(finished_sw
     (outdir / TABLE_FILE).mkdir()
     assert main([*ARGS, "--vary", "clearance_mm=0.1,0.2,0.3", "--vary", "restitution=0.5,0.9", "-o", str(outdir)]) \
         == EXIT_USAGE
-    one_error_line(capsys, "it is a directory", "remove it")
+    one_error_line(capsys, "is a directory, where the sweep writes its sweep.csv", "remove it")
     assert not (outdir / "clearance_mm=0.3,restitution=0.5").exists()  # no new cell ran

@@ -108,10 +108,13 @@ def _open_directory(outdir: Path, plan: SweepPlan, lock: SweepLock) -> None:
     from weftsim.output import check_file_target
 
     for name in (TABLE_FILE, FIGURE_FILE):  # before any cell runs: the table and figure come last
+        if (outdir / name).is_dir():
+            raise SweepError(f"{outdir / name} is a directory, where the sweep writes its {name}; remove it to run "
+                             "the sweep there")
         try:
             check_file_target(outdir / name)
         except OutputError as exc:
-            raise SweepError(f"{exc}; remove it to run the sweep there") from None
+            raise SweepError(str(exc)) from None
 
 
 def run_sweep(plan: SweepPlan, outdir: str | Path, jobs: int | None = None, scheduler: str | None = None,
