@@ -221,6 +221,12 @@ def test_save_result_of_something_else_and_a_bad_progress(tmp_path, saved):
         weftsim.simulate("reference", "reference", progress=5)
     with pytest.raises(weftsim.ArgumentError, match="load_result: path must be a file path"):
         weftsim.load_result(None)
+    with pytest.raises(weftsim.ArgumentError, match="load_sweep: directory must be a path"):
+        weftsim.load_sweep(None)
+    with pytest.raises(weftsim.OutputError, match="no such path"):
+        weftsim.load_result("a\x00b.npz")
+    with pytest.raises(weftsim.OutputError, match="cannot write"):
+        weftsim.save_result(weftsim.load_result(saved[0]), "a\x00b.npz")
 
 
 # --- a further round: special files, other keys ----------------------------------------------------------
