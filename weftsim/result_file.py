@@ -128,9 +128,7 @@ def read_meta(path: Path, archive: zipfile.ZipFile, headers: dict[str, tuple[tup
         if not isinstance(meta[key], kind):
             raise _fail(path, f"'meta' key {key!r} must be a {'JSON object' if kind is dict else 'string'}, "
                               f"got {_short(meta[key])}")
-    unknown = sorted(set(meta) - set(META_TYPES))
-    if unknown:
-        raise _fail(path, f"'meta' holds unknown key(s) {', '.join(map(repr, unknown[:3]))}")
+    # Other keys are ignored: nothing reads them (a later version may add some under the same format).
     if meta["engine"] not in ENGINES:
         raise _fail(path, f"'meta' engine must be one of {', '.join(ENGINES)}, got {_short(meta['engine'])}")
     if meta["status"] not in STATUSES:
