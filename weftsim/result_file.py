@@ -228,6 +228,8 @@ def check_scene(path: Path, scene: params.Scene) -> None:
         scene_from_keys(keys, "the file's scene")
     except ValueError as exc:
         raise _fail(path, f"its scene is not valid ({exc})") from None
+    if scene.geometry.fourbar_branch not in (1, -1):  # the one field a scene file writes as a sign ("+" or "-")
+        raise _fail(path, f"its scene's geometry.fourbar_branch must be 1 or -1, got {scene.geometry.fourbar_branch}")
     for joint_name, joint in (("joint", scene.joint), ("joint_f", scene.joint_f)):
         profiles = (joint.bearing_wear, joint.journal_wear)
         if any(profiles) and (len(profiles[0]) != len(profiles[1]) or len(profiles[0]) < 3
