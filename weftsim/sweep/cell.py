@@ -35,6 +35,7 @@ CELL_FILE = "cell.json"
 ERROR_FILE = "error.txt"
 SUMMARY_FILE = "summary.json"
 CELL_FORMAT = "weftsim-sweep-cell/1"
+MAX_RECORD_BYTES = 16 * 2**20  # a cell.json is a few kB (its scene's keys, its metrics)
 
 METRIC_CHANNELS = ("driving_torque_Nm", "rapier_acceleration_m_s2", "contact_force_N")
 
@@ -236,8 +237,11 @@ def read_record(cell_dir: Path) -> dict | None:
     Malformed (:func:`record_problem`): a record damaged or edited by hand is not trusted for the
     table or the grid; the next run of the sweep runs its cell again.
     """
+    path = Path(cell_dir) / CELL_FILE
     try:
-        record = json.loads((Path(cell_dir) / CELL_FILE).read_text(encoding="utf-8"))
+        if path.stat().st_size > MAX_RECORD_BYTES:  # not read into memory: not one of ours
+            return None
+        record = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError, RecursionError):
         return None
     if not isinstance(record, dict) or record.get("format") != CELL_FORMAT or record_problem(record, Path(cell_dir)):
