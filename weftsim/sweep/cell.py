@@ -239,7 +239,7 @@ def read_record(cell_dir: Path) -> dict | None:
     """
     path = Path(cell_dir) / CELL_FILE
     try:
-        if path.stat().st_size > MAX_RECORD_BYTES:  # not read into memory: not one of ours
+        if not path.is_file() or path.stat().st_size > MAX_RECORD_BYTES:  # a pipe, a device, or too big to be ours
             return None
         record = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError, RecursionError):
