@@ -200,6 +200,8 @@ def _listed_files(cell_dir: Path) -> set[str]:
     """Plain file names the cell's previous run manifest lists (anything else in it is ignored)."""
     from weftsim.output import MANIFEST
 
+    if not (cell_dir / MANIFEST).is_file():
+        return set()
     try:
         listed = json.loads((cell_dir / MANIFEST).read_text(encoding="utf-8")).get("files", [])
     except (OSError, ValueError, AttributeError, RecursionError):
@@ -288,6 +290,8 @@ def is_finished(cell_dir: Path, scene_keys: dict, engine: str) -> bool:
         return False
     expected = normalise(scene_keys)
     if record.get("scene") != expected:
+        return False
+    if not (Path(cell_dir) / SUMMARY_FILE).is_file():  # also a pipe, whose reading would wait forever
         return False
     try:
         summary = json.loads((Path(cell_dir) / SUMMARY_FILE).read_text(encoding="utf-8"))
