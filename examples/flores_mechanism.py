@@ -225,3 +225,25 @@ def ideal_slider_acceleration(theta, omega: float = CRANK_SPEED):
     s, c = np.sin(theta), np.cos(theta)
     big_s = np.sqrt(l * l - (r * s) ** 2)
     return omega**2 * (-r * c - r * r * np.cos(2.0 * theta) / big_s - r**4 * s * s * c * c / big_s**3)
+
+
+# The lubricated pin of Flores, Ambrosio, Claro and Lankarani (Mech. Mach. Theory 41, 2006): journal and
+# bearing radii 9.5 and 10 mm (c = 0.5 mm as in the dry pin), bearing length 40 mm, oil of 400 cP.
+LUBRICATED_JOURNAL_RADIUS, LUBRICATED_BEARING_LENGTH, OIL_VISCOSITY = 9.5e-3, 40e-3, 0.4  # m, m, Pa s
+
+
+def lubricated_joint(model: str | None = "short_half") -> ClearanceJoint:
+    """The pin B of the lubricated slider-crank (Flores et al. 2006); ``model=None``: the same pin dry.
+
+    ``model`` is the film model of :class:`~weftsim.params.Lubrication` (``"short_half"``: the short
+    bearing as the paper writes it; ``"finite"``: weftsim's finite-length film).  Roughness and asperity
+    parameters are weftsim's defaults (the paper has no asperity contact); the dry contact law beyond
+    e = c is the dry example's.
+    """
+    from dataclasses import replace
+
+    from weftsim.params import Lubrication
+
+    lubrication = None if model is None else Lubrication(viscosity=OIL_VISCOSITY, model=model)
+    return replace(flores_joint(), journal_radius=LUBRICATED_JOURNAL_RADIUS,
+                   bearing_length=LUBRICATED_BEARING_LENGTH, lubrication=lubrication)  # fmt: skip
