@@ -17,6 +17,8 @@ from weftsim.params import Scene
 # checked against each key's conversion (Key.scale), so a unit shown here is the unit the loader reads.
 UNITS: tuple[tuple[str, str, float], ...] = (
     ("_mpa_m_s", "MPa m/s", 1e6),
+    ("_mpa_s", "mPa s", 1e-3),
+    ("_um", "µm", 1e-6),
     ("_kg_m2", "kg m²", 1.0),
     ("_m_s2", "m/s²", 1.0),
     ("_m_s", "m/s", 1.0),
@@ -130,7 +132,7 @@ def page(docs: Path) -> str:
     """The Markdown of the key reference; ``docs`` is the docs directory (links to absent pages are left out)."""
     defaults = scene_module.to_file_keys(Scene())
     loom = scene_module.to_file_keys(scene_module.load_scene("loom"))
-    required = set(scene_module.REQUIRED) | set(scene_module.JOINT_F_REQUIRED)
+    required = set(scene_module.REQUIRED)  # a loose joint F takes what its table does not give from E
     lines = [
         "# Scene-key reference",
         "",

@@ -83,6 +83,7 @@ sphinx_gallery_conf = {
     "examples_dirs": str(ROOT / "examples"),
     "gallery_dirs": "auto_examples",
     "filename_pattern": r"/plot_",  # every plot_*.py runs at build time
+    "ignore_pattern": r"(__init__|flores_mechanism)\.py",  # a module the examples import, not a page
     "abort_on_example_error": True,
     "download_all_examples": True,
     "remove_config_comments": True,

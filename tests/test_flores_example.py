@@ -26,11 +26,13 @@ def example():
     spec = importlib.util.spec_from_file_location("plot_flores_slider_crank", EXAMPLE)
     module = importlib.util.module_from_spec(spec)
     sys.modules[spec.name] = module
+    sys.path.insert(0, str(EXAMPLE.parent))  # the example imports flores_mechanism beside it
     try:
         spec.loader.exec_module(module)
         yield module
     finally:
         del sys.modules[spec.name]
+        sys.path.remove(str(EXAMPLE.parent))
         matplotlib.pyplot.close("all")
 
 

@@ -47,6 +47,7 @@ from weftsim.api import (
     simulate,
 )
 from weftsim.errors import (  # noqa: E402
+    ArgumentError,
     EngineError,
     MissingExtra,
     OutputError,
@@ -62,6 +63,7 @@ from weftsim.params import Scene  # noqa: E402
 from weftsim.results import CHANNELS, RunResult  # noqa: E402
 
 __all__ = [
+    "ArgumentError",
     "CHANNELS",
     "DEFAULT_ENGINE",
     "ENGINE_NAMES",

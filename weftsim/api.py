@@ -24,7 +24,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import TYPE_CHECKING, Any, Callable
 
-from weftsim.errors import EngineError, PlausibilityWarning, RunFailed, SceneError, closest
+from weftsim.errors import ArgumentError, EngineError, OutputError, PlausibilityWarning, RunFailed, SceneError, closest
 from weftsim.params import Scene
 from weftsim.results import RunResult
 
@@ -188,10 +188,15 @@ def simulate(scene: Scene | str | os.PathLike, engine: str = "auto", *,
         ``scene`` is a file or name that does not load.
     weftsim.errors.RunFailed
         Only with ``raise_on_failure``: the run failed (``exc.result`` holds it).
+    weftsim.errors.ArgumentError
+        ``progress`` is neither None nor callable.
     """
     from weftsim.design_checks import before_run, warnings_of
 
     module = _engine_module(engine)
+    if progress is not None and not callable(progress):
+        raise ArgumentError(f"simulate: progress must be None or a function called with the completed fraction "
+                            f"(e.g. lambda f: print(f)), got {type(progress).__name__} {progress!r:.40}")
     scene = _as_scene(scene)
     for text in warnings_of(before_run(scene)):
         if on_warning is None:
@@ -222,11 +227,32 @@ def save_result(result: RunResult, path: str | os.PathLike) -> Path:
 
     Both tables (output samples and every solver step) are kept bit for bit, with the scene, the
     status, the solver statistics, the plausibility counts and the path; :func:`load_result`
-    rebuilds an equal :class:`RunResult`.  Returns the path, written as given.
+    rebuilds an equal :class:`RunResult`.  Returns the path, written as given (atomically: an
+    interrupted save leaves the previous file or none, never a truncated one).
+
+    Raises
+    ------
+    weftsim.errors.ArgumentError
+        ``result`` is not a :class:`RunResult` or ``path`` not a path.
+    weftsim.errors.OutputError
+        The file cannot be written.
     """
     from weftsim.results import save_npz
 
-    return save_npz(result, path)
+    if not isinstance(result, RunResult):
+        raise ArgumentError(f"save_result: result must be a RunResult (from weftsim.simulate or load_result), "
+                            f"got {type(result).__name__}")
+    if not isinstance(path, (str, os.PathLike)):
+        raise ArgumentError(f"save_result: path must be a file path, got {type(path).__name__}")
+    from weftsim.output import write_atomic
+
+    try:  # atomic: a run killed while saving leaves the previous file (or none), never a truncated one
+        write_atomic(Path(path), lambda tmp: save_npz(result, tmp))
+        return Path(path)
+    except OSError as exc:
+        raise OutputError(f"cannot write {path}: {exc.strerror or exc}") from None
+    except ValueError as exc:  # a NUL character in the path
+        raise OutputError(f"cannot write {path!r}: {exc}") from None
 
 
 def load_result(path: str | os.PathLike) -> RunResult:
@@ -235,10 +261,15 @@ def load_result(path: str | os.PathLike) -> RunResult:
     Raises
     ------
     weftsim.errors.OutputError
-        The file is missing, unreadable or not a weftsim result.
+        The file is missing, unreadable, not a weftsim result, or damaged or edited so that it no longer
+        is one (each checked before anything is allocated: :mod:`weftsim.result_file`).
+    weftsim.errors.ArgumentError
+        ``path`` is not a path.
     """
     from weftsim.results import load_npz
 
+    if not isinstance(path, (str, os.PathLike)):
+        raise ArgumentError(f"load_result: path must be a file path, got {type(path).__name__}")
     return load_npz(path)
 
 
@@ -265,4 +296,6 @@ def load_sweep(directory: str | os.PathLike) -> xarray.Dataset:
     """
     from weftsim.sweep.store import load_grid
 
+    if not isinstance(directory, (str, os.PathLike)):
+        raise ArgumentError(f"load_sweep: directory must be a path, got {type(directory).__name__}")
     return load_grid(Path(directory))

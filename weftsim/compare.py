@@ -191,7 +191,7 @@ def startup_impact_end(result: RunResult, name: str) -> float:
     From the centred journal the first contact is the same in every correct integration: its maximum
     is reproducible (docs/physics.md section 6).  A contact lasting the whole revolution ends it there.
     """
-    t, touching = result.steps["time_s"], result.steps[_contact_channel(result, name)] > 0.5
+    touching = result.steps[_contact_channel(result, name)] > 0.5
     first = np.flatnonzero(touching)
     if first.size == 0:
         return result.scene.drive.period
