@@ -61,12 +61,13 @@ def select_path(scene: Scene) -> dict:
     model, reason = select_model(scene)
     if model == "kinematic_tree":
         from weftsim.exudyn_engine.callbacks import resolve_route
-        from weftsim.exudyn_engine.tree_solve import tree_relative_tolerance, tree_solver
+        from weftsim.exudyn_engine.tree_solve import tree_local_error, tree_relative_tolerance, tree_solver
 
         route = resolve_route(s.callback)
         if tree_solver(scene) == "implicit":
             return {"model": model, "reason": reason,
-                    "method": f"generalized-alpha, adaptive step (local error {s.local_error:g} m at E), {route} callback"}
+                    "method": f"generalized-alpha, adaptive step (local error {tree_local_error(scene):g} m at E), "
+                              f"{route} callback"}
         return {"model": model, "reason": reason,
                 "method": f"{s.explicit_method} rtol {tree_relative_tolerance(scene):g}, {route} callback"}
     from weftsim.exudyn_engine.solver import adaptive, step_plan

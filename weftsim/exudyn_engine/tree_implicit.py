@@ -120,16 +120,15 @@ class ImplicitTree:
                  scene: Scene):
         # The explicit tree's largest step (a light impact must not begin and end inside one free-flight step;
         # gravity's fall through the clearance); imported here, tree_solve imports this module.
-        from weftsim.exudyn_engine.tree_solve import largest_step
+        from weftsim.exudyn_engine.tree_solve import largest_step, tree_local_error
 
-        s = scene.exudyn_solver
         self.mbs, self.solver, self.model, self.scene = mbs, solver, model, scene
         period = scene.output.sample_angle / scene.drive.speed
         self.max_step = largest_step(scene)
         g = scene.geometry
-        self.control = TreeStepController(mbs, solver, model.node, 0.0, s.local_error, scene.limits.min_step,
-                                      self.max_step, period, newmark_beta(SPECTRAL_RADIUS),
-                                      jump=tree_jump(g.l_fg, g.l_ef))  # fmt: skip
+        self.control = TreeStepController(mbs, solver, model.node, 0.0, tree_local_error(scene),
+                                          scene.limits.min_step, self.max_step, period, newmark_beta(SPECTRAL_RADIUS),
+                                          jump=tree_jump(g.l_fg, g.l_ef))  # fmt: skip
         friction = scene.joint.friction_coefficient > 0.0
         self.segments = FrictionSegments(model.force) if friction else None
 
