@@ -162,3 +162,16 @@ def test_the_run_time_estimate_follows_the_exudyn_trees_solver_with_friction():
     assert estimate_run_time(rough, "exudyn") == pytest.approx(EXUDYN_IMPLICIT_STIFF_FACTOR * base)
     assert estimate_run_time(explicit, "exudyn") == pytest.approx(EXUDYN_STIFF_FACTOR * base)
     assert not stiff_explicit(rough, ("exudyn",)) and stiff_explicit(explicit, ("exudyn",))
+
+
+def test_auto_runs_a_lubricated_tree_implicitly_at_the_films_local_error():
+    """An oil film is stiff near the wall: the explicit tree took 513 065 steps for one loom revolution at
+    c = 0.02 mm, 80 mPa s, generalized-alpha 2 167 (tree_solve.tree_solver); its local error is capped so the
+    smallest film thickness and an impact into the film stay within 4e-4 (tree_solve.LUBRICATED_LOCAL_ERROR)."""
+    from weftsim.exudyn_engine.tree_solve import LUBRICATED_LOCAL_ERROR, tree_local_error, tree_solver
+
+    oil = load_scene(MODELS / "loom.toml", {"joint_e.lubrication.viscosity_mpa_s": 80.0})
+    dry = load_scene(MODELS / "loom.toml")
+    assert tree_solver(oil) == "implicit" and tree_solver(dry) == "explicit"
+    assert tree_local_error(oil) == LUBRICATED_LOCAL_ERROR < tree_local_error(dry) == dry.exudyn_solver.local_error
+    assert f"local error {LUBRICATED_LOCAL_ERROR:g} m" in select_path(oil)["method"]

@@ -44,8 +44,10 @@ from weftsim.exudyn_engine.tree import TreeModel, build_tree
 from weftsim.exudyn_engine.selection import (  # noqa: F401 (re-exported: the tree's plan lives in selection)
     FRICTION_RELATIVE_TOLERANCE,
     GRAVITY_STEP_FRACTION,
+    LUBRICATED_LOCAL_ERROR,
     STEPS_PER_SAMPLE,
     largest_step,
+    tree_local_error,
     tree_relative_tolerance,
     tree_solver,
 )
@@ -323,7 +325,7 @@ def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, ca
     it = solver.it
     n_done = max(len(steps["time_s"]) - 1, 0)
     if implicit:
-        method = {"method": "generalized_alpha", "local_error_m": scene.exudyn_solver.local_error,
+        method = {"method": "generalized_alpha", "local_error_m": tree_local_error(scene),
                   "rejected_steps": int(it.rejectedModifiedNewtonSteps), "newton_iterations": int(it.newtonStepsCount),
                   "jacobian_evaluations": int(it.newtonJacobiCount), **stepper.counters()}  # fmt: skip
     else:
