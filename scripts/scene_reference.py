@@ -1,17 +1,26 @@
 """Print the scene-file key reference (Markdown) from weftsim.scene.SCHEMA, for the README."""
 
-from weftsim.params import Scene
+import dataclasses
+
+from weftsim.params import Lubrication, Scene
 from weftsim.scene import SCHEMA, to_file_keys
 
 
 def main() -> None:
-    defaults = to_file_keys(Scene())
+    # The lubrication tables are optional (absent: the dry joint); their defaults are those of a table given
+    # with its one required key.
+    lubricated = dataclasses.replace(Scene().joint, lubrication=Lubrication(viscosity=0.0))
+    scene = dataclasses.replace(Scene(), joint=lubricated, joint_f=dataclasses.replace(Scene().joint_f,
+                                                                                      lubrication=lubricated.lubrication))
+    defaults = to_file_keys(scene)
     print("| key | default | allowed | meaning |")
     print("|---|---|---|---|")
     for key in SCHEMA:
         value = defaults[key.path]
         if value is None:  # an optional key without a default
             value = "not set"
+        elif key.path.endswith("lubrication.viscosity_mpa_s"):
+            value = "required in the table"
         elif isinstance(value, float):
             value = f"{value:.6g}"
         elif isinstance(value, list):

@@ -45,7 +45,7 @@ def test_the_generalized_force_is_the_virtual_work_of_the_contact_force(route):
     against the reference engine's eccentricity (other coordinates: psi = q0 + q1 - pi)."""
     scene = load_scene(MODELS / "reference.toml")
     c = scene.joint.clearance
-    memory, stash, calls = [0.05, 1e-6, 0.05], [math.nan] * 8, [0]
+    memory, stash, calls = [0.05, 1e-6, 0.05], [math.nan] * 10, [0]
     force = make_tree_force(pack_parameters(scene), memory, stash, route, calls)
     p = ChainConstants.from_scene(scene)
     a0, psi0, da0, dpsi0 = initial_state(scene)[:4]

@@ -11,12 +11,21 @@ import math
 
 import numpy as np
 
-from weftsim.results import PEAK_CHANNELS, PEAK_CHANNELS_F, RunResult
+from weftsim.results import (
+    PEAK_CHANNELS, PEAK_CHANNELS_F, PEAK_CHANNELS_LUBRICATION, PEAK_CHANNELS_LUBRICATION_F, RunResult,
+)  # fmt: skip
 
 
 def peak_channels(result: RunResult) -> tuple[str, ...]:
-    """The channels summarised by peaks and statistics: :data:`PEAK_CHANNELS`, and joint F's when it has a clearance."""
-    return PEAK_CHANNELS + (PEAK_CHANNELS_F if result.has_joint_f else ())
+    """The channels summarised by peaks and statistics: :data:`PEAK_CHANNELS`, joint F's when it has a
+    clearance, and the film ratio and film, asperity and torque channels of each lubricated joint (the
+    film ratio's ``min`` is its summary: the thinnest film of the run)."""
+    names = PEAK_CHANNELS + (PEAK_CHANNELS_F if result.has_joint_f else ())
+    if "film_ratio" in result.steps:
+        names += ("film_ratio",) + PEAK_CHANNELS_LUBRICATION
+    if "film_ratio_f" in result.steps:
+        names += ("film_ratio_f",) + PEAK_CHANNELS_LUBRICATION_F
+    return names
 
 
 def revolution_index(time: np.ndarray, period: float) -> np.ndarray:

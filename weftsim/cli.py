@@ -112,11 +112,12 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("study", help="one of the paper's studies: figures, CSV and JSON (docs/paper-comparison.md)",
                        description="Run a study of the paper: contact-law (Fig. 7-9), clearance (Fig. 12), "
-                       "speed (Fig. 13, with the acceleration spectrum), engines (Fig. 16), or all of them.  "
+                       "speed (Fig. 13, with the acceleration spectrum), engines (Fig. 16), regime (the lubricated "
+                       "joint's film ratio and peak force over speed x clearance x viscosity), or all of them.  "
                        "Each study sets its own scenes; --set and the shorthands apply to every run of it, "
                        "except what the study sets itself (the clearance of 'clearance', the speed of 'speed', "
                        "the speed and clearance of 'contact-law': refused).")
-    p.add_argument("name", help="contact-law, clearance, speed, engines or all")
+    p.add_argument("name", help="contact-law, clearance, speed, engines, regime or all")
     p.add_argument("-o", "--output", default=None,
                    help="output directory (default: out/study-NAME; with 'all': parent of one directory per study)")
     p.add_argument("--models", default=None,
@@ -165,19 +166,28 @@ def cmd_wear(args: argparse.Namespace) -> int:
 def _check_fits(scene, outdir: Path, runs: int = 1) -> None:
     """Refuse a run whose output grid cannot be held or written (before anything is created)."""
     from weftsim.output import check_output_fits, output_rows
-    from weftsim.results import CHANNELS, JOINT_F_CHANNELS
+    from weftsim.results import scene_channels
 
     what = (f"output.sample_deg = {math.degrees(scene.output.sample_angle):g} over "
             f"drive.revolutions = {scene.drive.revolutions:g}")
-    columns = len(CHANNELS) + (0 if scene.joint_f.is_ideal else len(JOINT_F_CHANNELS))
+    columns = len(scene_channels(scene))
     check_output_fits(output_rows(scene), columns, outdir, what, runs)
 
 
 def _announce_run_time(scene, engines: tuple[str, ...], command: str) -> None:
     """One line on stderr with the estimated run time of a long run (a warning above LONG_RUN_S)."""
-    from weftsim.progress import LONG_RUN_S, SHOW_ESTIMATE_S, estimate_run_time, format_duration
+    from weftsim.output import _size
+    from weftsim.progress import (
+        LARGE_FILE_BYTES, LONG_RUN_S, SHOW_ESTIMATE_S, estimate_run_time, estimate_step_bytes, format_duration,
+    )  # fmt: skip
 
     estimate = sum(estimate_run_time(scene, engine) for engine in engines)
+    size = max(estimate_step_bytes(scene, engine) for engine in engines) if command == "run" else 0.0
+    if size > LARGE_FILE_BYTES:
+        print(f"weftsim {command}: warning: the per-step record will be ~{_size(size)} (held in memory, written "
+              "compressed to result.npz): an explicit solver steps at ~1e-9 s on the friction or film of the "
+              "joint (solver.reference.method = 'auto' integrates it implicitly); or shorten drive.revolutions",
+              file=sys.stderr, flush=True)
     if estimate < SHOW_ESTIMATE_S:
         return
     prefix = "warning: " if estimate > LONG_RUN_S else ""

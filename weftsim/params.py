@@ -148,6 +148,91 @@ class WearModel:
     profile_points: int = 360
 
 
+# Film models of Lubrication.model (the codes of weftsim.kernel.film: MODEL_FINITE, MODEL_SHORT, MODEL_LONG).
+FILM_MODELS = ("finite", "short", "long")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Lubrication:
+    """Oil film and asperity contact of a lubricated clearance joint (docs/lubrication.md).
+
+    A joint without a ``Lubrication`` (``ClearanceJoint.lubrication = None``) is the dry joint.  With
+    one, the film's pressure carries the journal for every eccentricity (no contact needed), the
+    asperities of both surfaces carry load where the minimum film thickness h_min = c - |e| is below
+    4 sigma (Greenwood and Tripp, Proc. Instn Mech. Engrs 185, 1970), and the dry contact law of the
+    joint takes over beyond e = c, continuously (:mod:`weftsim.kernel.lubricated`).
+
+    Attributes
+    ----------
+    viscosity : float
+        Dynamic viscosity eta of the oil at operating temperature, Pa s (>= 0; 0 = no film).
+    model : str
+        Film model: ``"finite"`` (finite length, default), ``"short"`` (Ocvirk) or ``"long"``
+        (Sommerfeld with Guembel cavitation), :data:`FILM_MODELS`.
+    roughness : float
+        Combined RMS roughness sigma = sqrt(sigma_j^2 + sigma_b^2) of journal and bearing, m.
+        Default 0.4 um: two ground surfaces of Rq ~ 0.3 um.
+    asperity_density_radius_roughness : float
+        eta_s beta sigma of Greenwood-Tripp (asperity density x asperity summit radius x sigma),
+        dimensionless; 0 switches asperity contact off.  Default 0.04 (0.03-0.07 for ground and honed
+        steel, the usual range of mixed-lubrication bearing models).
+    roughness_radius_ratio : float
+        sigma / beta (RMS roughness over asperity summit radius).  Default 1e-3.
+    boundary_friction_coefficient : float
+        mu_b of the boundary friction on the asperity load (modified Coulomb, with the joint's
+        ``friction_velocities``).  Default 0.1 (boundary-lubricated steel on steel or bronze).
+    film_floor_ratio : float
+        The film force is evaluated no closer than h_min = film_floor_ratio x sigma: below that film
+        thickness its pressure field is held at the floor's while the asperities take the rest, so the
+        film force stays finite where the dry law starts (e = c).  Default 1 (film ratio 1).
+    """
+
+    viscosity: float
+    model: str = "finite"
+    roughness: float = 0.4e-6
+    asperity_density_radius_roughness: float = 0.04
+    roughness_radius_ratio: float = 1e-3
+    boundary_friction_coefficient: float = 0.1
+    film_floor_ratio: float = 1.0
+
+    def __post_init__(self):
+        problem = lubrication_problem(self)
+        if problem is not None:
+            raise ValueError(problem)
+
+    @property
+    def model_code(self) -> int:
+        """The film kernel's model code (weftsim.kernel.film: finite 0, short 1, long 2)."""
+        return FILM_MODELS.index(self.model)
+
+
+def _number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def lubrication_problem(lub: Lubrication) -> str | None:
+    """One line naming the first invalid field of ``lub`` and what is allowed, or None."""
+    if not (_number(lub.viscosity) and lub.viscosity >= 0.0):
+        return f"`lubrication.viscosity` must be >= 0 (Pa s; 0 = no film), got {lub.viscosity!r}"
+    if lub.model not in FILM_MODELS:
+        return f"`lubrication.model` must be one of {FILM_MODELS}, got {lub.model!r}"
+    if not (_number(lub.roughness) and lub.roughness > 0.0):
+        return f"`lubrication.roughness` must be > 0 (m, combined RMS of both surfaces), got {lub.roughness!r}"
+    eta = lub.asperity_density_radius_roughness
+    if not (_number(eta) and 0.0 <= eta <= 1.0):
+        return f"`lubrication.asperity_density_radius_roughness` must be in [0, 1] (0 = no asperity contact), got {eta!r}"
+    ratio = lub.roughness_radius_ratio
+    if not (_number(ratio) and 0.0 < ratio <= 1.0):
+        return f"`lubrication.roughness_radius_ratio` must be in (0, 1] (sigma / beta), got {ratio!r}"
+    mu = lub.boundary_friction_coefficient
+    if not (_number(mu) and 0.0 <= mu <= 2.0):
+        return f"`lubrication.boundary_friction_coefficient` must be in [0, 2], got {mu!r}"
+    floor = lub.film_floor_ratio
+    if not (_number(floor) and 0.0 < floor <= 4.0):
+        return f"`lubrication.film_floor_ratio` must be in (0, 4] (film floor / sigma), got {floor!r}"
+    return None
+
+
 # Impact velocity rules of ClearanceJoint.impact_velocity_rule (weftsim.scene re-exports it).
 IMPACT_VELOCITY_RULES = ("max_approach", "onset")
 
@@ -193,6 +278,8 @@ class ClearanceJoint:
         (low, high): the design range of the radial clearance over the journal diameter, c / (2 R_j)
         (dimensionless).  Default (0.5e-3, 1.0e-3): a bushed pin in oscillating motion (docs/plausibility.md);
         a clearance outside it is warned about before the run.
+    lubrication : Lubrication or None
+        Oil film and asperity contact (``[joint_e.lubrication]``); None = the dry joint.
     bearing_wear, journal_wear : tuple of float
         Worn depth, m, at equally spaced angles over 360 deg in the bearing's (rocker 3) and the
         journal's (rod 4) body frame; empty = unworn (round).  The contact sees the clearance
@@ -214,6 +301,12 @@ class ClearanceJoint:
     design_clearance: tuple[float, float] = (0.5e-3, 1.0e-3)
     bearing_wear: tuple[float, ...] = ()
     journal_wear: tuple[float, ...] = ()
+    lubrication: Lubrication | None = None
+
+    @property
+    def is_lubricated(self) -> bool:
+        """True when the joint has an oil film (``lubrication`` given)."""
+        return self.lubrication is not None
 
     @property
     def is_worn(self) -> bool:
@@ -284,6 +377,13 @@ def joint_problem(joint: ClearanceJoint) -> str | None:
             or not 0.0 <= band[0] < band[1]:
         return (f"`design_clearance` must be (low, high) with 0 <= low < high (radial clearance / diameter), "
                 f"got {joint.design_clearance!r}")
+    lub = joint.lubrication
+    if lub is not None:
+        if not isinstance(lub, Lubrication):
+            return f"`lubrication` must be a weftsim.params.Lubrication or None, got {type(lub).__name__}"
+        if c > 0.0 and lub.film_floor_ratio * lub.roughness >= c:
+            return (f"`lubrication.roughness` x `film_floor_ratio` ({lub.film_floor_ratio * lub.roughness:.3g} m) "
+                    f"must be smaller than the clearance {c:.3g} m (the film needs room between the surfaces)")
     return None
 
 

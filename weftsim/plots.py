@@ -31,6 +31,13 @@ PANELS_F = (
 )
 
 
+# Added when every curve has a lubricated joint E (weftsim.results.LUBRICATION_CHANNELS).
+PANELS_LUBRICATION = (
+    ("film_ratio", "film ratio h_min/σ at E", 1.0),
+    ("film_force_N", "film force at E [N]", 1.0),
+)
+
+
 def clearance_label(scene: Scene) -> str:
     """``c = 0.25 mm`` (clearance at E alone, as before), or the clearance of each joint: ``c_E = 0.25, c_F = 0.25 mm``."""
     if scene.joint_f.is_ideal:
@@ -84,6 +91,7 @@ def channel_panels(curves: list[tuple], title: str, panels: tuple | None = None)
     """
     if panels is None:
         panels = PANELS + (PANELS_F if curves and all(PANELS_F[0][0] in data for _, data, _ in curves) else ())
+        panels += PANELS_LUBRICATION if curves and all("film_ratio" in data for _, data, _ in curves) else ()
     rows = len(panels) // 2
     fig = figure(figsize=(11, 3 * rows))
     axes = fig.subplots(rows, 2, sharex=True)

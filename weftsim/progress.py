@@ -65,12 +65,28 @@ class Progress:
 SECONDS_PER_REVOLUTION = {
     "reference scipy": 0.8,  # DOP853 at rtol 1e-9 on the compiled right-hand side: 0.78-0.89 s (1st revolution)
     "reference numba": 0.008,  # numba_DOP853 at rtol 1e-5 (the default): 79 ms for 10 revolutions
+    # numba_DOP853_RODAS4 at rtol 1e-6, the default with friction (issue 23): 2.3-3.1x the dry default in the
+    # same process (c = 0.5 mm, mu = 0.15; docs/performance.md "Friction"), so 3x the figure above.
+    "reference numba implicit": 0.024,
     "exudyn kinematic_tree": 0.10,  # the default path (DOPRI5 rtol 1e-6, numba route): 0.97-1.02 s for 10
     "exudyn rigid_body adaptive": 1.95,  # local error 3e-10 m: 1.94-2.00 s (1st revolution)
 }
 # Steps of the Runge-Kutta paths grow about as rtol^(-1/4) on this contact (the compiled DOP853: 0.08 s per
 # revolution at rtol 1e-9, 10x its cost at 1e-5); the figures above are at these tolerances.
-REFERENCE_RTOL = {"reference scipy": 1e-9, "reference numba": 1e-5}
+REFERENCE_RTOL = {"reference scipy": 1e-9, "reference numba": 1e-5, "reference numba implicit": 1e-6}
+# An explicit method on a stiff joint law (friction's ramp, an oil film) steps at its stability limit, ~1e-9 s
+# where the journal sticks: one revolution of c = 0.5 mm, 400 rpm, mu = 0.15 took 1661x the dry run with
+# numba_DOP853 and 1437x with the kinematic tree's DOPRI5 (issue 23).  Applied to a path that integrates
+# such a joint explicitly; update EXUDYN_STIFF_FACTOR when the Exudyn engine integrates friction implicitly.
+EXPLICIT_STIFF_FACTOR = 1500.0
+EXUDYN_STIFF_FACTOR = 1400.0
+# Recorded step rows per revolution (each contact step adds 3 dense points): the dry default ~7 100 (71 000
+# for 10 revolutions of the reference scene), the implicit path with friction ~13 000 (3 200 steps), an
+# explicit path with friction ~1e7 (2.5 M steps).  A row of result.npz holds ~20 float64 channels.
+STEP_ROWS_PER_REVOLUTION = 7.1e3
+IMPLICIT_STEP_ROWS_PER_REVOLUTION = 1.3e4
+NPZ_BYTES_PER_ROW = 160.0  # 20 channels x 8 bytes; savez_compressed gains little on these mantissas
+LARGE_FILE_BYTES = 200e6  # result.npz above this is announced before the run
 # The Exudyn rigid-body model takes fixed steps: its cost is per step (5.5 s for the 75 000 steps of
 # one revolution at 400 rpm with h = 2e-6 s, 73 us a step; 16.6 s for 3 revolutions).
 EXUDYN_SECONDS_PER_STEP = 7.3e-5
@@ -78,26 +94,68 @@ SHOW_ESTIMATE_S = 10.0  # shorter runs end before the line would be read
 LONG_RUN_S = 600.0  # above 10 min the estimate is a warning: the user may not have meant it
 
 
+def _stiff(scene: Scene) -> bool:
+    from weftsim.reference import stiff_joints
+
+    return bool(stiff_joints(scene))
+
+
+def _reference_path(scene: Scene) -> tuple[str, bool]:
+    """(key of :data:`SECONDS_PER_REVOLUTION`, whether a stiff joint is integrated explicitly)."""
+    from weftsim.reference import compiled_method
+
+    method = compiled_method(scene) or scene.reference_solver.method
+    if "RODAS4" in method:
+        return "reference numba implicit", False
+    path = "reference numba" if method.startswith("numba") else "reference scipy"
+    implicit_scipy = method in ("Radau", "BDF", "LSODA")
+    return path, _stiff(scene) and not implicit_scipy
+
+
 def estimate_run_time(scene: Scene, engine: str) -> float:
     """Estimated wall-clock seconds of one run of ``scene`` with ``engine`` (see
-    :data:`SECONDS_PER_REVOLUTION`); 0 for the closed-form ideal joint of the reference engine."""
+    :data:`SECONDS_PER_REVOLUTION`); 0 for the closed-form ideal joint of the reference engine.
+
+    Knows a stiff joint law (friction, an oil film: :func:`weftsim.reference.stiff_joints`): the reference
+    engine's implicit path costs ~3x a dry run, an explicit path on it :data:`EXPLICIT_STIFF_FACTOR` times.
+    """
     revolutions = scene.drive.revolutions
     if engine == "reference":
         if scene.is_ideal:
             return 0.0
-        from weftsim.reference import select_path
+        from weftsim.reference import effective_rtol
 
-        path = "reference numba" if "numba" in select_path(scene)["method"] else "reference scipy"
-        scale = (REFERENCE_RTOL[path] / scene.reference_solver.rtol) ** 0.25
-        return revolutions * SECONDS_PER_REVOLUTION[path] * scale
+        path, explicit_stiff = _reference_path(scene)
+        scale = (REFERENCE_RTOL[path] / effective_rtol(scene)) ** 0.25
+        return revolutions * SECONDS_PER_REVOLUTION[path] * scale * (EXPLICIT_STIFF_FACTOR if explicit_stiff else 1.0)
     from weftsim.exudyn_engine.selection import select_model
     from weftsim.exudyn_engine.solver import adaptive, step_plan
 
+    stiff = EXUDYN_STIFF_FACTOR if _stiff(scene) else 1.0
     if select_model(scene)[0] == "kinematic_tree":
-        return revolutions * SECONDS_PER_REVOLUTION["exudyn kinematic_tree"]
+        return revolutions * SECONDS_PER_REVOLUTION["exudyn kinematic_tree"] * stiff
     if adaptive(scene):
-        return revolutions * SECONDS_PER_REVOLUTION["exudyn rigid_body adaptive"]
+        return revolutions * SECONDS_PER_REVOLUTION["exudyn rigid_body adaptive"] * stiff
     return step_plan(scene)[1] * EXUDYN_SECONDS_PER_STEP  # the fixed steps it will take (longer for an ideal joint)
+
+
+def estimate_step_bytes(scene: Scene, engine: str) -> float:
+    """Estimated bytes of the per-step table of one run (``result.npz``, and about as much memory while held).
+
+    The reference engine's rows per revolution (:data:`STEP_ROWS_PER_REVOLUTION`), x
+    :data:`EXPLICIT_STIFF_FACTOR` on an explicit path with a stiff joint law; the Exudyn engine's in proportion
+    to its estimated time (its steps cost about the same everywhere).
+    """
+    if engine == "reference":
+        if scene.is_ideal:
+            return 0.0
+        path, explicit_stiff = _reference_path(scene)
+        rows = IMPLICIT_STEP_ROWS_PER_REVOLUTION if path == "reference numba implicit" else STEP_ROWS_PER_REVOLUTION
+        rows *= EXPLICIT_STIFF_FACTOR if explicit_stiff else 1.0
+    else:
+        dry = SECONDS_PER_REVOLUTION["exudyn kinematic_tree"]
+        rows = STEP_ROWS_PER_REVOLUTION * estimate_run_time(scene, engine) / max(scene.drive.revolutions, 1e-12) / dry
+    return rows * scene.drive.revolutions * NPZ_BYTES_PER_ROW
 
 
 def format_duration(seconds: float) -> str:

@@ -68,6 +68,24 @@ JOINT_F_CHANNELS: tuple[str, ...] = (
     "penetration_rate_f_m_s",
 )
 
+# Channels of a lubricated joint (docs/lubrication.md), present exactly when the scene gives the joint a
+# [joint_e.lubrication] / [joint_f.lubrication] table: minimum film thickness h_min = max(c - |e|, 0), film
+# ratio h_min / sigma, the film force's magnitude, the asperity load, the film's shear torque on the journal.
+LUBRICATION_CHANNELS: tuple[str, ...] = (
+    "film_thickness_m",
+    "film_ratio",
+    "film_force_N",
+    "asperity_force_N",
+    "film_torque_Nm",
+)
+LUBRICATION_CHANNELS_F: tuple[str, ...] = (
+    "film_thickness_f_m",
+    "film_ratio_f",
+    "film_force_f_N",
+    "asperity_force_f_N",
+    "film_torque_f_Nm",
+)
+
 # Joint E's channel of each joint-F channel (same quantity at the other joint).
 JOINT_E_NAME = dict(zip(JOINT_F_CHANNELS, ("contact_force_N", "penetration_m", "eccentricity_y_m",
                                            "eccentricity_z_m", "impact_velocity_m_s", "in_contact",
@@ -97,6 +115,19 @@ PEAK_CHANNELS: tuple[str, ...] = (
 )
 # Joint F's peak channels (summaries of a scene with clearance at F).
 PEAK_CHANNELS_F: tuple[str, ...] = ("contact_force_f_N", "penetration_f_m")
+# Peak channels of a lubricated joint (E's, F's); the film ratio's minimum is its summary (analysis).
+PEAK_CHANNELS_LUBRICATION: tuple[str, ...] = ("film_force_N", "asperity_force_N", "film_torque_Nm")
+PEAK_CHANNELS_LUBRICATION_F: tuple[str, ...] = ("film_force_f_N", "asperity_force_f_N", "film_torque_f_Nm")
+
+
+def optional_channels(names) -> tuple[str, ...]:
+    """The optional channel groups (joint F's, the lubricated joints') present among ``names``, in order."""
+    present = set(names)
+    out: tuple[str, ...] = ()
+    for group in (JOINT_F_CHANNELS, LUBRICATION_CHANNELS, LUBRICATION_CHANNELS_F):
+        if group[0] in present:
+            out += group
+    return out
 
 STATUSES = ("success", "failed")
 ENGINES = ("reference", "exudyn")
@@ -107,11 +138,13 @@ def _as_channels(data: dict[str, np.ndarray], what: str) -> dict[str, np.ndarray
     if missing:
         raise ValueError(f"{what} lacks channels {missing}; every engine must provide all of {list(CHANNELS)}")
     names = CHANNELS
-    given_f = [name for name in JOINT_F_CHANNELS if name in data]
-    if given_f:
-        if len(given_f) != len(JOINT_F_CHANNELS):
-            raise ValueError(f"{what} has joint F channels {given_f} but not all of {list(JOINT_F_CHANNELS)}")
-        names = CHANNELS + JOINT_F_CHANNELS
+    for group, label in ((JOINT_F_CHANNELS, "joint F"), (LUBRICATION_CHANNELS, "lubrication"),
+                         (LUBRICATION_CHANNELS_F, "joint F lubrication")):
+        given = [name for name in group if name in data]
+        if given:
+            if len(given) != len(group):
+                raise ValueError(f"{what} has {label} channels {given} but not all of {list(group)}")
+            names = names + group
     lengths = {name: np.shape(data[name]) for name in names}
     n = len(np.asarray(data["time_s"]))
     bad = {name: shape for name, shape in lengths.items() if shape != (n,)}
@@ -241,9 +274,25 @@ class RunResult:
         return frame
 
 
-def empty_channels(joint_f: bool = False) -> dict[str, np.ndarray]:
-    """All channels with no rows (``joint_f``: with joint F's), for a run that failed before its first step."""
+def empty_channels(joint_f: bool = False, scene: Scene | None = None) -> dict[str, np.ndarray]:
+    """All channels with no rows (``joint_f``: with joint F's; ``scene``: the channels it has), for a run
+    that failed before its first step."""
+    if scene is not None:
+        return {name: np.zeros(0) for name in scene_channels(scene)}
     return {name: np.zeros(0) for name in CHANNELS + (JOINT_F_CHANNELS if joint_f else ())}
+
+
+def scene_channels(scene: Scene) -> tuple[str, ...]:
+    """The channels a run of ``scene`` has: :data:`CHANNELS`, joint F's with a clearance at F, and the
+    lubrication channels of each lubricated loose joint."""
+    names = CHANNELS
+    if not scene.joint_f.is_ideal:
+        names += JOINT_F_CHANNELS
+    if not scene.joint.is_ideal and scene.joint.is_lubricated:
+        names += LUBRICATION_CHANNELS
+    if not scene.joint_f.is_ideal and scene.joint_f.is_lubricated:
+        names += LUBRICATION_CHANNELS_F
+    return names
 
 
 def angle_grid(end_time: float, omega: float, step_angle: float) -> np.ndarray:
@@ -349,7 +398,8 @@ def load_npz(path: str | os.PathLike) -> RunResult:
             if not isinstance(meta, dict) or meta.get("format") != NPZ_FORMAT:
                 raise OutputError(f"{path}: not a weftsim result of format {NPZ_FORMAT} "
                                   f"(found {meta.get('format') if isinstance(meta, dict) else meta!r})")
-            names = CHANNELS + (JOINT_F_CHANNELS if f"samples/{JOINT_F_CHANNELS[0]}" in data.files else ())
+            names = CHANNELS + optional_channels(name.partition("/")[2] for name in data.files
+                                                 if name.startswith("samples/"))
             tables = {table: {name: data[f"{table}/{name}"] for name in names} for table in ("samples", "steps")}
     except OutputError:
         raise

@@ -27,7 +27,8 @@ from typing import Any
 from weftsim import params
 from weftsim.errors import SceneError
 
-INTEGRATORS = ("auto", "DOP853", "RK45", "RK23", "Radau", "LSODA", "BDF", "numba_DOP853", "numba_RK45")
+INTEGRATORS = ("auto", "DOP853", "RK45", "RK23", "Radau", "LSODA", "BDF", "numba_DOP853", "numba_RK45", "numba_RODAS4",
+               "numba_DOP853_RODAS4")
 EXUDYN_MODELS = ("auto", "rigid_body", "kinematic_tree")
 EXPLICIT_METHODS = ("DOPRI5", "ODE23")
 STEP_CONTROLS = ("adaptive", "fixed")
@@ -82,6 +83,29 @@ def WEAR_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 - a cons
             doc="revolutions simulated first and not counted (start from the centred journal)"),
         Key(f"{table}.wear.profile_points", f"{joint}.wear.profile_points", "int", 1, 8, 100000, False,
             doc="points of the tabulated wear profiles over 360 deg"),
+    )
+
+
+def LUBRICATION_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 - a constant-like key factory
+    """The ``[<table>.lubrication]`` keys of a clearance joint (docs/lubrication.md).  The table is optional
+    (absent: the dry joint); given, it must name ``viscosity_mpa_s``, the other keys default."""
+    at = f"{table}.lubrication."
+    to = f"{joint}.lubrication."
+    return (
+        Key(at + "viscosity_mpa_s", to + "viscosity", "float", 1e-3, 0, None, False,
+            doc="dynamic viscosity of the oil at operating temperature (ISO VG 220 at 60 C: ~80 mPa s); 0 = no film"),
+        Key(at + "model", to + "model", "str", choices=params.FILM_MODELS,
+            doc="film model: finite (finite-length bearing, default), short (Ocvirk) or long (Sommerfeld)"),
+        Key(at + "roughness_um", to + "roughness", "float", 1e-6, 0,
+            doc="combined RMS roughness of journal and bearing (default 0.4 um, two ground surfaces)"),
+        Key(at + "asperity_density_radius_roughness", to + "asperity_density_radius_roughness", "float", 1, 0, 1,
+            False, doc="Greenwood-Tripp eta beta sigma (default 0.04); 0 = no asperity contact"),
+        Key(at + "roughness_radius_ratio", to + "roughness_radius_ratio", "float", 1, 0, 1,
+            doc="Greenwood-Tripp sigma / beta, RMS roughness over asperity summit radius (default 1e-3)"),
+        Key(at + "boundary_friction_coefficient", to + "boundary_friction_coefficient", "float", 1, 0, 2, False,
+            doc="friction coefficient on the asperity load (default 0.1)"),
+        Key(at + "film_floor_ratio", to + "film_floor_ratio", "float", 1, 0, 4,
+            doc="the film force is evaluated no closer than this many RMS roughnesses (default 1)"),
     )
 
 
@@ -143,6 +167,7 @@ SCHEMA: tuple[Key, ...] = (
         doc="optional; [low, high] design range of the radial clearance over the pin diameter, per mille "
             "(default [0.5, 1.0], a bushed pin in oscillating motion); outside it is warned about"),
     *WEAR_KEYS("joint_e", "joint"),
+    *LUBRICATION_KEYS("joint_e", "joint"),
     Key("drive.speed_rpm", "drive.speed", "float", RPM, 0, 5000, doc="constant crank speed"),
     Key("drive.revolutions", "drive.revolutions", "float", 1, 0, 1000, doc="crank revolutions to simulate"),
     Key("solver.reference.method", "reference_solver.method", "str", choices=INTEGRATORS,
@@ -224,7 +249,9 @@ REQUIRED_SECTIONS = ("mechanism", "inertia", "joint_e", "drive")
 # Model options inside those sections that are not part of the machine: they default.
 OPTIONAL = ("joint_e.impact_velocity_rule", "joint_e.journal_material.yield_strength_mpa",
             "joint_e.bearing_material.yield_strength_mpa", "joint_e.bearing_material.max_pressure_mpa",
-            "joint_e.bearing_material.max_pv_mpa_m_s", "joint_e.design_clearance_per_mille") + tuple(key.path for key in WEAR_KEYS("joint_e", "joint"))
+            "joint_e.bearing_material.max_pv_mpa_m_s", "joint_e.design_clearance_per_mille") \
+    + tuple(key.path for key in WEAR_KEYS("joint_e", "joint")) \
+    + tuple(key.path for key in LUBRICATION_KEYS("joint_e", "joint"))
 # [joint_f] is optional as a whole (absent: the ideal revolute joint at F).  Given with a clearance > 0
 # it must give every key [joint_e] must give (a loose joint is part of the machine).
 JOINT_F_REQUIRED = tuple("joint_f." + key.path.partition(".")[2] for key in SCHEMA
@@ -482,7 +509,33 @@ def _set(scene: params.Scene, target: str, value: Any) -> params.Scene:
     head, _, rest = target.partition(".")
     if not rest:
         return replace(scene, **{head: value})
-    return replace(scene, **{head: _set(getattr(scene, head), rest, value)})
+    inner = getattr(scene, head)
+    if inner is None and head == "lubrication":  # the table's first key: the film starts from the defaults
+        inner = params.Lubrication(viscosity=0.0)
+    return replace(scene, **{head: _set(inner, rest, value)})
+
+
+def _set_checked(scene: params.Scene, target: str, value: Any, where: str) -> params.Scene:
+    """:func:`_set`, with a cross-field refusal of the parameter objects (ValueError) as a SceneError."""
+    try:
+        return _set(scene, target, value)
+    except ValueError as exc:
+        raise SceneError(f"{where}: {exc}") from None
+
+
+LUBRICATION_TABLES = (("joint_e", "joint"), ("joint_f", "joint_f"))
+
+
+def _check_lubrication_given(keys, where: str, before: params.Scene | None = None) -> None:
+    """A ``[<joint>.lubrication]`` table must name ``viscosity_mpa_s`` (unless ``before`` already has a film)."""
+    keys = list(keys)
+    for table, attr in LUBRICATION_TABLES:
+        prefix = f"{table}.lubrication."
+        if before is not None and getattr(before, attr).lubrication is not None:
+            continue
+        if any(k.startswith(prefix) for k in keys) and prefix + "viscosity_mpa_s" not in keys:
+            raise SceneError(f"{where}: missing required key '{prefix}viscosity_mpa_s'; a [{table}.lubrication] "
+                             "table must give the oil's viscosity (the other lubrication keys default)")
 
 
 def _check_scene(scene: params.Scene, where: str, origin: dict[str, Path]) -> None:
@@ -548,7 +601,8 @@ def scene_from_keys(flat: dict[str, Any], where: str = "scene", origin: dict[str
         value = _convert(key, value, src)
         if key.path == "mechanism.fourbar_branch":
             value = BRANCHES[value]
-        scene = _set(scene, key.target, value)
+        scene = _set_checked(scene, key.target, value, src)
+    _check_lubrication_given(flat, where)
     _check_scene(scene, where, origin)
     return scene
 
@@ -621,6 +675,8 @@ def to_file_keys(scene: params.Scene) -> dict[str, Any]:
         obj: Any = scene
         for part in key.target.split("."):
             obj = getattr(obj, part)
+            if obj is None:
+                break  # a dry joint's lubrication keys: None, as any unset optional key
         if obj is None:  # an optional key the scene does not give
             pass
         elif key.path == "mechanism.fourbar_branch":
@@ -642,6 +698,7 @@ def apply_overrides(scene: params.Scene, overrides: dict[str, Any], where: str =
     SceneError
         For an unknown key, a bad value or a scene that fails the cross-key checks, naming ``where``.
     """
+    before = scene
     for dotted, value in overrides.items():
         if value is None:
             continue
@@ -654,6 +711,7 @@ def apply_overrides(scene: params.Scene, overrides: dict[str, Any], where: str =
         value = _convert(key, value, where)
         if key.path == "mechanism.fourbar_branch":
             value = BRANCHES[value]
-        scene = _set(scene, key.target, value)
+        scene = _set_checked(scene, key.target, value, where)
+    _check_lubrication_given([k for k, v in overrides.items() if v is not None], where, before)
     _check_scene(scene, where, {})
     return scene

@@ -149,8 +149,10 @@ def make_tree_force(prm: np.ndarray, memory: list, stash: list, route: str = "nu
     :func:`weftsim.kernel.chain.tree_joint_force`.  ``prm``: the scene's kernel parameter array
     (:func:`weftsim.reference.dynamics.pack_parameters`, friction included); ``memory`` =
     [v_held, delta0, rate0] of the last accepted step (written by the post-step bookkeeping); every
-    call leaves [t, delta, delta_dot, F_b,x, F_b,y, F_N, M_b, F_T v_T] in ``stash`` (F_b = F_N n - F_T t,
-    the force on the bearing; M_b its friction moment; F_T v_T the friction power): the last call of
+    call leaves [t, delta, delta_dot, F_b,x, F_b,y, F_N, M_b, F_T v_T, D'_lub, U_a] in ``stash`` (F_b = F_N n
+    - F_T t, the force on the bearing, plus the film's and asperities' of a lubricated joint; M_b its
+    moment; F_T v_T the dry friction power; D'_lub and U_a the lubricated part's dissipated power and the
+    asperity potential, 0 when dry): the last call of
     an accepted step is at its end state (the last DOPRI5 / ODE23 stage), so the bookkeeping needs no
     extra evaluation.
     """
@@ -164,7 +166,7 @@ def make_tree_force(prm: np.ndarray, memory: list, stash: list, route: str = "nu
 
     def tree_force(mbs, t, itemNumber, q, q_t):
         counter[0] += 1
-        g0, g1, stash[1], stash[2], stash[3], stash[4], stash[5], stash[6], stash[7] = force(
+        g0, g1, stash[1], stash[2], stash[3], stash[4], stash[5], stash[6], stash[7], stash[8], stash[9] = force(
             prm, t, q[0], q[1], q_t[0], q_t[1], memory[0], memory[1], memory[2])
         stash[0] = t
         return [g0, g1]

@@ -31,6 +31,13 @@ reports it as a ``ModelError`` carrying this message):
 - bodies that leave Exudyn's XY plane: an eccentricity with an out-of-plane part larger than the
   clearance (the contact only sees the in-plane part).
 
+Lubrication (``joint.lubrication``, :class:`weftsim.params.Lubrication`): the oil film, the asperity
+contact and the boundary friction of :mod:`weftsim.kernel.lubricated` act at every state, in contact or
+not, through the same connector and torque loads as friction (:mod:`.joint_friction`, with the kernel's
+:func:`~weftsim.kernel.lubricated.connector_lubricated_force`); ``model.friction.lubrication_history``
+records (t, D'_lub, U_a, |f_film|, F_a, T_j) at every accepted state.  Build the joint with
+``ClearanceJoint(..., lubrication=Lubrication(viscosity=...))``.
+
 A restitution outside the law's valid range (``law.valid_restitution``) is a warning.
 """
 
@@ -133,7 +140,8 @@ class ClearanceJointModel:
     tracker: OnsetTracker
     # [latest trial time seen by the force callback] (the overwritten post-step check, add_clearance_joint)
     trial_time: list = field(default_factory=lambda: [0.0], repr=False)
-    friction: JointFriction | None = None  # friction force and moments (joint.friction_coefficient > 0)
+    # friction force and moments (joint.friction_coefficient > 0), and the film of a lubricated joint
+    friction: JointFriction | None = None
 
     def state(self, mbs: exu.MainSystem) -> tuple[float, float]:
         """Current (delta, delta_dot) of the joint, m and m/s."""
@@ -152,6 +160,7 @@ class ClearanceJointModel:
         self.trial_time[0] = t0
         if self.friction is not None:
             self.friction.history.clear()
+            self.friction.lubrication_history.clear()
 
 
 def add_clearance_joint(mbs: exu.MainSystem, marker_bearing: exu.MarkerIndex, marker_journal: exu.MarkerIndex,
@@ -204,13 +213,13 @@ def add_clearance_joint(mbs: exu.MainSystem, marker_bearing: exu.MarkerIndex, ma
                       f"'{law.name}' law's damping was derived for: its contacts will not return this restitution; "
                       "choose a law valid there (e.g. 'flores' for any ce)", UserWarning, stacklevel=2)
     route = callbacks.resolve_route(callback)
-    if call_counter is not None and (route != "python" or joint.friction_coefficient > 0.0):
-        raise ValueError("`call_counter` works with callback='python' and no friction only")
+    if call_counter is not None and (route != "python" or joint.friction_coefficient > 0.0 or joint.is_lubricated):
+        raise ValueError("`call_counter` works with callback='python', no friction and no lubrication only")
     c, v_min = joint.clearance, joint.min_impact_velocity
     max_approach = joint.impact_velocity_rule == "max_approach"
     tracker = OnsetTracker(c, v_min, rule=joint.impact_velocity_rule)  # checks the rule's name
     friction = None
-    if joint.friction_coefficient > 0.0:
+    if joint.friction_coefficient > 0.0 or joint.is_lubricated:
         friction = JointFriction(mbs, marker_bearing, marker_journal, joint_parameters(joint, law), route,
                                  lambda: model.tracker.callback_state)  # fmt: skip
         force = friction.spring_force

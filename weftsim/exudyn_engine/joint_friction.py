@@ -36,6 +36,7 @@ from exudyn.itemInterface import LoadTorqueVector, MarkerBodyRigid
 
 from weftsim.exudyn_engine import callbacks
 from weftsim.kernel import joint as kernel_joint
+from weftsim.kernel.lubricated import connector_lubricated_force
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -86,7 +87,11 @@ class JointFriction:
     def __init__(self, mbs, marker_bearing, marker_journal, prm, route: str, memory):
         self.bearing, self.bearing_local, self.bearing_rotates = _body_of(mbs, marker_bearing)
         self.journal, self.journal_local, self.journal_rotates = _body_of(mbs, marker_journal)
-        self.kernel = callbacks.kernel_form(kernel_joint.connector_friction_force, route)
+        # A lubricated joint (the block's LUBRICATED flag): the same nine values with the film and the
+        # asperities added, then their power, potential and channels (weftsim.kernel.lubricated).
+        self.lubricated = bool(prm[kernel_joint.LUBRICATED] != 0.0)
+        function = connector_lubricated_force if self.lubricated else kernel_joint.connector_friction_force
+        self.kernel = callbacks.kernel_form(function, route)
         self.prm = callbacks.parameters_for_route(prm, route)
         if route == "numba":
             self.kernel(self.prm, 1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0)  # load (or compile) now
@@ -95,6 +100,7 @@ class JointFriction:
         self._key = None
         self._value = None
         self.history: list = []
+        self.lubrication_history: list = []
 
     def rates(self, mbs: exu.MainSystem) -> tuple[float, float]:
         """(omega_j, omega_b), rad/s about Z, of the current (trial) state."""
@@ -142,6 +148,9 @@ class JointFriction:
                                              loadVectorUserFunction=moment))  # fmt: skip
 
     def accept(self, mbs: exu.MainSystem, t: float) -> None:
-        """Record (t, F_N, F_T v_T) of an accepted state (post-step, before the tracker's update)."""
+        """Record (t, F_N, F_T v_T) of an accepted state (post-step, before the tracker's update); a
+        lubricated joint also (D'_lub, U_a, |f_film|, F_a, T_j) in :attr:`lubrication_history`."""
         out = self._state(mbs)
         self.history.append((t, out[4], out[5] * out[8]))
+        if self.lubricated:
+            self.lubrication_history.append((t,) + tuple(out[9:14]))

@@ -31,7 +31,10 @@ import numpy as np
 from exudyn.itemInterface import SensorBody, SensorNode, SensorObject
 
 from weftsim.exudyn_engine.mechanism import CRANK_COORDINATE, ROTATION_2D, MechanismModel
-from weftsim.results import CHANNELS, CONTACT_CHANNELS, JOINT_E_NAME, JOINT_F_CHANNELS
+from weftsim.results import (
+    CHANNELS, CONTACT_CHANNELS, JOINT_E_NAME, JOINT_F_CHANNELS, LUBRICATION_CHANNELS, LUBRICATION_CHANNELS_F,
+    optional_channels,
+)  # fmt: skip
 
 OVT = exu.OutputVariableType
 
@@ -111,7 +114,9 @@ def step_channels(mbs: exu.MainSystem, model: MechanismModel, sensors: dict) -> 
         ch["contact_energy_J"] = ch["contact_energy_J"] + contact.pop("contact_energy_J")
         ch["dissipated_energy_J"] = ch["dissipated_energy_J"] + contact.pop("dissipated_energy_J")
         if joint == "f":  # joint F's channels carry its suffix; E's keep their names
-            contact = {f_name: contact[e_name] for f_name, e_name in JOINT_E_NAME.items()}
+            lubricated = {f_name: contact[e_name] for f_name, e_name in zip(LUBRICATION_CHANNELS_F, LUBRICATION_CHANNELS)
+                          if e_name in contact}
+            contact = {f_name: contact[e_name] for f_name, e_name in JOINT_E_NAME.items()} | lubricated
         ch.update(contact)
     return ch
 
@@ -132,19 +137,30 @@ def _joint_channels(cl, data: dict, joint: str, t: np.ndarray, n: int) -> dict[s
     # The tracker records every post-step call (Exudyn also calls it once at t = 0): take,
     # for each stored step, the tracker's last record at that time.
     row = np.clip(np.searchsorted(hist["time"], t * (1.0 + 1e-12), side="right") - 1, 0, len(hist["time"]) - 1)
+    lubricated: dict[str, np.ndarray] = {}
+    energy = np.where(delta > 0.0, cl.law.elastic_energy(np.maximum(delta, 0.0)), 0.0)
+    lub_power = np.zeros(n)
     if cl.friction is not None:
         record = np.array(cl.friction.history).reshape(-1, 3)  # t, F_N, F_T v_T: one row per tracker record after t = 0
         at = np.clip(np.searchsorted(record[:, 0], t * (1.0 + 1e-12), side="right") - 1, 0, len(record) - 1)
         f_n, friction_power = record[at, 1], record[at, 2]
-    return {
+        if cl.friction.lubricated:  # film and asperities (weftsim.kernel.lubricated), one row per record too
+            lub = np.array(cl.friction.lubrication_history).reshape(-1, 6)  # t, D', U_a, |f_film|, F_a, T_j
+            lub = lub[at] if len(lub) else np.zeros((n, 6))
+            lub_power = lub[:, 1]
+            energy = energy + lub[:, 2]
+            sigma = cl.joint.lubrication.roughness
+            h_min = np.maximum(cl.joint.clearance - length, 0.0)
+            lubricated = dict(zip(LUBRICATION_CHANNELS, (h_min, h_min / sigma, lub[:, 3], lub[:, 4], lub[:, 5])))
+    return lubricated | {
         "contact_force_N": f_n,
         "penetration_m": delta,
         "eccentricity_y_m": ecc[:, 0],
         "eccentricity_z_m": ecc[:, 1],
         "impact_velocity_m_s": hist["impact_velocity"][row],
         "in_contact": hist["in_contact"][row],
-        "contact_energy_J": np.where(delta > 0.0, cl.law.elastic_energy(np.maximum(delta, 0.0)), 0.0),
-        "dissipated_energy_J": _cumtrapz((f_n - f_el) * rate - friction_power, t),
+        "contact_energy_J": energy,
+        "dissipated_energy_J": _cumtrapz((f_n - f_el) * rate - friction_power + lub_power, t),
         "penetration_rate_m_s": rate,
     }
 
@@ -157,7 +173,7 @@ def sample_channels(steps: dict[str, np.ndarray], times: np.ndarray) -> dict[str
     (a failed run) are dropped.
     """
     t = steps["time_s"]
-    names = [k for k in CHANNELS + JOINT_F_CHANNELS if k in steps]
+    names = [k for k in CHANNELS + optional_channels(steps) if k in steps]
     if len(t) == 0:
         return {k: np.zeros(0) for k in names}
     # Exudyn accumulates t += h: the last step may fall short of the end time by round-off.

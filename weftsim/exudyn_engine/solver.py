@@ -133,13 +133,15 @@ def simulation_settings(scene: Scene, n_steps: int) -> exu.SimulationSettings:
     ti.newton.relativeTolerance = s.newton_relative_tolerance
     ti.newton.maxIterations = s.newton_max_iterations
     ti.discontinuous.ignoreMaxIterations = False
-    if scene.joint.friction_coefficient > 0.0 and not scene.joint.is_ideal:
+    lubricated = any(j.is_lubricated and not j.is_ideal for j in (scene.joint, scene.joint_f))
+    if (scene.joint.friction_coefficient > 0.0 and not scene.joint.is_ideal) or lubricated:
         # The friction moments are torque loads reading the state (joint_friction.py): their dependence on
         # coordinates and velocities (the ramp's slope mu F_N / (v1 - v0) ~ 1e8 N s/m) enters Newton's
         # Jacobian only so, and only a fresh Jacobian follows the journal from sliding into sticking.
         # Measured on the loom (c = 0.25 mm, mu = 0.15, h = 2e-6 s): modified Newton, or full Newton
         # without the loads' velocity Jacobian (computeLoadsJacobian 0 or 1), fail at 103 deg with a
         # step-size collapse; full Newton with it runs (1.7 iterations per step).  Without friction: unchanged.
+        # A lubricated joint's film torques and boundary friction are such loads too (joint_friction.py).
         ti.computeLoadsJacobian = 2
         ti.newton.useModifiedNewton = False
     # Newton failures halve the step down to this floor; then the run fails (step-size collapse).

@@ -70,9 +70,10 @@ class TreeModel:
     tracker: OnsetTracker
     route: str
     memory: list  # [v_held, delta0, rate0] read by the force callback
-    stash: list  # [t, delta, delta_dot, F_b,x, F_b,y, F_N, M_b, F_T v_T] of the last callback
+    stash: list  # [t, delta, delta_dot, F_b,x, F_b,y, F_N, M_b, F_T v_T, D'_lub, U_a] of the last callback
     callback_calls: list = field(default_factory=lambda: [0])  # [count]
-    # [t, F_b,x, F_b,y, F_N, M_b, F_T v_T] per accepted state (tree_joint_force's contact on the bearing)
+    # [t, F_b,x, F_b,y, F_N, M_b, F_T v_T, D'_lub, U_a] per accepted state (tree_joint_force's joint force on
+    # the bearing, the lubricated part's dissipated power and the asperity potential)
     bearing_force: list = field(default_factory=list)
 
     def accept(self, mbs: exu.MainSystem, t: float) -> None:
@@ -81,11 +82,11 @@ class TreeModel:
             q = mbs.GetNodeOutput(self.node, exu.OutputVariableType.Coordinates)
             q_t = mbs.GetNodeOutput(self.node, exu.OutputVariableType.Coordinates_t)
             self.force(mbs, t, self.tree, q, q_t)
-        _, delta, rate, fx, fy, f_n, m_b, power = self.stash
+        _, delta, rate, fx, fy, f_n, m_b, power, lub_power, asperity_energy = self.stash
         tracker = self.tracker
         tracker.accept(t, delta, rate)
         self.memory[0], self.memory[1], self.memory[2] = tracker.held, delta, rate
-        self.bearing_force.append((t, fx, fy, f_n, m_b, power))
+        self.bearing_force.append((t, fx, fy, f_n, m_b, power, lub_power, asperity_energy))
 
 
 def build_tree(mbs: exu.MainSystem, scene: Scene, callback: str = "auto") -> TreeModel:
@@ -105,7 +106,7 @@ def build_tree(mbs: exu.MainSystem, scene: Scene, callback: str = "auto") -> Tre
     calls = [0]
     tracker = OnsetTracker(joint.clearance, joint.min_impact_velocity, rule=joint.impact_velocity_rule)
     memory = list(tracker.callback_state)
-    stash = [math.nan] + [0.0] * 7
+    stash = [math.nan] + [0.0] * 9
     force = callbacks.make_tree_force(pack_parameters(scene), memory, stash, route, calls)
     node = mbs.AddNode(NodeGenericODE2(
         referenceCoordinates=[0.0, 0.0], initialCoordinates=[a0, psi0 + math.pi - a0],

@@ -39,6 +39,8 @@ from weftsim.kernel.joint import (  # noqa: F401 - the joint block is part of th
     tangential_velocity,
 )  # fmt: skip
 from weftsim.kernel.laws import elastic_force
+from weftsim.kernel.lubricated import L_DISSIPATED, L_FX, L_FY, L_MB, L_MJ, is_lubricated, lubricated_force
+from weftsim.kernel.lubricated import connector_lubricated_force
 from weftsim.kernel.wear import worn_clearance
 
 if TYPE_CHECKING:
@@ -152,6 +154,13 @@ def chain(prm: np.ndarray, t: float, y: np.ndarray, contact: bool, impact_veloci
         # delta_dot also holds -dc/dt, so this term also books the work of the radial force as the
         # wall's profile passes under it (the small-wear normal, docs/wear.md section 2).
         dissipated = -(f_y * v_y + f_z * v_z + m_j * dpsi + m_b * omega * dphi) - f_el * delta_dot
+    if is_lubricated(prm):  # the film loads the joint in free flight too (weftsim.kernel.lubricated)
+        lub = lubricated_force(prm, c, ecc_y, ecc_z, v_y, v_z, dpsi, omega * dphi)
+        f_y += lub[L_FX]
+        f_z += lub[L_FY]
+        m_j += lub[L_MJ]
+        m_b += lub[L_MB]
+        dissipated += lub[L_DISSIPATED]
     s = sp * ca - cp * sa  # sin(psi - a)
     c = cp * ca + sp * sa  # cos(psi - a)
     k = prm[COUPLING]
@@ -196,8 +205,12 @@ def tree_joint_force(prm: np.ndarray, t: float, a: float, q1: float, da: float, 
         Q1 = -F_b . dP_j/dq1 + M_j = L_EF (F_bx sin b - F_by cos b) + M_j,
         Q0 = L_FG (F_bx sin a - F_by cos a) + Q1.
 
-    Returns (Q0, Q1, delta, delta_dot, F_bx, F_by, F_N, M_b, F_T v_T): N m, N m, m, m/s, N, N, N,
-    N m, W (the friction power on the pair, <= 0; 0 without friction).
+    A lubricated joint adds its film and asperity force at every state
+    (:func:`weftsim.kernel.lubricated.connector_lubricated_force`; F_b, M_j and M_b include them).
+
+    Returns (Q0, Q1, delta, delta_dot, F_bx, F_by, F_N, M_b, F_T v_T, D'_lub, U_a): N m, N m, m, m/s, N,
+    N, N, N m, W (the dry friction power on the pair, <= 0; 0 without friction), the lubricated part's
+    dissipated power (W) and the asperity potential (J) (both 0 for a dry joint).
     """
     l_fg, l_ef = prm[L_FG], prm[L_EF]
     b = a + q1
@@ -210,7 +223,13 @@ def tree_joint_force(prm: np.ndarray, t: float, a: float, q1: float, da: float, 
     b_y, b_z, db_y, db_z, dphi = crank_side(prm, t)
     omega = prm[OMEGA]
     # F_N = hypot of the normal force, as the channels computed it before friction: bit-identical at mu = 0.
-    fx, fy, delta, rate, f_n, f_t, m_j, m_b, v_t = connector_friction_force(
-        prm, px - b_y, py - b_z, vx - omega * db_y, vy - omega * db_z, held, delta0, rate0, db, omega * dphi)
+    lub_power = asperity_energy = 0.0
+    if is_lubricated(prm):
+        fx, fy, delta, rate, f_n, f_t, m_j, m_b, v_t, lub_power, asperity_energy = connector_lubricated_force(
+            prm, px - b_y, py - b_z, vx - omega * db_y, vy - omega * db_z, held, delta0, rate0, db, omega * dphi)[:11]
+    else:
+        fx, fy, delta, rate, f_n, f_t, m_j, m_b, v_t = connector_friction_force(
+            prm, px - b_y, py - b_z, vx - omega * db_y, vy - omega * db_z, held, delta0, rate0, db, omega * dphi)
     g1 = l_ef * (fx * sb - fy * cb) + m_j
-    return l_fg * (fx * sa - fy * ca) + g1, g1, delta, rate, fx, fy, f_n, m_b, f_t * v_t
+    return (l_fg * (fx * sa - fy * ca) + g1, g1, delta, rate, fx, fy, f_n, m_b, f_t * v_t, lub_power,
+            asperity_energy)  # fmt: skip

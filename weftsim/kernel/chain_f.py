@@ -42,6 +42,7 @@ from numba import njit
 from weftsim.kernel import chain as kc
 from weftsim.kernel.joint import BEARING_RADIUS, CLEARANCE, KIND, COEF, MU, N_JOINT, clearance_force, tangential_velocity
 from weftsim.kernel.laws import elastic_force
+from weftsim.kernel.lubricated import L_DISSIPATED, L_FX, L_FY, L_MB, L_MJ, is_lubricated, lubricated_force
 
 if TYPE_CHECKING:
     import numpy as np
@@ -200,6 +201,15 @@ def chain_f(prm: np.ndarray, t: float, y: np.ndarray, contact: int, impact: np.n
     delta_f = math.sqrt(ef_y * ef_y + ef_z * ef_z) - jf[CLEARANCE]
     if contact & 2:
         ff_y, ff_z, ff_n, delta_f, m_jf, m_bf, diss_f = contact_terms(jf, ef_y, ef_z, vf_y, vf_z, dpsi, da, impact[1])
+    # Lubricated joints carry their film at every state (weftsim.kernel.lubricated).
+    if both and is_lubricated(prm):
+        lub = lubricated_force(prm, prm[CLEARANCE], e_y, e_z, ve_y, ve_z, dpsi, w_rocker)
+        fe_y, fe_z, m_je, m_be = fe_y + lub[L_FX], fe_z + lub[L_FY], m_je + lub[L_MJ], m_be + lub[L_MB]
+        diss_e += lub[L_DISSIPATED]
+    if is_lubricated(jf):
+        lub = lubricated_force(jf, jf[CLEARANCE], ef_y, ef_z, vf_y, vf_z, dpsi, da)
+        ff_y, ff_z, m_jf, m_bf = ff_y + lub[L_FX], ff_z + lub[L_FY], m_jf + lub[L_MJ], m_bf + lub[L_MB]
+        diss_f += lub[L_DISSIPATED]
     a = y[0]
     sa, ca = math.sin(a), math.cos(a)
     l_fg, l_ef, omega = prm[kc.L_FG], prm[kc.L_EF], prm[kc.OMEGA]

@@ -34,13 +34,18 @@ if TYPE_CHECKING:
     from weftsim.contact import _Law
     from weftsim.params import ClearanceJoint
 
-# Indices into the joint parameter block.
+# Indices into the joint parameter block: the dry joint's, then the lubrication's (zeros when dry;
+# weftsim.kernel.lubricated reads them).
 (KIND, COEF, CLEARANCE, XI, BEARING_RADIUS, MU, V0, V1, V_MIN, TRACK_MAX, DEAD_RATE) = range(11)  # fmt: skip
-N_JOINT = 11
+(LUBRICATED, VISCOSITY, FILM_MODEL, ROUGHNESS, ASPERITY_COEF, BOUNDARY_MU, FILM_FLOOR, JOURNAL_RADIUS,
+ BEARING_LENGTH) = range(11, 20)  # fmt: skip
+N_JOINT = 20
 
 
 def joint_parameters(joint: ClearanceJoint, law: _Law) -> np.ndarray:
-    """The joint block: the law's (kind, coef, c, xi), R_b, mu, friction ramp, v_min, rule flag, dead zone.
+    """The joint block: the law's (kind, coef, c, xi), R_b, mu, friction ramp, v_min, rule flag, dead zone,
+    then the lubrication (flag, viscosity, film model, roughness, Greenwood-Tripp K E*, boundary mu, film
+    floor, R_j, L_b; zeros for a dry joint).
 
     ``joint``: a :class:`weftsim.params.ClearanceJoint`; ``law``: a law of :mod:`weftsim.contact`
     (its ``parameters``).  ``TRACK_MAX`` is 1.0 under the "max_approach" rule, 0.0 under "onset";
@@ -55,6 +60,20 @@ def joint_parameters(joint: ClearanceJoint, law: _Law) -> np.ndarray:
     out[V_MIN] = joint.min_impact_velocity
     out[TRACK_MAX] = 1.0 if joint.impact_velocity_rule == "max_approach" else 0.0
     out[DEAD_RATE] = RESTING_RATE_FRACTION * joint.min_impact_velocity
+    if joint.lubrication is not None:
+        from weftsim.kernel.asperity import greenwood_tripp_coefficient
+
+        lub = joint.lubrication
+        out[LUBRICATED] = 1.0
+        out[VISCOSITY] = lub.viscosity
+        out[FILM_MODEL] = lub.model_code
+        out[ROUGHNESS] = lub.roughness
+        out[ASPERITY_COEF] = greenwood_tripp_coefficient(lub.asperity_density_radius_roughness,
+                                                         lub.roughness_radius_ratio, joint.effective_modulus)
+        out[BOUNDARY_MU] = lub.boundary_friction_coefficient
+        out[FILM_FLOOR] = lub.film_floor_ratio
+        out[JOURNAL_RADIUS] = joint.journal_radius
+        out[BEARING_LENGTH] = joint.bearing_length
     return out
 
 

@@ -18,7 +18,8 @@ array: numba compiles once per machine (~9 s) and loads from its cache afterward
 The loop (:func:`advance`) returns to Python every 0.1 % of the run (progress) or when its step
 buffer is full; :mod:`.compiled_run` drives it and builds the result.
 
-Methods (``reference_solver.method``): ``"numba_DOP853"``, ``"numba_RK45"``.
+Methods (``reference_solver.method``): ``"numba_DOP853"``, ``"numba_RK45"``, ``"numba_RODAS4"`` (linearly implicit,
+:mod:`.compiled_ros`) and ``"numba_DOP853_RODAS4"`` (DOP853 in free flight, RODAS4 in contact segments).
 """
 
 from __future__ import annotations
@@ -36,12 +37,17 @@ from weftsim.reference.compiled_rk import (
 )  # fmt: skip
 from weftsim.reference.compiled_rk import DENSE as _RK_DENSE
 from weftsim.reference.compiled_rk import NFEV as _RK_NFEV
+from weftsim.reference import compiled_ros as ros
 from weftsim.kernel import roots
 from weftsim.kernel.python import specialize
 from weftsim.kernel.roots import SAMPLES
 from weftsim.reference.integrate import _CONTACT_SUBSTEPS, _ROOT_XTOL
 
-METHODS = {"numba_DOP853": DOP853, "numba_RK45": RK45}
+# RODAS4 (linearly implicit, :mod:`.compiled_ros`) on every step, or only in contact segments with DOP853 in
+# free flight (HYBRID: the stiffness is the contact's and the friction ramp's; free flight is not stiff).
+RODAS4 = ros.RODAS4
+HYBRID = 3
+METHODS = {"numba_DOP853": DOP853, "numba_RK45": RK45, "numba_RODAS4": RODAS4, "numba_DOP853_RODAS4": HYBRID}
 
 
 # Return codes of the core.
@@ -62,17 +68,27 @@ JOINT_SLOTS = np.array([[IMPACT, LAST_PENETRATION, FIRST_CONTACT], [IMPACT_F, LA
 # Guard limits: penetration bound at E (m), shortest accepted step (s), step budget (0: none), bound at F.
 PENETRATION_LIMIT, MIN_STEP_LIMIT, STEP_BUDGET, PENETRATION_LIMIT_F = range(4)
 # Int state: mode (mask of the joints in contact: bit 0 E, bit 1 F), segment to start, counters, next sample.
-CONTACT, START, STEPS, REJECTED, NFEV, DENSE, SEGMENTS, EVENTS, IMPACTS, NEXT_SAMPLE, PEAKS, NONPOSITIVE = range(12)
-N_INT_STATE = 12
+CONTACT, START, STEPS, REJECTED, NFEV, DENSE, SEGMENTS, EVENTS, IMPACTS, NEXT_SAMPLE, PEAKS, NONPOSITIVE, \
+    JACOBIANS, DECOMPOSITIONS, IMPLICIT_STEPS = range(15)
+N_INT_STATE = 15
 assert (NFEV, DENSE) == (_RK_NFEV, _RK_DENSE)  # compiled_rk counts evaluations into the same int state
 # Kinds of event (weftsim.reference.events).
 NO_EVENT, ONSET, SEPARATION, PEAK = 0, 1, 2, 3
 
 
 @njit(cache=True, error_model="numpy")
+def _dense_any(method, F, t_old, h, y_old, t, out):
+    """Dense output of the last step of ``method`` (an explicit one or RODAS4) at time t into out."""
+    if method == RODAS4:
+        ros.dense(F, t_old, h, y_old, t, out)
+    else:
+        _dense(method, F, t_old, h, y_old, t, out)
+
+
+@njit(cache=True, error_model="numpy")
 def _state(t, prm, method, F, t_old, h, y_old, tmp, joint):
     """(delta, delta_dot) of ``joint`` on the dense output of the last step at time t."""
-    _dense(method, F, t_old, h, y_old, t, tmp)
+    _dense_any(method, F, t_old, h, y_old, t, tmp)
     return penetration_at(prm, t, tmp, joint)
 
 
@@ -158,9 +174,13 @@ def advance(prm: np.ndarray, method: int, rtol: float, atol: float, max_step: fl
     y_new = np.empty(n_y)
     tmp = np.empty(n_y)
     scale = np.empty(n_y)
-    order = 7 if method == DOP853 else 4
-    f_row = 12 if method == DOP853 else 6
-    exponent = -1.0 / (order + 1)
+    J = np.zeros((n_y, n_y))
+    E = np.zeros((n_y, n_y))
+    piv = np.zeros(n_y, dtype=np.int64)
+    f_t = np.empty(n_y)
+    plus = np.empty(n_y)
+    minus = np.empty(n_y)
+    arg = np.empty(n_y)
     n_rows = 0
     capacity = stp_t.size
     n_samples = sample_times.size
@@ -182,6 +202,15 @@ def advance(prm: np.ndarray, method: int, rtol: float, atol: float, max_step: fl
         contact = ist[CONTACT]
         for j in range(N_JOINTS):
             impact[j] = fst[JOINT_SLOTS[j, 0]]
+        m = method
+        if method == HYBRID:
+            m = RODAS4 if contact != 0 else DOP853
+        order = 7 if m == DOP853 else 4
+        f_row = 12 if m == DOP853 else 6
+        if m == RODAS4:  # the error estimate k_6 is O(h^4): exponent -1/4 as in the code RODAS
+            exponent, safety, min_factor, max_factor = -1.0 / ros.ORDER, ros.SAFETY, ros.MIN_FACTOR, ros.MAX_FACTOR
+        else:
+            exponent, safety, min_factor, max_factor = -1.0 / (order + 1), _SAFETY, _MIN_FACTOR, _MAX_FACTOR
         if ist[START] == 1:
             _f(prm, t, y, contact, impact, f, ist)
             fst[H_ABS] = _initial_step(prm, t, y, f, t_end, max_step, order, rtol, atol, contact, impact, ist, tmp)
@@ -195,6 +224,9 @@ def advance(prm: np.ndarray, method: int, rtol: float, atol: float, max_step: fl
         min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
         h_abs = min(max(fst[H_ABS], min_step), max_step)
         rejected = False
+        if m == RODAS4:  # one Jacobian per step, kept through rejected attempts from the same (t, y)
+            ros.jacobian(prm, t, y, f, contact, impact, ist, J, f_t, plus, minus, tmp)
+            ist[JACOBIANS] += 1
         while True:
             if h_abs < min_step:
                 return STEP_TOO_SMALL, n_rows
@@ -205,20 +237,25 @@ def advance(prm: np.ndarray, method: int, rtol: float, atol: float, max_step: fl
                 t_new = t_end
             h = t_new - t
             h_abs = abs(h)
-            K[0, :] = f
-            _stages(prm, method, t, y, h, K, contact, impact, ist, y_new, tmp)
-            for j in range(n_y):
-                scale[j] = atol + max(abs(y[j]), abs(y_new[j])) * rtol
-            err = _error_norm(method, K, h, scale)
+            if m == RODAS4:
+                err = ros.step(prm, t, y, h, f, J, f_t, contact, impact, ist, K, E, piv, y_new, F, tmp, arg, rtol,
+                               atol)  # fmt: skip
+                ist[DECOMPOSITIONS] += 1
+            else:
+                K[0, :] = f
+                _stages(prm, m, t, y, h, K, contact, impact, ist, y_new, tmp)
+                for j in range(n_y):
+                    scale[j] = atol + max(abs(y[j]), abs(y_new[j])) * rtol
+                err = _error_norm(m, K, h, scale)
             if not err == err:  # NaN from a non-finite stage: reject and shrink
                 err = math.inf
             if err < 1.0:
-                factor = _MAX_FACTOR if err == 0.0 else min(_MAX_FACTOR, _SAFETY * err ** exponent)
+                factor = max_factor if err == 0.0 else min(max_factor, safety * err ** exponent)
                 if rejected:
                     factor = min(1.0, factor)
                 h_abs *= factor
                 break
-            h_abs *= max(_MIN_FACTOR, _SAFETY * err ** exponent)
+            h_abs *= max(min_factor, safety * err ** exponent)
             rejected = True
             ist[REJECTED] += 1
         fst[H_ABS] = h_abs
@@ -227,6 +264,10 @@ def advance(prm: np.ndarray, method: int, rtol: float, atol: float, max_step: fl
                 return NON_FINITE, n_rows
         ist[STEPS] += 1
         f_new = K[f_row]
+        if m == RODAS4:  # f at the new point: the dense output's last row and the next step's first evaluation
+            ist[IMPLICIT_STEPS] += 1
+            _f(prm, t_new, y_new, contact, impact, f_new, ist)
+            ros.finish_dense(F, h, f_new)
         fst[LAST_STEP] = h if t_new < t_end else math.inf
         breach = limits[STEP_BUDGET] > 0.0 and ist[STEPS] > limits[STEP_BUDGET]
         breach = breach or fst[LAST_STEP] < limits[MIN_STEP_LIMIT]
@@ -262,30 +303,34 @@ def advance(prm: np.ndarray, method: int, rtol: float, atol: float, max_step: fl
             possible = sign * g_new[j] > 0.0 or sign * r_old[j] > 0.0 > sign * r_new[j]
             if not (in_contact or possible):
                 continue
-            if not dense:
-                _dense_coefficients(prm, method, t, y, y_new, f_new, h, K, contact, impact, ist, F, tmp)
-                dense = True
-            j_kind, j_stop, j_value = _events_of_joint(prm, method, F, t, h, y, tmp, j, in_contact, impact[j],
+            if not dense and m != RODAS4:
+                _dense_coefficients(prm, m, t, y, y_new, f_new, h, K, contact, impact, ist, F, tmp)
+            dense = True
+            j_kind, j_stop, j_value = _events_of_joint(prm, m, F, t, h, y, tmp, j, in_contact, impact[j],
                                                        g_old[j], r_old[j], g_new[j], r_new[j], t_new, grid_t, grid_d,
                                                        grid_r, peak_t, peak_r)  # fmt: skip
             if j_kind != NO_EVENT and (kind == NO_EVENT or j_stop < t_stop):
                 kind, t_stop, value, event_joint = j_kind, j_stop, j_value, j
         k = ist[NEXT_SAMPLE]
         while k < n_samples and sample_times[k] <= t_stop:
-            if not dense:
-                _dense_coefficients(prm, method, t, y, y_new, f_new, h, K, contact, impact, ist, F, tmp)
-                dense = True
-            _dense(method, F, t, h, y, sample_times[k], tmp)
+            if not dense and m != RODAS4:
+                _dense_coefficients(prm, m, t, y, y_new, f_new, h, K, contact, impact, ist, F, tmp)
+            dense = True
+            _dense_any(m, F, t, h, y, sample_times[k], tmp)
             _record(smp_t, smp_y, smp_c, smp_i, k, sample_times[k], tmp, contact, impact)
             k += 1
         ist[NEXT_SAMPLE] = k
-        if contact != 0 and _CONTACT_SUBSTEPS > 0:
+        if contact != 0 and m == RODAS4:  # its steps are 3-5x shorter than DOP853's: the midpoint only
+            t_sub = 0.5 * (t + t_stop)
+            _dense_any(m, F, t, h, y, t_sub, tmp)
+            n_rows = _record(stp_t, stp_y, stp_c, stp_i, n_rows, t_sub, tmp, contact, impact)
+        elif contact != 0 and _CONTACT_SUBSTEPS > 0:
             for i in range(_CONTACT_SUBSTEPS):
                 t_sub = t + (t_stop - t) * _SUBSTEPS[i]
-                _dense(method, F, t, h, y, t_sub, tmp)
+                _dense_any(m, F, t, h, y, t_sub, tmp)
                 n_rows = _record(stp_t, stp_y, stp_c, stp_i, n_rows, t_sub, tmp, contact, impact)
         if kind != NO_EVENT:
-            _dense(method, F, t, h, y, t_stop, tmp)
+            _dense_any(m, F, t, h, y, t_stop, tmp)
             t = t_stop
             y[:] = tmp
             ist[EVENTS] += 1

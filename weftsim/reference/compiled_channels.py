@@ -199,9 +199,19 @@ def compiled_channels(scene: Scene, time: np.ndarray, states: np.ndarray, contac
         out = np.empty((time.size, len(CHANNELS)))
         _fill(prm, table, a0, scene.geometry.rapier_ratio, time, states, np.asarray(contact, dtype=np.bool_),
               np.asarray(impact, dtype=float), out)  # fmt: skip
-        return dict(zip(CHANNELS, np.ascontiguousarray(out.T)))
-    names = CHANNELS + JOINT_F_CHANNELS
-    out = np.empty((time.size, len(names)))
-    _fill_f(prm, table, a0, scene.geometry.rapier_ratio, time, states, np.asarray(contact, dtype=np.int64),
-            np.ascontiguousarray(impact, dtype=float).reshape(time.size, 2), out)  # fmt: skip
-    return dict(zip(names, np.ascontiguousarray(out.T)))
+        channels = dict(zip(CHANNELS, np.ascontiguousarray(out.T)))
+    else:
+        names = CHANNELS + JOINT_F_CHANNELS
+        out = np.empty((time.size, len(names)))
+        _fill_f(prm, table, a0, scene.geometry.rapier_ratio, time, states, np.asarray(contact, dtype=np.int64),
+                np.ascontiguousarray(impact, dtype=float).reshape(time.size, 2), out)  # fmt: skip
+        channels = dict(zip(names, np.ascontiguousarray(out.T)))
+    if scene.joint.is_lubricated or scene.joint_f.is_lubricated:
+        # The film and asperity channels; the asperities' potential joins the contact energy (the chain
+        # books only the film's and the boundary friction's work as dissipated, weftsim.kernel.lubricated).
+        from weftsim.lubrication import lubrication_table
+
+        lubricated, asperity_energy = lubrication_table(scene, prm, time, states)
+        channels["contact_energy_J"] = channels["contact_energy_J"] + asperity_energy
+        channels.update(lubricated)
+    return channels

@@ -2,7 +2,8 @@
 chunks (progress, wall-time budget, buffers), applies the run guards of :mod:`weftsim.guards`
 and builds the :class:`~weftsim.results.RunResult` with the compiled channels.
 
-Entry: :func:`solve_compiled` (``reference_solver.method`` = ``"numba_DOP853"`` or ``"numba_RK45"``).
+Entry: :func:`solve_compiled` (``reference_solver.method`` = ``"numba_DOP853"``, ``"numba_RK45"``,
+``"numba_RODAS4"`` or ``"numba_DOP853_RODAS4"``).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ import numpy as np
 from weftsim.guards import RunGuard, failure_message, non_finite_breach
 from weftsim.params import Scene
 from weftsim.reference.compiled import (
-    DENSE, DONE, EVENTS, FIRST_CONTACT, FIRST_CONTACT_F, GUARD, IMPACTS, LAST_PENETRATION, LAST_PENETRATION_F,
+    DECOMPOSITIONS, DENSE, DONE, EVENTS, IMPLICIT_STEPS, JACOBIANS, FIRST_CONTACT, FIRST_CONTACT_F, GUARD, IMPACTS, LAST_PENETRATION, LAST_PENETRATION_F,
     LAST_STEP, MAX_RATE, METHODS, N_FLOAT_STATE, N_INT_STATE, NEXT_SAMPLE, NFEV, NON_FINITE, NONPOSITIVE, PAUSED,
     PEAKS, REJECTED, SEGMENTS, START, STEP_TOO_SMALL, STEPS, T, _STEP_BUFFER,
     advance,
@@ -47,8 +48,12 @@ def _rows(scene: Scene, rows):
 
 
 def integrate_compiled(scene: Scene, progress: Callable[[float], None] | None = None,
-                       method: str = "numba_DOP853") -> tuple[tuple, tuple, dict, dict, str, str]:
+                       method: str = "numba_DOP853",
+                       rtol: float | None = None) -> tuple[tuple, tuple, dict, dict, str, str]:
     """Run the compiled integrator; returns (steps, samples, stats, events, status, message).
+
+    ``rtol``: the relative tolerance, default ``scene.reference_solver.rtol``
+    (:func:`weftsim.reference.effective_rtol` caps it for a stiff joint under "auto").
 
     ``steps`` and ``samples`` are tuples (t, y (n, 6 or 10), contact mask (bit 0 E, bit 1 F), held
     impact velocities (n, 2)) as :func:`weftsim.reference.compiled_channels.compiled_channels` takes them.
@@ -85,7 +90,8 @@ def integrate_compiled(scene: Scene, progress: Callable[[float], None] | None = 
     next_report = _PROGRESS_EVERY
     status, message, failure = "success", "", None
     # scipy raises rtol below 100 eps to it (a warning); the compiled path does the same, silently.
-    rtol = max(settings.rtol, 100.0 * np.finfo(float).eps)
+    rtol_asked = settings.rtol if rtol is None else rtol
+    rtol = max(rtol_asked, 100.0 * np.finfo(float).eps)
     steps_seen = 0
     while True:
         t_pause = next_report * t_end if pausing else 2.0 * t_end
@@ -122,14 +128,15 @@ def integrate_compiled(scene: Scene, progress: Callable[[float], None] | None = 
     steps, samples = _rows(scene, steps), _rows(scene, samples)
     stats = {
         "method": method,
-        "rtol": settings.rtol,
+        "rtol": rtol_asked,
         "atol": settings.atol,
         "max_step_rad": settings.max_step,
         "steps": int(ist[STEPS]),
         "rejected_steps": int(ist[REJECTED]),
         "function_evaluations": int(ist[NFEV]),
-        "jacobian_evaluations": 0,
-        "lu_decompositions": 0,
+        "jacobian_evaluations": int(ist[JACOBIANS]),
+        "lu_decompositions": int(ist[DECOMPOSITIONS]),
+        "implicit_steps": int(ist[IMPLICIT_STEPS]),
         "dense_output_calls": int(ist[DENSE]),
         "segments": int(ist[SEGMENTS]),
         "contact_events": int(ist[EVENTS]),
@@ -155,7 +162,7 @@ def integrate_compiled(scene: Scene, progress: Callable[[float], None] | None = 
 
 
 def solve_compiled(scene: Scene, progress: Callable[[float], None] | None = None, method: str | None = None,
-                   step_states: Callable[..., None] | None = None) -> RunResult:
+                   step_states: Callable[..., None] | None = None, rtol: float | None = None) -> RunResult:
     """The reference engine's clearance mode through the compiled integrator.
 
     ``method``: one of :data:`METHODS`; default ``scene.reference_solver.method``.
@@ -166,7 +173,7 @@ def solve_compiled(scene: Scene, progress: Callable[[float], None] | None = None
     from weftsim.results import empty_channels
 
     steps, samples, stats, events, status, message = integrate_compiled(
-        scene, progress, method or scene.reference_solver.method)
+        scene, progress, method or scene.reference_solver.method, rtol)
     if step_states is not None:
         step_states(*steps)
     wall0 = _time.perf_counter()

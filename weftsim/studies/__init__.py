@@ -7,6 +7,7 @@ name             what                                                           
 ``clearance``    c = 0.01, 0.25, 0.50 mm at 400 rpm, with the ideal joint               Fig. 12
 ``speed``        300, 500, 800 rpm at c = 0.25 mm; amplitude ratios; spectrum           Fig. 13
 ``engines``      reference vs exudyn, c = 0.50 mm at 400 rpm                            Fig. 16
+``regime``       lubricated E: min film ratio, peak force over speed x clearance x oil  -
 ===============  =====================================================================  ========
 
 Each writes into its output directory PNG figures named ``study-*.png``, CSV files of
@@ -21,7 +22,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Callable
 
-from weftsim.studies import clearance, common, contact_law, engines, speed
+from weftsim.studies import clearance, common, contact_law, engines, regime, speed
 from weftsim.studies.common import SimulationFailed, StudyError
 from weftsim.studies.spectrum import Spectrum, acceleration_spectrum, amplitude_spectrum
 
@@ -34,10 +35,11 @@ STUDIES: dict[str, tuple[Callable[..., dict], Callable[[dict], str]]] = {
     "clearance": (clearance.run, clearance.format_report),
     "speed": (speed.run, speed.format_report),
     "engines": (engines.run, engines.format_report),
+    "regime": (regime.run, regime.format_report),
 }
 # name -> the scene keys the study sets itself (refused as overrides), with why
 SETS: dict[str, dict[str, str]] = {"contact-law": contact_law.SETS, "clearance": clearance.SETS, "speed": speed.SETS,
-                                   "engines": engines.SETS}
+                                   "engines": engines.SETS, "regime": regime.SETS}
 
 
 def check_overrides(name: str, overrides: dict | None = None, revolutions: float | None = None) -> None:

@@ -21,7 +21,9 @@ from numba import njit
 
 from weftsim.analysis import time_weights
 from weftsim.kernel.chain import BEARING_RADIUS, OMEGA, chain, eccentricity, local_clearance, rocker_angle
-from weftsim.kernel.joint import tangential_velocity
+from weftsim.kernel.asperity import asperity_half_angle, asperity_load
+from weftsim.kernel.joint import ASPERITY_COEF, BEARING_LENGTH, JOURNAL_RADIUS, ROUGHNESS, tangential_velocity
+from weftsim.kernel.lubricated import is_lubricated
 from weftsim.kernel.wear import contact_half_angle, deposit
 
 if TYPE_CHECKING:
@@ -32,6 +34,10 @@ if TYPE_CHECKING:
 def contact_rows(prm: np.ndarray, time: np.ndarray, states: np.ndarray, contact: np.ndarray, impact: np.ndarray,
                  out: np.ndarray) -> None:
     """Per step row into ``out`` (n, 5): F_N (N), v_T (m/s), psi_b, psi_j (rad), phi0 (rad).
+
+    A lubricated joint: F_N is the load the solids carry, the asperity load F_a plus the dry law's beyond
+    e = c, never the film's (no wear under a full film: F_a = 0 while h_min >= 4 sigma); phi0 then covers
+    the asperity arc too (:func:`weftsim.kernel.asperity.asperity_half_angle`).
 
     ``psi_b``, ``psi_j``: the contact direction n in the bearing's (rocker) and the journal's (rod)
     frame; ``phi0``: half the contact arc (:func:`weftsim.kernel.wear.contact_half_angle`).  Rows
@@ -45,14 +51,23 @@ def contact_rows(prm: np.ndarray, time: np.ndarray, states: np.ndarray, contact:
         ecc_y, ecc_z, v_y, v_z, _, _, dphi = eccentricity(prm, t, y)[:7]
         length = math.sqrt(ecc_y * ecc_y + ecc_z * ecc_z)
         out[i, :] = 0.0
+        c = local_clearance(prm, t, ecc_y, ecc_z, v_y, v_z, y)[0]
+        half_angle = contact_half_angle(c, length - c)
+        if is_lubricated(prm) and length > 0.0:
+            # Mixed lubrication: the solids touch only through the asperities (and the dry law beyond e = c);
+            # the film's load wears nothing.  The arc is where the asperities touch, h < 4 sigma.
+            f_a = asperity_load(prm[ASPERITY_COEF], prm[ROUGHNESS], c, length, prm[JOURNAL_RADIUS],
+                                prm[BEARING_LENGTH])[0]  # fmt: skip
+            if f_a > 0.0:
+                f_n += f_a
+                half_angle = max(half_angle, asperity_half_angle(prm[ROUGHNESS], c, length))
         if f_n > 0.0 and length > 0.0:
-            c = local_clearance(prm, t, ecc_y, ecc_z, v_y, v_z, y)[0]
             direction = math.atan2(ecc_z, ecc_y)
             out[i, 0] = f_n
             out[i, 1] = tangential_velocity(ecc_y, ecc_z, v_y, v_z, length, y[3], prm[OMEGA] * dphi, prm[BEARING_RADIUS])
             out[i, 2] = direction - rocker_angle(prm, t)
             out[i, 3] = direction - y[1]
-            out[i, 4] = contact_half_angle(c, length - c)
+            out[i, 4] = half_angle
 
 
 @njit(cache=True, error_model="numpy")

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.analysis import channel_statistics
+from weftsim.analysis import channel_statistics, time_weights
 from weftsim.errors import WearError
 from weftsim.wear.archard import run_wear
 
@@ -31,6 +31,10 @@ if TYPE_CHECKING:
     from weftsim.wear.archard import RunWear
 
 SECONDS_PER_HOUR = 3600.0
+# Film ratio h_min / sigma below which a lubricated joint runs mixed (asperities carry part of the load;
+# above ~3 the film separates the surfaces: hydrodynamic).  The response's ``mixed_fraction`` is the time
+# share of the steady cycle below it.
+MIXED_FILM_RATIO = 3.0
 # Solver tolerance of the runs on a worn geometry: at the reference engine's default (rtol 1e-5) the
 # separation search misses a few exits of the journal from the worn part of the wall and the run's
 # contact-history check fails (measured: 4 steps down to -1.2e-7 m on the reference loom's sixth
@@ -93,10 +97,16 @@ def _response(steps: dict, t0: float) -> dict:
     acc = channel_statistics(t, steps["rapier_acceleration_m_s2"][keep])
     torque = channel_statistics(t, steps["driving_torque_Nm"][keep])
     force = channel_statistics(t, steps["contact_force_N"][keep])
+    film = {"film_ratio_min": math.nan, "film_ratio_mean": math.nan, "mixed_fraction": math.nan}
+    if "film_ratio" in steps:  # a lubricated joint E: the film ratio over the steady cycle
+        ratio = steps["film_ratio"][keep]
+        weights = time_weights(t)
+        film = {"film_ratio_min": float(ratio.min()), "film_ratio_mean": float(np.dot(weights, ratio) / weights.sum()),
+                "mixed_fraction": float(np.dot(weights, ratio < MIXED_FILM_RATIO) / weights.sum())}
     return {"rapier_acceleration_rms_m_s2": acc["rms"], "rapier_acceleration_p99_m_s2": acc["p99_abs"],
             "driving_torque_rms_Nm": torque["rms"], "driving_torque_p99_Nm": torque["p99_abs"],
             "contact_force_mean_N": force["mean"], "contact_force_p99_N": force["p99"],
-            "contact_force_max_N": force["max"]}
+            "contact_force_max_N": force["max"], **film}
 
 
 def simulate_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray) -> tuple[RunWear, dict]:

@@ -23,7 +23,7 @@ if TYPE_CHECKING:
 STATE = "wear_state.npz"
 RESPONSE = ("rapier_acceleration_rms_m_s2", "rapier_acceleration_p99_m_s2", "driving_torque_rms_Nm",
             "driving_torque_p99_Nm", "contact_force_mean_N", "contact_force_p99_N", "contact_force_max_N",
-            "solver_rtol")
+            "solver_rtol", "film_ratio_min", "film_ratio_mean", "mixed_fraction")
 
 
 class StateMismatch(ValueError):
@@ -48,7 +48,7 @@ def save_state(outdir: Path, scene: Scene, updates: list[Update]) -> Path:
         "journal": np.array([u.journal for u in updates]),
         "rate_bearing": np.array([u.rate_bearing for u in updates]),
         "rate_journal": np.array([u.rate_journal for u in updates]),
-        "response": np.array([[u.response[k] for k in RESPONSE] for u in updates]),
+        "response": np.array([[u.response.get(k, math.nan) for k in RESPONSE] for u in updates]),
     }
 
     def write(tmp: Path) -> None:
@@ -95,7 +95,7 @@ def table(scene: Scene, updates: list[Update]) -> dict[str, np.ndarray]:
         "wear_volume_mm3": 1e9 * volumes(updates),
     }
     for key in RESPONSE:
-        col[key] = [u.response[key] for u in updates]
+        col[key] = [u.response.get(key, math.nan) for u in updates]
     return {k: np.asarray(v, dtype=float) for k, v in col.items()}
 
 

@@ -1,0 +1,132 @@
+"""Force of a lubricated clearance joint: oil film + asperity contact + the dry law (the one definition).
+
+A lubricated joint (``joint.lubrication``, the block of :mod:`.joint` from ``LUBRICATED`` on) is loaded
+at every eccentricity, in contact or not::
+
+    f_journal = f_film(e*, e_dot*, omega_j, omega_b)        oil film, :func:`weftsim.kernel.film.film_force`
+              - F_a(|e|) n + F_Ta t                         asperities (Greenwood-Tripp, :mod:`.asperity`)
+                                                            and boundary friction on their load
+              + f_dry                                       the dry law beyond |e| = c (:mod:`.joint`)
+
+- **Film.** Evaluated at |e*| = min(|e|, c - h_floor), h_floor = ``film_floor_ratio`` sigma: below a film
+  of h_floor its pressure field is held (the smooth-surface Reynolds film means nothing much thinner than
+  the roughness) and the asperities carry the rest.  e* keeps the direction of e; e_dot* keeps the
+  radial rate d|e|/dt and the whirl rate (e x e_dot)/|e|^2 (its tangential part scaled by |e*|/|e|), so
+  the squeeze and wedge terms see the true motion.  The film force then stays finite where the dry law
+  starts (its squeeze term grows as (1 - eps^2)^-2.5 towards eps = 1).  The film's shear torques act on
+  journal and bearing; its power -(f.e_dot + T_j omega_j + T_b omega_b) is dissipated.
+- **Asperities.** F_a(|e|) of :func:`weftsim.kernel.asperity.asperity_load`, zero while h_min >= 4 sigma,
+  held at its value at |e| = c beyond c; it has a potential U_a (stored, not dissipated).  Boundary
+  friction F_Ta = -mu_b c_d(v_T) F_a sign(v_T) acts at the contact point Q = P_b + R_b n with the moments
+  of the dry friction, M_j = (R_b - |e|) F_Ta, M_b = -R_b F_Ta (:func:`weftsim.kernel.joint.friction_force`
+  with mu_b and the joint's friction ramp).
+- **Dry law.** Unchanged (:func:`weftsim.kernel.joint.clearance_force_at`): zero at |e| = c and growing
+  from there, so the total radial force is continuous in |e| (film and asperity terms are continuous and
+  held constant in |e| beyond their limits, the dry law starts from 0).
+
+Dissipated power of the film and the boundary friction, the part of the power the asperity potential does
+not store: D' = -(f_l.e_dot + M_lj omega_j + M_lb omega_b) - F_a d|e|/dt.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from weftsim.kernel.asperity import asperity_load
+from weftsim.kernel.film import film_force
+from weftsim.kernel.joint import (
+    ASPERITY_COEF, BEARING_LENGTH, BEARING_RADIUS, BOUNDARY_MU, CLEARANCE, FILM_FLOOR, FILM_MODEL, JOURNAL_RADIUS, LUBRICATED,
+    ROUGHNESS, V0, V1, VISCOSITY, connector_friction_force, tangential_velocity,
+)  # fmt: skip
+from weftsim.kernel.laws import friction_factor
+
+# Outputs of lubricated_force, in order (the channels of weftsim.lubrication read them by these indices).
+(L_FX, L_FY, L_MJ, L_MB, L_FILM, L_ASPERITY, L_FILM_TORQUE, L_ASPERITY_ENERGY, L_DISSIPATED, L_FILM_POWER) = range(10)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def is_lubricated(prm) -> bool:
+    """True when the joint block ``prm`` has an oil film (``joint.lubrication`` given)."""
+    return prm[LUBRICATED] != 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def film_at_floor(prm, clearance: float, ex: float, ey: float, vx: float, vy: float, w_j: float,
+                  w_b: float) -> tuple[float, float, float, float]:
+    """Film force on the journal and shear torques (f_x, f_y, T_j, T_b), N and N m, with |e| held at
+    c - h_floor at most (module docstring); zeros at zero viscosity."""
+    viscosity = prm[VISCOSITY]
+    if viscosity <= 0.0:
+        return 0.0, 0.0, 0.0, 0.0
+    length = math.sqrt(ex * ex + ey * ey)
+    cap = clearance - prm[FILM_FLOOR] * prm[ROUGHNESS]
+    if length > cap:
+        nx, ny = ex / length, ey / length
+        radial = vx * nx + vy * ny
+        scale = cap / length
+        tx, ty = vx - radial * nx, vy - radial * ny
+        ex, ey = cap * nx, cap * ny
+        vx, vy = radial * nx + scale * tx, radial * ny + scale * ty
+    return film_force(ex, ey, vx, vy, w_j, w_b, clearance, prm[JOURNAL_RADIUS], prm[BEARING_LENGTH], viscosity,
+                      int(prm[FILM_MODEL]))  # fmt: skip
+
+
+@njit(cache=True, error_model="numpy")
+def lubricated_force(prm, clearance: float, ex: float, ey: float, vx: float, vy: float, w_j: float,
+                     w_b: float) -> tuple[float, ...]:
+    """Film and asperity force of a lubricated joint (block ``prm``) at eccentricity e and its rate.
+
+    ``clearance``: the local clearance along e (m; the round joint's c); ``w_j``, ``w_b``: angular
+    velocities of journal and bearing about the joint axis (rad/s).  The dry law is not included
+    (:func:`weftsim.kernel.joint.clearance_force_at` adds it in contact).
+
+    Returns
+    -------
+    (f_x, f_y, M_j, M_b, |f_film|, F_a, T_j, U_a, D', P_film): force on the journal (N), moments on
+    journal and bearing about their centres (N m; film shear torques + boundary friction), the film
+    force's magnitude (N), the asperity load (N), the film's shear torque on the journal (N m), the
+    asperity potential (J), the dissipated power (W, module docstring) and the film's part of it (W).
+    Indices: ``L_FX`` ... ``L_FILM_POWER``.
+    """
+    ffx, ffy, t_j, t_b = film_at_floor(prm, clearance, ex, ey, vx, vy, w_j, w_b)
+    film_power = -(ffx * vx + ffy * vy + t_j * w_j + t_b * w_b)
+    length = math.sqrt(ex * ex + ey * ey)
+    r_j, l_b = prm[JOURNAL_RADIUS], prm[BEARING_LENGTH]
+    f_a, u_a = asperity_load(prm[ASPERITY_COEF], prm[ROUGHNESS], clearance, length, r_j, l_b)
+    fx, fy, m_j, m_b = ffx, ffy, t_j, t_b
+    dissipated = film_power
+    if f_a > 0.0 and length > 0.0:
+        nx, ny = ex / length, ey / length
+        f_t = 0.0
+        mu_b = prm[BOUNDARY_MU]
+        r_b = prm[BEARING_RADIUS]
+        if mu_b > 0.0:
+            v_t = tangential_velocity(ex, ey, vx, vy, length, w_j, w_b, r_b)
+            c_d = friction_factor(v_t, prm[V0], prm[V1])
+            if c_d > 0.0:
+                f_t = -mu_b * c_d * f_a if v_t > 0.0 else mu_b * c_d * f_a
+            dissipated -= f_t * v_t  # -F_Ta v_T >= 0
+        fx += -f_a * nx - f_t * ny
+        fy += -f_a * ny + f_t * nx
+        m_j += (r_b - length) * f_t
+        m_b += -r_b * f_t
+    return fx, fy, m_j, m_b, math.hypot(ffx, ffy), f_a, t_j, u_a, dissipated, film_power
+
+
+@njit(cache=True, error_model="numpy")
+def connector_lubricated_force(prm, ex: float, ey: float, vx: float, vy: float, held: float, delta0: float,
+                               rate0: float, omega_j: float, omega_b: float) -> tuple[float, ...]:
+    """:func:`weftsim.kernel.joint.connector_friction_force` with the film and asperity terms (Exudyn).
+
+    Returns the same nine values (the force on the bearing, now - f_journal of :func:`lubricated_force`
+    added; M_j, M_b including the film's torques and the boundary friction), then the lubricated part's
+    dissipated power D' (W), the asperity potential U_a (J), the film force's magnitude (N), the
+    asperity load F_a (N) and the film's shear torque on the journal T_j (N m).
+    """
+    fx, fy, delta, rate, f_n, f_t, m_j, m_b, v_t = connector_friction_force(prm, ex, ey, vx, vy, held, delta0,
+                                                                            rate0, omega_j, omega_b)  # fmt: skip
+    lub = lubricated_force(prm, prm[CLEARANCE], ex, ey, vx, vy, omega_j, omega_b)
+    return (fx - lub[L_FX], fy - lub[L_FY], delta, rate, f_n, f_t, m_j + lub[L_MJ], m_b + lub[L_MB], v_t,
+            lub[L_DISSIPATED], lub[L_ASPERITY_ENERGY], lub[L_FILM], lub[L_ASPERITY], lub[L_FILM_TORQUE])  # fmt: skip

@@ -1,0 +1,211 @@
+"""Linearly implicit (Rosenbrock) step of the compiled reference path (numba): RODAS4.
+
+RODAS4 of Hairer & Wanner (Solving Ordinary Differential Equations II, 2nd ed., Springer 1996,
+section IV.7; the coefficients of their code RODAS, the method of order 4 with an embedded order 3,
+L-stable and stiffly accurate) in the form of that section, eq. (7.4'): with E = I / (h gamma) - J,
+
+    E k_i = f(t + c_i h, y + sum_j a_ij k_j) + sum_j (c_ij / h) k_j + h d_i df/dt,   i = 1..6,
+
+the embedded solution y + sum_j a_5j k_j + k_5 and the solution y_new = that + k_6, so k_6 is the
+local error estimate.  Dense output: the cubic Hermite interpolant of (y, f) at both ends of the step
+(f at the end is the next step's first evaluation, so it costs nothing), local error O(h^4), C^1 across
+steps:
+
+    y(t + s h) = h00(s) y + h10(s) h f(t, y) + h01(s) y_new + h11(s) h f(t + h, y_new).
+
+Each step solves 6 linear systems with one LU decomposition of E, so its step size is set by
+accuracy, not by the stiffness of a lasting contact or of the friction ramp (the explicit DOP853
+steps at ~1e-9 s where the journal sticks: the ramp's slope mu F_N / (v1 - v0) ~ 1e7-1e8 N s/m).
+
+The Jacobian J = df/dy and df/dt come from the one kernel (:func:`weftsim.kernel.chain_f.rhs_any`) by forward
+differences with fixed, small perturbations (:data:`JAC_STEP_Q`, :data:`JAC_STEP_V`, :data:`JAC_STEP_T`) from
+f(t, y), which the step needs anyway: n - 1 evaluations (5 for the 2-DOF chain).  The quadrature states W3 and
+D are not read by the right-hand side, so their columns are zero and are not perturbed.  Accuracy, measured in
+``tests/test_rosenbrock.py`` against an extrapolated central difference: relative error 5e-8-7e-6 inside a
+contact with friction (central differences: 2e-8-8e-7, at twice the evaluations and no measurable gain in
+steps or peaks; docs/reference-solver.md section 3, "Linearly implicit path").  At delta = 0 and at the kinks
+of the friction ramp no difference is a derivative; the step's error control rejects what that spoils.
+
+Every function is module-level ``@njit(cache=True, error_model="numpy")``;
+:mod:`weftsim.reference.compiled` drives them in its event-driven loop.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from weftsim.reference.compiled_rk import _f
+
+RODAS4 = 2  # method code next to compiled_rk.DOP853 (0) and RK45 (1)
+ORDER = 4  # of the solution; the error estimate k_6 is O(h^4), so the step-size exponent is 1/4
+# Perturbations of the forward differences: coordinates (rad, or m for the free rod's centre) and their
+# rates (rad/s, m/s), and time (s).  1e-9 rad moves the journal by ~0.3 nm, against penetrations of
+# 1e-7-1e-5 m (truncation ~ (0.3 nm / delta)^2, < 1e-5); the rates by ~0.3 nm/s, far inside the
+# friction ramp of 1e-4 m/s.  Round-off ~ eps |f| / 1e-9 ~ 1e-3 rad/s^2 against derivatives of 1e3-1e9;
+# truncation ~ (0.3 nm / delta), 1e-5 at delta = 30 um.
+JAC_STEP_Q = 1e-9
+JAC_STEP_V = 1e-9
+JAC_STEP_T = 1e-10
+N_QUADRATURES = 2  # W3 and D at the end of the state: not read by the right-hand side
+
+GAMMA = 0.25
+C = np.array([0.0, 0.386, 0.21, 0.63, 1.0, 1.0])
+D = np.array([0.25, -0.1043, 0.1035, -0.3620000000000023e-01, 0.0, 0.0])
+A = np.zeros((6, 6))
+A[1, 0] = 0.1544000000000000e+01
+A[2, 0], A[2, 1] = 0.9466785280815826e+00, 0.2557011698983284e+00
+A[3, 0], A[3, 1], A[3, 2] = 0.3314825187068521e+01, 0.2896124015972201e+01, 0.9986419139977817e+00
+A[4, 0], A[4, 1], A[4, 2], A[4, 3] = (0.1221224509226641e+01, 0.6019134481288629e+01, 0.1253708332932087e+02,
+                                      -0.6878860361058950e+00)  # fmt: skip
+A[5, :4] = A[4, :4]
+A[5, 4] = 1.0
+CC = np.zeros((6, 6))
+CC[1, 0] = -0.5668800000000000e+01
+CC[2, 0], CC[2, 1] = -0.2430093356833875e+01, -0.2063599157091915e+00
+CC[3, 0], CC[3, 1], CC[3, 2] = -0.1073529058151375e+00, -0.9594562251023355e+01, -0.2047028614809616e+02
+CC[4, 0], CC[4, 1], CC[4, 2], CC[4, 3] = (0.7496443313967647e+01, -0.1024680431464352e+02, -0.3399990352819905e+02,
+                                          0.1170890893206160e+02)  # fmt: skip
+CC[5, 0], CC[5, 1], CC[5, 2], CC[5, 3], CC[5, 4] = (0.8083246795921522e+01, -0.7981132988064893e+01,
+                                                    -0.3152159432874371e+02, 0.1631930543123136e+02,
+                                                    -0.6058818238834054e+01)  # fmt: skip
+# Step-size control of the code RODAS: factor = 0.9 err^(-1/4) within [1/5, 6].
+SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 6.0
+
+
+@njit(cache=True, error_model="numpy")
+def jacobian(prm, t, y, f0, contact, impact, ist, J, f_t, plus, minus, tmp):
+    """J = df/dy (n, n) and f_t = df/dt (n,) at (t, y) by forward differences of the kernel from f0 = f(t, y).
+
+    Columns of W3 and D stay zero (the right-hand side does not read them).  n - 1 evaluations.
+    """
+    n = y.size
+    n_mech = n - N_QUADRATURES
+    half = n_mech // 2
+    J[:, :] = 0.0
+    tmp[:] = y
+    for j in range(n_mech):
+        step = JAC_STEP_Q if j < half else JAC_STEP_V
+        tmp[j] = y[j] + step
+        _f(prm, t, tmp, contact, impact, plus, ist)
+        tmp[j] = y[j]
+        inv = 1.0 / step
+        for i in range(n):
+            J[i, j] = (plus[i] - f0[i]) * inv
+    _f(prm, t + JAC_STEP_T, y, contact, impact, plus, ist)
+    for i in range(n):
+        f_t[i] = (plus[i] - f0[i]) * (1.0 / JAC_STEP_T)
+
+
+@njit(cache=True, error_model="numpy")
+def lu_factor(M, piv):
+    """In-place LU decomposition with partial pivoting of a small dense matrix; False if singular."""
+    n = M.shape[0]
+    for k in range(n):
+        p = k
+        big = abs(M[k, k])
+        for i in range(k + 1, n):
+            if abs(M[i, k]) > big:
+                big = abs(M[i, k])
+                p = i
+        piv[k] = p
+        if big == 0.0 or not math.isfinite(big):
+            return False
+        if p != k:
+            for j in range(n):
+                M[k, j], M[p, j] = M[p, j], M[k, j]
+        inv = 1.0 / M[k, k]
+        for i in range(k + 1, n):
+            m = M[i, k] * inv
+            M[i, k] = m
+            if m != 0.0:
+                for j in range(k + 1, n):
+                    M[i, j] -= m * M[k, j]
+    return True
+
+
+@njit(cache=True, error_model="numpy")
+def lu_solve(M, piv, b):
+    """Solve in place with the factors of :func:`lu_factor`."""
+    n = M.shape[0]
+    for k in range(n):
+        p = piv[k]
+        if p != k:
+            b[k], b[p] = b[p], b[k]
+    for i in range(n):
+        acc = b[i]
+        for j in range(i):
+            acc -= M[i, j] * b[j]
+        b[i] = acc
+    for i in range(n - 1, -1, -1):
+        acc = b[i]
+        for j in range(i + 1, n):
+            acc -= M[i, j] * b[j]
+        b[i] = acc / M[i, i]
+
+
+@njit(cache=True, error_model="numpy")
+def step(prm, t, y, h, f0, J, f_t, contact, impact, ist, K, E, piv, y_new, F, tmp, arg, rtol, atol):
+    """One RODAS4 step of length h from (t, y) with f0 = f(t, y): y_new, the dense rows F[0:3], error norm.
+
+    Returns the RMS norm of k_6 scaled by atol + rtol max(|y|, |y_new|) (as the explicit methods),
+    inf when the matrix is singular or a stage is not finite.
+    """
+    n = y.size
+    inv_hg = 1.0 / (h * GAMMA)
+    for i in range(n):
+        for j in range(n):
+            E[i, j] = -J[i, j]
+        E[i, i] += inv_hg
+    if not lu_factor(E, piv):
+        return math.inf
+    for s in range(6):
+        if s == 0:
+            tmp[:] = f0
+        else:
+            for i in range(n):
+                acc = 0.0
+                for r in range(s):
+                    acc += A[s, r] * K[r, i]
+                arg[i] = y[i] + acc
+            _f(prm, t + C[s] * h, arg, contact, impact, tmp, ist)
+        for i in range(n):
+            acc = tmp[i] + h * D[s] * f_t[i]
+            for r in range(s):
+                acc += CC[s, r] / h * K[r, i]
+            K[s, i] = acc
+        lu_solve(E, piv, K[s])
+    err = 0.0
+    for i in range(n):
+        y_new[i] = arg[i] + K[5, i]
+        if not math.isfinite(y_new[i]):
+            return math.inf
+        e = K[5, i] / (atol + rtol * max(abs(y[i]), abs(y_new[i])))
+        err += e * e
+    for i in range(n):
+        F[0, i] = y_new[i]
+        F[1, i] = h * f0[i]
+    return math.sqrt(err / n)
+
+
+@njit(cache=True, error_model="numpy")
+def finish_dense(F, h, f_new):
+    """Complete the dense rows with h f(t + h, y_new) (evaluated by the caller for the next step anyway)."""
+    for i in range(f_new.size):
+        F[2, i] = h * f_new[i]
+
+
+@njit(cache=True, error_model="numpy")
+def dense(F, t_old, h, y_old, t, out):
+    """Cubic Hermite interpolation of the last step at time t (module docstring), O(h^4) locally."""
+    s = (t - t_old) / h
+    s2 = s * s
+    s3 = s2 * s
+    h00 = 2.0 * s3 - 3.0 * s2 + 1.0
+    h10 = s3 - 2.0 * s2 + s
+    h01 = 1.0 - h00
+    h11 = s3 - s2
+    for i in range(y_old.size):
+        out[i] = h00 * y_old[i] + h10 * F[1, i] + h01 * F[0, i] + h11 * F[2, i]
