@@ -65,8 +65,7 @@ def _write(tmp_path, text):
 
 
 @pytest.mark.parametrize("text, expected", [
-    ("[joint_f]\nclearance_mm = 0.25\n", "missing required keys joint_f.journal_radius_mm"),
-    ("[joint_f]\nlaw = 'flores'\n", "missing required keys joint_f.clearance_mm"),
+    ("[joint_f]\nlaw = 'flores'\n", "key 'joint_f.law' describes the clearance joint at F, but joint F is ideal"),
     ("[joint_f]\nclearance_mm = -1\n", "key 'joint_f.clearance_mm' must be >= 0"),
     ("[joint_f]\nclearance_mn = 0.25\n", "unknown key 'joint_f.clearance_mn'"),
 ])

@@ -26,8 +26,11 @@ engine computed:
 the crank angle theta = omega t gives the rocker angle phi(theta) (:func:`weftsim.spherical.rocker_angle`)
 and so the bearing centre P_b = L_OE u(theta_OE0 + phi); the eccentricity channels give the journal
 centre P_j = P_b + e; the rapier displacement gives the sector angle
-theta_FG = theta_FG(0) + s / (d5 d7 / d6) and so F = G + L_FG u(theta_FG). The rod length ``|F - P_j|``
-is then a check of the engine's closure, not an input (``weftsim animate`` reports it).
+theta_FG = theta_FG(0) + s / (d5 d7 / d6) and so F = G + L_FG u(theta_FG), the centre of the sector's
+eye. With a clearance at F the rod's pin there is P_jF = F + e_F (the F eccentricity channels), and the
+rod is drawn from P_j to P_jF. The rod length ``|P_jF - P_j|`` is then a check of the engine's
+closure, not an input (``weftsim animate`` reports it). Each joint with a clearance is drawn as its
+clearance circle, magnified, with its journal centre; an ideal joint as a plain pin.
 """
 
 from __future__ import annotations
@@ -70,7 +73,7 @@ class MechanismFrames:
     bearing, journal : ndarray, shape (n, 2)
         Bearing centre P_b (point E of rocker 3) and journal centre P_j = P_b + e (point E of rod 4).
     point_f : ndarray, shape (n, 2)
-        Joint F between rod 4 and sector 5.
+        Joint F between rod 4 and sector 5: the centre of the sector's eye (the bearing at F).
     point_g : ndarray, shape (2,)
         Sector pivot G = (L_OG, 0).
     eccentricity : ndarray, shape (n, 2)
@@ -80,7 +83,13 @@ class MechanismFrames:
     rapier_displacement : ndarray, shape (n,)
         s, m, positive into the shed.
     clearance, axis_length : float
-        Radial clearance c and the display length of the axes, m.
+        Radial clearance c at E and the display length of the axes, m.
+    eccentricity_f : ndarray, shape (n, 2)
+        e_F = P_jF - F at joint F (zero where F is ideal).
+    in_contact_f : ndarray of bool, shape (n,)
+        Whether the rod's pin touches the sector's eye at F.
+    clearance_f : float
+        Radial clearance at F, m (0: ideal joint).
     """
 
     time_s: np.ndarray
@@ -96,11 +105,23 @@ class MechanismFrames:
     rapier_displacement: np.ndarray
     clearance: float
     axis_length: float
+    eccentricity_f: np.ndarray | None = None
+    in_contact_f: np.ndarray | None = None
+    clearance_f: float = 0.0
+
+    @property
+    def journal_f(self) -> np.ndarray:
+        """The rod's pin at F, P_jF = F + e_F (F itself where the joint is ideal), m."""
+        return self.point_f if self.eccentricity_f is None else self.point_f + self.eccentricity_f
 
     @property
     def rod_length(self) -> np.ndarray:
-        """``|F - P_j|`` at each frame, m: the closure check (L_EF for a consistent run)."""
-        return np.hypot(*(self.point_f - self.journal).T)
+        """``|P_jF - P_j|`` at each frame, m: the closure check (L_EF for a consistent run)."""
+        return np.hypot(*(self.journal_f - self.journal).T)
+
+    def joints(self) -> list[tuple[str, float]]:
+        """(name, clearance) of each joint with a clearance, E before F."""
+        return [(name, c) for name, c in (("E", self.clearance), ("F", self.clearance_f)) if c > 0.0]
 
 
 def _unit(angle) -> np.ndarray:
@@ -160,6 +181,9 @@ def mechanism_frames(result: RunResult, frames: int = DEFAULT_FRAMES) -> Mechani
     theta_fg = theta_fg0 + steps["rapier_displacement_m"][rows] / g.rapier_ratio
     point_g = np.array([g.l_og, 0.0])
     length = AXIS_DISPLAY_LENGTH * g.l_oe
+    loose_f = not scene.joint_f.is_ideal and "eccentricity_f_y_m" in steps
+    ecc_f = (np.column_stack([steps["eccentricity_f_y_m"][rows], steps["eccentricity_f_z_m"][rows]]) if loose_f
+             else np.zeros((rows.size, 2)))
     return MechanismFrames(
         time_s=time,
         crank_angle_deg=np.degrees(theta) % 360.0,
@@ -174,6 +198,9 @@ def mechanism_frames(result: RunResult, frames: int = DEFAULT_FRAMES) -> Mechani
         rapier_displacement=steps["rapier_displacement_m"][rows],
         clearance=scene.joint.clearance,
         axis_length=length,
+        eccentricity_f=ecc_f,
+        in_contact_f=(steps["in_contact_f"][rows] > 0.5) if loose_f else np.zeros(rows.size, dtype=bool),
+        clearance_f=scene.joint_f.clearance if loose_f else 0.0,
     )
 
 
@@ -202,31 +229,41 @@ def _linkage_artists(ax, frames: MechanismFrames, magnification: float):
     arm, = ax.plot([], [], color="tab:green", lw=4, solid_capstyle="round", label="rocker arm OE (3)")
     rod, = ax.plot([], [], color="tab:blue", lw=4, solid_capstyle="round", label="rod EF (4)")
     sector, = ax.plot([], [], color="tab:orange", lw=4, solid_capstyle="round", label="sector arm FG (5)")
-    magnified = frames.clearance > 0.0
-    ring = Circle((0.0, 0.0), magnification * frames.clearance, fill=False, color="k", lw=1.0, zorder=5)
-    journal, = ax.plot([], [], marker="o", ms=6, color="tab:blue", ls="none", zorder=6,
-                       label="journal centre (red: in contact)")
-    trail, = ax.plot([], [], color="tab:red", lw=0.7, alpha=0.6, zorder=5)
-    if magnified:
-        ax.add_patch(ring)
-        label = ax.text(0.0, 0.0, f"clearance x{magnification:g}", fontsize=8, ha="left", va="bottom")
-    else:
-        label = ax.text(0.0, 0.0, "ideal joint", fontsize=8, ha="left", va="bottom")
-    moving = (crank, rocker, arm, rod, sector, journal, trail, ring, label)
+    ecc_f = frames.eccentricity_f if frames.eccentricity_f is not None else np.zeros_like(frames.eccentricity)
+    contact_f = frames.in_contact_f if frames.in_contact_f is not None else np.zeros(len(ecc_f), dtype=bool)
+    # Per joint: its bearing centres, eccentricities, contact flags and clearance.
+    joints = (("E", frames.bearing, frames.eccentricity, frames.in_contact, frames.clearance),
+              ("F", frames.point_f, ecc_f, contact_f, frames.clearance_f))
+    moving_joints = []
+    for index, (name, centres, ecc, contact, clearance) in enumerate(joints):
+        ring = Circle((0.0, 0.0), magnification * clearance, fill=False, color="k", lw=1.0, zorder=5)
+        journal, = ax.plot([], [], marker="o", ms=6, color="tab:blue", ls="none", zorder=6,
+                           label="journal centre (red: in contact)" if index == 0 else None)
+        trail, = ax.plot([], [], color="tab:red", lw=0.7, alpha=0.6, zorder=5)
+        if clearance > 0.0:
+            ax.add_patch(ring)
+            text = f"clearance at {name} x{magnification:g}"
+        else:
+            ring.set_visible(False)
+            text = f"ideal joint {name}"
+        label = ax.text(0.0, 0.0, text, fontsize=8, ha="left", va="bottom")
+        moving_joints.append((centres, ecc, contact, clearance, ring, journal, trail, label))
+    moving = (crank, rocker, arm, rod, sector) + tuple(a for j in moving_joints for a in j[4:])
 
     def move(k: int):
-        e, j, f = frames.bearing[k], frames.journal[k], frames.point_f[k]
+        e, j, f = frames.bearing[k], frames.journal[k], frames.journal_f[k]
         crank.set_data([0.0, frames.crank_axis_tip[k, 0]], [0.0, frames.crank_axis_tip[k, 1]])
         rocker.set_data([0.0, frames.rocker_axis_tip[k, 0]], [0.0, frames.rocker_axis_tip[k, 1]])
         arm.set_data([0.0, e[0]], [0.0, e[1]])
         rod.set_data([j[0], f[0]], [j[1], f[1]])
-        sector.set_data([f[0], frames.point_g[0]], [f[1], frames.point_g[1]])
-        drawn = e + magnification * frames.eccentricity[: k + 1]
-        journal.set_data([drawn[-1, 0]], [drawn[-1, 1]])
-        journal.set_color("tab:red" if frames.in_contact[k] else "tab:blue")
-        trail.set_data(drawn[-12:, 0], drawn[-12:, 1])
-        ring.center = tuple(e)
-        label.set_position((e[0] + 1.2 * magnification * frames.clearance + 0.004, e[1]))
+        sector.set_data([frames.point_f[k, 0], frames.point_g[0]], [frames.point_f[k, 1], frames.point_g[1]])
+        for centres, ecc, contact, clearance, ring, journal, trail, label in moving_joints:
+            drawn = centres[k] + magnification * ecc[max(k - 11, 0): k + 1]
+            journal.set_data([drawn[-1, 0]], [drawn[-1, 1]])
+            journal.set_color("tab:red" if contact[k] else "tab:blue")
+            trail.set_data(drawn[:, 0], drawn[:, 1])
+            ring.center = tuple(centres[k])
+            label.set_position((centres[k][0] + 1.2 * magnification * clearance + 0.004, centres[k][1]))
 
     return move, moving
 
@@ -276,8 +313,8 @@ def animation_figure(result: RunResult, frames: MechanismFrames,
     from weftsim.plots import figure
 
     scene = result.scene
-    if magnification is None:
-        magnification = clearance_magnification(frames.clearance, scene.geometry.l_ef)
+    if magnification is None:  # one scale for both joints, set by the larger clearance
+        magnification = clearance_magnification(max(frames.clearance, frames.clearance_f), scene.geometry.l_ef)
     fig = figure(figsize=(7.0, 6.0))
     grid = fig.add_gridspec(2, 1, height_ratios=(5, 1))
     ax, strip = fig.add_subplot(grid[0]), fig.add_subplot(grid[1])
@@ -296,17 +333,17 @@ def animation_figure(result: RunResult, frames: MechanismFrames,
     stroke = float(np.ptp(linkage_state(np.linspace(0.0, 2.0 * math.pi, 721), scene.geometry).rapier_displacement))
     move_rapier, rapier = _rapier_artists(strip, frames, stroke)
     rpm = scene.drive.speed * 30.0 / math.pi
-    joint = (f"c = {frames.clearance * 1e3:g} mm at E, drawn x{magnification:g}" if frames.clearance > 0.0
-             else "ideal joint at E")
     title = fig.suptitle("", fontsize=9)
-    caption = (f"scene {scene.name}, engine {result.engine}, {rpm:g} rpm, {joint}\n"
+    caption = (f"scene {scene.name}, engine {result.engine}, {rpm:g} rpm, {joint_caption(frames, magnification)}\n"
                "projection on the four-bar plane x = 0 (view along axis D)")
+    flags = {"E": frames.in_contact, "F": frames.in_contact_f}
 
     def draw(k: int):
         move_linkage(k)
         move_rapier(k)
-        state = "in contact" if frames.in_contact[k] else "free flight"
-        title.set_text(f"{caption}\ncrank angle {frames.crank_angle_deg[k]:5.1f} deg, journal {state}")
+        states = [f"journal at {name} {'in contact' if flags[name][k] else 'free flight'}"
+                  for name, _ in frames.joints()] or ["ideal joints"]
+        title.set_text(f"{caption}\ncrank angle {frames.crank_angle_deg[k]:5.1f} deg, {', '.join(states)}")
 
     fig.tight_layout()
     draw(0)
@@ -314,6 +351,16 @@ def animation_figure(result: RunResult, frames: MechanismFrames,
     for artist in moving:
         artist.set_animated(True)
     return fig, draw, moving
+
+
+def joint_caption(frames: MechanismFrames, magnification: float) -> str:
+    """``c = 0.25 mm at F (E ideal), drawn x50``: the joints with a clearance, as the picture draws them."""
+    loose = frames.joints()
+    if not loose:
+        return "ideal joints at E and F"
+    sizes = ", ".join(f"c = {c * 1e3:g} mm at {name}" for name, c in loose)
+    ideal = [name for name in ("E", "F") if name not in dict(loose)]
+    return f"{sizes}{f' ({ideal[0]} ideal)' if ideal else ''}, drawn x{magnification:g}"
 
 
 def render_frames(fig: Figure, draw: Callable[[int], None], moving: tuple[Artist, ...],

@@ -415,9 +415,12 @@ def cmd_animate(args: argparse.Namespace) -> int:
         frames = write_animation(result, target, frames=args.frames)
     except OSError as exc:
         raise CliError(f"cannot write {target}: {exc.strerror or exc}") from None
+    from weftsim.animate import clearance_magnification, joint_caption
+
     closure = float(abs(frames.rod_length - scene.geometry.l_ef).max())
+    scale = clearance_magnification(max(frames.clearance, frames.clearance_f), scene.geometry.l_ef)
     print(f"wrote {target}: {args.frames} frames over crank angles {frames.crank_angle_deg[0]:.1f}.."
-          f"{frames.crank_angle_deg[-1]:.1f} deg; "
+          f"{frames.crank_angle_deg[-1]:.1f} deg, {joint_caption(frames, scale)}; "
           f"drawn rod EF within {closure:.1e} m of L_EF = {scene.geometry.l_ef:g} m")
     return 0
 
@@ -493,6 +496,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         plan = plan_sweep(args.scene, args.vary, fixed, engine, allow_large=args.yes,
                           allow_cwd_engine=args.allow_cwd_engine,
                           announce=lambda line: print(line, file=sys.stderr, flush=True))
+        for note in plan.notes:
+            print(f"weftsim sweep: {note}", file=sys.stderr, flush=True)
         outdir = output_directory(args, plan.base, "sweep-" + engine.replace(":", "."))
         report = run_sweep(plan, outdir, jobs=args.jobs, scheduler=args.scheduler, cell_figures=args.cell_figures)
     except _SweepTerminated as exc:

@@ -186,8 +186,18 @@ def scene_from_args(args: argparse.Namespace) -> Scene:
     from weftsim.api import scene_overrides
     from weftsim.scene import load_scene
 
+    from weftsim.joint_keys import inheritance_note, wear_only_keys, wear_only_message
+
     overrides = scene_overrides(set_overrides(args), where="command line", **shorthand_values(args))
-    return load_scene(args.scene, overrides)
+    command = getattr(args, "command", None) or "run"
+    idle = wear_only_keys(overrides) if command != "wear" else []
+    if idle:
+        raise CliError(wear_only_message(idle[0], command))
+    scene = load_scene(args.scene, overrides)
+    note = inheritance_note(scene)
+    if note:  # one line on stderr: what joint F took from E (stdout stays the report's)
+        print(f"weftsim {getattr(args, 'command', None) or 'scene'}: {note}", file=sys.stderr, flush=True)
+    return scene
 
 
 def add_output_flags(parser: argparse.ArgumentParser, default: str) -> None:

@@ -13,6 +13,13 @@ exit status are the reproducible quantities:
 
 The side-by-side table (min, max, RMS over the last revolution and the exudyn/reference
 ratio of each peak, as the paper reports 1.035 and 1.099 against ADAMS) is information.
+
+The report says what was compared and what was not (:func:`not_compared`).  With a clearance,
+the first-revolution maxima are the comparison's core: a run shorter than one revolution compares
+the first-contact angle alone, and that is never called an agreement: the status is ``"partial"``
+(exit status 5, :data:`weftsim.exitcodes.EXIT_PARTIAL`) and the line says what to run instead.
+The statistics of revolutions 2..N are listed as not compared below 10 revolutions (the status may
+still be ``"agree"``: the first revolution is compared in full).
 """
 
 from __future__ import annotations
@@ -114,6 +121,32 @@ def agreement_checks(exudyn: RunResult, reference: RunResult) -> list[dict]:
     return checks
 
 
+def not_compared(exudyn: RunResult, reference: RunResult) -> list[dict]:
+    """What :func:`agreement_checks` leaves out for want of revolutions: ``{"what", "why", "core"}`` each.
+
+    ``core`` is True for the first-revolution maxima of a clearance scene: without them only the
+    first-contact angle is compared, and the comparison is partial.
+    """
+    if reference.scene.is_ideal:
+        return []
+    covered = min(complete_revolutions(exudyn), complete_revolutions(reference))
+    ran = min(_revolutions_run(exudyn), _revolutions_run(reference))
+    out = []
+    if covered < 1:
+        out.append({"what": "first-revolution maxima of contact force, rapier acceleration and driving torque",
+                    "why": f"they need one complete crank revolution and the runs cover {ran:.4g}", "core": True})
+    if covered < STATISTICS_MIN_REVOLUTIONS:
+        out.append({"what": "RMS, mean and 99th percentiles over revolutions 2..N",
+                    "why": f"they need {STATISTICS_MIN_REVOLUTIONS} complete revolutions and the runs cover "
+                           f"{covered}", "core": False})
+    return out
+
+
+def _revolutions_run(result: RunResult) -> float:
+    t = result.steps["time_s"]
+    return float(t[-1] / result.scene.drive.period) if t.size else 0.0
+
+
 def _joint_first_contact_deg(result: RunResult, joint: str) -> float | None:
     """Crank angle of the first contact at ``joint`` ("e" or "f"), deg, or None."""
     t = result.events.get(f"first_contact_time_{joint}_s")
@@ -141,10 +174,20 @@ def compare_results(exudyn: RunResult, reference: RunResult) -> dict:
                               "ratio_max": _ratio(te[name]["max"], tr[name]["max"]),
                               "ratio_min": _ratio(te[name]["min"], tr[name]["min"]),
                               "ratio_rms": _ratio(te[name]["rms"], tr[name]["rms"])}
-    checks = agreement_checks(exudyn, reference) if exudyn.ok and reference.ok else []
-    agree = exudyn.ok and reference.ok and all(c["passed"] for c in checks)
+    both_ran = exudyn.ok and reference.ok
+    checks = agreement_checks(exudyn, reference) if both_ran else []
+    missing = not_compared(exudyn, reference) if both_ran else []
+    if not both_ran:
+        status = "failed"
+    elif not all(c["passed"] for c in checks):
+        status = "disagree"
+    elif any(m["core"] for m in missing):
+        status = "partial"
+    else:
+        status = "agree"
+    # "agree" is True only for a full agreement: a partial comparison (the first-contact angle alone) is not one.
     return {"scene": reference.scene.name, "engines": engines, "channels": channels, "checks": checks,
-            "agree": agree}
+            "not_compared": missing, "status": status, "agree": status == "agree"}
 
 
 def _fmt(value, width=12, digits=5) -> str:
@@ -157,6 +200,8 @@ def format_report(report: dict) -> str:
     """Side-by-side table for the terminal."""
     lines = [f"scene {report['scene']}: last revolution, exudyn vs reference"]
     lines.append(f"{'channel':28s} {'':4s} {'exudyn':>12s} {'reference':>12s} {'ratio':>8s}")
+    if not report["channels"]:
+        lines.append("  (no complete revolution in both runs: nothing to tabulate)")
     for name, row in report["channels"].items():
         for stat in ("min", "max", "rms"):
             ratio = row.get(f"ratio_{stat}")
@@ -174,17 +219,29 @@ def format_report(report: dict) -> str:
         mark = "ok  " if check["passed"] else "FAIL"
         lines.append(f"  {mark} {check['name']}: difference {_fmt(check['difference'], 9, 3)} "
                      f"(tolerance {check['tolerance']:g})")
-    lines.append("engines AGREE" if report["agree"] else "engines DISAGREE")
+    for item in report.get("not_compared", []):
+        lines.append(f"  not compared: {item['what']} ({item['why']})")
+    lines.append(VERDICT_LINES[report.get("status", "agree" if report["agree"] else "disagree")])
     return "\n".join(lines)
+
+
+VERDICT_LINES = {
+    "agree": "engines AGREE on every check above",
+    "disagree": "engines DISAGREE",
+    "partial": "comparison PARTIAL: only the first-contact angle was compared (no verdict on the peaks); "
+               "run at least one complete revolution for an agreement",
+    "failed": "engines not compared: an engine failed",
+}
 
 
 def verdict(report: dict, outdir: str | Path) -> tuple[int, str]:
     """Exit status of a comparison and, when it is not 0, the one line that says why.
 
     3 when an engine failed (its message, and where its partial results are), 4 when both ran
-    but a check missed its tolerance (how many, the first one, and where the report is).
+    but a check missed its tolerance (how many, the first one, and where the report is), 5 when
+    what was compared agrees but the comparison is partial (what was not compared and why).
     """
-    from weftsim.exitcodes import EXIT_DISAGREE, EXIT_FAILED
+    from weftsim.exitcodes import EXIT_DISAGREE, EXIT_FAILED, EXIT_PARTIAL
 
     failed = [(name, info) for name, info in report["engines"].items() if info["status"] != "success"]
     if failed:
@@ -199,6 +256,12 @@ def verdict(report: dict, outdir: str | Path) -> tuple[int, str]:
         return EXIT_DISAGREE, (f"engines disagree on {len(missed)} of {len(report['checks'])} checks; first: "
                                f"{first['name']}: difference {difference} above tolerance {first['tolerance']:g} "
                                f"(all checks in {outdir}/compare.json)")
+    if report.get("status") == "partial":
+        core = [m for m in report["not_compared"] if m["core"]]
+        return EXIT_PARTIAL, (f"partial comparison: the engines agree on what was compared "
+                              f"({', '.join(c['name'] for c in report['checks'])}), but the "
+                              f"{core[0]['what']} were not compared: {core[0]['why']}; run at least 1 revolution "
+                              f"(--revolutions 1) for a verdict (all in {outdir}/compare.json)")
     return 0, ""
 
 

@@ -60,6 +60,11 @@ def request_stop(reason: str) -> None:
     _STOP_REQUEST[:] = [reason]
 
 
+def stop_requested() -> str | None:
+    """The reason given to :func:`request_stop` while a stop is asked for, else None."""
+    return _STOP_REQUEST[0] if _STOP_REQUEST else None
+
+
 def clear_stop() -> None:
     """Withdraw :func:`request_stop` (before the next run)."""
     _STOP_REQUEST.clear()
@@ -181,8 +186,9 @@ class RunGuard:
             return Breach(
                 "step_size",
                 f"the step size collapsed to {step_size:.3g} s (below limits.min_step_s = {self.min_step:.3g} s)",
-                "the equations became too stiff or discontinuous for the method: try another method ('Radau' "
-                "or 'LSODA' for stiff contact), a looser rtol/atol, or check the joint's stiffness and the contact law",
+                "the equations became too stiff or discontinuous for the method: try another method "
+                "(solver.reference.method = 'Radau' or 'LSODA' for stiff contact), a looser tolerance, or check "
+                "the joint's stiffness and the contact law",
             )  # fmt: skip
         if self.max_steps is not None and self.steps > self.max_steps:
             return Breach(

@@ -368,6 +368,6 @@ def write_run(result: RunResult, outdir: str | Path, figure: bool = True, force:
         files["npz"] = ("result.npz", lambda target: write_atomic(target, lambda tmp: save_npz(result, tmp)))
     if figure and result.steps["time_s"].size:
         files["figure"] = ("channels.png", lambda target: write_figure(target, plot_channels([result])))
-        if result.scene.joint.clearance > 0.0:
+        if result.scene.loose_joints:  # one orbit panel per joint with a clearance (E, F)
             files["orbit"] = ("orbit.png", lambda target: write_figure(target, plot_orbit(result)))
     return write_files(outdir, what, files)

@@ -542,6 +542,9 @@ class Scene:
     compare: CompareTolerance = field(default_factory=CompareTolerance)
     limits: Limits = field(default_factory=Limits)
     source: str = ""
+    # Keys of [joint_f] (without the table name) that F takes from [joint_e] because the scene does not
+    # give them (weftsim.joint_keys); bookkeeping of how the scene was written, not part of the machine.
+    joint_f_inherits: tuple[str, ...] = field(default=(), compare=False)
 
     @property
     def loose_joints(self) -> tuple[str, ...]:

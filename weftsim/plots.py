@@ -153,20 +153,26 @@ def contact_onsets(steps: dict[str, np.ndarray]) -> np.ndarray:
     return onset_rows(contact_mode(steps))
 
 
+# The channels of each joint's orbit: eccentricity y, z and the held impact velocity (0 in free flight).
+ORBIT_CHANNELS = {"e": ("eccentricity_y_m", "eccentricity_z_m", "impact_velocity_m_s"),
+                  "f": ("eccentricity_f_y_m", "eccentricity_f_z_m", "impact_velocity_f_m_s")}
+
+
 def plot_orbit(result: RunResult, title: str | None = None) -> Figure:
-    """Orbit of the journal centre inside the clearance circle at E, with the impacts marked.
+    """Orbit of the journal centre inside the clearance circle of each joint with a clearance, impacts marked.
 
     The eccentricity e = P_j - P_b (journal centre minus bearing centre, docs/physics.md
     section 2) is drawn at every accepted solver step in the four-bar plane (model y, z),
     inside the circle ``|e| = c`` of the radial clearance: on the circle the journal touches the
     bearing wall, outside it the two penetrate by ``δ = |e| - c``.  Each contact onset (an impact)
     is a dot coloured by its impact velocity δ̇⁻; the first is ringed.  The orbit of the journal
-    centre is the standard picture of a clearance joint (as in Flores and Ambrósio 2004).
+    centre is the standard picture of a clearance joint (as in Flores and Ambrósio 2004).  One panel
+    per joint with a clearance: E, then F (its rod pin in the sector's eye, docs/clearance-f.md).
 
     Parameters
     ----------
     result : RunResult
-        A run with a clearance joint (``scene.joint.clearance > 0``).
+        A run with a clearance joint (at E, at F or at both).
     title : str, optional
         Defaults to the scene, engine, clearance and crank speed.
 
@@ -174,15 +180,30 @@ def plot_orbit(result: RunResult, title: str | None = None) -> Figure:
     -------
     matplotlib.figure.Figure
     """
-    clearance = result.scene.joint.clearance
-    if not clearance > 0.0:
+    scene = result.scene
+    joints = [(name, joint) for name, joint in (("e", scene.joint), ("f", scene.joint_f))
+              if joint.clearance > 0.0 and ORBIT_CHANNELS[name][0] in result.steps]
+    if not joints:
         raise ValueError(f"the orbit needs a clearance joint: joint_e.clearance_mm must be > 0, got "
-                         f"{clearance * 1e3:g}")
-    steps = result.steps
-    y_mm, z_mm = steps["eccentricity_y_m"] * 1e3, steps["eccentricity_z_m"] * 1e3
-    onsets = contact_onsets(steps)
-    fig = figure(figsize=(6.4, 6.8))
-    ax = fig.subplots()
+                         f"{scene.joint.clearance * 1e3:g} (or joint_f.clearance_mm > 0)")
+    fig = figure(figsize=(6.4 * len(joints), 6.8))
+    axes = np.atleast_1d(fig.subplots(1, len(joints)))
+    rpm = scene.drive.speed * 30 / math.pi
+    for ax, (name, joint) in zip(axes, joints):
+        _orbit_panel(fig, ax, result.steps, ORBIT_CHANNELS[name], joint.clearance)
+        ax.set_title(title or f"scene {scene.name}, engine {result.engine}:\njournal orbit at {name.upper()} "
+                              f"(c = {joint.clearance * 1e3:g} mm, {rpm:g} rpm)", fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def _orbit_panel(fig, ax, steps: dict, channels: tuple[str, str, str], clearance: float) -> None:
+    """One joint's orbit: its clearance circle, the journal centre at every step, and the impacts."""
+    from weftsim.plausibility import onset_rows
+
+    ecc_y, ecc_z, impact = channels
+    y_mm, z_mm = steps[ecc_y] * 1e3, steps[ecc_z] * 1e3
+    onsets = onset_rows(np.asarray(steps[impact]) > 0.0)  # contact segments: v_imp held > 0 (contact_onsets)
     circle = np.linspace(0.0, 2.0 * math.pi, 361)
     c_mm = clearance * 1e3
     ax.plot(c_mm * np.cos(circle), c_mm * np.sin(circle), color="0.3", lw=1.2,
@@ -190,7 +211,7 @@ def plot_orbit(result: RunResult, title: str | None = None) -> Figure:
     ax.plot(y_mm, z_mm, lw=0.6, color="tab:blue", label="journal centre (every solver step)",
             rasterized=len(y_mm) > 20000)
     if onsets.size:
-        speed = steps["impact_velocity_m_s"][onsets]
+        speed = steps[impact][onsets]
         dots = ax.scatter(y_mm[onsets], z_mm[onsets], c=speed, s=18, cmap="plasma", zorder=3,
                           label=f"impacts ({onsets.size}), colour = impact velocity")
         ax.scatter(y_mm[onsets[:1]], z_mm[onsets[:1]], s=90, facecolors="none", edgecolors="k", zorder=4,
@@ -204,8 +225,3 @@ def plot_orbit(result: RunResult, title: str | None = None) -> Figure:
     ax.set_ylabel("eccentricity z [mm]")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2)
-    rpm = result.scene.drive.speed * 30 / math.pi
-    ax.set_title(title or f"scene {result.scene.name}, engine {result.engine}:\njournal orbit at E "
-                          f"(c = {c_mm:g} mm, {rpm:g} rpm)", fontsize=10)
-    fig.tight_layout()
-    return fig

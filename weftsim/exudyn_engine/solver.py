@@ -57,7 +57,7 @@ def check_settings(scene: Scene) -> str | None:
     """Message naming the first invalid Exudyn-engine setting, or None."""
     s = scene.exudyn_solver
     if s.model not in MODELS:
-        return f"`exudyn_solver.model` must be one of {MODELS}, got {s.model!r}"
+        return f"`solver.exudyn.model` must be one of {MODELS}, got {s.model!r}"
     if select_model(scene)[0] == "kinematic_tree":
         from weftsim.exudyn_engine.tree_solve import check_tree_settings
 
@@ -65,26 +65,26 @@ def check_settings(scene: Scene) -> str | None:
         if problem is not None:
             return problem
     if not (s.step_size > 0.0 and math.isfinite(s.step_size)):
-        return f"`exudyn_solver.step_size` must be > 0, got {s.step_size}"
+        return f"`solver.exudyn.step_size_s` must be > 0, got {s.step_size}"
     if not 0.0 <= s.spectral_radius <= 1.0:
-        return f"`exudyn_solver.spectral_radius` must be in [0, 1], got {s.spectral_radius}"
+        return f"`solver.exudyn.spectral_radius` must be in [0, 1], got {s.spectral_radius}"
     if not s.newton_relative_tolerance > 0.0:
-        return f"`exudyn_solver.newton_relative_tolerance` must be > 0, got {s.newton_relative_tolerance}"
+        return f"`solver.exudyn.newton_relative_tolerance` must be > 0, got {s.newton_relative_tolerance}"
     if not s.newton_max_iterations >= 1:
-        return f"`exudyn_solver.newton_max_iterations` must be >= 1, got {s.newton_max_iterations}"
+        return f"`solver.exudyn.newton_max_iterations` must be >= 1, got {s.newton_max_iterations}"
     if s.step_control not in STEP_CONTROLS:
-        return f"`exudyn_solver.step_control` must be one of {STEP_CONTROLS}, got {s.step_control!r}"
+        return f"`solver.exudyn.step_control` must be one of {STEP_CONTROLS}, got {s.step_control!r}"
     if not (s.local_error > 0.0 and math.isfinite(s.local_error)):
-        return f"`exudyn_solver.local_error` must be > 0 (m), got {s.local_error}"
+        return f"`solver.exudyn.local_error_m` must be > 0 (m), got {s.local_error}"
     if route_error(s.callback):
-        return f"`exudyn_solver.{route_error(s.callback)[1:]}"
+        return f"`solver.exudyn.{route_error(s.callback)[1:]}"
     if s.callback == "numba" and not scene.is_ideal:
         try:
             import numba  # noqa: F401 - optional dependency of this route only
         except ImportError:
-            return "`exudyn_solver.callback` = 'numba' needs numba installed; use 'auto' or 'python'"
+            return "`solver.exudyn.callback` = 'numba' needs numba installed; use 'auto' or 'python'"
     if not scene.output.sample_angle > 0.0:
-        return f"`output.sample_angle` must be > 0, got {scene.output.sample_angle}"
+        return f"`output.sample_deg` must be > 0, got {math.degrees(scene.output.sample_angle):g}"
     for table, joint in (("joint_e", scene.joint), ("joint_f", scene.joint_f)):
         if joint.is_ideal:
             continue
@@ -173,11 +173,13 @@ def _failed(scene: Scene, message: str, wall: float) -> RunResult:
 def _what_to_try(scene: Scene, h: float) -> str:
     s = scene.exudyn_solver
     if adaptive(scene):
-        return (f"try a smaller `exudyn_solver.local_error` (now {s.local_error:.3g} m), or step_control = 'fixed' "
-                f"with a small `exudyn_solver.step_size`, a spectral radius below {s.spectral_radius} or more "
-                f"`newton_max_iterations` (now {s.newton_max_iterations})")  # fmt: skip
-    return (f"try a smaller `exudyn_solver.step_size` (now {h:.3g} s), a spectral radius below "
-            f"{s.spectral_radius} or more `newton_max_iterations` (now {s.newton_max_iterations})")  # fmt: skip
+        return (f"try a smaller `solver.exudyn.local_error_m` (now {s.local_error:.3g} m), or "
+                f"`solver.exudyn.step_control` = 'fixed' with a small `solver.exudyn.step_size_s`, a "
+                f"`solver.exudyn.spectral_radius` below {s.spectral_radius} or more "
+                f"`solver.exudyn.newton_max_iterations` (now {s.newton_max_iterations})")  # fmt: skip
+    return (f"try a smaller `solver.exudyn.step_size_s` (now {h:.3g} s), a `solver.exudyn.spectral_radius` below "
+            f"{s.spectral_radius} or more `solver.exudyn.newton_max_iterations` "
+            f"(now {s.newton_max_iterations})")  # fmt: skip
 
 
 def _failure_reason(solver, scene: Scene) -> tuple[str, str]:

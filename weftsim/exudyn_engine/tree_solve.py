@@ -1,6 +1,6 @@
 """``solve`` of the kinematic-tree model (:mod:`.tree`): explicit solver, channels, failures.
 
-Solver: Exudyn's explicit ``exudyn_solver.explicit_method`` (DOPRI5 or ODE23) with
+Solver: Exudyn's explicit ``solver.exudyn.explicit_method`` (DOPRI5 or ODE23) with
 automatic step size, ``relative_tolerance`` (at most :data:`FRICTION_RELATIVE_TOLERANCE` with
 friction) and ``absolute_tolerance`` (on the joint
 angles, rad, and rates, rad/s), end-of-step accelerations on (else the rapier acceleration
@@ -86,20 +86,20 @@ def check_tree_settings(scene: Scene) -> str | None:
     s = scene.exudyn_solver
     if not scene.joint_f.is_ideal:
         return ("the 'kinematic_tree' Exudyn model carries the clearance at E only, and this scene has one at F "
-                "(joint_f); use `exudyn_solver.model` = 'auto' or 'rigid_body' (it adds the clearance joint at F)")
+                "(joint_f); use `solver.exudyn.model` = 'auto' or 'rigid_body' (it adds the clearance joint at F)")
     if scene.joint.is_ideal:
         return ("the 'kinematic_tree' Exudyn model needs a clearance joint (with an ideal joint nothing moves "
-                "freely); use `exudyn_solver.model` = 'rigid_body' or the reference engine")  # fmt: skip
+                "freely); use `solver.exudyn.model` = 'rigid_body' or the reference engine")  # fmt: skip
     routes = ("auto",) + callbacks.ROUTES
     if s.callback not in routes:
         return (f"the 'kinematic_tree' Exudyn model has the callback routes {routes}, got {s.callback!r}; "
-                "use `exudyn_solver.model` = 'rigid_body' for it")  # fmt: skip
+                "use `solver.exudyn.model` = 'rigid_body' for it")  # fmt: skip
     if s.explicit_method not in EXPLICIT_METHODS:
-        return f"`exudyn_solver.explicit_method` must be one of {tuple(EXPLICIT_METHODS)}, got {s.explicit_method!r}"
+        return f"`solver.exudyn.explicit_method` must be one of {tuple(EXPLICIT_METHODS)}, got {s.explicit_method!r}"
     for name in ("relative_tolerance", "absolute_tolerance"):
         value = getattr(s, name)
         if not (value > 0.0 and math.isfinite(value)):
-            return f"`exudyn_solver.{name}` must be > 0, got {value}"
+            return f"`solver.exudyn.{name}` must be > 0, got {value}"
     return None
 
 
@@ -304,7 +304,7 @@ def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, ca
             found = non_finite_breach("non-finite values (NaN or inf) in the results (explicit solvers do not stop on NaN)")
             status, message, kind = "failed", found.what, found.kind
     t_last = float(steps["time_s"][-1]) if len(steps["time_s"]) else 0.0
-    hint = ("try a tighter `exudyn_solver.relative_tolerance`, the 'rigid_body' model, or the reference engine")
+    hint = ("try a tighter `solver.exudyn.relative_tolerance`, the 'rigid_body' model, or the reference engine")
     if breach and (status == "success" or kind is None):
         status, kind = "failed", breach[0].kind
         message = failure_message("Exudyn engine (kinematic_tree)", t_last, omega, breach[0].what, breach[0].hint)

@@ -49,21 +49,21 @@ def _check(scene: Scene) -> str | None:
     settings = scene.reference_solver
     allowed = [AUTO] + sorted(METHODS) + list(COMPILED_METHODS)
     if settings.method not in allowed:
-        return f"`reference_solver.method` must be one of {allowed}, got {settings.method!r}"
+        return f"`solver.reference.method` must be one of {allowed}, got {settings.method!r}"
     if compiled_method(scene) is not None:
         try:
             import numba  # noqa: F401 - a dependency; checked for installs that lost it
         except ImportError:
-            return f"`reference_solver.method` = {settings.method!r} needs numba installed; use 'DOP853' (scipy)"
+            return f"`solver.reference.method` = {settings.method!r} needs numba installed; use 'DOP853' (scipy)"
     if not scene.joint_f.is_ideal and compiled_method(scene) is None:
-        return (f"`reference_solver.method` = {settings.method!r} cannot run a clearance at F (joint_f): the scipy "
+        return (f"`solver.reference.method` = {settings.method!r} cannot run a clearance at F (joint_f): the scipy "
                 f"path carries the clearance at E only; use 'auto' or one of {list(COMPILED_METHODS)}")
-    for name in ("rtol", "atol", "max_step"):
+    for name, key, scale in (("rtol", "rtol", 1.0), ("atol", "atol", 1.0), ("max_step", "max_step_deg", 180 / math.pi)):
         value = getattr(settings, name)
         if not (value > 0.0 and math.isfinite(value)):
-            return f"`reference_solver.{name}` must be > 0, got {value}"
+            return f"`solver.reference.{key}` must be > 0, got {value * scale:g}"
     if not scene.output.sample_angle > 0.0:
-        return f"`output.sample_angle` must be > 0, got {scene.output.sample_angle}"
+        return f"`output.sample_deg` must be > 0, got {math.degrees(scene.output.sample_angle):g}"
     return None
 
 

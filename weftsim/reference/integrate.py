@@ -56,7 +56,7 @@ AUTO = "auto"
 
 
 def resolve_method(scene: Scene) -> str:
-    """The scipy method name the scene's ``reference_solver.method`` stands for."""
+    """The scipy method name the scene's ``solver.reference.method`` stands for."""
     name = scene.reference_solver.method
     if name == AUTO:
         return "LSODA" if scene.joint.friction_coefficient > 0.0 else "DOP853"
@@ -209,8 +209,8 @@ def _integrate(scene: Scene, progress) -> Trajectory:
         traj.stats["failure"] = kind
         traj.message = failure_message(
             f"reference solver ({name})", t, omega, text,
-            hint or "try a smaller `max_step`, a looser `rtol`/`atol`, or method 'Radau' or 'LSODA' "
-            "(scene [solver.reference])",
+            hint or "try a smaller `solver.reference.max_step_deg`, a looser `solver.reference.rtol`/`atol`, or "
+            "`solver.reference.method` = 'Radau' or 'LSODA'",
         )  # fmt: skip
 
     while t < t_end and traj.status == "success":

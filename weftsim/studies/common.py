@@ -203,6 +203,14 @@ def study_overrides(study: str, sets: dict[str, str], revolutions: float | None,
         if key in sets:
             raise StudyError(f"the {study} study sets {key} itself ({sets[key]}); do not override it "
                              "(neither --set nor its shorthand flag)")
+        if key == "joint_f.clearance_mm" and given[key]:
+            # The studies are the paper's figures, of the clearance at E: their tables and figures hold
+            # joint E's contact alone, and a clearance at F would be left out of them (issue 24).
+            raise StudyError(f"the {study} study is of the clearance at E (the paper's figures); a clearance at F "
+                             "is not in its tables or figures: sweep it instead (weftsim sweep clearance_f --vary "
+                             "joint_f.clearance_mm=...), whose table carries each joint")
+        if ".wear." in key:
+            raise StudyError(f"key '{key}' is read by `weftsim wear` only: the {study} study does not depend on it")
     if "drive.revolutions" in given:
         if revolutions is not None:
             raise StudyError("the revolutions are given twice (as revolutions and as drive.revolutions); "

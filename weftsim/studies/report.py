@@ -305,7 +305,11 @@ def engines_section(en: dict) -> list[str]:
     for check in cmp["checks"]:
         out.append(f"| {check['name']} | {_g(check['exudyn'], 7)} | {_g(check['reference'], 7)} | "
                    f"{_g(check['difference'], 3)} | {check['tolerance']:g} | {'yes' if check['passed'] else 'NO'} |")
-    out += ["", f"Engines {'agree' if cmp['agree'] else 'DISAGREE'}; wall time: "
+    for item in cmp.get("not_compared", []):
+        out.append(f"Not compared: {item['what']} ({item['why']}).")
+    verdicts = {"agree": "Engines agree", "disagree": "Engines DISAGREE", "failed": "Engines not compared (a run failed)",
+                "partial": "Comparison partial (only the first-contact angle compared; no verdict on the peaks)"}
+    out += ["", f"{verdicts.get(cmp.get('status'), 'Engines agree' if cmp['agree'] else 'Engines DISAGREE')}; wall time: "
             + ", ".join(f"{e} {m['wall_time_s']:.1f} s" for e, m in en["runs"].items()) + ".", ""]
     return out
 

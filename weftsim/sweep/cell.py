@@ -36,7 +36,11 @@ ERROR_FILE = "error.txt"
 SUMMARY_FILE = "summary.json"
 CELL_FORMAT = "weftsim-sweep-cell/1"
 
-METRIC_CHANNELS = ("driving_torque_Nm", "rapier_acceleration_m_s2", "contact_force_N")
+# Channels summarised per cell: contact_force_N is joint E's, contact_force_f_N joint F's.  A joint that is
+# ideal in a cell has no contact force: its columns are empty there (not 0, which would read as a force
+# the joint never carried; the ideal joint's reaction is not a contact force).
+METRIC_CHANNELS = ("driving_torque_Nm", "rapier_acceleration_m_s2", "contact_force_N", "contact_force_f_N")
+JOINT_OF_CHANNEL = {"contact_force_N": "joint", "contact_force_f_N": "joint_f"}
 
 
 def normalise(data: Any) -> Any:
@@ -59,7 +63,9 @@ def cell_metrics(result: RunResult) -> dict[str, Any]:
     (``last_revolution``, 1-based; the first one when the run is shorter than one),
     ``*_p99`` the time-weighted 99th percentile of the magnitude over revolutions
     2..N (None with fewer than two complete revolutions).  Peaks come from the
-    solver steps, which resolve the impacts (see :mod:`weftsim.analysis`).
+    solver steps, which resolve the impacts (see :mod:`weftsim.analysis`).  The
+    contact force of a joint that is ideal in the run (E's ``contact_force_N``,
+    F's ``contact_force_f_N``) is None: there is no contact there.
     """
     from weftsim.analysis import complete_revolutions, peaks, statistics
 
@@ -80,6 +86,9 @@ def cell_metrics(result: RunResult) -> dict[str, Any]:
     out["last_revolution"] = last_index + 1
     stats = statistics(result) if n >= 2 else None
     for channel in METRIC_CHANNELS:
+        joint = JOINT_OF_CHANNEL.get(channel)
+        if channel not in first or (joint is not None and getattr(result.scene, joint).is_ideal):
+            continue  # an ideal joint: no contact force (the columns stay empty)
         out[f"{channel}_rev1_peak"] = _peak(first, channel)
         out[f"{channel}_last_peak"] = _peak(last, channel)
         out[f"{channel}_p99"] = stats[channel]["p99_abs"] if stats else None

@@ -28,6 +28,7 @@ from weftsim.errors import SweepError
 from weftsim.scene import SCHEMA, Key
 
 SWEEPABLE_KINDS = ("float", "int", "str", "bool")
+LIST_SIZES = {"floats2": 2, "floats3": 3}  # list-valued keys: --set only (a comma separates --vary values)
 RANGE_DIGITS = 12  # range values are rounded to 12 significant digits: 0.08, not 0.08000000000000002
 COMMON_KEYS = ("clearance_mm", "speed_rpm", "law", "revolutions", "restitution", "friction_coefficient")
 SAFE_TEXT = re.compile(r"^[A-Za-z0-9_.+-]+$")  # string values must be usable in a directory name
@@ -134,7 +135,9 @@ def _range(key: Key, text: str, flag: str) -> list[Any]:
 def parse_values(key: Key, text: str, flag: str = "--vary") -> list[Any]:
     """Values of ``text``: a list ``a,b,c`` or an inclusive range ``start:stop:count``."""
     if key.kind not in SWEEPABLE_KINDS:
-        raise SweepError(f"{flag}: '{key.path}' holds a list of numbers and cannot be swept")
+        size = LIST_SIZES[key.kind]
+        raise SweepError(f"{flag}: '{key.path}' holds a list of {size} numbers and cannot be swept; set it for "
+                         f"every cell with --set {key.path}={','.join(['X'] * size)}")
     if not text.strip():
         raise SweepError(f"{flag}: no values given for '{key.path}'")
     values = _range(key, text, flag) if ":" in text else [_scalar(key, t, flag) for t in text.split(",")]
@@ -168,10 +171,28 @@ def parse_vary(text: str) -> Axis:
     return Axis(key.path, short_name(key), tuple(parse_values(key, values, f"--vary {name}")))
 
 
+def _number_list(key: Key, text: str, flag: str) -> list[float]:
+    """``v0,v1`` of a list-valued key (``friction_velocities_m_s``): its numbers; sizes checked here."""
+    size = LIST_SIZES[key.kind]
+    parts = [part.strip() for part in text.split(",")]
+    if len(parts) != size:
+        raise SweepError(f"{flag}: '{key.path}' takes a list of {size} numbers separated by commas "
+                         f"(e.g. {key.path}={','.join(['1e-4', '2e-4', '1e-3'][:size])}), got {text!r}")
+    try:
+        return [float(part) for part in parts]
+    except ValueError:
+        raise SweepError(f"{flag}: '{key.path}' takes {size} numbers, got {text!r}") from None
+
+
 def parse_set(text: str) -> tuple[str, Any]:
-    """``KEY=VALUE`` (a fixed override for every cell) -> (dotted key, value)."""
+    """``KEY=VALUE`` (a fixed override for every cell) -> (dotted key, value).
+
+    A list-valued key takes its numbers separated by commas (``friction_velocities_m_s=1e-4,2e-4``).
+    """
     name, value = _split(text, "--set")
     key = resolve_key(name)
+    if key.kind in LIST_SIZES:
+        return key.path, _number_list(key, value, f"--set {name}")
     values = parse_values(key, value, f"--set {name}")
     if len(values) != 1:
         raise SweepError(f"--set {name}: takes one value, got {len(values)} (use --vary to sweep it)")

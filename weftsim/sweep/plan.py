@@ -49,6 +49,7 @@ class SweepPlan:
     base_keys: dict
     cells: tuple[PlannedCell, ...]
     base: Scene  # the base scene (after --set), from which each cell's scene is rebuilt
+    notes: tuple[str, ...] = ()  # lines for the user: what joint F takes from E (weftsim.joint_keys)
 
     @property
     def axis_names(self) -> list[str]:
@@ -58,7 +59,7 @@ class SweepPlan:
         """The cell's validated scene."""
         from weftsim.scene import apply_overrides
 
-        return apply_overrides(self.base, planned.overrides, CELL_NAME_CHECK)
+        return apply_overrides(self.base, planned.overrides, CELL_NAME_CHECK, refuse_ideal_keys=False)
 
     def scene_keys(self, planned: PlannedCell) -> dict:
         """The cell's resolved scene as stored in ``cell.json`` and compared on resume."""
@@ -89,32 +90,48 @@ def plan_sweep(scene_path: str | Path, vary: list[str], fixed: list[str] | tuple
     weftsim.scene.SceneError
         The base scene itself is invalid.
     """
+    from weftsim.joint_keys import (ideal_joint_keys, ideal_key_message, inheritance_note, wear_only_keys,
+                                    wear_only_message)
     from weftsim.scene import SceneError, apply_overrides, load_scene, to_file_keys
 
     axes = tuple(parse_vary(text) for text in vary)
     fixed_overrides = dict(parse_set(text) for text in fixed)
+    idle = wear_only_keys([axis.key for axis in axes] + list(fixed_overrides))
+    if idle:
+        raise SweepError(wear_only_message(idle[0], "sweep"))
     size = grid_size(axes)
     if size > LARGE_GRID_CELLS and not allow_large:
         raise SweepError(f"the grid has {size:,} cells, more than {LARGE_GRID_CELLS:,}: check the --vary counts, "
                          "or pass --yes to plan and run them all")
     cells = grid_cells(axes, fixed_overrides)
     check_engine(engine, allow_cwd_engine)
-    base = load_scene(scene_path, fixed_overrides)
+    base = load_scene(scene_path, fixed_overrides, refuse_ideal_keys=False)  # checked over the cells below
     if announce and size > LARGE_GRID_CELLS // 10:
         announce(f"sweep: validating the scenes of {size:,} cells (about 1 ms each)")
-    planned, problems = [], {}
+    planned, problems, notes = [], {}, []
+    idle_everywhere: set[str] | None = None  # keys at a joint that is ideal in every cell so far
     for cell in cells:
         candidate = PlannedCell(cell, {**cell.overrides, "name": f"{base.name}[{cell.name}]"})
         try:
-            apply_overrides(base, candidate.overrides, CELL_NAME_CHECK)
+            scene = apply_overrides(base, candidate.overrides, CELL_NAME_CHECK, refuse_ideal_keys=False)
         except SceneError as exc:
             problems.setdefault(str(exc), []).append(cell.name)
             continue
+        idle = set(ideal_joint_keys(scene, cell.overrides))
+        idle_everywhere = idle if idle_everywhere is None else idle_everywhere & idle
+        note = inheritance_note(scene)
+        if note and not notes:
+            notes.append(note)
         planned.append(candidate)
+    if idle_everywhere and not problems:
+        # A key of a joint that is ideal in every cell changes nothing: the cells would be identical
+        # copies.  Refused with the line `run --set` gives for it (a key that matters in some cells is kept).
+        key = sorted(idle_everywhere)[0]
+        raise SweepError(f"{ideal_key_message(key, CELL_NAME_CHECK)} (in every cell of the sweep)")
     if problems:
         lines = [f"{message} (cell{'s' if len(names) > 1 else ''} {', '.join(names[:3])}"
                  f"{f' and {len(names) - 3} more' if len(names) > 3 else ''})" for message, names in problems.items()]
         bad = sum(len(n) for n in problems.values())
         raise SweepError(f"{bad} of {len(cells)} cells are invalid, nothing was run: " + "; ".join(lines))
     return SweepPlan(str(scene_path), engine, axes, fixed_overrides, normalise(to_file_keys(base)), tuple(planned),
-                     base)
+                     base, tuple(notes))

@@ -20,8 +20,9 @@ PANEL_LABELS = {
     "driving_torque_Nm": "peak |driving torque| [N·m]",
     "rapier_acceleration_m_s2": "peak |rapier acceleration| [m/s²]",
     "contact_force_N": "peak contact force at E [kN]",
+    "contact_force_f_N": "peak contact force at F [kN]",
 }
-SCALES = {"contact_force_N": 1e-3}  # contact forces reach 1e5 N: shown in kN
+SCALES = {"contact_force_N": 1e-3, "contact_force_f_N": 1e-3}  # contact forces reach 1e5 N: shown in kN
 
 
 UNITS = {"mm": "mm", "rpm": "rpm", "deg": "deg", "gpa": "GPa", "kg": "kg", "s": "s", "kg_m2": "kg m²"}
@@ -59,6 +60,15 @@ def _value(row: dict, channel: str, which: str) -> float:
     return _number(row.get(f"{channel}_{which}_peak")) if row.get("status") == "success" else math.nan
 
 
+def shown_channels(rows: list[dict]) -> tuple[str, ...]:
+    """The panels to draw: torque and acceleration always, the contact force of each joint with a clearance
+    in some successful cell (a joint ideal in every cell has no contact force to show)."""
+    def present(channel: str) -> bool:
+        return any(math.isfinite(_value(row, channel, "rev1")) for row in rows)
+
+    return tuple(c for c in METRIC_CHANNELS if c not in ("contact_force_N", "contact_force_f_N") or present(c))
+
+
 def _edges(centres: np.ndarray) -> np.ndarray:
     """Cell edges half-way between centres (ends mirrored), so uneven grids draw honestly."""
     if centres.size == 1:
@@ -91,15 +101,18 @@ def _grid_panel(fig, ax, grid, xc, yc, channel, annotate):
 
 
 def plot_sweep_1d(rows: list[dict], name: str, title: str = "") -> Figure:
-    """Three panels: peak torque, acceleration and contact force against the varied parameter."""
+    """Panels of peak torque, acceleration and the contact force of each clearance joint (E, F) against
+    the varied parameter."""
     from weftsim.plots import pyplot
 
     plt = pyplot()
     values, numeric = _axis_values(rows, name)
     x = np.array(values, dtype=float) if numeric else np.arange(len(values), dtype=float)
     by_value = {row[name]: row for row in rows}
-    fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
-    for ax, channel in zip(axes, METRIC_CHANNELS):
+    channels = shown_channels(rows)
+    fig, axes = plt.subplots(1, len(channels), figsize=(4.4 * len(channels), 3.8), squeeze=False)
+    axes = axes[0]
+    for ax, channel in zip(axes, channels):
         for (which, label), style in zip(windows(rows), ("o-", "s--")):
             y = np.array([_value(by_value[v], channel, which) for v in values]) * SCALES.get(channel, 1.0)
             ax.plot(x, y, style, ms=4, lw=1, label=label)
@@ -115,7 +128,7 @@ def plot_sweep_1d(rows: list[dict], name: str, title: str = "") -> Figure:
 
 
 def plot_sweep_2d(rows: list[dict], x_name: str, y_name: str, title: str = "") -> Figure:
-    """Heat maps of peak torque, acceleration and contact force over the (x, y) grid.
+    """Heat maps of peak torque, acceleration and each clearance joint's contact force over the (x, y) grid.
 
     One row for the first revolution and, when the runs are longer, one for the last
     complete revolution; values are written into the cells of small grids.
@@ -129,10 +142,11 @@ def plot_sweep_2d(rows: list[dict], x_name: str, y_name: str, title: str = "") -
     yc = np.array(ys, dtype=float) if y_numeric else np.arange(len(ys), dtype=float)
     index = {(row[x_name], row[y_name]): row for row in rows}
     shown = windows(rows)
-    fig, axes = plt.subplots(len(shown), 3, figsize=(15, 4.2 * len(shown)), constrained_layout=True,
-                             squeeze=False)
+    channels = shown_channels(rows)
+    fig, axes = plt.subplots(len(shown), len(channels), figsize=(5 * len(channels), 4.2 * len(shown)),
+                             constrained_layout=True, squeeze=False)
     for (which, label), axes_row in zip(shown, axes):
-        for ax, channel in zip(axes_row, METRIC_CHANNELS):
+        for ax, channel in zip(axes_row, channels):
             grid = np.full((len(ys), len(xs)), np.nan)
             for i, yv in enumerate(ys):
                 for j, xv in enumerate(xs):

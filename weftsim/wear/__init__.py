@@ -53,16 +53,23 @@ def check_request(scene: Scene, hours: float, engine: str, limit: float | None) 
     if engine == "exudyn":
         raise WearError("--engine exudyn: the Exudyn engine has no worn-geometry contact yet; the wear prediction "
                         "runs on the reference engine (--engine reference, the default)")
-    if not (hours > 0.0 and math.isfinite(hours)):
-        raise WearError(f"--hours must be a finite number > 0, got {hours}")
+    from weftsim.wear.extrapolate import MAX_HOURS
+
+    if not (0.0 < hours <= MAX_HOURS):
+        raise WearError(f"--hours must be > 0 and at most {MAX_HOURS:g} h (114 years of continuous running), "
+                        f"got {hours:g}")
     if limit is not None and not (limit > scene.joint.clearance and math.isfinite(limit)):
         raise WearError(f"--limit-clearance-mm must be larger than the scene's clearance "
                         f"{scene.joint.clearance * 1e3:g} mm, got {limit * 1e3:g}")
-    if scene.joint.is_ideal:
-        raise WearError("joint_e.clearance_mm is 0 (ideal joint): there is no contact to wear; give a clearance > 0")
-    if not scene.joint_f.is_ideal:
+    if limit is not None and limit >= scene.joint.journal_radius:
+        raise WearError(f"--limit-clearance-mm must be smaller than the journal radius "
+                        f"{scene.joint.journal_radius * 1e3:g} mm (the prediction ends before the clearance "
+                        f"reaches it, docs/wear.md), got {limit * 1e3:g}")
+    if not scene.joint_f.is_ideal:  # first: a scene with F alone loose is refused for F, not for E's 0
         raise WearError("the scene gives a clearance at F: the wear prediction covers joint E with F ideal so far "
                         "(docs/wear.md); set joint_f.clearance_mm = 0 or leave out [joint_f]")
+    if scene.joint.is_ideal:
+        raise WearError("joint_e.clearance_mm is 0 (ideal joint): there is no contact to wear; give a clearance > 0")
 
 
 def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine: str = "reference",
@@ -89,10 +96,20 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
     Returns
     -------
     dict
-        The summary (``wear.json``) with ``"files"``: kind -> path written.
+        The summary (``wear.json``) with ``"files"``: kind -> path written.  ``"ended"`` says why a
+        prediction stopped short of ``hours`` at a geometric limit (None otherwise); the hours and
+        final wear are then those at the limit.
+
+    Raises
+    ------
+    WearError
+        The request is refused, or an update failed (its simulation, or wear too fast to
+        extrapolate): every update before it is written first (``wear.csv``, ``wear.json``, the
+        profiles) and the message says so.
     """
-    from weftsim.output import begin_directory, write_figure, write_files, write_json
+    from weftsim.output import begin_directory
     from weftsim.wear import store
+    from weftsim.wear.extrapolate import predict
 
     check_request(scene, hours, engine, limit)
     outdir = Path(outdir)
@@ -101,16 +118,54 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
     wall0 = time.perf_counter()
     done = store.load_state(outdir, scene)
 
+    latest = list(done)
+
     def on_update(updates):
+        latest[:] = updates
         store.save_state(outdir, scene, updates)
         if progress is not None and updates[-1].hours > 0.0:  # no time-left estimate from a zero fraction
             progress(min(updates[-1].hours / hours, 1.0))
 
-    from weftsim.wear.extrapolate import predict
+    try:
+        updates = predict(scene, hours, done, on_update=on_update, stop=stop)
+        if not updates:  # stopped (Ctrl-C) before the first update was done: nothing to write
+            raise KeyboardInterrupt
+    except WearError as exc:
+        if not latest:
+            raise
+        _write_results(scene, latest, hours, limit, time.perf_counter() - wall0, outdir, what, figures, str(exc))
+        raise WearError(f"{exc}; the prediction stopped there: the {len(latest)} updates before it "
+                        f"(0 to {latest[-1].hours:.6g} h) are in {outdir}/wear.csv and wear.json") from None
+    return _write_results(scene, updates, hours, limit, time.perf_counter() - wall0, outdir, what, figures)
 
-    updates = predict(scene, hours, done, on_update=on_update, stop=stop)
-    wall = time.perf_counter() - wall0
+
+def _write_results(scene: Scene, updates: list, hours: float, limit: float | None, wall: float, outdir: Path,
+                   what: dict, figures: bool, failure: str | None = None) -> dict:
+    """Write the tables, the summary and the figures of ``updates``; returns the summary with ``"files"``.
+
+    ``failure``: why the prediction stopped at an update that failed (``wear.json`` keeps it).
+    """
+    from dataclasses import replace
+
+    from weftsim.output import write_figure, write_files, write_json
+    from weftsim.wear import store
+    from weftsim.wear.extrapolate import advance, effective_clearance, ended_by_limit, limit_hours
+
     data = store.summary(scene, updates, hours, limit, wall)
+    ended = ended_by_limit(scene, updates)
+    data["ended"] = ended
+    data["failure"] = failure
+    if ended is not None:  # the last update extrapolates up to the limit: report the state there
+        end_hours, end_revolutions, bearing, journal = advance(updates[-1], scene)
+        if limit is not None:
+            end = replace(updates[-1], hours=end_hours, revolutions=end_revolutions, bearing=bearing, journal=journal)
+            data["hours_to_limit"] = limit_hours([*updates, end], scene.joint.clearance, limit)
+        data.update(hours_reached=end_hours,
+                    final_effective_clearance_mm=1e3 * effective_clearance(scene.joint.clearance, bearing, journal),
+                    final_bearing_wear_max_mm=1e3 * float(bearing.max()),
+                    final_journal_wear_max_mm=1e3 * float(journal.max()),
+                    wear_volume_mm3=data["wear_volume_mm3"] + 1e9 * updates[-1].volume_rate
+                    * updates[-1].step_revolutions)
     columns = store.table(scene, updates)
     files = {
         "state": (store.STATE, lambda p: p),

@@ -50,9 +50,8 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
                                         stop=lambda: state["signal"] is not None, figures=not args.no_plot)
         except StateMismatch as exc:
             raise CliError(str(exc)) from None
-        except WearError as exc:
-            raise CliError(f"{exc} (the updates before it are kept in {outdir}; rerun to resume)",
-                            EXIT_FAILED) from None
+        except WearError as exc:  # the updates before it are written (the message says where)
+            raise CliError(str(exc), EXIT_FAILED) from None
         finally:
             progress.close()
     print(f"scene {scene.name}: {data['hours_reached']:.6g} h in {data['updates']} updates "
@@ -64,6 +63,10 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
               (f"reached after {reached:.6g} h" if reached is not None else data["note"]))
     for path in data["files"].values():
         print(f"  wrote {path}")
+    if data.get("ended"):
+        print(f"  the prediction ends at {data['hours_reached']:.6g} h of the {args.hours:g} asked for: "
+              f"{data['ended']}; nothing beyond it is predicted")
+        return 0
     if not data["complete"]:
         raise CliError(f"stopped after {data['hours_reached']:.6g} h; the state is in {outdir}: run the same "
                         "command again to resume", 130)

@@ -10,6 +10,14 @@ fraction ``max_clearance_change`` of its value per update,
     N = f c_eff / (max dh_b + max dh_j)        (dh per revolution; an upper bound of dc_eff/rev),
 
 cut to the hours left.  Each update is one :class:`Update`: the state a run resumes from.
+
+The prediction ends early, with one line saying why, where the worn geometry leaves the model
+(:func:`geometric_limit`): the effective clearance reaches the journal radius (the bound a scene
+puts on ``joint_e.clearance_mm``; the journal would be worn through), or a worn wall's slope reaches
+:data:`MAX_WALL_SLOPE` (the small-wear geometry of docs/wear.md section 2).  The update that would
+cross it extrapolates only up to it (:func:`predict`); nothing is simulated beyond.  Wear so fast
+that an update's own revolutions grow the clearance by more than ``max_clearance_change`` cannot be
+extrapolated at all and is refused (:class:`~weftsim.errors.WearError`).
 """
 
 from __future__ import annotations
@@ -43,6 +51,19 @@ MIXED_FILM_RATIO = 3.0
 # with RETRY_*; wear.csv records the rtol each update ran at (solver_rtol).
 WORN_RTOL, WORN_ATOL = 1e-6, 1e-9
 RETRY_RTOL, RETRY_ATOL, RETRY_MAX_STEP = 1e-8, 1e-11, math.radians(0.1)
+# Largest slope dh/(R dpsi) of a worn wall the model takes: it treats the worn wall's normal as the
+# eccentricity direction n, off by the slope angle alpha.  At 0.1 rad the force along n is off by
+# 1 - cos(alpha) = 0.5 % and the neglected tangential part of the wall's force is 10 % of F_N, the
+# size of a dry friction force the joint model otherwise counts; the reference loom at c_eff = 0.36 mm
+# has 0.012 rad (docs/wear.md section 2).
+MAX_WALL_SLOPE = 0.1
+# Longest prediction: 1e6 h are 114 years of continuous running, beyond any machine's life (a loom
+# runs some 1e5 h); longer requests are typing errors (1e308) that the extrapolation cannot serve.
+MAX_HOURS = 1e6
+
+
+class WearInterrupted(Exception):
+    """A stop was asked for (Ctrl-C, SIGTERM) while an update was being simulated: the update is dropped."""
 
 
 
@@ -71,6 +92,50 @@ class Update:
 def effective_clearance(c0: float, bearing: np.ndarray, journal: np.ndarray) -> float:
     """c0 + max h_b + max h_j, m: the clearance where the two worn spots face each other (the load line)."""
     return c0 + float(np.max(bearing, initial=0.0)) + float(np.max(journal, initial=0.0))
+
+
+def wall_slope(profile: np.ndarray, radius: float) -> float:
+    """Largest slope |dh/dpsi| / R of a periodic worn-depth table (central differences), rad."""
+    if profile.size < 3:
+        return 0.0
+    dpsi = 2.0 * math.pi / profile.size
+    return float(np.max(np.abs(np.roll(profile, -1) - np.roll(profile, 1)))) / (2.0 * dpsi * radius)
+
+
+def geometric_limit(scene: Scene, bearing: np.ndarray, journal: np.ndarray) -> str | None:
+    """Why the worn geometry (bearing, journal; m) is beyond the model, as one clause, or None."""
+    joint = scene.joint
+    c_eff = effective_clearance(joint.clearance, bearing, journal)
+    if c_eff >= joint.journal_radius * (1.0 - 1e-9):
+        return (f"the effective clearance reaches the journal radius {joint.journal_radius * 1e3:g} mm (the bound "
+                f"of joint_e.clearance_mm; the journal would be worn through)")
+    slope = max(wall_slope(bearing, joint.bearing_radius), wall_slope(journal, joint.journal_radius))
+    if slope >= MAX_WALL_SLOPE * (1.0 - 1e-9):
+        return (f"a worn wall's slope reaches {MAX_WALL_SLOPE:g} rad (the small-wear geometry the contact "
+                "model assumes, docs/wear.md section 2)")
+    return None
+
+
+def ended_by_limit(scene: Scene, updates: Sequence[Update]) -> str | None:
+    """The :func:`geometric_limit` that ended the prediction ``updates`` at its last update, or None."""
+    if not updates or updates[-1].step_revolutions == 0.0:
+        return None
+    return geometric_limit(scene, *advance(updates[-1], scene)[2:])
+
+
+def _cut_to_limit(update: Update, scene: Scene) -> Update:
+    """``update`` with its revolutions cut so the geometry just reaches :func:`geometric_limit` (unchanged if
+    its whole extrapolation stays inside)."""
+    if geometric_limit(scene, *advance(update, scene)[2:]) is None:
+        return update
+    inside, outside = 0.0, update.step_revolutions
+    for _ in range(60):  # bisection to a relative 1e-18 of N: the limit is reached to round-off
+        middle = 0.5 * (inside + outside)
+        if geometric_limit(scene, *advance(replace(update, step_revolutions=middle), scene)[2:]) is None:
+            inside = middle
+        else:
+            outside = middle
+    return replace(update, step_revolutions=outside)
 
 
 def worn_scene(scene: Scene, bearing: np.ndarray, journal: np.ndarray, revolutions: float,
@@ -117,6 +182,8 @@ def simulate_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray) -> t
     from weftsim import reference
     from weftsim.reference.dynamics import pack_parameters
 
+    from weftsim.guards import stop_requested
+
     w = scene.joint.wear
     for retry in (False, True):
         run_scene = worn_scene(scene, bearing, journal, w.settle_revolutions + w.revolutions_per_update, retry)
@@ -124,6 +191,8 @@ def simulate_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray) -> t
         result = reference.solve(run_scene, step_states=lambda *a: rows.update(steps=a))
         if result.ok:
             break
+        if stop_requested() is not None or result.solver_stats.get("failure") == "interrupted":
+            raise WearInterrupted(result.message)
     else:
         raise WearError(f"the simulation on the worn geometry failed (also at rtol {RETRY_RTOL:g}): {result.message}")
     t0 = w.settle_revolutions * scene.drive.period
@@ -144,7 +213,15 @@ def next_update(scene: Scene, hours_done: float, revolutions_done: float, bearin
     revs_per_hour = scene.drive.speed / (2.0 * math.pi) * SECONDS_PER_HOUR
     left = (hours - hours_done) * revs_per_hour
     c_eff = effective_clearance(scene.joint.clearance, bearing, journal)
-    n = left if growth <= 0.0 else min(left, w.max_clearance_change * c_eff / growth)
+    allowed = math.inf if growth <= 0.0 else w.max_clearance_change * c_eff / growth
+    if allowed < w.revolutions_per_update and left > allowed:
+        raise WearError(
+            f"the wear is too fast to extrapolate: the {w.revolutions_per_update} revolutions of an update alone "
+            f"grow the clearance by {100 * w.revolutions_per_update * growth / c_eff:.3g} %, more than "
+            f"joint_e.wear.max_clearance_change = {100 * w.max_clearance_change:g} % (wear_coefficient "
+            f"{w.wear_coefficient:g}, hardness {w.bearing_hardness / 1e6:g} / {w.journal_hardness / 1e6:g} MPa: "
+            "check [joint_e.wear])")
+    n = min(left, allowed)
     return Update(hours_done, revolutions_done, bearing.copy(), journal.copy(), n, rate_b, rate_j,
                   (wear.bearing_volume + wear.journal_volume) * per_rev, response)
 
@@ -164,14 +241,19 @@ def predict(scene: Scene, hours: float, updates: Sequence[Update] = (),
 
     ``updates``: updates already done (resume: the run continues after the last);
     ``on_update(updates)``: called after each update (storing, progress); ``stop()``: True asks to
-    end after the current update.  The last update simulates the final geometry, with N = 0.
+    end after the current update.  The last update simulates the final geometry, with N = 0; or,
+    when the prediction ends at a geometric limit (:func:`ended_by_limit`), extrapolates up to it.
+    A stop asked for while an update is simulated (:func:`weftsim.guards.request_stop`) drops it.
     """
-    if not hours > 0.0 or not math.isfinite(hours):
-        raise WearError(f"--hours must be a finite number > 0, got {hours}")
+    if not (0.0 < hours <= MAX_HOURS):
+        raise WearError(f"--hours must be > 0 and at most {MAX_HOURS:g} h (114 years of continuous running), "
+                        f"got {hours:g}")
     if scene.joint.is_ideal:
         raise WearError("joint_e.clearance_mm is 0 (ideal joint): there is no contact to wear; give a clearance > 0")
     n = scene.joint.wear.profile_points
     done = list(updates)
+    if ended_by_limit(scene, done) is not None:  # resumed after the geometric limit: nothing to add
+        return done
     if done:
         state = advance(done[-1], scene)
         if done[-1].step_revolutions == 0.0:  # the run had finished: nothing left but a longer request
@@ -182,13 +264,18 @@ def predict(scene: Scene, hours: float, updates: Sequence[Update] = (),
     while True:
         hours_done, revs_done, bearing, journal = state
         finished = hours_done >= hours * (1.0 - 1e-12)
-        update = next_update(scene, hours_done, revs_done, bearing, journal, hours)
+        try:
+            update = next_update(scene, hours_done, revs_done, bearing, journal, hours)
+        except WearInterrupted:
+            return done  # the update in progress is dropped; the state holds the ones before it
         if finished:
             update = replace(update, step_revolutions=0.0)
+        else:
+            update = _cut_to_limit(update, scene)
         done.append(update)
         if on_update is not None:
             on_update(done)
-        if finished or (stop is not None and stop()):
+        if finished or ended_by_limit(scene, done) is not None or (stop is not None and stop()):
             return done
         state = advance(update, scene)
 
