@@ -329,3 +329,145 @@ def test_pool_workers_start_once_and_run_many_cells(tmp_path):
         assert sorted(numbers) == list(range(1, len(numbers) + 1))
     assert all(is_finished(tmp_path / r["cell"], read_record(tmp_path / r["cell"])["scene"], FAKE)
                for r in report.rows)
+
+
+# --- edited cell records and manifests (issue 24) --------------------------------------------------------
+
+GRID = ["--vary", "clearance_mm=0.1,0.2", "--vary", "restitution=0.5,0.9"]
+
+
+@pytest.fixture(scope="module")
+def finished_sweep(tmp_path_factory):
+    """A finished 2 x 2 sweep of the stand-in engine, copied by each test before it edits it."""
+    outdir = tmp_path_factory.mktemp("sweep") / "s"
+    assert main([*ARGS, *GRID, "-o", str(outdir)]) == 0
+    return outdir
+
+
+def _copy_sweep(finished_sweep, tmp_path):
+    import shutil
+
+    outdir = tmp_path / "s"
+    shutil.copytree(finished_sweep, outdir)
+    return outdir
+
+
+CELL = "clearance_mm=0.1,restitution=0.5"
+
+
+@pytest.mark.parametrize("edit", [
+    lambda r: r.update(metrics=[1, 2]),
+    lambda r: r.pop("params"),
+    lambda r: r["params"].update(clearance_mm=0.7),  # names another cell
+    lambda r: r.update(status="garbage"),
+    "[" * 100000 + "]" * 100000,
+])
+def test_an_edited_cell_record_is_run_again(finished_sweep, tmp_path, capsys, edit):
+    """A cell.json edited by hand is not trusted: the rerun runs its cell again, the grid counts it as not run
+    until then, and nothing raises."""
+    import weftsim
+
+    outdir = _copy_sweep(finished_sweep, tmp_path)
+    record_path = outdir / CELL / CELL_FILE
+    if isinstance(edit, str):
+        record_path.write_text(edit)
+    else:
+        record = json.loads(record_path.read_text())
+        edit(record)
+        record_path.write_text(json.dumps(record))
+    assert read_record(outdir / CELL) is None
+    grid = weftsim.load_sweep(outdir)
+    assert grid["status"].sel(clearance_mm=0.1, restitution=0.5).item() == "not run"
+    assert (grid["status"] == "success").sum().item() == 3
+    capsys.readouterr()
+    assert main([*ARGS, *GRID, "-o", str(outdir)]) == 0
+    assert "3 already finished, 1 succeeded" in capsys.readouterr().out
+    assert weftsim.load_sweep(outdir)["status"].sel(clearance_mm=0.1, restitution=0.5).item() == "success"
+
+
+def _many_axes(count):
+    from weftsim.scene import SCHEMA
+
+    keys = [k.path for k in SCHEMA if k.kind == "float"][:count]
+    assert len(keys) == count
+    return [{"name": k, "key": k, "values": [1.0, 2.0]} for k in keys]
+
+
+@pytest.mark.parametrize("edit, words", [
+    (lambda m: m["axes"][0].update(name="status"), ["axis name 'status' is a column of the table"]),
+    (lambda m: m["axes"][0].update(name=5), ["axis name 5"]),
+    (lambda m: m.update(axes=_many_axes(30)), ["1,073,741,824 cells", "more than the 1,000,000"]),
+    (lambda m: m.update(axes=_many_axes(64)), ["18,446,744,073,709,551,616 cells"]),
+    (lambda m: m["axes"][1].update(name=m["axes"][0]["name"]), ["an axis is listed more than once"]),
+    (lambda m: m["axes"][0].update(values=[0.1, 0.1, 0.2]), ["a value of clearance_mm is listed more than once"]),
+    (lambda m: m["axes"][0].update(values=[{"a": 1}]), ["not a list of numbers"]),
+    (lambda m: m["axes"][0].update(values=[]), ["not a list of numbers"]),
+    (lambda m: m["axes"][0].update(key="bogus.key"), ["'bogus.key' is not a scene key"]),
+    (lambda m: m["axes"][0].update(name="a/b"), ["axis name 'a/b'"]),
+])
+def test_an_edited_manifest_is_one_line_for_load_sweep_and_the_rerun(finished_sweep, tmp_path, capsys, edit, words):
+    import weftsim
+
+    outdir = _copy_sweep(finished_sweep, tmp_path)
+    manifest = json.loads((outdir / SWEEP_FILE).read_text())
+    edit(manifest)
+    (outdir / SWEEP_FILE).write_text(json.dumps(manifest))
+    with pytest.raises(SweepError) as caught:
+        weftsim.load_sweep(outdir)
+    assert "damaged" in str(caught.value) and "\n" not in str(caught.value)
+    for word in words:
+        assert word in str(caught.value)
+    capsys.readouterr()
+    assert main([*ARGS, *GRID, "-o", str(outdir)]) == EXIT_USAGE
+    one_error_line(capsys, "damaged", *words)
+
+
+def test_a_deeply_nested_manifest_is_one_line(finished_sweep, tmp_path, capsys):
+    outdir = _copy_sweep(finished_sweep, tmp_path)
+    (outdir / SWEEP_FILE).write_text("[" * 100000 + "]" * 100000)
+    assert main([*ARGS, *GRID, "-o", str(outdir)]) == EXIT_USAGE
+    one_error_line(capsys, "nests too deeply")
+
+
+@pytest.mark.parametrize("edit", [
+    lambda r: r.update(params=[1]),
+    lambda r: r["params"].update(clearance_mm={"x": 1}),
+    lambda r: r.update(wall_time_s="slow"),
+    lambda r: r["metrics"].update(contact_force_N_rev1_peak="big"),
+    lambda r: r.update(scene="x"),
+])
+def test_other_edited_cell_records_are_not_trusted(finished_sweep, tmp_path, edit):
+    outdir = _copy_sweep(finished_sweep, tmp_path)
+    record_path = outdir / CELL / CELL_FILE
+    record = json.loads(record_path.read_text())
+    edit(record)
+    record_path.write_text(json.dumps(record))
+    assert read_record(outdir / CELL) is None
+
+
+def test_a_garbage_status_in_every_cell_loads_as_not_run(finished_sweep, tmp_path):
+    import weftsim
+
+    outdir = _copy_sweep(finished_sweep, tmp_path)
+    for cell in outdir.iterdir():
+        if (cell / CELL_FILE).exists():
+            record = json.loads((cell / CELL_FILE).read_text())
+            record["status"] = "garbage"
+            (cell / CELL_FILE).write_text(json.dumps(record))
+    grid = weftsim.load_sweep(outdir)
+    assert set(grid["status"].values.ravel()) == {"not run"}
+
+
+@pytest.mark.parametrize("vary, yes", [("restitution=0.5:1:100000000", False), ("restitution=0.5:1:100000000", True),
+                                       ("restitution=0.5:1:1000000000000000000", False)])
+def test_a_huge_range_is_counted_before_its_values_are_built(tmp_path, capsys, monkeypatch, vary, yes):
+    """10^8 values took minutes and gigabytes before the 2,000-cell refusal; the count comes from the text,
+    so no value is built (parse_vary, which builds them, is never called)."""
+    def build(text):
+        raise AssertionError(f"values of {text} built before the refusal")
+
+    monkeypatch.setattr("weftsim.sweep.plan.parse_vary", build)
+    status = main([*ARGS, "--vary", vary, *(["--yes"] if yes else []), "-o", str(tmp_path / "x")])
+    assert status == EXIT_USAGE
+    one_error_line(capsys, "cells, more than the 1,000,000 a sweep can hold")
+    assert not (tmp_path / "x").exists()

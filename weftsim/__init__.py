@@ -48,6 +48,7 @@ from weftsim.api import (  # noqa: E402 (after __version__, which submodules rea
     simulate,
 )
 from weftsim.errors import (  # noqa: E402
+    ArgumentError,
     EngineError,
     MissingExtra,
     OutputError,
@@ -63,6 +64,7 @@ from weftsim.params import Scene  # noqa: E402
 from weftsim.results import CHANNELS, RunResult  # noqa: E402
 
 __all__ = [
+    "ArgumentError",
     "CHANNELS",
     "DEFAULT_ENGINE",
     "ENGINE_NAMES",

@@ -56,6 +56,27 @@ if TYPE_CHECKING:
 FORMATS = (".gif", ".mp4")
 DEFAULT_FRAMES = 72  # one frame per 5 deg of crank: smooth enough, ~1 MB as a GIF
 DEFAULT_FPS = 18  # a revolution in 4 s: the loom's motion slowed about 27x at 400 rpm
+# At most this many frames: one per 0.25 deg of crank, finer than the 0.5 deg output samples they are
+# drawn from.  Pillow holds every frame of a GIF until it writes the file (0.42 MB each at 700 x 600
+# pixels: ~600 MB here), and each takes ~10 ms to draw.
+MAX_FRAMES = 1440
+FRAME_BYTES = 7.0 * 6.0 * 100.0**2  # one palette frame of the 7 x 6 in figure at 100 dpi
+
+
+def check_frames(frames: int) -> None:
+    """Refuse a frame count outside 2..:data:`MAX_FRAMES`, or one whose frames do not fit in memory.
+
+    Raises ValueError with one line naming the limit.
+    """
+    from weftsim.output import _available_memory
+
+    if isinstance(frames, bool) or not isinstance(frames, int) or not 2 <= frames <= MAX_FRAMES:
+        raise ValueError(f"--frames must be a whole number from 2 to {MAX_FRAMES} (one frame per 0.25 deg of crank; "
+                         f"a GIF holds every frame in memory while it is written), got {frames!r}")
+    available = _available_memory()
+    if available is not None and frames * FRAME_BYTES > available:
+        raise ValueError(f"--frames {frames}: the frames need ~{frames * FRAME_BYTES / 1e6:.0f} MB of memory, more "
+                         f"than the {available / 1e6:.0f} MB available; ask for fewer")
 AXIS_DISPLAY_LENGTH = 0.5  # crank and rocker axes drawn at this fraction of L_OE
 
 
@@ -387,9 +408,11 @@ def _gif(frames, fps: float, target: Path) -> None:
     """Save RGB frames as one looping GIF (Pillow ships with matplotlib)."""
     from PIL import Image
 
-    images = [Image.fromarray(rgb).quantize(colors=128, method=Image.Quantize.FASTOCTREE) for rgb in frames]
-    images[0].save(target, format="GIF", save_all=True, append_images=images[1:],
-                   duration=int(round(1000.0 / fps)), loop=0, disposal=1)
+    images = (Image.fromarray(rgb).quantize(colors=128, method=Image.Quantize.FASTOCTREE) for rgb in frames)
+    first = next(images)
+    # A generator: Pillow keeps its own copy of each frame until the file is written; a list here held a second.
+    first.save(target, format="GIF", save_all=True, append_images=images, duration=int(round(1000.0 / fps)), loop=0,
+               disposal=1)
 
 
 def _mp4(frames, fps: float, target: Path) -> None:
@@ -453,6 +476,7 @@ def write_animation(result: RunResult, path: str | Path, frames: int = DEFAULT_F
     from weftsim.output import write_atomic
 
     suffix = check_format(path)
+    check_frames(frames)
     if not fps > 0:
         raise ValueError(f"fps must be > 0, got {fps}")
     points = mechanism_frames(result, frames)

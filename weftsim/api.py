@@ -25,7 +25,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import TYPE_CHECKING, Any, Callable
 
-from weftsim.errors import EngineError, PlausibilityWarning, RunFailed, SceneError
+from weftsim.errors import ArgumentError, EngineError, OutputError, PlausibilityWarning, RunFailed, SceneError
 from weftsim.params import Scene
 from weftsim.results import RunResult
 
@@ -191,6 +191,9 @@ def simulate(scene: Scene | str | os.PathLike, engine: str = "auto", *,
     from weftsim.design_checks import before_run, warnings_of
 
     module = _engine_module(engine)
+    if progress is not None and not callable(progress):
+        raise ArgumentError(f"simulate: progress must be None or a function called with the completed fraction "
+                            f"(e.g. lambda f: print(f)), got {type(progress).__name__} {progress!r:.40}")
     scene = _as_scene(scene)
     for text in warnings_of(before_run(scene)):
         if on_warning is None:
@@ -225,7 +228,18 @@ def save_result(result: RunResult, path: str | os.PathLike) -> Path:
     """
     from weftsim.results import save_npz
 
-    return save_npz(result, path)
+    if not isinstance(result, RunResult):
+        raise ArgumentError(f"save_result: result must be a RunResult (from weftsim.simulate or load_result), "
+                            f"got {type(result).__name__}")
+    if not isinstance(path, (str, os.PathLike)):
+        raise ArgumentError(f"save_result: path must be a file path, got {type(path).__name__}")
+    from weftsim.output import write_atomic
+
+    try:  # atomic: a run killed while saving leaves the previous file (or none), never a truncated one
+        write_atomic(Path(path), lambda tmp: save_npz(result, tmp))
+        return Path(path)
+    except OSError as exc:
+        raise OutputError(f"cannot write {path}: {exc.strerror or exc}") from None
 
 
 def load_result(path: str | os.PathLike) -> RunResult:
@@ -238,6 +252,8 @@ def load_result(path: str | os.PathLike) -> RunResult:
     """
     from weftsim.results import load_npz
 
+    if not isinstance(path, (str, os.PathLike)):
+        raise ArgumentError(f"load_result: path must be a file path, got {type(path).__name__}")
     return load_npz(path)
 
 

@@ -390,8 +390,9 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def cmd_animate(args: argparse.Namespace) -> int:
-    from weftsim.animate import check_format, write_animation
+    from weftsim.animate import check_format, check_frames, write_animation
     from weftsim.api import resolve_engine
+    from weftsim.output import check_file_target
 
     scene = scene_from_args(args)
     engine = resolve_engine(args.engine)
@@ -400,10 +401,10 @@ def cmd_animate(args: argparse.Namespace) -> int:
     target = Path(args.output) if args.output else output_directory(args, scene, engine) / "animation.gif"
     try:
         check_format(target)
-        if args.frames < 2:
-            raise ValueError(f"--frames must be >= 2, got {args.frames}")
+        check_frames(args.frames)
     except ValueError as exc:
         raise CliError(str(exc)) from None
+    check_file_target(target)  # before the solve: a path that cannot be written fails now, not after it
     _check_fits(scene, target.parent)
     _announce_run_time(scene, (engine,), "animate")
     with _stop_on_interrupt("animate"):
@@ -436,6 +437,9 @@ def _replay_in_viewer(args: argparse.Namespace, scene, engine: str) -> int:
     if problem is not None:
         raise CliError(problem)
     target = Path(args.output) if args.output else output_directory(args, scene, "exudyn") / "viewer-solution.txt"
+    from weftsim.output import check_file_target
+
+    check_file_target(target)
     _check_fits(scene, target.parent)
     print(f"scene {scene.name}: solving the Exudyn rigid-body model for the viewer ({period_label(scene)})",
           flush=True)

@@ -34,6 +34,10 @@ class EngineError(WeftsimError, ValueError):
     """An engine name that is not one of :data:`weftsim.api.ENGINE_NAMES`."""
 
 
+class ArgumentError(WeftsimError, TypeError):
+    """A function of the Python interface got an argument of the wrong kind (names it and what it takes)."""
+
+
 class OutputError(WeftsimError, OSError):
     """The output directory or a file in it cannot be written, or a saved result cannot be read."""
 

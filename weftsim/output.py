@@ -72,6 +72,32 @@ def prepare_directory(path: str | Path, force: bool = False) -> Path:
     return path
 
 
+def check_file_target(target: str | Path) -> Path:
+    """Check, creating nothing, that the file ``target`` can be written once a long computation is done.
+
+    Its directory must exist and be writable, or be creatable: the nearest existing ancestor a
+    writable directory.  Raises :class:`OutputError` naming the part of the path that is in the way.
+    """
+    target = Path(target)
+    if target.is_dir():
+        raise OutputError(f"cannot write {target}: it is a directory; give a file name")
+    for ancestor in target.parents:
+        if ancestor.exists() or ancestor.is_symlink():
+            if not ancestor.is_dir():
+                raise OutputError(f"cannot write {target}: {ancestor} is a file, not a directory")
+            if not os.access(ancestor, os.W_OK | os.X_OK):
+                raise OutputError(f"cannot write {target}: directory {ancestor} is not writable")
+            if ancestor == target.parent:  # permissions do not tell all (a read-only mount, /proc): try a file
+                try:
+                    fd, probe = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=ancestor)
+                    os.close(fd)
+                    os.unlink(probe)
+                except OSError as exc:
+                    raise OutputError(f"cannot write {target}: {exc.strerror or exc}") from None
+            return target
+    return target
+
+
 def _umask() -> int:
     mask = os.umask(0o022)  # the only way to read it is to set it; put it back at once
     os.umask(mask)
@@ -153,10 +179,14 @@ def write_figure(target: Path, figure: Figure) -> Path:
 
 
 def _manifest_files(outdir: Path) -> set[str]:
+    """Plain file names the directory's manifest lists (none if it is unreadable or malformed)."""
     try:
-        return set(json.loads((outdir / MANIFEST).read_text()).get("files", []))
-    except (OSError, ValueError):
+        listed = json.loads((outdir / MANIFEST).read_text()).get("files", [])
+    except (OSError, ValueError, RecursionError, AttributeError):
         return set()
+    if not isinstance(listed, list):
+        return set()
+    return {n for n in listed if isinstance(n, str) and n not in ("", ".", "..") and "/" not in n and "\0" not in n}
 
 
 def _overwrite_in_place(target: Path, text: str) -> None:
@@ -202,8 +232,9 @@ def finish_directory(outdir: Path, written: dict[str, Path], what: dict) -> None
     names = sorted(p.name for p in written.values())
     _set_manifest(outdir, {**what, "state": "complete", "files": names})
     for stale in old - set(names):
-        if "/" not in stale and stale != MANIFEST:
-            (outdir / stale).unlink(missing_ok=True)
+        path = outdir / stale
+        if stale != MANIFEST and (path.is_symlink() or path.is_file()):  # never a directory someone put there
+            path.unlink(missing_ok=True)
 
 
 def _rescue(failed: dict[str, tuple[str, Callable[[Path], Path]]]) -> tuple[Path | None, dict[str, str]]:

@@ -17,16 +17,11 @@ import dataclasses
 import json
 import math
 import os
-import types
-import typing
-import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
-
-from weftsim import params
 
 from weftsim.errors import OutputError, require
 from weftsim.params import Scene
@@ -329,34 +324,6 @@ def _plain(value: Any) -> Any:
     return value
 
 
-def _dataclass_type(hint: Any) -> type | None:
-    """The dataclass named by a field's type hint (also inside ``X | None``), else None."""
-    if dataclasses.is_dataclass(hint):
-        return hint
-    if typing.get_origin(hint) in (typing.Union, types.UnionType):
-        found = [arg for arg in typing.get_args(hint) if dataclasses.is_dataclass(arg)]
-        return found[0] if found else None
-    return None
-
-
-def _rebuild(cls: type, data: dict) -> Any:
-    """The dataclass ``cls`` from :func:`_plain`'s dict: nested dataclasses and tuples restored by the
-    field types, so a scene comes back equal to the one saved (JSON keeps every float exactly)."""
-    hints = typing.get_type_hints(cls, vars(params))
-    values = {}
-    for f in dataclasses.fields(cls):
-        if f.name not in data:  # a field added after the file was written keeps its default
-            continue
-        value, hint = data[f.name], hints.get(f.name)
-        nested = _dataclass_type(hint)
-        if nested is not None and isinstance(value, dict):
-            value = _rebuild(nested, value)
-        elif isinstance(value, list) and (hint is tuple or typing.get_origin(hint) is tuple):
-            value = tuple(value)
-        values[f.name] = value
-    return cls(**values)
-
-
 def save_npz(result: RunResult, path: str | os.PathLike) -> Path:
     """Write ``result`` to one NPZ file from which :func:`load_npz` rebuilds it exactly.
 
@@ -384,31 +351,18 @@ def save_npz(result: RunResult, path: str | os.PathLike) -> Path:
 
 
 def load_npz(path: str | os.PathLike) -> RunResult:
-    """The :class:`RunResult` saved by :func:`save_npz`.
+    """The :class:`RunResult` saved by :func:`save_npz`, read as untrusted input.
+
+    The archive's directory and every array's header are checked before any array is read
+    (:mod:`weftsim.result_file`), so a damaged or crafted file is refused with one line and
+    never allocates what its headers claim.
 
     Raises
     ------
     weftsim.errors.OutputError
-        The file cannot be read, is not a weftsim result, or lacks a channel.
+        The file cannot be read, is not a weftsim result, lacks or has malformed channels, or its
+        ``meta`` (scene, engine, status, ...) is not what :func:`save_npz` writes.
     """
-    path = Path(path)
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            meta = json.loads(str(data["meta"][()]))
-            if not isinstance(meta, dict) or meta.get("format") != NPZ_FORMAT:
-                raise OutputError(f"{path}: not a weftsim result of format {NPZ_FORMAT} "
-                                  f"(found {meta.get('format') if isinstance(meta, dict) else meta!r})")
-            names = CHANNELS + optional_channels(name.partition("/")[2] for name in data.files
-                                                 if name.startswith("samples/"))
-            tables = {table: {name: data[f"{table}/{name}"] for name in names} for table in ("samples", "steps")}
-    except OutputError:
-        raise
-    except FileNotFoundError:
-        raise OutputError(f"{path}: result file not found") from None
-    except KeyError as exc:
-        raise OutputError(f"{path}: not a complete weftsim result (no {exc.args[0]!r} in it)") from None
-    except (OSError, ValueError, zipfile.BadZipFile) as exc:
-        raise OutputError(f"{path}: cannot be read as a weftsim result ({exc})") from None
-    scene = _rebuild(Scene, meta["scene"])
-    return RunResult(scene, meta["engine"], meta["status"], meta["message"], tables["samples"], tables["steps"],
-                     meta["solver_stats"], meta["events"], meta["plausibility"], meta["path"])
+    from weftsim.result_file import read_npz
+
+    return read_npz(path)

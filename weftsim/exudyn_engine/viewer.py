@@ -54,13 +54,18 @@ class ViewerUnavailable(WeftsimError):
     exit_status = EXIT_USAGE
 
 
-def display_problem(environ: Mapping[str, str] | None = None, platform: str | None = None) -> str | None:
+def display_problem(environ: Mapping[str, str] | None = None, platform: str | None = None,
+                    probe: bool | None = None) -> str | None:
     """Why no viewer window can open here (one line), or None.
 
     On Linux and the BSDs a window needs an X11 (``DISPLAY``) or Wayland (``WAYLAND_DISPLAY``) server;
     macOS and Windows always have a desktop.  ``EXUDYN_SUPPRESS_UI_WINDOW_OPEN`` (set by test and
     documentation builds) makes Exudyn skip every window, which would leave the viewer with nothing to do.
+    ``probe`` (default: when ``environ`` is the process's own) also connects to the display's socket
+    (:func:`weftsim.display.unreachable_display`): a ``DISPLAY`` with no server behind it makes the
+    renderer abort the process natively.
     """
+    probe = environ is None if probe is None else probe
     environ = os.environ if environ is None else environ
     platform = sys.platform if platform is None else platform
     instead = "`weftsim animate SCENE` (without --viewer) writes a GIF instead"
@@ -69,6 +74,12 @@ def display_problem(environ: Mapping[str, str] | None = None, platform: str | No
     if platform.startswith(("linux", "freebsd", "openbsd", "netbsd")) and not (
             environ.get("DISPLAY") or environ.get("WAYLAND_DISPLAY")):
         return f"the Exudyn viewer needs a display (neither DISPLAY nor WAYLAND_DISPLAY is set); {instead}"
+    if probe and platform.startswith(("linux", "freebsd", "openbsd", "netbsd")):
+        from weftsim.display import unreachable_display
+
+        problem = unreachable_display(environ)
+        if problem is not None:
+            return f"the Exudyn viewer needs a display: {problem}; {instead}"
     return None
 
 

@@ -210,7 +210,7 @@ def _listed_files(cell_dir: Path) -> set[str]:
 
     try:
         listed = json.loads((cell_dir / MANIFEST).read_text(encoding="utf-8")).get("files", [])
-    except (OSError, ValueError, AttributeError):
+    except (OSError, ValueError, AttributeError, RecursionError):
         return set()
     return {n for n in listed if isinstance(n, str) and n and "/" not in n and n not in (".", "..")} \
         if isinstance(listed, list) else set()
@@ -240,12 +240,49 @@ def store_cell(cell_dir: Path, record: dict, files: dict[str, bytes], detail: st
 
 
 def read_record(cell_dir: Path) -> dict | None:
-    """The cell's ``cell.json``, or None if absent or unreadable (a cell to run again)."""
+    """The cell's ``cell.json``, or None if absent, unreadable or malformed (a cell to run again).
+
+    Malformed (:func:`record_problem`): a record damaged or edited by hand is not trusted for the
+    table or the grid; the next run of the sweep runs its cell again.
+    """
     try:
         record = json.loads((Path(cell_dir) / CELL_FILE).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+    except (OSError, ValueError, RecursionError):
         return None
-    return record if isinstance(record, dict) and record.get("format") == CELL_FORMAT else None
+    if not isinstance(record, dict) or record.get("format") != CELL_FORMAT or record_problem(record, Path(cell_dir)):
+        return None
+    return record
+
+
+def _scalar(value: Any) -> bool:
+    return isinstance(value, (str, int, float)) and not (isinstance(value, float) and not math.isfinite(value))
+
+
+def record_problem(record: dict, cell_dir: Path) -> str:
+    """What makes ``record`` (a parsed ``cell.json``) unusable ('' if nothing): a field of the wrong
+    type, a status other than success or failed, or parameters that do not name its directory."""
+    from weftsim.sweep.grid import cell_name
+
+    params = record.get("params")
+    if not isinstance(params, dict) or not params or not all(isinstance(k, str) and _scalar(v)
+                                                             for k, v in params.items()):
+        return "params is not a map of parameter names to values"
+    if cell_name(params) != cell_dir.name:
+        return f"params name the cell {cell_name(params)!r}, not its directory {cell_dir.name!r}"
+    if record.get("status") not in ("success", "failed"):
+        return "status is neither success nor failed"
+    for key, kind in (("metrics", dict), ("error", str), ("engine", str)):
+        if not isinstance(record.get(key), kind):
+            return f"{key} is not a {kind.__name__}"
+    if not all(v is None or isinstance(v, (int, float)) and not isinstance(v, bool)
+               for v in record["metrics"].values()):
+        return "a metric is not a number"
+    wall = record.get("wall_time_s")
+    if wall is not None and (isinstance(wall, bool) or not isinstance(wall, (int, float))):
+        return "wall_time_s is not a number"
+    if record.get("scene") is not None and not isinstance(record["scene"], dict):
+        return "scene is not a map of scene keys"
+    return ""
 
 
 def is_finished(cell_dir: Path, scene_keys: dict, engine: str) -> bool:
@@ -259,7 +296,7 @@ def is_finished(cell_dir: Path, scene_keys: dict, engine: str) -> bool:
         return False
     try:
         summary = json.loads((Path(cell_dir) / SUMMARY_FILE).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+    except (OSError, ValueError, RecursionError):
         return False
     # The run on disk must be the cell's own: `weftsim run -o SWEEP/cell` with another scene replaces
     # summary.json and channels.csv but not cell.json, and must not pass for this cell.

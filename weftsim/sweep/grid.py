@@ -164,6 +164,19 @@ class Axis:
     values: tuple
 
 
+def value_count(text: str) -> int:
+    """How many values ``KEY=VALUES`` gives, read from the text without building them (a range's
+    count, a list's items); 1 where the text is malformed, which :func:`parse_vary` then reports."""
+    values = text.partition("=")[2]
+    if ":" in values:
+        parts = values.split(":")
+        try:
+            return max(int(parts[2]), 1) if len(parts) == 3 else 1
+        except ValueError:
+            return 1
+    return values.count(",") + 1
+
+
 def parse_vary(text: str) -> Axis:
     """``KEY=VALUES`` -> :class:`Axis`."""
     name, values = _split(text, "--vary")

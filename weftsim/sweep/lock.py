@@ -85,7 +85,7 @@ class SweepLock:
             holder = json.loads(self.path.read_text(encoding="utf-8"))
         except FileNotFoundError:
             return {}
-        except (OSError, ValueError):
+        except (OSError, ValueError, RecursionError):
             holder = None
         return holder if isinstance(holder, dict) else {"pid": None, "host": "?", "started": "?"}
 

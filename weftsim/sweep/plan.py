@@ -9,13 +9,14 @@ costs one line, not hours.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable
 
 from weftsim.sweep.cell import normalise
 from weftsim.sweep.engines import check_engine
-from weftsim.sweep.grid import Axis, Cell, SweepError, grid_cells, grid_size, parse_set, parse_vary
+from weftsim.sweep.grid import Axis, Cell, SweepError, grid_cells, grid_size, parse_set, parse_vary, value_count
 
 if TYPE_CHECKING:
     from weftsim.params import Scene
@@ -23,6 +24,9 @@ if TYPE_CHECKING:
 # Beyond this many cells a sweep must be asked for with --yes.  The README's clearance x speed map
 # has 121 cells; 2000 cells of the reference engine at 2 revolutions are about an hour on 2 cores.
 LARGE_GRID_CELLS = 2000
+# No sweep beyond this many cells, even with --yes: a million directories of runs (months of the
+# reference engine on 2 cores), and the grid arrays of load_sweep must fit in memory.
+MAX_GRID_CELLS = 1_000_000
 CELL_NAME_CHECK = "command line"  # where a cell's bad value is said to come from (as for `run` flags)
 
 
@@ -94,15 +98,20 @@ def plan_sweep(scene_path: str | Path, vary: list[str], fixed: list[str] | tuple
                                     wear_only_message)
     from weftsim.scene import SceneError, apply_overrides, load_scene, to_file_keys
 
+    # Counted from the text first: a range of 10^8 values is refused before any of them is built.
+    size = math.prod(value_count(text) for text in vary)
+    if size > MAX_GRID_CELLS:
+        raise SweepError(f"the grid has {size:,} cells, more than the {MAX_GRID_CELLS:,} a sweep can hold (a directory "
+                         "a cell, also with --yes): check the --vary counts")
+    if size > LARGE_GRID_CELLS and not allow_large:
+        raise SweepError(f"the grid has {size:,} cells, more than {LARGE_GRID_CELLS:,}: check the --vary counts, "
+                         "or pass --yes to plan and run them all")
     axes = tuple(parse_vary(text) for text in vary)
     fixed_overrides = dict(parse_set(text) for text in fixed)
     idle = wear_only_keys([axis.key for axis in axes] + list(fixed_overrides))
     if idle:
         raise SweepError(wear_only_message(idle[0], "sweep"))
     size = grid_size(axes)
-    if size > LARGE_GRID_CELLS and not allow_large:
-        raise SweepError(f"the grid has {size:,} cells, more than {LARGE_GRID_CELLS:,}: check the --vary counts, "
-                         "or pass --yes to plan and run them all")
     cells = grid_cells(axes, fixed_overrides)
     check_engine(engine, allow_cwd_engine)
     base = load_scene(scene_path, fixed_overrides, refuse_ideal_keys=False)  # checked over the cells below

@@ -21,6 +21,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import re
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -42,6 +43,9 @@ METRIC_COLUMNS = tuple(
     + [f"{c}_p99" for c in METRIC_CHANNELS]
 )
 INFO_COLUMNS = ("status", "wall_time_s", "complete_revolutions", "last_revolution", "first_contact_deg")
+# What an axis may be called: a short name or a dotted scene key (grid.short_name), never a column of the table.
+SAFE_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_.]*$")
+RESERVED_NAMES = frozenset(("cell", "error", *INFO_COLUMNS, *METRIC_COLUMNS))
 
 
 def manifest(scene_path: str, base_keys: dict, fixed: dict, engine: str, axes: list[Axis]) -> dict[str, Any]:
@@ -63,6 +67,9 @@ def read_manifest(outdir: Path) -> dict | None:
         return None
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
+    except RecursionError:
+        raise SweepError(f"{path} nests too deeply to be a weftsim sweep manifest; move it away to start a new "
+                         "sweep there") from None
     except (OSError, ValueError) as exc:
         raise SweepError(f"{path} cannot be read ({exc}); move it away to start a new sweep there") from None
     if not isinstance(data, dict) or data.get("format") != SWEEP_FORMAT:
@@ -87,6 +94,40 @@ def _manifest_problem(data: dict) -> str:
         if not isinstance(axis, dict) or not isinstance(axis.get("key"), str) \
                 or not isinstance(axis.get("values"), list):
             return f"a varied key is not of the form {{key, values}}: {axis!r:.80}"
+    return _axes_problem(axes)
+
+
+def _axes_problem(axes: list[dict]) -> str:
+    """Names, keys and values of the manifest's axes that cannot make a grid ('' if none)."""
+    import math
+
+    from weftsim.sweep.grid import resolve_key
+    from weftsim.sweep.plan import MAX_GRID_CELLS
+
+    names = []
+    for axis in axes:
+        name = axis.get("name", axis["key"])
+        if not isinstance(name, str) or not name or not SAFE_NAME.match(name):
+            return f"axis name {name!r:.40} is not a scene key's name"
+        if name in RESERVED_NAMES:
+            return f"axis name {name!r} is a column of the table (status, wall_time_s, the peaks ...)"
+        try:
+            resolve_key(axis["key"])
+        except SweepError:
+            return f"varied key {axis['key']!r:.60} is not a scene key"
+        values = axis["values"]
+        if not values or not all(isinstance(v, (str, int, float)) and not (isinstance(v, float) and not math.isfinite(v))
+                                 for v in values):
+            return f"the values of {name} are not a list of numbers, text or true/false"
+        texts = [format_value(v) for v in values]
+        if len(set(texts)) != len(texts):
+            return f"a value of {name} is listed more than once"
+        names.append(name)
+    if len(set(names)) != len(names) or len({a["key"] for a in axes}) != len(axes):
+        return "an axis is listed more than once"
+    cells = math.prod(len(a["values"]) for a in axes)
+    if cells > MAX_GRID_CELLS:
+        return f"its grid has {cells:,} cells, more than the {MAX_GRID_CELLS:,} a sweep can hold"
     return ""
 
 

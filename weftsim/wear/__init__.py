@@ -74,7 +74,7 @@ def check_request(scene: Scene, hours: float, engine: str, limit: float | None) 
 
 def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine: str = "reference",
                          limit: float | None = None, progress: Callable[[float], None] | None = None,
-                         stop: Callable[[], bool] | None = None, figures: bool = True) -> dict:
+                         stop: Callable[[], bool] | None = None, figures: bool = True, force: bool = False) -> dict:
     """Predict the wear over ``hours`` of operation into ``outdir``, resuming a stored state.
 
     Parameters
@@ -84,8 +84,10 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
     hours : float
         Operating hours to predict.
     outdir : path
-        A directory checked by :func:`weftsim.output.prepare_directory`; ``wear_state.npz`` in it is
-        resumed when it belongs to the same scene (:class:`~.store.StateMismatch` otherwise).
+        Created if needed and checked by :func:`weftsim.output.prepare_directory` (``force``: also a
+        directory weftsim did not write); ``wear_state.npz`` in it is resumed when it belongs to the
+        same scene and passes :func:`weftsim.wear.resume.read_state` (:class:`~.store.StateMismatch`
+        otherwise, as for a request of fewer hours than it holds).
     limit : float, optional
         Clearance limit, m: ``wear.json`` gives the hours at which the effective clearance reaches it.
     progress : callable, optional
@@ -107,16 +109,22 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
         extrapolate): every update before it is written first (``wear.csv``, ``wear.json``, the
         profiles) and the message says so.
     """
-    from weftsim.output import begin_directory
+    from weftsim.output import begin_directory, prepare_directory
     from weftsim.wear import store
     from weftsim.wear.extrapolate import predict
 
     check_request(scene, hours, engine, limit)
-    outdir = Path(outdir)
+    outdir = prepare_directory(outdir, force)
     what = {"kind": "wear", "scene": scene.name}
     begin_directory(outdir, what)  # ours from the first update on: an interrupted prediction resumes here
     wall0 = time.perf_counter()
     done = store.load_state(outdir, scene)
+    from weftsim.wear.resume import check_resume
+
+    check_resume(done, scene, hours, outdir)
+    # The last stored update's rates are the one part of the state its history does not pin down (the
+    # next update's profiles would): resume from where that update started, simulating it again.
+    done = done[:-1]
 
     latest = list(done)
 

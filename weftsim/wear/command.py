@@ -6,6 +6,7 @@ import sys
 from typing import TYPE_CHECKING
 
 from weftsim.exitcodes import EXIT_FAILED
+from weftsim.progress import format_duration
 
 if TYPE_CHECKING:
     import argparse
@@ -27,6 +28,26 @@ def add_flags(p: argparse.ArgumentParser, positive: Callable[[Callable[[str], fl
     p.add_argument("--no-plot", action="store_true", help="skip the figures")
 
 
+def _duration(seconds: float) -> str:
+    return f"{seconds:.2g} s" if seconds < 1.0 else format_duration(seconds)
+
+
+def update_time(scene: Scene) -> float:
+    """Estimated wall-clock seconds of one wear update: the reference engine's estimate
+    (:func:`weftsim.progress.estimate_run_time`) for its settle + steady revolutions at the solver
+    tolerance of a worn geometry (:data:`weftsim.wear.extrapolate.WORN_RTOL`)."""
+    from dataclasses import replace
+
+    from weftsim.progress import estimate_run_time
+    from weftsim.wear.extrapolate import WORN_RTOL
+
+    w = scene.joint.wear
+    solver = replace(scene.reference_solver, rtol=min(scene.reference_solver.rtol, WORN_RTOL))
+    one = replace(scene, drive=replace(scene.drive, revolutions=w.settle_revolutions + w.revolutions_per_update),
+                  reference_solver=solver)
+    return estimate_run_time(one, "reference")
+
+
 def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
         stop_on_interrupt: Callable[[str], AbstractContextManager]) -> int:
     """Predict, report progress on stderr and the result on stdout; Ctrl-C keeps the state for a resume."""
@@ -41,13 +62,14 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     outdir = prepare_directory(outdir, args.force)
     print(f"scene {scene.name}, wear at E over {args.hours:g} h on the reference engine; each update simulates "
           f"{scene.joint.wear.settle_revolutions} + {scene.joint.wear.revolutions_per_update} revolutions "
-          f"(~0.1 s), the update interval grows the clearance by at most "
+          f"(~{_duration(update_time(scene))}), the update interval grows the clearance by at most "
           f"{100 * scene.joint.wear.max_clearance_change:g} %", file=sys.stderr, flush=True)
     progress = Progress(f"wear {scene.name}")
     with stop_on_interrupt("wear") as state:
         try:
             data = predict_to_directory(scene, args.hours, outdir, args.engine, limit, progress,
-                                        stop=lambda: state["signal"] is not None, figures=not args.no_plot)
+                                        stop=lambda: state["signal"] is not None, figures=not args.no_plot,
+                                        force=args.force)
         except StateMismatch as exc:
             raise CliError(str(exc)) from None
         except WearError as exc:  # the updates before it are written (the message says where)

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from weftsim.errors import WearError
 from weftsim.output import write_atomic, write_csv
 from weftsim.wear.extrapolate import Update, effective_clearance, limit_hours
 
@@ -26,8 +27,9 @@ RESPONSE = ("rapier_acceleration_rms_m_s2", "rapier_acceleration_p99_m_s2", "dri
             "solver_rtol", "film_ratio_min", "film_ratio_mean", "mixed_fraction")
 
 
-class StateMismatch(ValueError):
-    """The directory's stored state belongs to another scene or other wear settings."""
+class StateMismatch(WearError):
+    """The directory's stored state cannot be resumed: another scene or other wear settings, a damaged
+    or edited file (:mod:`weftsim.wear.resume`), or more hours than asked for."""
 
 
 def scene_identity(scene: Scene) -> str:
@@ -50,6 +52,9 @@ def save_state(outdir: Path, scene: Scene, updates: list[Update]) -> Path:
         "rate_journal": np.array([u.rate_journal for u in updates]),
         "response": np.array([[u.response.get(k, math.nan) for k in RESPONSE] for u in updates]),
     }
+    from weftsim.wear.resume import digest
+
+    arrays["digest"] = np.array(digest(arrays))
 
     def write(tmp: Path) -> None:
         with open(tmp, "wb") as handle:
@@ -59,19 +64,16 @@ def save_state(outdir: Path, scene: Scene, updates: list[Update]) -> Path:
 
 
 def load_state(outdir: Path, scene: Scene) -> list[Update]:
-    """The updates stored in ``outdir`` (empty if none); StateMismatch if they are of another scene."""
+    """The updates stored in ``outdir`` (empty if none), checked by :func:`weftsim.wear.resume.read_state`.
+
+    Raises StateMismatch if they are of another scene, damaged or inconsistent.
+    """
+    from weftsim.wear.resume import read_state
+
     path = Path(outdir) / STATE
-    if not path.exists():
+    if not path.exists() and not path.is_symlink():
         return []
-    with np.load(path, allow_pickle=False) as data:
-        if str(data["scene"]) != scene_identity(scene):
-            raise StateMismatch(f"{path} holds a wear prediction of another scene or other [joint_e.wear] "
-                                "settings; choose another output directory with -o, or delete it to start over")
-        return [Update(float(data["hours"][i]), float(data["revolutions"][i]), data["bearing"][i].copy(),
-                       data["journal"][i].copy(), float(data["step_revolutions"][i]), data["rate_bearing"][i].copy(),
-                       data["rate_journal"][i].copy(), float(data["volume_rate"][i]),
-                       dict(zip(RESPONSE, map(float, data["response"][i]))))
-                for i in range(data["hours"].size)]
+    return read_state(path, scene)
 
 
 def volumes(updates: list[Update]) -> np.ndarray:
