@@ -167,13 +167,17 @@ def _field_type(hint: Any) -> tuple[type | None, bool, Any]:
 
 
 def _value(hint: Any, value: Any, where: str) -> Any:
-    """``value`` checked against a plain field hint (float, int, str, bool, tuple of floats)."""
+    """``value`` checked against a plain field hint (float, int, str, bool, tuple of floats or of names)."""
     if hint is float and _number(value):
         return float(value) if isinstance(value, int) else value
     if hint is int and isinstance(value, int) and not isinstance(value, bool):
         return value
     if hint in (str, bool) and isinstance(value, hint):
         return value
+    if typing.get_origin(hint) is tuple and typing.get_args(hint) == (str, Ellipsis):  # names (joint_f_inherits)
+        if isinstance(value, list) and all(isinstance(v, str) for v in value):
+            return tuple(value)
+        raise ValueError(f"scene field {where} must be a list of names, got {_short(value)}")
     if typing.get_origin(hint) is tuple or hint is tuple:
         if isinstance(value, list) and all(_number(v) for v in value):
             args = typing.get_args(hint)
