@@ -199,7 +199,13 @@ def simulate_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray) -> t
     t, y, contact, impact = rows["steps"]
     keep = t >= t0
     wear = run_wear(run_scene, pack_parameters(run_scene), t[keep], y[keep], contact[keep], impact[keep])
-    return wear, {**_response(result.steps, t0), "solver_rtol": run_scene.reference_solver.rtol}
+    per_rev = 1.0 / w.revolutions_per_update
+    sliding = {"sliding_distance_per_rev_m": wear.sliding_distance * per_rev,
+               "sliding_work_per_rev_J": wear.sliding_work * per_rev,
+               # Archard's load: the mean of F_N weighted by the sliding ds = |v_T| dt (not by dt)
+               "contact_force_sliding_mean_N": wear.sliding_work / wear.sliding_distance
+               if wear.sliding_distance > 0.0 else math.nan}
+    return wear, {**_response(result.steps, t0), "solver_rtol": run_scene.reference_solver.rtol, **sliding}
 
 
 def next_update(scene: Scene, hours_done: float, revolutions_done: float, bearing: np.ndarray, journal: np.ndarray,
