@@ -168,3 +168,41 @@ def test_wear_result_checks_itself(tmp_path):
     assert data["profile_volume_mm3"] == pytest.approx(data["wear_volume_mm3"], rel=1e-9)
     assert data["archard_volume_mm3"] == pytest.approx(data["wear_volume_mm3"], rel=1e-9)
     assert data["sliding_weighted_mean_load_N"] > 1.5 * data["time_mean_load_N"]
+
+
+def test_a_hard_cycle_backs_off_and_goes_on(monkeypatch, tmp_path):
+    """An update whose simulation fails everywhere halves the update before it and goes on (issue 26)."""
+    from weftsim.wear import extrapolate, predict_to_directory
+
+    real = extrapolate.simulate_update
+    calls = {"n": 0}
+
+    def flaky(scene, bearing, journal):
+        calls["n"] += 1
+        if calls["n"] == 3:  # the third geometry is a 'hard cycle'
+            raise extrapolate.UpdateFailed("the simulation on the worn geometry failed (test)")
+        return real(scene, bearing, journal)
+
+    monkeypatch.setattr(extrapolate, "simulate_update", flaky)
+    scene = load_scene(REFERENCE)
+    data = predict_to_directory(scene, 1.5, tmp_path / "w", figures=False)
+    assert data["complete"] and data["backoffs"] == 1
+    updates = extrapolate.predict(scene, 1.5)  # the same prediction without the hard cycle
+    # Update 1's N was halved: c_eff grew by ~half the allowed 2 % before the geometry that ran.
+    c = [float(v) for v in np.loadtxt(tmp_path / "w" / "wear.csv", delimiter=",", skiprows=1,
+                                      usecols=[7], ndmin=1)]
+    c_free = [1e3 * extrapolate.effective_clearance(scene.joint.clearance, u.bearing, u.journal) for u in updates]
+    assert c[2] - c[1] < 0.75 * (c_free[2] - c_free[1])
+    assert data["profile_volume_mm3"] == pytest.approx(data["wear_volume_mm3"], rel=1e-9)
+
+    def always(scene, bearing, journal):
+        calls["n"] += 1
+        if calls["n"] > 2:
+            raise extrapolate.UpdateFailed("the simulation on the worn geometry failed (test)")
+        return real(scene, bearing, journal)
+
+    calls["n"] = 0
+    monkeypatch.setattr(extrapolate, "simulate_update", always)
+    with pytest.raises(WearError, match="halvings"):
+        predict_to_directory(scene, 1.5, tmp_path / "v", figures=False)
+    assert (tmp_path / "v" / "wear.csv").is_file()  # every update before it is written

@@ -93,6 +93,9 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     print(f"scene {scene.name}: {data['hours_reached']:.6g} h in {data['updates']} updates "
           f"({data['wall_time_s']:.1f} s); effective clearance {data['initial_clearance_mm']:g} -> "
           f"{data['final_effective_clearance_mm']:.4g} mm, wear volume {data['wear_volume_mm3']:.4g} mm^3")
+    if data.get("backoffs"):
+        print(f"  {data['backoffs']} hard cycle(s) (an update whose simulation failed at every tolerance and "
+              "integrator) were passed by halving the update before them (docs/wear.md section 3)")
     if data.get("sliding_distance_m"):
         print(f"  Archard's check: sliding {data['sliding_distance_m']:.4g} m under the sliding-weighted mean load "
               f"{data['sliding_weighted_mean_load_N']:.4g} N (the time mean is {data['time_mean_load_N']:.4g} N) gives "

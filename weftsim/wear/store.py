@@ -25,7 +25,7 @@ STATE = "wear_state.npz"
 RESPONSE = ("rapier_acceleration_rms_m_s2", "rapier_acceleration_p99_m_s2", "driving_torque_rms_Nm",
             "driving_torque_p99_Nm", "contact_force_mean_N", "contact_force_p99_N", "contact_force_max_N",
             "solver_rtol", "film_ratio_min", "film_ratio_mean", "mixed_fraction", "sliding_distance_per_rev_m",
-            "sliding_work_per_rev_J", "contact_force_sliding_mean_N")
+            "sliding_work_per_rev_J", "contact_force_sliding_mean_N", "backoffs_after")
 
 
 class StateMismatch(WearError):
@@ -135,6 +135,8 @@ def summary(scene: Scene, updates: list[Update], hours: float, limit: float | No
         "final_journal_wear_max_mm": 1e3 * float(last.journal.max()),
         "wear_volume_mm3": 1e9 * float(volumes(updates)[-1]),
         **archard_check(scene, updates),
+        # hard cycles passed by halving the update before them (extrapolate.MAX_BACKOFFS)
+        "backoffs": int(sum(np.nan_to_num(u.response.get("backoffs_after", 0.0)) > 0 for u in updates)),
         "wall_time_s": wall_time,
     }
     if limit is not None:
