@@ -137,6 +137,9 @@ def run_ensemble(args: argparse.Namespace, scene: Scene, outdir: str | Path,
                              announce=lambda text: print(text, file=sys.stderr, flush=True))
     except WearError as exc:
         raise CliError(str(exc)) from None
+    except KeyboardInterrupt:
+        raise CliError(f"interrupted: every job's updates so far are in {outdir}/jobs; run the same command again "
+                       "to resume", 130) from None
     m = data["method"]
     print(f"scene {scene.name}: hours to an effective clearance of {args.limit_clearance_mm:g} mm at E, "
           f"{data['samples']} samples ({len(data['jobs'])} simulated predictions, {data['wall_time_s']:.0f} s)")
