@@ -10,8 +10,8 @@ def main() -> None:
     # The lubrication tables are optional (absent: the dry joint); their defaults are those of a table given
     # with its one required key.
     lubricated = dataclasses.replace(Scene().joint, lubrication=Lubrication(viscosity=0.0))
-    scene = dataclasses.replace(Scene(), joint=lubricated, joint_f=dataclasses.replace(Scene().joint_f,
-                                                                                      lubrication=lubricated.lubrication))
+    joint_f = dataclasses.replace(Scene().joint_f, lubrication=lubricated.lubrication)
+    scene = dataclasses.replace(Scene(), joint=lubricated, joint_f=joint_f)
     defaults = to_file_keys(scene)
     print("| key | default | allowed | meaning |")
     print("|---|---|---|---|")

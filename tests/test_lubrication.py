@@ -1,4 +1,4 @@
-"""The lubricated clearance joint (issue 22 parts 2-6; docs/lubrication.md).
+"""The lubricated clearance joint (issue 22 parts 2-6; docs/lubricated-joint.md).
 
 Scene keys and their one-line errors; the dry joint unchanged bit for bit; the Greenwood-Tripp asperity
 load (zero for thick films, continuous, its potential); the total radial force continuous where the dry
@@ -100,8 +100,8 @@ def test_dry_scene_is_bit_for_bit_the_former_joint():
 
 
 def test_no_film_and_no_asperities_is_the_dry_joint_exactly():
-    off = {**OIL, "joint_e.lubrication.viscosity_mpa_s": 0.0, "joint_e.lubrication.asperity_density_radius_roughness": 0.0,
-           **EXPLICIT}  # the integrator of the dry run ("auto" takes an implicit one for a lubricated joint)
+    off = {**OIL, "joint_e.lubrication.viscosity_mpa_s": 0.0,
+           "joint_e.lubrication.asperity_density_radius_roughness": 0.0, **EXPLICIT}  # the integrator of the dry run ("auto" takes an implicit one for a lubricated joint)
     dry, lubricated = solve(_scene()), solve(_scene(**off))
     for name in ("driving_torque_Nm", "contact_force_N", "eccentricity_y_m", "dissipated_energy_J"):
         np.testing.assert_array_equal(lubricated.steps[name], dry.steps[name])  # the added terms are exact zeros
@@ -130,7 +130,11 @@ def test_asperity_load_is_continuous_and_its_potential_is_its_integral():
     # Continuous: no step between neighbours larger than the largest slope times the spacing, x 1.01.
     slope = np.max(np.abs(np.gradient(load, ecc)))
     assert np.max(np.abs(np.diff(load))) <= 1.01 * slope * (ecc[1] - ecc[0])
-    assert load[-1] == pytest.approx(asperity_load(COEF, SIGMA, C, C, R, L)[0], rel=1e-15)  # held beyond c
+    # Beyond c: continued with the slope at c (C1): the one-sided difference quotients agree there.
+    at = np.searchsorted(ecc, C)
+    inside = (load[at - 1] - load[at - 2]) / (ecc[1] - ecc[0])
+    beyond = (load[-1] - load[-2]) / (ecc[1] - ecc[0])
+    assert beyond == pytest.approx(inside, rel=1e-2)  # first differences lag by h/2 |F''|: ~1e-3 measured
     # dU/d|e| = F_a: the trapezoid of F_a against U's change; trapezoid error (h^2/12) |F''| ~ 1e-7 relative.
     integral = np.concatenate([[0.0], np.cumsum(0.5 * (load[1:] + load[:-1]) * np.diff(ecc))])
     np.testing.assert_allclose(energy - energy[0], integral, rtol=1e-5, atol=1e-6 * energy[-1])
@@ -177,16 +181,18 @@ def test_film_ratio_and_forces_of_a_lubricated_run(runs):
     oil = runs["oil"]
     assert oil.ok, oil.message
     steps = oil.steps
-    assert np.all(steps["film_ratio"] >= 1.0)  # the film floor: the journal never reaches the dry law here
     np.testing.assert_allclose(steps["film_thickness_m"], steps["film_ratio"] * 0.4e-6, rtol=1e-12)
-    assert np.all(steps["contact_force_N"] == 0.0) and steps["film_force_N"].max() > 1e3
+    # No asperity load under a full film (h_min >= 4 sigma); the dry law only where the film is gone (h_min = 0).
+    assert np.all(steps["asperity_force_N"][steps["film_ratio"] >= H_CUTOFF] == 0.0)
+    assert np.all(steps["film_ratio"][steps["contact_force_N"] > 0.0] == 0.0)
+    assert steps["film_force_N"].max() > 1e3 and steps["asperity_force_N"].max() > 0.0
 
 
 def test_energy_balance_includes_the_film_dissipation(runs):
     oil, dry = runs["oil"], runs["dry"]
     # Reference engine: the dissipated work is an integrated state, the balance closes to the solver's
-    # tolerance: RODAS4 at rtol 1e-6 ("auto" with a film) measured 3.4e-5 of the largest kinetic energy here,
-    # 6.3e-5 over a revolution (DOP853 at 1e-5: 2.9e-6); dry 1.8e-6.
+    # tolerance: RODAS4 at rtol 1e-5 ("auto" with a film) measured 8.5e-7 of the largest kinetic energy here
+    # (6.3e-5 over a revolution at rtol 1e-6 with the short film); dry 3.2e-6.
     assert _energy_residual(oil.steps) < 2e-4
     dissipated = oil.steps["dissipated_energy_J"]
     assert np.all(np.diff(dissipated) >= -1e-9 * dissipated[-1])  # the film takes energy out, never gives it back
@@ -203,8 +209,8 @@ def test_vanishing_viscosity_gives_the_dry_joint(runs):
         gaps.append(abs(steps["contact_force_N"].max() - dry["contact_force_N"].max()) / dry["contact_force_N"].max())
     assert gaps[0] > gaps[1] > gaps[2]
     # The film at its floor is a damper ~ eta: the gap of the impact's peak falls tenfold per decade
-    # (measured 1.1e-2, 1.2e-3, 1.2e-4 with the short-bearing film; the dry run's own solver noise at
-    # rtol 1e-5 is ~4e-4 on the peak torque).
+    # (measured 1.0e-4, 4.2e-6, 4.3e-7 with the finite film, 1.1e-2, 1.2e-3, 1.2e-4 with the short one; the dry
+    # run's own solver noise at rtol 1e-5 is ~4e-4 on the peak torque).
     assert gaps[2] < 1e-3
 
 
@@ -220,7 +226,8 @@ def test_engines_agree_on_a_lubricated_run(runs):
         a, b = np.abs(ref.steps[name]).max(), np.abs(tree.steps[name]).max()
         assert b == pytest.approx(a, rel=tolerance), name
     assert tree.steps["film_ratio"].min() == pytest.approx(ref.steps["film_ratio"].min(), rel=tolerance)
-    # The tree integrates the film's power with trapezoids over its steps: measured 4e-4 of the kinetic energy.
+    # The tree integrates the film's power over its steps with a quadratic rule: measured 1.3e-6 of the kinetic
+    # energy here, 1.7e-4 over a revolution with the short film.
     assert _energy_residual(tree.steps) < 2e-3
 
 
@@ -228,12 +235,15 @@ def test_reusable_exudyn_joint_carries_the_film(runs):
     from weftsim import exudyn_engine
 
     ref = runs["oil"]
+    # The squeeze film's peak at the floor lasts a few microseconds: the adaptive generalized-alpha step at the
+    # default local error (3e-10 m) cuts it 1.6 % low, at 3e-11 m 0.65 % (the reference engine is converged:
+    # 13 023.2 N m at rtol 1e-5 with RODAS4, 13 024.0 with DOP853 at 1e-8).
     scene = dataclasses.replace(ref.scene, exudyn_solver=dataclasses.replace(ref.scene.exudyn_solver,
-                                                                             model="rigid_body"))  # fmt: skip
+                                                                             model="rigid_body", local_error=3e-11))
     rigid = exudyn_engine.solve(scene)
     assert rigid.ok, rigid.message
     tolerance = ref.scene.compare.first_revolution_peaks
-    for name in ("driving_torque_Nm", "film_force_N"):  # measured 0.27 % and 0.33 %
+    for name in ("driving_torque_Nm", "film_force_N"):
         assert np.abs(rigid.steps[name]).max() == pytest.approx(np.abs(ref.steps[name]).max(), rel=tolerance), name
 
 
@@ -261,3 +271,25 @@ def test_regime_study_on_one_cell(tmp_path, monkeypatch):
     assert cell["regime"] == regime.regime(cell["film_ratio_min"])
     assert cell["joint_force_max_N"] >= cell["film_force_max_N"] > 0.0
     assert (tmp_path / "out" / "study-regime.png").is_file() and (tmp_path / "out" / "regime.csv").is_file()
+
+
+# --- wear in the mixed regime --------------------------------------------------------------------------
+
+
+def test_wear_load_is_the_asperity_and_dry_load_never_the_film():
+    from weftsim.reference.dynamics import pack_parameters
+    from weftsim.wear.archard import contact_rows
+
+    scene = _oil_scene()
+    kept = {}
+    result = solve(scene, step_states=lambda *rows: kept.update(rows=rows))
+    time, states, contact, impact = kept["rows"]
+    rows = np.zeros((time.size, 5))
+    contact_rows(pack_parameters(scene), time, states, contact, impact, rows)
+    steps = result.steps
+    assert steps["film_force_N"].max() > 1e3  # the film carries load ...
+    solid = steps["asperity_force_N"] + steps["contact_force_N"]
+    np.testing.assert_allclose(rows[:, 0], solid, rtol=1e-12, atol=1e-9)  # ... and wears nothing
+    full_film = steps["film_ratio"] >= H_CUTOFF
+    assert full_film.any() and np.all(rows[full_film, 0] == 0.0)
+    assert np.any(rows[:, 0] > 0.0)  # the mixed and dry parts of the run do wear

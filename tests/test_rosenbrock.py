@@ -196,3 +196,13 @@ def test_run_time_and_record_estimates_know_friction():
     assert estimate_run_time(explicit, "reference") == pytest.approx(EXPLICIT_STIFF_FACTOR
                                                                      * estimate_run_time(dry, "reference"))
     assert estimate_step_bytes(explicit, "reference") > 1e9 > 1e7 > estimate_step_bytes(rough, "reference")
+
+
+def test_weftsim_run_announces_an_explicit_friction_run_before_it_starts(capsys):
+    from weftsim.cli import _announce_run_time
+
+    _announce_run_time(_scene(mu=0.15, degrees=720.0, method="numba_DOP853"), ("reference",), "run")
+    err = capsys.readouterr().err
+    assert "warning: the per-step record will be ~" in err and "estimated run time" in err
+    _announce_run_time(_scene(mu=0.15, degrees=720.0), ("reference",), "run")  # the default: seconds, small
+    assert capsys.readouterr().err == ""

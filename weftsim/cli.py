@@ -175,25 +175,29 @@ def _check_fits(scene, outdir: Path, runs: int = 1) -> None:
 
 
 def _announce_run_time(scene, engines: tuple[str, ...], command: str) -> None:
-    """One line on stderr with the estimated run time of a long run (a warning above LONG_RUN_S)."""
+    """One line on stderr with the estimated run time of a long run (a warning above LONG_RUN_S), and for
+    ``weftsim run`` one with the estimated size of the per-step record above LARGE_FILE_BYTES."""
     from weftsim.output import _size
     from weftsim.progress import (
         LARGE_FILE_BYTES, LONG_RUN_S, SHOW_ESTIMATE_S, estimate_run_time, estimate_step_bytes, format_duration,
+        stiff_explicit,
     )  # fmt: skip
 
     estimate = sum(estimate_run_time(scene, engine) for engine in engines)
+    if estimate >= SHOW_ESTIMATE_S:
+        prefix = "warning: " if estimate > LONG_RUN_S else ""
+        print(f"weftsim {command}: {prefix}estimated run time ~{format_duration(estimate)} for "
+              f"{scene.drive.revolutions:g} revolutions (within a factor of ~3); Ctrl-C stops it and keeps what was "
+              "computed", file=sys.stderr, flush=True)
     size = max(estimate_step_bytes(scene, engine) for engine in engines) if command == "run" else 0.0
     if size > LARGE_FILE_BYTES:
+        why = f"{scene.drive.revolutions:g} revolutions of solver steps"
+        if stiff_explicit(scene, engines):
+            why = ("an explicit solver steps at ~1e-9 s on the friction or film of the joint (the reference engine's "
+                   "solver.reference.method = 'auto' integrates it implicitly)")
         print(f"weftsim {command}: warning: the per-step record will be ~{_size(size)} (held in memory, written "
-              "compressed to result.npz): an explicit solver steps at ~1e-9 s on the friction or film of the "
-              "joint (solver.reference.method = 'auto' integrates it implicitly); or shorten drive.revolutions",
-              file=sys.stderr, flush=True)
-    if estimate < SHOW_ESTIMATE_S:
-        return
-    prefix = "warning: " if estimate > LONG_RUN_S else ""
-    print(f"weftsim {command}: {prefix}estimated run time ~{format_duration(estimate)} for "
-          f"{scene.drive.revolutions:g} revolutions (within a factor of ~3); Ctrl-C stops it and keeps what was "
-          "computed", file=sys.stderr, flush=True)
+              f"compressed to result.npz): {why}; fewer drive.revolutions make it smaller", file=sys.stderr,
+              flush=True)
 
 
 # Signals that stop a run gracefully: the engine ends at its next step and what it computed is

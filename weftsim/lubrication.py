@@ -1,4 +1,4 @@
-"""Channels of the lubricated joints, from the states of a run (both engines; docs/lubrication.md).
+"""Channels of the lubricated joints, from the states of a run (both engines; docs/lubricated-joint.md).
 
 The film and the asperities are evaluated by the kernel the engines integrated
 (:func:`weftsim.kernel.lubricated.lubricated_force`) at each row's eccentricity, its rate and the

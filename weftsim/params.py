@@ -148,13 +148,14 @@ class WearModel:
     profile_points: int = 360
 
 
-# Film models of Lubrication.model (the codes of weftsim.kernel.film: MODEL_FINITE, MODEL_SHORT, MODEL_LONG).
-FILM_MODELS = ("finite", "short", "long")
+# Film models of Lubrication.model (the codes of weftsim.kernel.film: MODEL_FINITE, MODEL_SHORT, MODEL_LONG,
+# MODEL_SHORT_HALF, in this order).
+FILM_MODELS = ("finite", "short", "long", "short_half")
 
 
 @dataclass(frozen=True, kw_only=True)
 class Lubrication:
-    """Oil film and asperity contact of a lubricated clearance joint (docs/lubrication.md).
+    """Oil film and asperity contact of a lubricated clearance joint (docs/lubricated-joint.md).
 
     A joint without a ``Lubrication`` (``ClearanceJoint.lubrication = None``) is the dry joint.  With
     one, the film's pressure carries the journal for every eccentricity (no contact needed), the
@@ -167,8 +168,9 @@ class Lubrication:
     viscosity : float
         Dynamic viscosity eta of the oil at operating temperature, Pa s (>= 0; 0 = no film).
     model : str
-        Film model: ``"finite"`` (finite length, default), ``"short"`` (Ocvirk) or ``"long"``
-        (Sommerfeld with Guembel cavitation), :data:`FILM_MODELS`.
+        Film model: ``"finite"`` (finite length, default), ``"short"`` (Ocvirk), ``"long"``
+        (Sommerfeld with Guembel cavitation) or ``"short_half"`` (the short bearing as Flores, Ambrosio,
+        Claro and Lankarani write it), :data:`FILM_MODELS` (docs/lubrication.md).
     roughness : float
         Combined RMS roughness sigma = sqrt(sigma_j^2 + sigma_b^2) of journal and bearing, m.
         Default 0.4 um: two ground surfaces of Rq ~ 0.3 um.
@@ -220,7 +222,8 @@ def lubrication_problem(lub: Lubrication) -> str | None:
         return f"`lubrication.roughness` must be > 0 (m, combined RMS of both surfaces), got {lub.roughness!r}"
     eta = lub.asperity_density_radius_roughness
     if not (_number(eta) and 0.0 <= eta <= 1.0):
-        return f"`lubrication.asperity_density_radius_roughness` must be in [0, 1] (0 = no asperity contact), got {eta!r}"
+        return (f"`lubrication.asperity_density_radius_roughness` must be in [0, 1] (0 = no asperity contact), "
+                f"got {eta!r}")
     ratio = lub.roughness_radius_ratio
     if not (_number(ratio) and 0.0 < ratio <= 1.0):
         return f"`lubrication.roughness_radius_ratio` must be in (0, 1] (sigma / beta), got {ratio!r}"

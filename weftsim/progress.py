@@ -139,6 +139,13 @@ def estimate_run_time(scene: Scene, engine: str) -> float:
     return step_plan(scene)[1] * EXUDYN_SECONDS_PER_STEP  # the fixed steps it will take (longer for an ideal joint)
 
 
+def stiff_explicit(scene: Scene, engines: tuple[str, ...]) -> bool:
+    """True when one of ``engines`` integrates a stiff joint law of ``scene`` with an explicit method."""
+    if not _stiff(scene):
+        return False
+    return "exudyn" in engines or ("reference" in engines and not scene.is_ideal and _reference_path(scene)[1])
+
+
 def estimate_step_bytes(scene: Scene, engine: str) -> float:
     """Estimated bytes of the per-step table of one run (``result.npz``, and about as much memory while held).
 

@@ -63,7 +63,7 @@ JOINT_F_CHANNELS: tuple[str, ...] = (
     "penetration_rate_f_m_s",
 )
 
-# Channels of a lubricated joint (docs/lubrication.md), present exactly when the scene gives the joint a
+# Channels of a lubricated joint (docs/lubricated-joint.md), present exactly when the scene gives the joint a
 # [joint_e.lubrication] / [joint_f.lubrication] table: minimum film thickness h_min = max(c - |e|, 0), film
 # ratio h_min / sigma, the film force's magnitude, the asperity load, the film's shear torque on the journal.
 LUBRICATION_CHANNELS: tuple[str, ...] = (

@@ -93,7 +93,7 @@ def WEAR_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 - a cons
 
 
 def LUBRICATION_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 - a constant-like key factory
-    """The ``[<table>.lubrication]`` keys of a clearance joint (docs/lubrication.md).  The table is optional
+    """The ``[<table>.lubrication]`` keys of a clearance joint (docs/lubricated-joint.md).  The table is optional
     (absent: the dry joint); given, it must name ``viscosity_mpa_s``, the other keys default."""
     at = f"{table}.lubrication."
     to = f"{joint}.lubrication."
@@ -101,7 +101,8 @@ def LUBRICATION_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 -
         Key(at + "viscosity_mpa_s", to + "viscosity", "float", 1e-3, 0, None, False,
             doc="dynamic viscosity of the oil at operating temperature (ISO VG 220 at 60 C: ~80 mPa s); 0 = no film"),
         Key(at + "model", to + "model", "str", choices=params.FILM_MODELS,
-            doc="film model: finite (finite-length bearing, default), short (Ocvirk) or long (Sommerfeld)"),
+            doc="film model: finite (finite-length bearing, default), short (Ocvirk), long (Sommerfeld) or "
+                "short_half (Flores et al.'s short bearing)"),
         Key(at + "roughness_um", to + "roughness", "float", 1e-6, 0,
             doc="combined RMS roughness of journal and bearing (default 0.4 um, two ground surfaces)"),
         Key(at + "asperity_density_radius_roughness", to + "asperity_density_radius_roughness", "float", 1, 0, 1,
@@ -177,8 +178,10 @@ SCHEMA: tuple[Key, ...] = (
     Key("drive.speed_rpm", "drive.speed", "float", RPM, 0, 5000, doc="constant crank speed"),
     Key("drive.revolutions", "drive.revolutions", "float", 1, 0, 1000, doc="crank revolutions to simulate"),
     Key("solver.reference.method", "reference_solver.method", "str", choices=INTEGRATORS,
-        doc="method of the reference engine: scipy's, or numba_* (compiled, docs/performance.md); "
-            "auto = numba_DOP853 (the fastest path meeting the accuracy targets)"),
+        doc="method of the reference engine: scipy's, or numba_* (compiled, docs/performance.md; numba_RODAS4 "
+            "linearly implicit, numba_DOP853_RODAS4 implicit in contact); auto = numba_DOP853, or with friction "
+            "numba_DOP853_RODAS4 at rtol <= 1e-6, or with a lubricated joint numba_RODAS4 (the fastest paths "
+            "meeting the accuracy targets)"),
     Key("solver.reference.rtol", "reference_solver.rtol", "float", 1, 0, 1e-2, doc="relative tolerance"),
     Key("solver.reference.atol", "reference_solver.atol", "float", 1, 0, 1e-2, doc="absolute tolerance"),
     Key("solver.reference.max_step_deg", "reference_solver.max_step", "float", DEG, 0, 90,

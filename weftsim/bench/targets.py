@@ -128,6 +128,8 @@ def stiff_items(models: str | Path, repeats: int, log: Callable[[str], None] = p
 
 
 def _ratio_item(case: str, overrides: dict, refs: dict, dry: dict, models, repeats: int) -> dict:
+    """The lubricated run's time against the dry one's; its errors are against the dry solution (a film changes
+    the peaks), so only the ratio is judged here; its accuracy needs a converged lubricated ensemble."""
     row = measure(case, Setting("reference", "reference", "default", overrides), refs["dry"], models,
                   FRICTION_REVOLUTIONS, repeats, 8.0, 1.0)  # fmt: skip
     ratio = dry["realtime_ratio"] / row["realtime_ratio"]

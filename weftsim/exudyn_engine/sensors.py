@@ -114,8 +114,8 @@ def step_channels(mbs: exu.MainSystem, model: MechanismModel, sensors: dict) -> 
         ch["contact_energy_J"] = ch["contact_energy_J"] + contact.pop("contact_energy_J")
         ch["dissipated_energy_J"] = ch["dissipated_energy_J"] + contact.pop("dissipated_energy_J")
         if joint == "f":  # joint F's channels carry its suffix; E's keep their names
-            lubricated = {f_name: contact[e_name] for f_name, e_name in zip(LUBRICATION_CHANNELS_F, LUBRICATION_CHANNELS)
-                          if e_name in contact}
+            pairs = zip(LUBRICATION_CHANNELS_F, LUBRICATION_CHANNELS)
+            lubricated = {f_name: contact[e_name] for f_name, e_name in pairs if e_name in contact}
             contact = {f_name: contact[e_name] for f_name, e_name in JOINT_E_NAME.items()} | lubricated
         ch.update(contact)
     return ch

@@ -16,13 +16,13 @@ at every eccentricity, in contact or not::
   starts (its squeeze term grows as (1 - eps^2)^-2.5 towards eps = 1).  The film's shear torques act on
   journal and bearing; its power -(f.e_dot + T_j omega_j + T_b omega_b) is dissipated.
 - **Asperities.** F_a(|e|) of :func:`weftsim.kernel.asperity.asperity_load`, zero while h_min >= 4 sigma,
-  held at its value at |e| = c beyond c; it has a potential U_a (stored, not dissipated).  Boundary
+  continued beyond |e| = c with its slope at c (C1); it has a potential U_a (stored, not dissipated).  Boundary
   friction F_Ta = -mu_b c_d(v_T) F_a sign(v_T) acts at the contact point Q = P_b + R_b n with the moments
   of the dry friction, M_j = (R_b - |e|) F_Ta, M_b = -R_b F_Ta (:func:`weftsim.kernel.joint.friction_force`
   with mu_b and the joint's friction ramp).
 - **Dry law.** Unchanged (:func:`weftsim.kernel.joint.clearance_force_at`): zero at |e| = c and growing
-  from there, so the total radial force is continuous in |e| (film and asperity terms are continuous and
-  held constant in |e| beyond their limits, the dry law starts from 0).
+  from there, so the total radial force is continuous in |e| (the film term is continuous and held
+  constant in |e| beyond its floor, the asperity term is C1, the dry law starts from 0).
 
 Dissipated power of the film and the boundary friction, the part of the power the asperity potential does
 not store: D' = -(f_l.e_dot + M_lj omega_j + M_lb omega_b) - F_a d|e|/dt.
@@ -37,8 +37,8 @@ from numba import njit
 from weftsim.kernel.asperity import asperity_load
 from weftsim.kernel.film import film_force
 from weftsim.kernel.joint import (
-    ASPERITY_COEF, BEARING_LENGTH, BEARING_RADIUS, BOUNDARY_MU, CLEARANCE, FILM_FLOOR, FILM_MODEL, JOURNAL_RADIUS, LUBRICATED,
-    ROUGHNESS, V0, V1, VISCOSITY, connector_friction_force, tangential_velocity,
+    ASPERITY_COEF, BEARING_LENGTH, BEARING_RADIUS, BOUNDARY_MU, CLEARANCE, FILM_FLOOR, FILM_MODEL, JOURNAL_RADIUS,
+    LUBRICATED, ROUGHNESS, V0, V1, VISCOSITY, connector_friction_force, tangential_velocity,
 )  # fmt: skip
 from weftsim.kernel.laws import friction_factor
 

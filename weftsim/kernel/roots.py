@@ -10,11 +10,7 @@ follows it.
 
 The dense output is the global ``state(t, *args) -> (delta, delta_dot)`` (m, m/s) and the
 functions pass its extra arguments ``args`` along: the compiled path binds ``state`` to its compiled
-dense output (:func:`weftsim.kernel.python.specialize`; DOP853's or RK45's interpolant, or the cubic
-Hermite interpolant of a RODAS4 step, :mod:`weftsim.reference.compiled_ros`).  numba's cache keys these
-bound copies by this file's source and time stamp, not by what ``state`` is bound to: a change of the
-bound function must come with a change of this file, or a stale compiled copy calls the old one.  The
-scipy path uses the plain-Python form
+dense output (:func:`weftsim.kernel.python.specialize`), the scipy path uses the plain-Python form
 (:func:`weftsim.kernel.python.python_form`) with ``state`` bound to a call of a closure over scipy's
 dense output.  Roots by the Illinois variant of regula falsi (Dowell & Jarratt, BIT 11, 1971),
 maxima by golden-section search (Kiefer 1953).

@@ -1,5 +1,5 @@
 """Regime map of the lubricated joint at E: minimum film ratio and peak force over crank speed x
-clearance x viscosity (``weftsim study regime``; docs/lubrication.md).
+clearance x viscosity (``weftsim study regime``; docs/lubricated-joint.md).
 
 Each cell is one reference-engine run of :data:`REVOLUTIONS` revolutions of the loom (models/loom.toml; the
 reference mechanism when that scene is not installed, as the report says) with a ``[joint_e.lubrication]``
@@ -30,6 +30,7 @@ CLEARANCES_MM = (0.02, 0.05, 0.1, 0.25)
 VISCOSITIES_MPA_S = (20.0, 80.0, 320.0)  # ISO VG 220 at ~100 C, ~60 C, ~30 C
 REVOLUTIONS = 2.0
 HYDRODYNAMIC, MIXED = 3.0, 1.0  # film ratio limits of the regimes
+FLOOR_DRAWN = 0.3  # the figure's lowest film ratio
 SETS = {"drive.speed_rpm": "it varies the crank speed", "joint_e.clearance_mm": "it varies the clearance at E",
         "joint_e.lubrication.viscosity_mpa_s": "it varies the viscosity"}
 SCENES = ("loom.toml", "reference.toml")  # the first one installed
@@ -60,7 +61,8 @@ def _cell(scene_name: str, models, overrides: dict, progress: bool) -> dict:
     if "film_ratio" in steps:
         total = steps["film_force_N"] + steps["asperity_force_N"] + joint
         ratio = float(steps["film_ratio"].min())
-        out |= {"film_ratio_min": ratio, "regime": regime(ratio), "film_force_max_N": float(steps["film_force_N"].max()),
+        out |= {"film_ratio_min": ratio, "regime": regime(ratio),
+                "film_force_max_N": float(steps["film_force_N"].max()),
                 "asperity_force_max_N": float(steps["asperity_force_N"].max()), "joint_force_max_N": float(total.max())}
     return out
 
@@ -95,7 +97,8 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
     written = {"csv": write_csv(outdir / "regime.csv", {key: [row[key] for row in rows] for key in rows[0]
                                                         if key != "regime"})}
     written["figure"] = write_figure(outdir / "study-regime.png", regime_figure(rows, scene_name))
-    report = {"study": "regime", "scene": scene_name.removesuffix(".toml"), "revolutions": overrides["drive.revolutions"],
+    report = {"study": "regime", "scene": scene_name.removesuffix(".toml"),
+              "revolutions": overrides["drive.revolutions"],
               "limits": {"hydrodynamic_above": HYDRODYNAMIC, "dry_below": MIXED}, "cells": rows,
               "files": sorted(p.name for p in written.values()) + ["regime.json"]}
     written["json"] = write_json(outdir / "regime.json", report)
@@ -115,25 +118,31 @@ def regime_figure(rows: list[dict], scene_name: str):
     colours = dict(zip(speeds, ("tab:blue", "tab:orange", "tab:red", "tab:green")))
     for k, eta in enumerate(etas):
         top, bottom = axes[0, k], axes[1, k]
-        top.axhspan(1e-3, MIXED, color="tab:red", alpha=0.08)
+        top.axhspan(FLOOR_DRAWN, MIXED, color="tab:red", alpha=0.08)
         top.axhspan(MIXED, HYDRODYNAMIC, color="tab:orange", alpha=0.1)
         top.axhspan(HYDRODYNAMIC, 1e4, color="tab:green", alpha=0.06)
         for rpm in speeds:
             cells = [r for r in rows if r["viscosity_mpa_s"] == eta and r["speed_rpm"] == rpm]
             c = [r["clearance_mm"] for r in cells]
-            top.plot(c, [max(r["film_ratio_min"], 1e-2) for r in cells], "o-", color=colours[rpm], label=f"{rpm:g} rpm")
+            # Lambda = 0 (the film gone) is drawn at the bottom edge of the axis.
+            top.plot(c, [max(r["film_ratio_min"], FLOOR_DRAWN) for r in cells], "o-", color=colours[rpm],
+                     label=f"{rpm:g} rpm")
             bottom.plot(c, [r["joint_force_max_N"] for r in cells], "o-", color=colours[rpm], label=f"{rpm:g} rpm, oil")
             bottom.plot(c, [r["dry_contact_force_max_N"] for r in cells], "x--", color=colours[rpm], lw=0.8,
                         label=f"{rpm:g} rpm, dry")
         top.set_yscale("log")
-        top.set_ylim(0.3, max(10.0, max(r["film_ratio_min"] for r in rows) * 1.5))
+        top.set_ylim(FLOOR_DRAWN, max(10.0, max(r["film_ratio_min"] for r in rows) * 1.5))
         top.set_title(f"viscosity {eta:g} mPa s")
         top.set_ylabel("minimum film ratio h_min / sigma")
-        top.text(0.02, 0.02, "dry < 1 < mixed < 3 < hydrodynamic", transform=top.transAxes, fontsize=7)
+        top.text(0.02, 0.04, "dry < 1 < mixed < 3 < hydrodynamic (film gone: bottom edge)", transform=top.transAxes,
+                 fontsize=7)
         bottom.set_yscale("log")
         bottom.set_ylabel("peak joint force [N]")
         bottom.set_xlabel("radial clearance at E [mm]")
         bottom.set_xscale("log")
+        clearances = sorted({row["clearance_mm"] for row in rows})
+        bottom.set_xticks(clearances, [f"{c:g}" for c in clearances])
+        bottom.minorticks_off()
         for ax in (top, bottom):
             ax.grid(alpha=0.3, which="both")
         top.legend(fontsize=7)

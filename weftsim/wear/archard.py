@@ -64,7 +64,8 @@ def contact_rows(prm: np.ndarray, time: np.ndarray, states: np.ndarray, contact:
         if f_n > 0.0 and length > 0.0:
             direction = math.atan2(ecc_z, ecc_y)
             out[i, 0] = f_n
-            out[i, 1] = tangential_velocity(ecc_y, ecc_z, v_y, v_z, length, y[3], prm[OMEGA] * dphi, prm[BEARING_RADIUS])
+            out[i, 1] = tangential_velocity(ecc_y, ecc_z, v_y, v_z, length, y[3], prm[OMEGA] * dphi,
+                                            prm[BEARING_RADIUS])
             out[i, 2] = direction - rocker_angle(prm, t)
             out[i, 3] = direction - y[1]
             out[i, 4] = half_angle
