@@ -359,3 +359,38 @@ def test_the_exudyn_model_message_names_the_scene_key(capsys, tmp_path):
     status, _, err = run(capsys, "run", "clearance_f", "--engine", "exudyn", "--set",
                          "solver.exudyn.model=kinematic_tree", "--revolutions", 0.05, "-o", tmp_path / "x")
     assert status in (2, 3) and "solver.exudyn.model" in err and "exudyn_solver" not in err
+
+
+def test_a_law_range_warning_names_the_scene_key_once(capsys, tmp_path):
+    """Further round: the Exudyn engine also printed the reusable joint's Python warning (a file path and
+    `restitution`) beside the scene's own line naming joint_f.restitution."""
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:  # pytest would otherwise keep them from stderr
+        warnings.simplefilter("always")
+        status, _, err = run(capsys, "run", "clearance_f", "--set", "joint_f.restitution=0.3", "--engine", "exudyn",
+                             "--revolutions", 0.05, "-o", tmp_path / "x")
+    assert status == 0, err
+    assert "joint_f.restitution = 0.3 is outside" in err
+    assert not [w for w in caught if "restitution" in str(w.message)], [str(w.message) for w in caught]
+
+
+def test_ctrl_c_during_wear_exits_130_saying_interrupted(tmp_path):
+    """The issue's row through the real command line: SIGINT while the updates run."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "w"
+    process = subprocess.Popen([sys.executable, "-m", "weftsim.cli", "wear", str(REFERENCE), "--hours", "10000",
+                                "-o", str(out), "--no-plot"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    for _ in range(600):  # until the first update is stored (a few seconds; the CI machine may be slower)
+        if (out / "wear_state.npz").exists():
+            break
+        time.sleep(0.1)
+    process.send_signal(signal.SIGINT)
+    _, err = process.communicate(timeout=120)
+    assert process.returncode == 130, err
+    assert "interrupted" in err and "simulation failed" not in err and "Traceback" not in err
+    assert (out / "wear.csv").exists()

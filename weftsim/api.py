@@ -266,9 +266,10 @@ def load_sweep(directory: str | os.PathLike) -> xarray.Dataset:
         One dimension per varied key (named as in the cell names, e.g. ``clearance_mm``; its
         ``scene_key`` attribute is the dotted key), coordinates the values in file units; data
         variables the table columns of ``sweep.csv`` (peaks of the first and last revolution and
-        99th percentiles of driving torque, rapier acceleration and contact force, wall time,
-        first contact angle) and ``status`` (``"success"``, ``"failed"`` or ``"not run"``).
-        Values of cells not run, or without the number, are NaN.
+        99th percentiles of driving torque, rapier acceleration and the contact force at E
+        (``contact_force_N_*``) and at F (``contact_force_f_N_*``), wall time, first contact angle)
+        and ``status`` (``"success"``, ``"failed"`` or ``"not run"``).  Values of cells not run, or
+        without the number (a joint ideal in that cell has no contact force), are NaN.
 
     Raises
     ------

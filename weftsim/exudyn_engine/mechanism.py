@@ -31,6 +31,7 @@ unspecified mass (crank, sector: balanced, centre of mass on their fixed axis) g
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -190,7 +191,9 @@ def build_mechanism(mbs: exu.MainSystem, scene: Scene, callback: str | None = No
     else:  # F with a clearance: the sector's eye is the bearing, the rod's pin the journal
         bearing_f = mbs.AddMarker(MarkerBodyPosition(bodyNumber=sector["bodyNumber"], localPosition=[g.l_fg, 0.0, 0.0]))
         journal_f = mbs.AddMarker(MarkerBodyPosition(bodyNumber=rod["bodyNumber"], localPosition=[half, 0.0, 0.0]))
-        clearance_f = add_clearance_joint(mbs, bearing_f, journal_f, scene.joint_f, callback=route)
+        with warnings.catch_warnings():  # the scene's own check names joint_f.restitution (weftsim.plausibility);
+            warnings.simplefilter("ignore", UserWarning)  # the joint's warning names the Python field
+            clearance_f = add_clearance_joint(mbs, bearing_f, journal_f, scene.joint_f, callback=route)
     _pin(mbs, ground, [g.l_og, 0.0, 0.0], sector["bodyNumber"], [0.0, 0.0, 0.0])  # G
     bodies = {"crank": crank, "coupler": coupler, "rocker": rocker, "rod": rod, "sector": sector}
     if not reflect_gears:
@@ -204,8 +207,10 @@ def build_mechanism(mbs: exu.MainSystem, scene: Scene, callback: str | None = No
     if scene.joint.is_ideal:
         mbs.AddObject(ObjectJointRevolute2D(markerNumbers=[marker_bearing, marker_journal]))
     else:
-        clearance = add_clearance_joint(mbs, marker_bearing, marker_journal, scene.joint,
-                                        callback=route, call_counter=call_counter)  # fmt: skip
+        with warnings.catch_warnings():  # as at F: the scene's check names joint_e.restitution
+            warnings.simplefilter("ignore", UserWarning)
+            clearance = add_clearance_joint(mbs, marker_bearing, marker_journal, scene.joint,
+                                            callback=route, call_counter=call_counter)  # fmt: skip
 
     drive = mbs.CreateCoordinateConstraint(itemNumbers=[None, crank["nodeNumber"]],
                                            coordinates=[None, CRANK_COORDINATE],

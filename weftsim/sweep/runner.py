@@ -85,7 +85,10 @@ def write_figure(plan: SweepPlan, outdir: Path, rows: list[dict]) -> Path | None
     from weftsim.sweep.plots import plot_sweep
 
     base = plan.base_keys
-    title = (f"{Path(plan.scene_path).name}, {plan.engine} engine, {base['joint_e.law']}, "
+    varied = {axis.key for axis in plan.axes}
+    laws = [f"{base[f'joint_{j}.law']} at {j.upper()}" for j in ("e", "f")  # the laws of the joints with a clearance
+            if (base.get(f"joint_{j}.clearance_mm") or 0) > 0 or f"joint_{j}.clearance_mm" in varied]
+    title = (f"{Path(plan.scene_path).name}, {plan.engine} engine, {', '.join(laws) or 'ideal joints'}, "
              f"{base['drive.revolutions']:g} revolutions: largest magnitude over a crank revolution")
     figure = plot_sweep(rows, plan.axis_names, title)
     return save(outdir / FIGURE_FILE, figure) if figure is not None else None

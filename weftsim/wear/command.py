@@ -111,8 +111,8 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
               f"{data['ended']}; nothing beyond it is predicted")
         return 0
     if not data["complete"]:
-        raise CliError(f"stopped after {data['hours_reached']:.6g} h; the state is in {outdir}: run the same "
-                        "command again to resume", 130)
+        raise CliError(f"interrupted: stopped after {data['hours_reached']:.6g} h; the state is in {outdir}: run the "
+                        "same command again to resume", 130)
     return 0
 
 
