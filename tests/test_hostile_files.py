@@ -221,3 +221,47 @@ def test_save_result_of_something_else_and_a_bad_progress(tmp_path, saved):
         weftsim.simulate("reference", "reference", progress=5)
     with pytest.raises(weftsim.ArgumentError, match="load_result: path must be a file path"):
         weftsim.load_result(None)
+
+
+# --- a further round: special files, other keys ----------------------------------------------------------
+
+
+def test_special_files_are_refused_without_blocking(tmp_path):
+    """A named pipe blocked the reader forever (it waited for a writer); a device or a link loop are no results."""
+    os.mkfifo(tmp_path / "pipe.npz")
+    _refused(tmp_path / "pipe.npz", "not a regular file")
+    (tmp_path / "loop.npz").symlink_to(tmp_path / "loop.npz")
+    _refused(tmp_path / "loop.npz", "cannot be read as a weftsim result")
+    with pytest.raises(weftsim.OutputError, match="not a regular file"):
+        weftsim.load_result("/dev/zero")
+
+
+def test_a_first_contact_after_the_end_of_the_run(tmp_path, saved):
+    meta = json.loads(json.dumps(saved[2]))
+    meta["events"]["first_contact_time_s"] = 10.0
+    _refused(_npz(tmp_path / "r.npz", _with_meta(saved[1], meta)), "after the run's end")
+
+
+def test_a_manifest_that_is_a_directory_is_one_line(tmp_path, capsys):
+    from weftsim.cli import main
+
+    (tmp_path / "out" / ".weftsim-output.json").mkdir(parents=True)
+    assert main(["run", "reference", "--engine", "reference", "--revolutions", "0.05", "--no-plot",
+                 "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "is not weftsim's manifest file" in err[0], err
+
+
+def test_a_manifest_listing_odd_names_removes_nothing_of_the_user(tmp_path):
+    """A run manifest edited to list a directory, a parent path and non-text entries: the rerun neither fails
+    nor removes anything but its own stale files."""
+    from weftsim.output import MANIFEST, write_files, write_text
+
+    out = tmp_path / "out"
+    (out / "sub").mkdir(parents=True)
+    (tmp_path / "x").write_text("keep")
+    (out / MANIFEST).write_text(json.dumps({"files": ["../x", "sub", 5, None, "old.csv"], "state": "complete"}))
+    (out / "old.csv").write_text("stale")
+    write_files(out, {"kind": "test"}, {"a": ("a.txt", lambda p: write_text(p, "new"))})
+    assert (out / "sub").is_dir() and (tmp_path / "x").read_text() == "keep"
+    assert not (out / "old.csv").exists() and (out / "a.txt").read_text() == "new"

@@ -141,8 +141,10 @@ def test_an_edited_response_statistic_fails_the_checksum(finished, tmp_path):
     _refused(finished[0], _copy(finished, tmp_path, arrays), "checksum")
 
 
-def test_a_state_of_another_scene_is_refused(finished, tmp_path):
-    other = weftsim.load_scene("reference", clearance_mm=0.3)
+@pytest.mark.parametrize("overrides", [{"joint_e.clearance_mm": 0.3}, {"joint_e.wear.profile_points": 180}])
+def test_a_state_of_another_scene_is_refused(finished, tmp_path, overrides):
+    """Named as another scene's, also where its arrays no longer fit (fewer profile points)."""
+    other = weftsim.load_scene("reference", overrides)
     _refused(other, _copy(finished, tmp_path, finished[2]), "another scene")
 
 

@@ -471,3 +471,33 @@ def test_a_huge_range_is_counted_before_its_values_are_built(tmp_path, capsys, m
     assert status == EXIT_USAGE
     one_error_line(capsys, "cells, more than the 1,000,000 a sweep can hold")
     assert not (tmp_path / "x").exists()
+
+
+@pytest.mark.parametrize("damage", ["garbage", "directory", "huge pid"])
+def test_a_damaged_lock_is_one_line_or_taken_over(finished_sweep, tmp_path, capsys, damage):
+    """A lock that is not weftsim's (bytes, a directory) was reported as held by "process None on host ?";
+    a lock naming a process id no system has (10^30) raised OverflowError: it is stale and taken over."""
+    outdir = _copy_sweep(finished_sweep, tmp_path)
+    lock = outdir / LOCK_FILE
+    if damage == "garbage":
+        lock.write_bytes(b"\x00\xffnot json")
+    elif damage == "directory":
+        lock.mkdir()
+    else:
+        lock.write_text(json.dumps({"host": socket.gethostname(), "pid": 10**30, "started": "?"}))
+    status = main([*ARGS, *GRID, "-o", str(outdir)])
+    if damage == "huge pid":
+        assert status == 0
+    else:
+        assert status == EXIT_USAGE
+        one_error_line(capsys, "is not a lock weftsim can read", "delete it")
+
+
+def test_a_table_path_that_is_a_directory_is_refused_before_any_cell(finished_sweep, tmp_path, capsys):
+    outdir = _copy_sweep(finished_sweep, tmp_path)
+    (outdir / TABLE_FILE).unlink()
+    (outdir / TABLE_FILE).mkdir()
+    assert main([*ARGS, "--vary", "clearance_mm=0.1,0.2,0.3", "--vary", "restitution=0.5,0.9", "-o", str(outdir)]) \
+        == EXIT_USAGE
+    one_error_line(capsys, "is a directory, where the sweep writes its sweep.csv", "remove it")
+    assert not (outdir / "clearance_mm=0.3,restitution=0.5").exists()  # no new cell ran

@@ -187,6 +187,8 @@ def simulate(scene: Scene | str | os.PathLike, engine: str = "auto", *,
         ``scene`` is a file or name that does not load.
     weftsim.errors.RunFailed
         Only with ``raise_on_failure``: the run failed (``exc.result`` holds it).
+    weftsim.errors.ArgumentError
+        ``progress`` is neither None nor callable.
     """
     from weftsim.design_checks import before_run, warnings_of
 
@@ -224,7 +226,15 @@ def save_result(result: RunResult, path: str | os.PathLike) -> Path:
 
     Both tables (output samples and every solver step) are kept bit for bit, with the scene, the
     status, the solver statistics, the plausibility counts and the path; :func:`load_result`
-    rebuilds an equal :class:`RunResult`.  Returns the path, written as given.
+    rebuilds an equal :class:`RunResult`.  Returns the path, written as given (atomically: an
+    interrupted save leaves the previous file or none, never a truncated one).
+
+    Raises
+    ------
+    weftsim.errors.ArgumentError
+        ``result`` is not a :class:`RunResult` or ``path`` not a path.
+    weftsim.errors.OutputError
+        The file cannot be written.
     """
     from weftsim.results import save_npz
 
@@ -248,7 +258,10 @@ def load_result(path: str | os.PathLike) -> RunResult:
     Raises
     ------
     weftsim.errors.OutputError
-        The file is missing, unreadable or not a weftsim result.
+        The file is missing, unreadable, not a weftsim result, or damaged or edited so that it no longer
+        is one (each checked before anything is allocated: :mod:`weftsim.result_file`).
+    weftsim.errors.ArgumentError
+        ``path`` is not a path.
     """
     from weftsim.results import load_npz
 

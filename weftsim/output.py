@@ -69,6 +69,10 @@ def prepare_directory(path: str | Path, force: bool = False) -> Path:
         raise OutputError(f"cannot create output directory {path}: {exc.strerror}") from None
     if not os.access(path, os.W_OK | os.X_OK):
         raise OutputError(f"output directory {path} is not writable")
+    manifest = path / MANIFEST
+    if (manifest.exists() or manifest.is_symlink()) and (manifest.is_symlink() or not manifest.is_file()):
+        raise OutputError(f"{manifest} is not weftsim's manifest file (a directory, a link or a device); "
+                          "remove it, or choose another directory with -o")
     return path
 
 

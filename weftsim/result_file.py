@@ -188,7 +188,14 @@ def _value(hint: Any, value: Any, where: str) -> Any:
     if hint in (float, int, str, bool):
         kind = {float: "a number", int: "a whole number", str: "text", bool: "true or false"}[hint]
         raise ValueError(f"scene field {where} must be {kind}, got {_short(value)}")
-    raise ValueError(f"scene field {where} has a type weftsim cannot check ({hint})")
+    if typing.get_origin(hint) is typing.Literal:
+        if value in typing.get_args(hint):
+            return value
+        raise ValueError(f"scene field {where} must be one of {typing.get_args(hint)}, got {_short(value)}")
+    # Another kind of field (none today): its value is checked with the whole scene (check_scene).
+    if isinstance(value, (str, int, float, bool, list)):
+        return tuple(value) if isinstance(value, list) else value
+    raise ValueError(f"scene field {where} must be a number, text or a list, got {_short(value)}")
 
 
 def rebuild(cls: type, data: Any, where: str = "scene") -> Any:
@@ -283,6 +290,9 @@ def check_times(path: Path, meta: dict, scene: params.Scene, tables: dict) -> No
         t = np.asarray(tables[table]["time_s"], dtype=float)
         if t.size and not (np.all(np.isfinite(t)) and np.all(np.diff(t) >= 0.0) and t[0] >= 0.0):
             raise _fail(path, f"{table}/time_s is not a time axis (finite, from >= 0, never decreasing)")
+    first = meta["events"].get("first_contact_time_s")
+    if first is not None and first > scene.drive.end_time * (1.0 + 1e-9):
+        raise _fail(path, f"its first contact at {first:.6g} s is after the run's end, {scene.drive.end_time:.6g} s")
     if meta["status"] == "success":
         t = tables["steps"]["time_s"]
         # The last accepted step lands on the end time (both engines); 1e-9 relative is far above its round-off

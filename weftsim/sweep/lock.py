@@ -51,7 +51,7 @@ def _running(holder: dict) -> bool | None:
     if holder.get("boot_id") and _boot_id() and holder["boot_id"] != _boot_id():
         return False  # the machine has rebooted since: no process of before runs now
     pid = holder.get("pid")
-    if not isinstance(pid, int) or pid <= 0:
+    if isinstance(pid, bool) or not isinstance(pid, int) or not 0 < pid < 2**31:  # no process has another id
         return False
     try:
         os.kill(pid, 0)
@@ -87,7 +87,7 @@ class SweepLock:
             return {}
         except (OSError, ValueError, RecursionError):
             holder = None
-        return holder if isinstance(holder, dict) else {"pid": None, "host": "?", "started": "?"}
+        return holder if isinstance(holder, dict) else {"damaged": True}
 
     def acquire(self) -> None:
         """Take the lock, taking over a stale one; SweepError naming the holder of a live one."""
@@ -98,6 +98,9 @@ class SweepLock:
             holder = self._read()
             if not holder:
                 continue
+            if holder.get("damaged"):
+                raise SweepError(f"{self.path} is not a lock weftsim can read (damaged, or a directory); if no sweep "
+                                 f"runs in {self.path.parent}, delete it and run again")
             running = _running(holder)
             if running is False:
                 # Rename first: of two sweeps taking over the same stale lock, only one rename succeeds.

@@ -108,6 +108,16 @@ def _open_directory(outdir: Path, plan: SweepPlan, lock: SweepLock) -> None:
         raise SweepError(str(exc)) from None
     lock.acquire()
     write_json(outdir / SWEEP_FILE, merge_manifest(outdir, new))  # again under the lock: another sweep may have been first
+    from weftsim.output import check_file_target
+
+    for name in (TABLE_FILE, FIGURE_FILE):  # before any cell runs: the table and figure come last
+        if (outdir / name).is_dir():
+            raise SweepError(f"{outdir / name} is a directory, where the sweep writes its {name}; remove it to run "
+                             "the sweep there")
+        try:
+            check_file_target(outdir / name)
+        except OutputError as exc:
+            raise SweepError(str(exc)) from None
 
 
 def run_sweep(plan: SweepPlan, outdir: str | Path, jobs: int | None = None, scheduler: str | None = None,

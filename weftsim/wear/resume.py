@@ -83,14 +83,17 @@ def read_state(path: Path, scene: Scene) -> list[Update]:
         archive = open_archive(path, WHAT, "weftsim writes wear_state.npz as a file")
         with archive:
             headers = array_headers(path, archive, expected, WHAT)
-            problem = _shape_problem(headers, scene.joint.wear.profile_points, len(RESPONSE))
-            if problem:
-                raise StateMismatch(f"{path}: damaged wear state: {problem}{_advice(path)}")
+            shape, dtype = headers.get("scene", ((0,), np.dtype(float)))
+            if shape != () or dtype.kind != "U" or dtype.itemsize > 4 * MAX_SCENE_TEXT:
+                raise StateMismatch(f"{path}: damaged wear state: it holds no scene keys as one text{_advice(path)}")
             stored_scene = str(read_array(archive, "scene")[()])
-            if stored_scene != scene_identity(scene):
+            if stored_scene != scene_identity(scene):  # first: a state of another scene is not a damaged one
                 raise StateMismatch(
                     f"{path} holds a wear prediction of another scene or other [joint_e.wear] settings; choose "
                     "another output directory with -o, or delete it to start over")
+            problem = _shape_problem(headers, scene.joint.wear.profile_points, len(RESPONSE))
+            if problem:
+                raise StateMismatch(f"{path}: damaged wear state: {problem}{_advice(path)}")
             data = {name: np.asarray(read_array(archive, name), dtype=float) for name in (*SERIES, *PROFILES)}
             response = np.asarray(read_array(archive, "response"), dtype=float)
             stored = str(read_array(archive, "digest")[()]) if "digest" in headers else None
@@ -115,9 +118,6 @@ def _shape_problem(headers: dict, points: int, responses: int) -> str:
     missing = sorted({"scene", *SERIES, *PROFILES, "response"} - set(headers))
     if missing:
         return f"it lacks {', '.join(missing)}"
-    shape, dtype = headers["scene"]
-    if shape != () or dtype.kind != "U" or dtype.itemsize > 4 * MAX_SCENE_TEXT:
-        return f"'scene' is {dtype} of shape {shape}, not the scene's keys as one text"
     if "digest" in headers and (headers["digest"][0] != () or headers["digest"][1].kind != "U"
                                 or headers["digest"][1].itemsize > 4 * 64):
         return "'digest' is not one SHA-256 text"
