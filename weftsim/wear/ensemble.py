@@ -141,16 +141,22 @@ def combine(scene: Scene, uncertain: list[Uncertain], dynamic: list[Uncertain], 
     bad_nodes = [n for n in node_names if n in failed]
     if bad_nodes:
         raise WearError(f"the ensemble's design run {bad_nodes[0]} failed: {failed[bad_nodes[0]]}")
-    start = max(results[n]["clearance_m"][0] for n in node_names)
+    start = min(results[n]["clearance_m"][0] for n in node_names)
     levels = np.unique(np.concatenate([np.linspace(start, limit, LEVELS + 1)[1:],
                                        [v for v in levels_extra if start < v <= limit]]))
-    log_nodes = np.log(np.array([hours_at(results[n], levels) for n in node_names]))  # (nodes, levels)
+    node_hours = np.array([hours_at(results[n], levels) for n in node_names])  # (nodes, levels)
     chaos_names = [centre] + sorted(n for n in results if n.startswith("chaos_") and n not in failed)
     chaos = np.array([hours_at(results[n], levels) for n in chaos_names])
-    chaos_factor = chaos / chaos.mean(axis=0)  # (runs, levels)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        chaos_factor = np.where(chaos.mean(axis=0) > 0.0, chaos / chaos.mean(axis=0), 1.0)  # (runs, levels)
     # The design runs are one chaotic draw each; shift the design to pass through the chaos runs' mean at
     # the centre (the centre run is chaos run 0), so that the chaos factor is not counted twice there.
-    log_nodes = log_nodes - np.log(chaos_factor[0])
+    node_hours = node_hours / chaos_factor[0]
+    # Log-hours are interpolated where every design point has started wearing; a level below some design
+    # point's starting clearance (hours 0 there: a clearance key is uncertain) is interpolated in hours.
+    positive = np.all(node_hours > 0.0, axis=0)
+    with np.errstate(divide="ignore"):
+        log_nodes = np.where(positive, np.log(node_hours), node_hours)
 
     rng = np.random.default_rng(seed)
     u = latin_hypercube(samples, len(uncertain) + 1, rng)
@@ -160,7 +166,7 @@ def combine(scene: Scene, uncertain: list[Uncertain], dynamic: list[Uncertain], 
         w = _lagrange(np.array(sorted(set(nodes[:, d]))), values[v.key])
         index = [sorted(set(nodes[:, d])).index(x) for x in nodes[:, d]]
         weights = weights * w[:, index]
-    log_hours = weights @ log_nodes if dynamic else np.repeat(log_nodes, samples, axis=0)
+    mixed = weights @ log_nodes if dynamic else np.repeat(log_nodes, samples, axis=0)
     base = to_file_keys(scene)
     share_b = results[centre]["bearing_share"]
     scale = np.ones(samples)
@@ -171,7 +177,8 @@ def combine(scene: Scene, uncertain: list[Uncertain], dynamic: list[Uncertain], 
     scale /= share_b * base["joint_e.wear.bearing_hardness_mpa"] / hb \
         + (1.0 - share_b) * base["joint_e.wear.journal_hardness_mpa"] / hj
     draw = np.minimum((u[:, -1] * len(chaos_names)).astype(int), len(chaos_names) - 1)
-    hours = np.exp(log_hours) * scale[:, None] * chaos_factor[draw]  # (samples, levels)
+    base_hours = np.where(positive, np.exp(mixed), np.maximum(mixed, 0.0))
+    hours = base_hours * scale[:, None] * chaos_factor[draw]  # (samples, levels)
     at_limit = hours[:, -1]
     inputs = {**values, "chaotic scatter": chaos_factor[draw, -1]}
     shares = rank_shares(inputs, np.log(at_limit))
@@ -241,6 +248,7 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
                 if i == lv.size - 1 or any(abs(lv[i] - v) < 1e-12 for v in levels)}
     data = {
         "scene": scene.name,
+        "joint": "E",  # wear at joint E (the wear prediction's joint so far)
         "limit_clearance_mm": 1e3 * limit,
         "samples": samples,
         "seed": seed,

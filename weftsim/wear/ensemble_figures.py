@@ -49,7 +49,7 @@ def band_figure(band: dict, title: str = "") -> Figure:
 
 def shares_figure(data: dict, title: str = "") -> Figure:
     """Each input's share of the spread of log hours (squared rank correlations, normalised)."""
-    fig = figure(figsize=(7, 1.2 + 0.5 * len(data["shares"])))
+    fig = figure(figsize=(9, 1.6 + 0.5 * len(data["shares"])))
     ax = fig.add_subplot(1, 1, 1)
     names = list(data["shares"])
     shares = [data["shares"][n]["share"] for n in names]
@@ -58,7 +58,7 @@ def shares_figure(data: dict, title: str = "") -> Figure:
     for i, (s, r) in enumerate(zip(shares, signs)):
         ax.text(s, i, f" {100 * s:.0f} % (rho {r:+.2f})", va="center", fontsize=8)
     ax.set_xlim(0, 1.15)
-    ax.set_xlabel("share of the spread of log(hours to the limit)  (red: more of it, fewer hours)")
+    ax.set_xlabel("share of the spread of log(hours to the limit); red: more of it, fewer hours")
     ax.set_title(title)
     fig.tight_layout()
     return fig
