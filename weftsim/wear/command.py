@@ -33,6 +33,8 @@ def add_flags(p: argparse.ArgumentParser, positive: Callable[[Callable[[str], fl
                           "uniform(low,high) or triangular(low,mode,high); repeatable. Needs --limit-clearance-mm")
     ens.add_argument("--samples", type=int, default=1000, help="ensemble samples (default 1000; cost no simulation)")
     ens.add_argument("--seed", type=int, default=0, help="seed of the ensemble's sampling (default 0)")
+    ens.add_argument("--chaos-runs", type=int, default=6, help="predictions of the nominal design point differing "
+                     "in the last bits of k, sampling the chaotic scatter (default 6)")
     ens.add_argument("--jobs", type=int, help="local worker processes for the ensemble's simulations (default: cores)")
     ens.add_argument("--scheduler", help="address of a Dask scheduler to run the ensemble's simulations on")
 
@@ -134,6 +136,7 @@ def run_ensemble(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     try:
         data = wear_ensemble(scene, args.uncertain, args.samples, limit, outdir, jobs=args.jobs,
                              scheduler=args.scheduler, seed=args.seed, figures=not args.no_plot, force=args.force,
+                             chaos_runs=args.chaos_runs,
                              announce=lambda text: print(text, file=sys.stderr, flush=True))
     except WearError as exc:
         raise CliError(str(exc)) from None

@@ -69,7 +69,8 @@ def _lagrange(nodes: np.ndarray, x: np.ndarray) -> np.ndarray:
     return w
 
 
-def plan(scene: Scene, uncertain: list[Uncertain]) -> tuple[list[tuple[str, Scene]], list[Uncertain], np.ndarray]:
+def plan(scene: Scene, uncertain: list[Uncertain], chaos_runs: int = CHAOS_RUNS
+         ) -> tuple[list[tuple[str, Scene]], list[Uncertain], np.ndarray]:
     """(jobs as (name, scene), the dynamic inputs, their design values (nodes, dims)); checks every design scene."""
     from weftsim.scene import SceneError, apply_overrides, to_file_keys
 
@@ -98,7 +99,7 @@ def plan(scene: Scene, uncertain: list[Uncertain]) -> tuple[list[tuple[str, Scen
         name = "node_" + "_".join(str(i) for i in index) if dynamic else "centre"
         jobs.append((name, node_scene))
         if index == centre:
-            jobs.extend((f"chaos_{j}", _last_bits(node_scene, j)) for j in range(1, CHAOS_RUNS))
+            jobs.extend((f"chaos_{j}", _last_bits(node_scene, j)) for j in range(1, chaos_runs))
     return jobs, dynamic, nodes
 
 
@@ -198,7 +199,7 @@ def quantile_table(hours: np.ndarray) -> dict:
 def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: int, limit: float,
                   outdir: str | Path, jobs: int | None = None, scheduler: str | None = None, seed: int = 0,
                   figures: bool = True, force: bool = False, levels: tuple[float, ...] = (),
-                  announce: Callable[[str], None] | None = None) -> dict:
+                  chaos_runs: int = CHAOS_RUNS, announce: Callable[[str], None] | None = None) -> dict:
     """Run a wear ensemble into ``outdir``; returns the summary (``ensemble.json``) with ``"files"``.
 
     Parameters
@@ -217,6 +218,8 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
         Local worker processes, or the address of a Dask scheduler (as ``weftsim sweep``).
     levels : tuple of float
         Extra clearance levels (m) to report quantiles at (besides the limit).
+    chaos_runs : int
+        Predictions of the centre design point differing in the last bits of k (1 to 50; 1 = no scatter).
     """
     from weftsim.output import begin_directory, prepare_directory, write_csv, write_figure, write_files, write_json
     from weftsim.wear import check_request
@@ -227,8 +230,10 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
         raise WearError("an ensemble needs at least one --uncertain KEY=DISTRIBUTION")
     if not (isinstance(samples, int) and 10 <= samples <= 10**6):
         raise WearError(f"--samples must be a whole number from 10 to 1000000, got {samples!r}")
+    if not (isinstance(chaos_runs, int) and 1 <= chaos_runs <= 50):
+        raise WearError(f"--chaos-runs must be a whole number from 1 to 50, got {chaos_runs!r}")
     check_request(scene, 1.0, "reference", limit)
-    job_list, dynamic, nodes = plan(scene, parsed)
+    job_list, dynamic, nodes = plan(scene, parsed, chaos_runs)
     for name, s in job_list:
         if not limit > s.joint.clearance:
             raise WearError(f"the design point {name} starts at a clearance of {1e3 * s.joint.clearance:g} mm, not "
