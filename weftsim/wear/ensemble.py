@@ -238,6 +238,14 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
         if not limit > s.joint.clearance:
             raise WearError(f"the design point {name} starts at a clearance of {1e3 * s.joint.clearance:g} mm, not "
                             f"below the limit {1e3 * limit:g} mm: narrow the clearance's distribution or raise the limit")
+    if announce is not None:
+        from weftsim.wear.command import update_time
+
+        announce(f"ensemble: {len(job_list)} simulated predictions to {1e3 * limit:g} mm ("
+                 f"{3 ** len(dynamic) if dynamic else 1} design point(s) of {len(dynamic)} simulated key(s), "
+                 f"{chaos_runs - 1} more chaos run(s)); one update of the nominal scene ~{update_time(scene):.2g} s, "
+                 f"~{math.log(limit / scene.joint.clearance) / math.log1p(scene.joint.wear.max_clearance_change):.0f} "
+                 "updates a prediction; the samples cost no simulation")
     outdir = prepare_directory(outdir, force)
     what = {"kind": "wear ensemble", "scene": scene.name}
     begin_directory(outdir, what)
