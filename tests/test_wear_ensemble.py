@@ -138,7 +138,7 @@ def test_cli_ensemble_writes_and_resumes(tmp_path):
     out = tmp_path / "ens"
     cmd = [sys.executable, "-m", "weftsim.cli", "wear", str(REFERENCE), "--uncertain",
            "joint_e.wear.wear_coefficient=lognormal(1e-7,0.5)", "--uncertain", "drive.speed_rpm=uniform(390,410)",
-           "--samples", "200", "--limit-clearance-mm", "0.26", "--jobs", "2", "-o", str(out)]
+           "--chaos-runs", "2", "--samples", "200", "--limit-clearance-mm", "0.26", "--jobs", "2", "-o", str(out)]
     first = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
     assert first.returncode == 0, first.stderr
     data = json.loads((out / "ensemble.json").read_text())
