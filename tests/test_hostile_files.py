@@ -191,6 +191,8 @@ def _edit_scene(edit):
     (_edit_scene(lambda s: s["drive"].update(speed=0)), ["drive.speed_rpm' must be > 0"]),
     (_edit_scene(lambda s: s.update(bogus=1)), ["unknown field(s) bogus"]),
     (_edit_scene(lambda s: s["joint"].update(bearing_wear=[1e-3] * 7)), ["wear profiles"]),
+    (_edit_scene(lambda s: s["geometry"].update(fourbar_branch=7)), ["fourbar_branch must be 1 or -1"]),
+    (_edit_scene(lambda s: s["inertia"].update(coupler_inertia=[1, 2])), ["list of 3 numbers"]),
     # A changed length of the run: the data no longer belong to the scene.
     (_edit_scene(lambda s: s["drive"].update(revolutions=5.0)), ["steps end at", "not at the scene's end time"]),
 ])
@@ -221,6 +223,12 @@ def test_save_result_of_something_else_and_a_bad_progress(tmp_path, saved):
         weftsim.simulate("reference", "reference", progress=5)
     with pytest.raises(weftsim.ArgumentError, match="load_result: path must be a file path"):
         weftsim.load_result(None)
+    with pytest.raises(weftsim.ArgumentError, match="load_sweep: directory must be a path"):
+        weftsim.load_sweep(None)
+    with pytest.raises(weftsim.OutputError, match="no such path"):
+        weftsim.load_result("a\x00b.npz")
+    with pytest.raises(weftsim.OutputError, match="cannot write"):
+        weftsim.save_result(weftsim.load_result(saved[0]), "a\x00b.npz")
 
 
 # --- a further round: special files, other keys ----------------------------------------------------------

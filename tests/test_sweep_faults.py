@@ -501,3 +501,19 @@ def test_a_table_path_that_is_a_directory_is_refused_before_any_cell(finished_sw
         == EXIT_USAGE
     one_error_line(capsys, "is a directory, where the sweep writes its sweep.csv", "remove it")
     assert not (outdir / "clearance_mm=0.3,restitution=0.5").exists()  # no new cell ran
+
+
+@pytest.mark.parametrize("where", ["manifest", "cell"])
+def test_a_named_pipe_in_place_of_a_json_file_does_not_block(finished_sweep, tmp_path, where):
+    """Reading a pipe waits for a writer forever: the manifest is refused, the cell's record not trusted."""
+    import weftsim
+
+    outdir = _copy_sweep(finished_sweep, tmp_path)
+    path = outdir / SWEEP_FILE if where == "manifest" else outdir / CELL / CELL_FILE
+    path.unlink()
+    os.mkfifo(path)
+    if where == "manifest":
+        with pytest.raises(SweepError, match="is not a file"):
+            weftsim.load_sweep(outdir)
+    else:
+        assert weftsim.load_sweep(outdir)["status"].sel(clearance_mm=0.1, restitution=0.5).item() == "not run"

@@ -250,6 +250,8 @@ def save_result(result: RunResult, path: str | os.PathLike) -> Path:
         return Path(path)
     except OSError as exc:
         raise OutputError(f"cannot write {path}: {exc.strerror or exc}") from None
+    except ValueError as exc:  # a NUL character in the path
+        raise OutputError(f"cannot write {path!r}: {exc}") from None
 
 
 def load_result(path: str | os.PathLike) -> RunResult:
@@ -293,4 +295,6 @@ def load_sweep(directory: str | os.PathLike) -> xarray.Dataset:
     """
     from weftsim.sweep.store import load_grid
 
+    if not isinstance(directory, (str, os.PathLike)):
+        raise ArgumentError(f"load_sweep: directory must be a path, got {type(directory).__name__}")
     return load_grid(Path(directory))

@@ -59,6 +59,8 @@ def open_archive(path: Path, what: str, directory_hint: str) -> zipfile.ZipFile:
         raise OutputError(f"{path}: file not found") from None
     except OSError as exc:
         raise fail(path, what, exc.strerror or str(exc)) from None
+    except ValueError as exc:  # a NUL character in the path
+        raise fail(path, what, f"no such path ({exc})") from None
     if stat.S_ISDIR(info.st_mode):
         raise fail(path, what, f"it is a directory ({directory_hint})")
     if not stat.S_ISREG(info.st_mode):

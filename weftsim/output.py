@@ -184,6 +184,8 @@ def write_figure(target: Path, figure: Figure) -> Path:
 
 def _manifest_files(outdir: Path) -> set[str]:
     """Plain file names the directory's manifest lists (none if it is unreadable or malformed)."""
+    if not (outdir / MANIFEST).is_file():  # also a pipe, whose reading would wait forever
+        return set()
     try:
         listed = json.loads((outdir / MANIFEST).read_text()).get("files", [])
     except (OSError, ValueError, RecursionError, AttributeError):

@@ -128,9 +128,7 @@ def read_meta(path: Path, archive: zipfile.ZipFile, headers: dict[str, tuple[tup
         if not isinstance(meta[key], kind):
             raise _fail(path, f"'meta' key {key!r} must be a {'JSON object' if kind is dict else 'string'}, "
                               f"got {_short(meta[key])}")
-    unknown = sorted(set(meta) - set(META_TYPES))
-    if unknown:
-        raise _fail(path, f"'meta' holds unknown key(s) {', '.join(map(repr, unknown[:3]))}")
+    # Other keys are ignored: nothing reads them (a later version may add some under the same format).
     if meta["engine"] not in ENGINES:
         raise _fail(path, f"'meta' engine must be one of {', '.join(ENGINES)}, got {_short(meta['engine'])}")
     if meta["status"] not in STATUSES:
@@ -234,6 +232,8 @@ def check_scene(path: Path, scene: params.Scene) -> None:
         scene_from_keys(keys, "the file's scene")
     except ValueError as exc:
         raise _fail(path, f"its scene is not valid ({exc})") from None
+    if scene.geometry.fourbar_branch not in (1, -1):  # the one field a scene file writes as a sign ("+" or "-")
+        raise _fail(path, f"its scene's geometry.fourbar_branch must be 1 or -1, got {scene.geometry.fourbar_branch}")
     for joint_name, joint in (("joint", scene.joint), ("joint_f", scene.joint_f)):
         profiles = (joint.bearing_wear, joint.journal_wear)
         if any(profiles) and (len(profiles[0]) != len(profiles[1]) or len(profiles[0]) < 3

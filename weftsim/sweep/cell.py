@@ -35,6 +35,7 @@ CELL_FILE = "cell.json"
 ERROR_FILE = "error.txt"
 SUMMARY_FILE = "summary.json"
 CELL_FORMAT = "weftsim-sweep-cell/1"
+MAX_RECORD_BYTES = 16 * 2**20  # a cell.json is a few kB (its scene's keys, its metrics)
 
 # Channels summarised per cell: contact_force_N is joint E's, contact_force_f_N joint F's.  A joint that is
 # ideal in a cell has no contact force: its columns are empty there (not 0, which would read as a force
@@ -208,6 +209,8 @@ def _listed_files(cell_dir: Path) -> set[str]:
     """Plain file names the cell's previous run manifest lists (anything else in it is ignored)."""
     from weftsim.output import MANIFEST
 
+    if not (cell_dir / MANIFEST).is_file():
+        return set()
     try:
         listed = json.loads((cell_dir / MANIFEST).read_text(encoding="utf-8")).get("files", [])
     except (OSError, ValueError, AttributeError, RecursionError):
@@ -245,8 +248,11 @@ def read_record(cell_dir: Path) -> dict | None:
     Malformed (:func:`record_problem`): a record damaged or edited by hand is not trusted for the
     table or the grid; the next run of the sweep runs its cell again.
     """
+    path = Path(cell_dir) / CELL_FILE
     try:
-        record = json.loads((Path(cell_dir) / CELL_FILE).read_text(encoding="utf-8"))
+        if not path.is_file() or path.stat().st_size > MAX_RECORD_BYTES:  # a pipe, a device, or too big to be ours
+            return None
+        record = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError, RecursionError):
         return None
     if not isinstance(record, dict) or record.get("format") != CELL_FORMAT or record_problem(record, Path(cell_dir)):
@@ -293,6 +299,8 @@ def is_finished(cell_dir: Path, scene_keys: dict, engine: str) -> bool:
         return False
     expected = normalise(scene_keys)
     if record.get("scene") != expected:
+        return False
+    if not (Path(cell_dir) / SUMMARY_FILE).is_file():  # also a pipe, whose reading would wait forever
         return False
     try:
         summary = json.loads((Path(cell_dir) / SUMMARY_FILE).read_text(encoding="utf-8"))

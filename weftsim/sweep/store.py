@@ -36,6 +36,7 @@ if TYPE_CHECKING:
 SWEEP_FILE = "sweep.json"
 TABLE_FILE = "sweep.csv"
 SWEEP_FORMAT = "weftsim-sweep/1"
+MAX_MANIFEST_BYTES = 256 * 2**20  # not read into memory beyond this
 
 METRIC_COLUMNS = tuple(
     [f"{c}_rev1_peak" for c in METRIC_CHANNELS]
@@ -65,6 +66,11 @@ def read_manifest(outdir: Path) -> dict | None:
     path = Path(outdir) / SWEEP_FILE
     if not path.exists():
         return None
+    if not path.is_file():  # a directory, a pipe (reading it would wait forever), a device
+        raise SweepError(f"{path} is not a file; move it away to start a new sweep there")
+    if path.stat().st_size > MAX_MANIFEST_BYTES:
+        raise SweepError(f"{path} is {path.stat().st_size / 1e6:.0f} MB, more than any sweep manifest (a million "
+                         "cells' values are ~20 MB); move it away to start a new sweep there")
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
     except RecursionError:
