@@ -237,7 +237,8 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
     for name, s in job_list:
         if not limit > s.joint.clearance:
             raise WearError(f"the design point {name} starts at a clearance of {1e3 * s.joint.clearance:g} mm, not "
-                            f"below the limit {1e3 * limit:g} mm: narrow the clearance's distribution or raise the limit")
+                            f"below the limit {1e3 * limit:g} mm: narrow the clearance's distribution or raise "
+                            "the limit")
     if announce is not None:
         from weftsim.wear.command import update_time
 
