@@ -266,7 +266,8 @@ REQUIRED_SECTIONS = ("mechanism", "inertia", "joint_e", "drive")
 OPTIONAL = ("joint_e.impact_velocity_rule", "joint_e.journal_material.yield_strength_mpa",
             "joint_e.bearing_material.yield_strength_mpa", "joint_e.bearing_material.max_pressure_mpa",
             "joint_e.bearing_material.max_pv_mpa_m_s", "joint_e.design_clearance_per_mille") \
-    + tuple(key.path for key in WEAR_KEYS("joint_e", "joint")) + tuple(key.path for key in LUBRICATION_KEYS("joint_e", "joint"))
+    + tuple(key.path for key in WEAR_KEYS("joint_e", "joint")) \
+    + tuple(key.path for key in LUBRICATION_KEYS("joint_e", "joint"))
 # [joint_f] is optional as a whole (absent: the ideal revolute joint at F).  Given a clearance > 0, F takes
 # every key of [joint_e] its table does not give (weftsim.joint_keys).
 REQUIRED = tuple(key.path for key in SCHEMA

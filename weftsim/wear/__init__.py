@@ -166,8 +166,10 @@ def _write_results(scene: Scene, updates: list, hours: float, limit: float | Non
     data["failure"] = failure
     if ended is not None:  # the last update extrapolates up to the limit: report the state there
         end_hours, end_revolutions, bearing, journal = advance(updates[-1], scene)
+        end = replace(updates[-1], hours=end_hours, revolutions=end_revolutions, bearing=bearing, journal=journal,
+                      step_revolutions=0.0)
+        data.update(store.archard_check(scene, [*updates, end]))  # the volumes at the limit
         if limit is not None:
-            end = replace(updates[-1], hours=end_hours, revolutions=end_revolutions, bearing=bearing, journal=journal)
             data["hours_to_limit"] = limit_hours([*updates, end], scene.joint.clearance, limit)
         data.update(hours_reached=end_hours,
                     final_effective_clearance_mm=1e3 * effective_clearance(scene.joint.clearance, bearing, journal),

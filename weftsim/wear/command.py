@@ -20,12 +20,23 @@ if TYPE_CHECKING:
 def add_flags(p: argparse.ArgumentParser, positive: Callable[[Callable[[str], float]], Callable[[str], float]]) -> None:
     """Flags of ``weftsim wear SCENE --hours H [--engine E] [--limit-clearance-mm X]`` beside the shared
     scene and output flags."""
-    p.add_argument("--hours", type=positive(float), required=True, help="operating hours to predict")
+    p.add_argument("--hours", type=positive(float), help="operating hours to predict (not with --uncertain: an "
+                   "ensemble runs each prediction to --limit-clearance-mm)")
     p.add_argument("--engine", default="reference", help="reference (default); exudyn is refused (no worn "
                    "geometry in its contact yet, docs/wear.md)")
     p.add_argument("--limit-clearance-mm", type=positive(float),
                    help="clearance limit: wear.json gives the hours at which the effective clearance reaches it")
     p.add_argument("--no-plot", action="store_true", help="skip the figures")
+    ens = p.add_argument_group("ensemble (docs/wear.md section 7)")
+    ens.add_argument("--uncertain", action="append", default=[], metavar="KEY=DISTRIBUTION",
+                     help="an uncertain scene key, in its file units: normal(mean,sd), lognormal(median,sigma_of_log), "
+                          "uniform(low,high) or triangular(low,mode,high); repeatable. Needs --limit-clearance-mm")
+    ens.add_argument("--samples", type=int, default=1000, help="ensemble samples (default 1000; cost no simulation)")
+    ens.add_argument("--seed", type=int, default=0, help="seed of the ensemble's sampling (default 0)")
+    ens.add_argument("--chaos-runs", type=int, default=6, help="predictions of the nominal design point differing "
+                     "in the last bits of k, sampling the chaotic scatter (default 6)")
+    ens.add_argument("--jobs", type=int, help="local worker processes for the ensemble's simulations (default: cores)")
+    ens.add_argument("--scheduler", help="address of a Dask scheduler to run the ensemble's simulations on")
 
 
 def _duration(seconds: float) -> str:
@@ -58,6 +69,11 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     from weftsim.wear.store import StateMismatch
 
     limit = None if args.limit_clearance_mm is None else args.limit_clearance_mm * 1e-3
+    if args.uncertain:
+        return run_ensemble(args, scene, outdir, stop_on_interrupt)
+    if args.hours is None:
+        raise CliError("--hours is required (or --uncertain KEY=DISTRIBUTION with --limit-clearance-mm for an "
+                       "ensemble)")
     check_request(scene, args.hours, args.engine, limit)  # a WearError is one line, exit 2
     outdir = prepare_directory(outdir, args.force, scene)
     resumed = _stored_updates(outdir, scene, args.force)
@@ -83,6 +99,13 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     print(f"scene {scene.name}: {data['hours_reached']:.6g} h in {data['updates']} updates "
           f"({data['wall_time_s']:.1f} s); effective clearance {data['initial_clearance_mm']:g} -> "
           f"{data['final_effective_clearance_mm']:.4g} mm, wear volume {data['wear_volume_mm3']:.4g} mm^3")
+    if data.get("backoffs"):
+        print(f"  {data['backoffs']} hard cycle(s) (an update whose simulation failed at every tolerance and "
+              "integrator) were passed by halving the update before them (docs/wear.md section 3)")
+    if data.get("sliding_distance_m"):
+        print(f"  Archard's check: sliding {data['sliding_distance_m']:.4g} m under the sliding-weighted mean load "
+              f"{data['sliding_weighted_mean_load_N']:.4g} N (the time mean is {data['time_mean_load_N']:.4g} N) gives "
+              f"{data['archard_volume_mm3']:.4g} mm^3; the profiles hold {data['profile_volume_mm3']:.4g} mm^3")
     if limit is not None:
         reached = data.get("hours_to_limit")
         print(f"  clearance limit {args.limit_clearance_mm:g} mm: " +
@@ -112,3 +135,41 @@ def _stored_updates(outdir: Path, scene: Scene, force: bool) -> list:
             raise CliError(str(exc)) from None
         (outdir / store.STATE).unlink(missing_ok=True)
         return []
+
+
+def run_ensemble(args: argparse.Namespace, scene: Scene, outdir: str | Path,
+                 stop_on_interrupt: Callable[[str], AbstractContextManager]) -> int:
+    """``weftsim wear SCENE --uncertain KEY=DIST ... --limit-clearance-mm X``: the hours to X as a distribution."""
+    from weftsim.cli_grammar import CliError
+    from weftsim.wear import WearError
+    from weftsim.wear.ensemble import wear_ensemble
+
+    if args.limit_clearance_mm is None:
+        raise CliError("--uncertain needs --limit-clearance-mm: an ensemble gives the hours to that clearance")
+    if args.hours is not None:
+        raise CliError("--hours does not go with --uncertain: each prediction of an ensemble runs to "
+                       "--limit-clearance-mm")
+    if args.engine != "reference":
+        raise CliError("an ensemble runs on the reference engine (--engine reference)")
+    limit = args.limit_clearance_mm * 1e-3
+    try:
+        data = wear_ensemble(scene, args.uncertain, args.samples, limit, outdir, jobs=args.jobs,
+                             scheduler=args.scheduler, seed=args.seed, figures=not args.no_plot, force=args.force,
+                             chaos_runs=args.chaos_runs,
+                             announce=lambda text: print(text, file=sys.stderr, flush=True))
+    except WearError as exc:
+        raise CliError(str(exc)) from None
+    except KeyboardInterrupt:
+        raise CliError(f"interrupted: every job's updates so far are in {outdir}/jobs; run the same command again "
+                       "to resume", 130) from None
+    m = data["method"]
+    print(f"scene {scene.name}: hours to an effective clearance of {args.limit_clearance_mm:g} mm at E, "
+          f"{data['samples']} samples ({len(data['jobs'])} simulated predictions, {data['wall_time_s']:.0f} s)")
+    for name, q in data["hours_to_limit"].items():
+        print(f"  {name}: {q['hours']:.4g} h ({100 * m['quantile_confidence']:g} % interval {q['low']:.4g} - "
+              f"{q['high']:.4g} h)")
+    print("  shares of the spread: " + ", ".join(f"{k} {100 * v['share']:.0f} %" for k, v in
+                                                 sorted(data["shares"].items(), key=lambda kv: -kv[1]["share"])))
+    for path in data["files"].values():
+        print(f"  wrote {path}")
+    return 0

@@ -66,6 +66,17 @@ class WearInterrupted(Exception):
     """A stop was asked for (Ctrl-C, SIGTERM) while an update was being simulated: the update is dropped."""
 
 
+class UpdateFailed(WearError):
+    """The simulation of an update failed at every tolerance and integrator tried (a hard cycle)."""
+
+
+# A hard cycle (an update whose simulation fails at every tolerance and integrator) is one chaotic event of
+# one geometry: the prediction backs off, halving the previous update's N (a slightly different geometry,
+# still within max_clearance_change), up to MAX_BACKOFFS times in a row before it gives up.
+MAX_BACKOFFS = 4
+IMPLICIT_METHOD = "numba_DOP853_RODAS4"  # the last attempt: DOP853 in free flight, RODAS4 in contact
+
+
 
 @dataclass(frozen=True)
 class Update:
@@ -139,7 +150,7 @@ def _cut_to_limit(update: Update, scene: Scene) -> Update:
 
 
 def worn_scene(scene: Scene, bearing: np.ndarray, journal: np.ndarray, revolutions: float,
-               retry: bool = False) -> Scene:
+               retry: bool = False, method: str | None = None) -> Scene:
     """``scene`` on the worn geometry (unworn when both profiles are zero) for ``revolutions``.
 
     The solver tolerance of a worn geometry is at most WORN_RTOL, WORN_ATOL; ``retry``: RETRY_*.
@@ -153,6 +164,8 @@ def worn_scene(scene: Scene, bearing: np.ndarray, journal: np.ndarray, revolutio
     if retry:
         solver = replace(solver, rtol=min(solver.rtol, RETRY_RTOL), atol=min(solver.atol, RETRY_ATOL),
                          max_step=min(solver.max_step, RETRY_MAX_STEP))
+    if method is not None:
+        solver = replace(solver, method=method)
     return replace(scene, joint=joint, drive=replace(scene.drive, revolutions=revolutions), reference_solver=solver)
 
 
@@ -185,8 +198,10 @@ def simulate_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray) -> t
     from weftsim.guards import stop_requested
 
     w = scene.joint.wear
-    for retry in (False, True):
-        run_scene = worn_scene(scene, bearing, journal, w.settle_revolutions + w.revolutions_per_update, retry)
+    attempts = ((False, None), (True, None), (True, IMPLICIT_METHOD))
+    for retry, method in attempts:
+        run_scene = worn_scene(scene, bearing, journal, w.settle_revolutions + w.revolutions_per_update, retry,
+                               method)
         rows = {}
         result = reference.solve(run_scene, step_states=lambda *a: rows.update(steps=a))
         if result.ok:
@@ -194,12 +209,19 @@ def simulate_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray) -> t
         if stop_requested() is not None or result.solver_stats.get("failure") == "interrupted":
             raise WearInterrupted(result.message)
     else:
-        raise WearError(f"the simulation on the worn geometry failed (also at rtol {RETRY_RTOL:g}): {result.message}")
+        raise UpdateFailed(f"the simulation on the worn geometry failed (also at rtol {RETRY_RTOL:g} and with "
+                           f"{IMPLICIT_METHOD}): {result.message}")
     t0 = w.settle_revolutions * scene.drive.period
     t, y, contact, impact = rows["steps"]
     keep = t >= t0
     wear = run_wear(run_scene, pack_parameters(run_scene), t[keep], y[keep], contact[keep], impact[keep])
-    return wear, {**_response(result.steps, t0), "solver_rtol": run_scene.reference_solver.rtol}
+    per_rev = 1.0 / w.revolutions_per_update
+    sliding = {"sliding_distance_per_rev_m": wear.sliding_distance * per_rev,
+               "sliding_work_per_rev_J": wear.sliding_work * per_rev,
+               # Archard's load: the mean of F_N weighted by the sliding ds = |v_T| dt (not by dt)
+               "contact_force_sliding_mean_N": wear.sliding_work / wear.sliding_distance
+               if wear.sliding_distance > 0.0 else math.nan}
+    return wear, {**_response(result.steps, t0), "solver_rtol": run_scene.reference_solver.rtol, **sliding}
 
 
 def next_update(scene: Scene, hours_done: float, revolutions_done: float, bearing: np.ndarray, journal: np.ndarray,
@@ -261,6 +283,7 @@ def predict(scene: Scene, hours: float, updates: Sequence[Update] = (),
             done.pop()
     else:
         state = (0.0, 0.0, np.zeros(n), np.zeros(n))
+    backoffs = 0
     while True:
         hours_done, revs_done, bearing, journal = state
         finished = hours_done >= hours * (1.0 - 1e-12)
@@ -268,6 +291,19 @@ def predict(scene: Scene, hours: float, updates: Sequence[Update] = (),
             update = next_update(scene, hours_done, revs_done, bearing, journal, hours)
         except WearInterrupted:
             return done  # the update in progress is dropped; the state holds the ones before it
+        except UpdateFailed as exc:
+            if not done or done[-1].step_revolutions <= 0.0 or backoffs >= MAX_BACKOFFS:
+                if backoffs:
+                    raise UpdateFailed(f"{exc} (after {backoffs} halvings of the update before it)") from None
+                raise
+            backoffs += 1  # a hard cycle: land on a slightly different geometry and go on
+            done[-1] = replace(done[-1], step_revolutions=0.5 * done[-1].step_revolutions,
+                               response={**done[-1].response, "backoffs_after": float(backoffs)})
+            if on_update is not None:
+                on_update(done)
+            state = advance(done[-1], scene)
+            continue
+        backoffs = 0
         if finished:
             update = replace(update, step_revolutions=0.0)
         else:

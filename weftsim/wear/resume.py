@@ -144,7 +144,10 @@ def _value_problem(data: dict, response: np.ndarray) -> str:
             return f"'{name}' holds a value that is not finite"
         if np.any(values < 0.0):
             return f"'{name}' holds a negative value (times, revolutions, depths and rates are >= 0)"
-    if np.any(np.isinf(response)) or not np.all(response[:, -1] > 0.0):
+    from weftsim.wear.store import RESPONSE
+
+    # NaN is allowed: the film statistics of a dry joint (store.RESPONSE)
+    if np.any(np.isinf(response)) or not np.all(response[:, RESPONSE.index("solver_rtol")] > 0.0):
         return "'response' holds an infinite statistic or a solver tolerance that is not > 0"
     if np.any(data["step_revolutions"][:-1] == 0.0):
         return "an update before the last extrapolates over 0 revolutions (only the final update does)"

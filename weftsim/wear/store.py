@@ -24,7 +24,8 @@ if TYPE_CHECKING:
 STATE = "wear_state.npz"
 RESPONSE = ("rapier_acceleration_rms_m_s2", "rapier_acceleration_p99_m_s2", "driving_torque_rms_Nm",
             "driving_torque_p99_Nm", "contact_force_mean_N", "contact_force_p99_N", "contact_force_max_N",
-            "solver_rtol", "film_ratio_min", "film_ratio_mean", "mixed_fraction")
+            "solver_rtol", "film_ratio_min", "film_ratio_mean", "mixed_fraction", "sliding_distance_per_rev_m",
+            "sliding_work_per_rev_J", "contact_force_sliding_mean_N", "backoffs_after")
 
 
 class StateMismatch(WearError):
@@ -133,6 +134,9 @@ def summary(scene: Scene, updates: list[Update], hours: float, limit: float | No
         "final_bearing_wear_max_mm": 1e3 * float(last.bearing.max()),
         "final_journal_wear_max_mm": 1e3 * float(last.journal.max()),
         "wear_volume_mm3": 1e9 * float(volumes(updates)[-1]),
+        **archard_check(scene, updates),
+        # hard cycles passed by halving the update before them (extrapolate.MAX_BACKOFFS)
+        "backoffs": int(sum(np.nan_to_num(u.response.get("backoffs_after", 0.0)) > 0 for u in updates)),
         "wall_time_s": wall_time,
     }
     if limit is not None:
@@ -142,3 +146,34 @@ def summary(scene: Scene, updates: list[Update], hours: float, limit: float | No
         if reached is None:
             out["note"] = f"the effective clearance did not reach {1e3 * limit:g} mm within {last.hours:.6g} h"
     return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in out.items()}
+
+
+def archard_check(scene: Scene, updates: list[Update]) -> dict:
+    """The wear result checking itself (docs/wear.md section 4): volumes three ways, and Archard's load.
+
+    - ``wear_volume_mm3`` (the sum of each update's Archard volume per revolution times its N);
+    - ``profile_volume_mm3``: the worn depth profiles integrated over their surfaces (h L R dpsi);
+    - ``archard_volume_mm3``: k (1/H_b + 1/H_j) F_s S with the sliding distance S = sum N s_rev and the
+      sliding-weighted mean load F_s = sum N W_rev / S (``sliding_weighted_mean_load_N``).
+    ``time_mean_load_N`` is the plain time mean of the contact force (N-weighted over the updates):
+    V = k F S / H with it is wrong wherever the load and the sliding speed vary together.
+    """
+    j = scene.joint
+    w = j.wear
+    last = updates[-1]
+    cell = 2.0 * math.pi / last.bearing.size
+    profile = (float(last.bearing.sum()) * j.bearing_radius + float(last.journal.sum()) * j.journal_radius) \
+        * j.bearing_length * cell
+    n = np.array([u.step_revolutions for u in updates[:-1]])
+    rows = [(u.response.get("sliding_distance_per_rev_m", math.nan), u.response.get("sliding_work_per_rev_J", math.nan),
+             u.response.get("contact_force_mean_N", math.nan)) for u in updates[:-1]]
+    s_rev, w_rev, f_mean = (np.array(c, dtype=float) for c in zip(*rows)) if rows else (np.zeros(0),) * 3
+    distance = float(np.dot(n, s_rev))
+    work = float(np.dot(n, w_rev))
+    specific = w.wear_coefficient * (1.0 / w.bearing_hardness + 1.0 / w.journal_hardness)
+    load = work / distance if distance > 0.0 else math.nan
+    return {"profile_volume_mm3": 1e9 * profile,
+            "archard_volume_mm3": 1e9 * specific * load * distance if distance > 0.0 else 0.0,
+            "sliding_distance_m": distance,
+            "sliding_weighted_mean_load_N": load,
+            "time_mean_load_N": float(np.dot(n, f_mean) / n.sum()) if n.size and n.sum() > 0.0 else math.nan}
