@@ -27,8 +27,9 @@ Run it as a script: ``python examples/plot_lubricated_slider_crank.py`` (about 2
 # example's coarsest step; the film's torques are loads read from the state, so the solver runs full
 # Newton with their Jacobian, as with friction).  The mechanism is that of the dry example
 # (examples/flores_mechanism.py); the ideal joint is the slider-crank's closed form.
-# Halving the step (measured, 1e-6 s) changes the oiled runs' largest |e|/c by 1.5e-6 (short_half) and
-# 1e-6 (finite) and their RMS deviation from the ideal acceleration by 6e-5 and 8e-5 (relative).
+# Halving the step (measured, 1e-6 s) changes the oiled runs' largest eccentricity ratio e/c by 1.5e-6
+# (short_half) and 1e-6 (finite) and their RMS deviation from the ideal acceleration by 6e-5 and 8e-5
+# (relative).
 
 from __future__ import annotations
 

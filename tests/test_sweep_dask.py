@@ -154,7 +154,7 @@ def test_workers_in_another_directory_without_the_sweep_directory(tmp_path, sche
         cell = client_dir / "sweep" / row["cell"]
         # A cell whose engine raised has no run to write: its record and the error with the traceback.
         expected = ["cell.json", "error.txt"] if row["status"] == "failed" else ["cell.json", "channels.csv",
-                                                                                "summary.json"]
+                                                                                "scene.toml", "summary.json"]
         assert sorted(p.name for p in cell.iterdir() if not p.name.startswith(".")) == sorted(expected)
         assert read_record(cell)["worker"]["pid"] != os.getpid()
     with distributed.Client(scheduler) as client:

@@ -159,7 +159,7 @@ class Lubrication:
 
     A joint without a ``Lubrication`` (``ClearanceJoint.lubrication = None``) is the dry joint.  With
     one, the film's pressure carries the journal for every eccentricity (no contact needed), the
-    asperities of both surfaces carry load where the minimum film thickness h_min = c - |e| is below
+    asperities of both surfaces carry load where the minimum film thickness ``h_min = c - |e|`` is below
     4 sigma (Greenwood and Tripp, Proc. Instn Mech. Engrs 185, 1970), and the dry contact law of the
     joint takes over beyond e = c, continuously (:mod:`weftsim.kernel.lubricated`).
 

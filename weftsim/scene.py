@@ -630,6 +630,9 @@ def load_scene(path: str | os.PathLike, overrides: dict[str, Any] | None = None,
                overrides_from: str = "command line", *, refuse_ideal_keys: bool = True) -> params.Scene:
     """Read, merge (``extends``), override and validate a scene file.
 
+    Joint F given a clearance takes every key of ``[joint_e]`` its table does not give
+    (:func:`weftsim.joint_keys.inherit_joint_f`); ``scene.joint_f_inherits`` names them.
+
     Parameters
     ----------
     path : str or path-like
@@ -643,9 +646,6 @@ def load_scene(path: str | os.PathLike, overrides: dict[str, Any] | None = None,
         Refuse an override of a joint key (other than its ``clearance_mm``) at a joint that is ideal
         in the resulting scene: it would change nothing (:mod:`weftsim.joint_keys`).  A sweep passes
         False and checks its cells together.
-
-    Joint F given a clearance takes every key of ``[joint_e]`` its table does not give
-    (:func:`weftsim.joint_keys.inherit_joint_f`); ``scene.joint_f_inherits`` names them.
 
     Raises
     ------

@@ -83,7 +83,7 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
         With ``scene.joint.wear`` (the ``[joint_e.wear]`` keys).
     hours : float
         Operating hours to predict.
-    outdir : path
+    outdir : str or path-like
         Created if needed and checked by :func:`weftsim.output.prepare_directory` (``force``: also a
         directory weftsim did not write); ``wear_state.npz`` in it is resumed when it belongs to the
         same scene and passes :func:`weftsim.wear.resume.read_state` (:class:`~.store.StateMismatch`

@@ -212,7 +212,7 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
         Monte Carlo samples (Latin hypercube), 10 to 10**6; samples cost no simulation.
     limit : float
         Clearance limit, m.
-    outdir : path
+    outdir : str or path-like
         Output directory; ``jobs/`` in it holds the simulated predictions (resumed on a rerun).
     jobs, scheduler :
         Local worker processes, or the address of a Dask scheduler (as ``weftsim sweep``).
