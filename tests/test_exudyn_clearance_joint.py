@@ -435,7 +435,7 @@ def test_solving_twice_without_reset_is_an_error_and_reset_repeats_the_run():
     ok, _ = _solve(mbs, _settings(2e-4, 1e-7))
     assert ok
     again = model.tracker.history()
-    # Runs are bitwise deterministic (EXUDYN.md): the same history, one contact, time never decreasing.
+    # Runs are bitwise deterministic (measured on Exudyn 1.13): the same history, one contact, time never decreasing.
     np.testing.assert_array_equal(again["impact_velocity"], first["impact_velocity"])
     assert model.tracker.contact_events == 1 and np.all(np.diff(again["time"]) >= 0.0)
 

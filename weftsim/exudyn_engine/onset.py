@@ -4,7 +4,7 @@ The contact laws (:mod:`weftsim.contact`) scale their damping by the impact velo
 v_imp = delta_dot at the instant delta crosses zero.  A fixed-step integrator sees the
 crossing only between two accepted states: the last free one (delta0 <= 0, rate0) and
 the first penetrated one (delta1 > 0, rate1).  Taking rate1 as v_imp makes an O(h)
-error that caps the accuracy of peak forces near 1e-3 (EXUDYN.md); interpolating
+error that caps the accuracy of peak forces near 1e-3 (measured on Exudyn 1.13); interpolating
 delta and delta_dot linearly within the step to the zero crossing of delta makes it
 O(h^2)::
 

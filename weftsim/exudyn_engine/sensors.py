@@ -200,7 +200,8 @@ def first_nonfinite_row(steps: dict[str, np.ndarray]) -> int | None:
 
 
 def silence(settings: exu.SimulationSettings) -> None:
-    """No console output and no files: results come from sensors stored in memory (EXUDYN.md)."""
+    """No console output and no files: results come from sensors stored in memory (by default Exudyn
+    writes a solution folder and prints banners)."""
     settings.timeIntegration.verboseMode = 0
     settings.solution.file.write = False
     settings.solution.sensors.writePeriod = 0.0
