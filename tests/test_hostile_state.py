@@ -177,7 +177,7 @@ def test_the_command_line_says_it_in_one_line(finished, tmp_path, capsys):
 def test_the_update_time_estimate_grows_with_the_revolutions_per_update():
     """revolutions_per_update = 1000 was announced as ~0.1 s an update; the estimate is the engine's for the
     update's 1 + N revolutions, so it grows with N (a factor (1 + 1000) / (1 + 4) here)."""
-    from weftsim.wear.command import update_time
+    from weftsim.wear.extrapolate import update_time
 
     short = update_time(weftsim.load_scene("reference"))
     long = update_time(weftsim.load_scene("reference", {"joint_e.wear.revolutions_per_update": 1000}))

@@ -43,22 +43,6 @@ def _duration(seconds: float) -> str:
     return f"{seconds:.2g} s" if seconds < 1.0 else format_duration(seconds)
 
 
-def update_time(scene: Scene) -> float:
-    """Estimated wall-clock seconds of one wear update: the reference engine's estimate
-    (:func:`weftsim.progress.estimate_run_time`) for its settle + steady revolutions at the solver
-    tolerance of a worn geometry (:data:`weftsim.wear.extrapolate.WORN_RTOL`)."""
-    from dataclasses import replace
-
-    from weftsim.progress import estimate_run_time
-    from weftsim.wear.extrapolate import WORN_RTOL
-
-    w = scene.joint.wear
-    solver = replace(scene.reference_solver, rtol=min(scene.reference_solver.rtol, WORN_RTOL))
-    one = replace(scene, drive=replace(scene.drive, revolutions=w.settle_revolutions + w.revolutions_per_update),
-                  reference_solver=solver)
-    return estimate_run_time(one, "reference")
-
-
 def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
         stop_on_interrupt: Callable[[str], AbstractContextManager]) -> int:
     """Predict, report progress on stderr and the result on stdout; Ctrl-C keeps the state for a resume."""
@@ -66,6 +50,7 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     from weftsim.output import prepare_directory
     from weftsim.progress import Progress
     from weftsim.wear import WearError, check_request, predict_to_directory
+    from weftsim.wear.extrapolate import update_time
     from weftsim.wear.store import StateMismatch
 
     limit = None if args.limit_clearance_mm is None else args.limit_clearance_mm * 1e-3

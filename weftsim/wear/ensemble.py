@@ -240,7 +240,7 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
                             f"below the limit {1e3 * limit:g} mm: narrow the clearance's distribution or raise "
                             "the limit")
     if announce is not None:
-        from weftsim.wear.command import update_time
+        from weftsim.wear.extrapolate import update_time
 
         announce(f"ensemble: {len(job_list)} simulated predictions to {1e3 * limit:g} mm ("
                  f"{3 ** len(dynamic) if dynamic else 1} design point(s) of {len(dynamic)} simulated key(s), "

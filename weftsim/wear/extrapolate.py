@@ -326,3 +326,16 @@ def limit_hours(updates: Sequence[Update], c0: float, limit: float) -> float | N
     if c and c[0] >= limit:
         return 0.0
     return None
+
+
+def update_time(scene: Scene) -> float:
+    """Estimated wall-clock seconds of one wear update: the reference engine's estimate
+    (:func:`weftsim.progress.estimate_run_time`) for its settle + steady revolutions at the solver
+    tolerance of a worn geometry (:data:`WORN_RTOL`)."""
+    from weftsim.progress import estimate_run_time
+
+    w = scene.joint.wear
+    solver = replace(scene.reference_solver, rtol=min(scene.reference_solver.rtol, WORN_RTOL))
+    one = replace(scene, drive=replace(scene.drive, revolutions=w.settle_revolutions + w.revolutions_per_update),
+                  reference_solver=solver)
+    return estimate_run_time(one, "reference")
