@@ -165,16 +165,6 @@ def _contact_channel(result: RunResult, name: str) -> str:
     return "in_contact_f" if name.endswith("_f_N") or result.scene.joint.is_ideal else "in_contact"
 
 
-def _segment(result: RunResult, name: str, index: int) -> tuple[float, float] | None:
-    """Start and end time of the contact that holds step ``index``, or None in free flight."""
-    t, touching = result.steps["time_s"], result.steps[_contact_channel(result, name)] > 0.5
-    if not touching[index]:
-        return None
-    free = np.flatnonzero(~touching)
-    before, after = free[free < index], free[free > index]
-    return (float(t[before[-1] + 1] if before.size else t[0]), float(t[after[0] - 1] if after.size else t[-1]))
-
-
 def _first_revolution_argmax(result: RunResult, name: str) -> int:
     t = result.steps["time_s"]
     return int(np.argmax(np.where(t <= result.scene.drive.period + 1e-12, result.steps[name], -np.inf)))
@@ -191,12 +181,13 @@ def startup_impact_end(result: RunResult, name: str) -> float:
     From the centred journal the first contact is the same in every correct integration: its maximum
     is reproducible (docs/physics.md section 6).  A contact lasting the whole revolution ends it there.
     """
-    touching = result.steps[_contact_channel(result, name)] > 0.5
+    t, touching = result.steps["time_s"], result.steps[_contact_channel(result, name)] > 0.5
     first = np.flatnonzero(touching)
     if first.size == 0:
         return result.scene.drive.period
-    span = _segment(result, name, int(first[0]))
-    return min(span[1], result.scene.drive.period) if span else result.scene.drive.period
+    free = np.flatnonzero(~touching[first[0]:])  # the steps of free flight after the first contact began
+    last_touching = t[first[0] + free[0] - 1] if free.size else t[-1]
+    return min(float(last_touching), result.scene.drive.period)
 
 
 def startup_impact_max(result: RunResult, name: str) -> float:
