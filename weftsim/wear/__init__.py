@@ -161,6 +161,10 @@ def _write_results(scene: Scene, updates: list, hours: float, limit: float | Non
     from weftsim.wear.extrapolate import advance, effective_clearance, ended_by_limit, limit_hours
 
     data = store.summary(scene, updates, hours, limit, wall)
+    if limit is not None:  # censored: not reaching the limit within the hours, or never (wears nothing)
+        from weftsim.wear.censored import limit_note
+
+        data.update(limit_note(scene, updates, limit, data.get("hours_to_limit")))
     ended = ended_by_limit(scene, updates)
     data["ended"] = ended
     data["failure"] = failure

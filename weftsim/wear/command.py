@@ -20,8 +20,8 @@ if TYPE_CHECKING:
 def add_flags(p: argparse.ArgumentParser, positive: Callable[[Callable[[str], float]], Callable[[str], float]]) -> None:
     """Flags of ``weftsim wear SCENE --hours H [--engine E] [--limit-clearance-mm X]`` beside the shared
     scene and output flags."""
-    p.add_argument("--hours", type=positive(float), help="operating hours to predict (not with --uncertain: an "
-                   "ensemble runs each prediction to --limit-clearance-mm)")
+    p.add_argument("--hours", type=positive(float), help="operating hours to predict; with --uncertain the horizon "
+                   "(default 1e5): samples not reaching --limit-clearance-mm within it are reported as censored")
     p.add_argument("--engine", default="reference", help="reference (default); exudyn is refused (no worn "
                    "geometry in its contact yet, docs/wear.md)")
     p.add_argument("--limit-clearance-mm", type=positive(float),
@@ -35,6 +35,8 @@ def add_flags(p: argparse.ArgumentParser, positive: Callable[[Callable[[str], fl
     ens.add_argument("--seed", type=int, default=0, help="seed of the ensemble's sampling (default 0)")
     ens.add_argument("--chaos-runs", type=int, default=6, help="predictions of the nominal design point differing "
                      "in the last bits of k, sampling the chaotic scatter (default 6)")
+    ens.add_argument("--design-points", action="append", default=[], metavar="KEY=N",
+                     help="N design points (2-9) for a simulated --uncertain key instead of 3; repeatable")
     ens.add_argument("--jobs", type=int, help="local worker processes for the ensemble's simulations (default: cores)")
     ens.add_argument("--scheduler", help="address of a Dask scheduler to run the ensemble's simulations on")
 
@@ -93,8 +95,8 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
               f"{data['archard_volume_mm3']:.4g} mm^3; the profiles hold {data['profile_volume_mm3']:.4g} mm^3")
     if limit is not None:
         reached = data.get("hours_to_limit")
-        print(f"  clearance limit {args.limit_clearance_mm:g} mm: " +
-              (f"reached after {reached:.6g} h" if reached is not None else data["note"]))
+        print(f"  clearance limit {args.limit_clearance_mm:g} mm: reached after {reached:.6g} h" if reached is not None
+              else f"  {data['note']}")
     for path in data["files"].values():
         print(f"  wrote {path}")
     if data.get("ended"):
@@ -131,17 +133,22 @@ def run_ensemble(args: argparse.Namespace, scene: Scene, outdir: str | Path,
 
     if args.limit_clearance_mm is None:
         raise CliError("--uncertain needs --limit-clearance-mm: an ensemble gives the hours to that clearance")
-    if args.hours is not None:
-        raise CliError("--hours does not go with --uncertain: each prediction of an ensemble runs to "
-                       "--limit-clearance-mm")
+    design_points = {}
+    for text in args.design_points:
+        key, _, n = text.partition("=")
+        try:
+            design_points[key.strip()] = int(n)
+        except ValueError:
+            raise CliError(f"--design-points {text!r}: give KEY=N with a whole number N from 2 to 9") from None
     if args.engine != "reference":
         raise CliError("an ensemble runs on the reference engine (--engine reference)")
     limit = args.limit_clearance_mm * 1e-3
     try:
         data = wear_ensemble(scene, args.uncertain, args.samples, limit, outdir, jobs=args.jobs,
                              scheduler=args.scheduler, seed=args.seed, figures=not args.no_plot, force=args.force,
-                             chaos_runs=args.chaos_runs,
-                             announce=lambda text: print(text, file=sys.stderr, flush=True))
+                             chaos_runs=args.chaos_runs, design_points=design_points,
+                             announce=lambda text: print(text, file=sys.stderr, flush=True),
+                             **({} if args.hours is None else {"horizon": args.hours}))
     except WearError as exc:
         raise CliError(str(exc)) from None
     except KeyboardInterrupt:
@@ -150,9 +157,16 @@ def run_ensemble(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     m = data["method"]
     print(f"scene {scene.name}: hours to an effective clearance of {args.limit_clearance_mm:g} mm at E, "
           f"{data['samples']} samples ({len(data['jobs'])} simulated predictions, {data['wall_time_s']:.0f} s)")
+    from weftsim.wear.censored import text_hours
+
+    horizon, never = data["horizon_hours"], bool(data["never"])
+    reach = data["reaching_limit"]
+    print(f"  reaching it within {horizon:g} h: {100 * reach['fraction']:.3g} % of the samples "
+          f"({100 * m['quantile_confidence']:g} % interval {100 * reach['low']:.3g} - {100 * reach['high']:.3g} %)"
+          + (f"; design points that never wear: {', '.join(data['never'])}" if never else ""))
     for name, q in data["hours_to_limit"].items():
-        print(f"  {name}: {q['hours']:.4g} h ({100 * m['quantile_confidence']:g} % interval {q['low']:.4g} - "
-              f"{q['high']:.4g} h)")
+        print(f"  {name}: {text_hours(q['hours'], horizon)} ({100 * m['quantile_confidence']:g} % interval "
+              f"{text_hours(q['low'], horizon)} - {text_hours(q['high'], horizon)})")
     print("  shares of the spread: " + ", ".join(f"{k} {100 * v['share']:.0f} %" for k, v in
                                                  sorted(data["shares"].items(), key=lambda kv: -kv[1]["share"])))
     for path in data["files"].values():

@@ -24,87 +24,37 @@ processes or a Dask cluster, each job resumable.
 
 from __future__ import annotations
 
-import itertools
 import math
 import time
-from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from weftsim.errors import WearError
+from weftsim.wear.censored import censored_quantile, fraction_interval, json_hours
+from weftsim.wear.ensemble_design import (DESIGN_QUANTILES, RESCALED, _lagrange, centre_name,  # noqa: F401
+                                          interpolate, plan)
 from weftsim.wear.jobs import hours_at, run_job
-from weftsim.wear.uncertain import Uncertain, latin_hypercube, parse_uncertain, quantile_interval, rank_shares
+from weftsim.wear.uncertain import Uncertain, latin_hypercube, parse_uncertain, rank_shares
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
     from weftsim.params import Scene
 
-RESCALED = ("joint_e.wear.wear_coefficient", "joint_e.wear.bearing_hardness_mpa", "joint_e.wear.journal_hardness_mpa")
-DESIGN_QUANTILES = (0.05, 0.5, 0.95)
 CHAOS_RUNS = 6  # the centre run and five whose k differs in the last bits (docs/wear.md section 6 used six)
 LEVELS = 40  # clearance levels of the band between the largest starting clearance and the limit
 QUANTILES = (0.1, 0.5, 0.9)
 CONFIDENCE = 0.9
-
-
-def _last_bits(scene: Scene, j: int) -> Scene:
-    """``scene`` with its wear coefficient j units in the last place larger (the same physics to 1e-15)."""
-    k = scene.joint.wear.wear_coefficient
-    for _ in range(j):
-        k = math.nextafter(k, math.inf)
-    return replace(scene, joint=replace(scene.joint, wear=replace(scene.joint.wear, wear_coefficient=k)))
-
-
-def _lagrange(nodes: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """(n, len(nodes)) weights of quadratic Lagrange interpolation at ``x`` (clamped to the nodes' range)."""
-    x = np.clip(x, nodes.min(), nodes.max())
-    w = np.ones((x.size, nodes.size))
-    for i, xi in enumerate(nodes):
-        for m, xm in enumerate(nodes):
-            if m != i:
-                w[:, i] *= (x - xm) / (xi - xm)
-    return w
-
-
-def plan(scene: Scene, uncertain: list[Uncertain], chaos_runs: int = CHAOS_RUNS
-         ) -> tuple[list[tuple[str, Scene]], list[Uncertain], np.ndarray]:
-    """(jobs as (name, scene), the dynamic inputs, their design values (nodes, dims)); checks every design scene."""
-    from weftsim.scene import SceneError, apply_overrides, to_file_keys
-
-    keys = to_file_keys(scene)
-    seen = set()
-    for u in uncertain:
-        if u.key in seen:
-            raise WearError(f"--uncertain {u.key} is given twice")
-        seen.add(u.key)
-        if u.key not in keys or u.key == "name":
-            raise WearError(f"--uncertain {u.key}: not a scene key (weftsim list shows them)")
-        if u.key in RESCALED and not np.all(u.ppf(np.array([1e-6, 0.5, 1 - 1e-6])) > 0.0):
-            raise WearError(f"--uncertain {u.text}: {u.key} must stay > 0; a lognormal keeps it positive")
-    dynamic = [u for u in uncertain if u.key not in RESCALED]
-    design = np.array([[float(u.ppf(np.array([q]))[0]) for u in dynamic] for q in DESIGN_QUANTILES])
-    nodes = np.array(list(itertools.product(*[design[:, d] for d in range(len(dynamic))]))) if dynamic \
-        else np.zeros((1, 0))
-    jobs = []
-    centre = tuple(1 for _ in dynamic)
-    for index in itertools.product(range(len(DESIGN_QUANTILES)), repeat=len(dynamic)):
-        values = {u.key: float(design[i, d]) for d, (u, i) in enumerate(zip(dynamic, index))}
-        try:
-            node_scene = apply_overrides(scene, values, "--uncertain", refuse_ideal_keys=False) if values else scene
-        except SceneError as exc:
-            raise WearError(f"--uncertain: the design point {values} is not a valid scene: {exc}") from None
-        name = "node_" + "_".join(str(i) for i in index) if dynamic else "centre"
-        jobs.append((name, node_scene))
-        if index == centre:
-            jobs.extend((f"chaos_{j}", _last_bits(node_scene, j)) for j in range(1, chaos_runs))
-    return jobs, dynamic, nodes
+# Horizon of an ensemble (--hours with --uncertain): a sample that does not reach the limit within it is
+# censored ("> H h").  1e5 h is the life of a loom (11 years of continuous running); the design's jobs run
+# to MAX_HOURS = 10 H, so a sample rescaled by k0 / k >= 0.1 is still resolved (others are counted).
+HORIZON_HOURS = 1e5
 
 
 def _run_jobs(jobs: list[tuple[str, Scene]], limit: float, outdir: Path, jobs_n: int | None, scheduler: str | None,
-              announce: Callable[[str], None] | None) -> dict[str, dict]:
+              announce: Callable[[str], None] | None, horizon: float | None = None) -> dict[str, dict]:
     import concurrent.futures as cf
 
     from weftsim.sweep.pool import executor
@@ -112,7 +62,7 @@ def _run_jobs(jobs: list[tuple[str, Scene]], limit: float, outdir: Path, jobs_n:
     pool, _, stop = executor(jobs_n, scheduler, len(jobs), "reference")
     results: dict[str, dict] = {}
     try:
-        futures = {pool.submit(run_job, s, limit, str(outdir / "jobs" / name)): name for name, s in jobs}
+        futures = {pool.submit(run_job, s, limit, str(outdir / "jobs" / name), horizon): name for name, s in jobs}
         for future in cf.as_completed(futures):
             name = futures[future]
             try:
@@ -121,7 +71,10 @@ def _run_jobs(jobs: list[tuple[str, Scene]], limit: float, outdir: Path, jobs_n:
                 results[name] = {"error": f"{type(exc).__name__}: {exc}", "wall_s": math.nan}
             if announce:
                 r = results[name]
-                announce(f"ensemble: job {name} {'failed: ' + r['error'] if r['error'] else 'done'} "
+                state = "failed: " + r["error"] if r["error"] else \
+                    ("does not reach the limit" + (f": {r['never']}" if r.get("never") else
+                                                   f" within {r['horizon_h']:g} h") if r.get("censored") else "done")
+                announce(f"ensemble: job {name} {state} "
                          f"({len(results)}/{len(jobs)}, {r.get('wall_s', math.nan):.1f} s)")
     except KeyboardInterrupt:
         stop(True)
@@ -131,13 +84,18 @@ def _run_jobs(jobs: list[tuple[str, Scene]], limit: float, outdir: Path, jobs_n:
 
 
 def combine(scene: Scene, uncertain: list[Uncertain], dynamic: list[Uncertain], nodes: np.ndarray,
-            results: dict[str, dict], samples: int, limit: float, seed: int, levels_extra=()) -> dict:
-    """The ensemble from the jobs' curves: per-sample hours at every clearance level (module docstring)."""
+            results: dict[str, dict], samples: int, limit: float, seed: int, levels_extra=(),
+            horizon: float = HORIZON_HOURS) -> dict:
+    """The ensemble from the jobs' curves: per-sample hours at every clearance level (module docstring).
+
+    Hours are ``inf`` where a sample does not reach a level within ``horizon`` (censored).
+    """
     from weftsim.scene import to_file_keys
+    from weftsim.wear.extrapolate import MAX_HOURS
 
     node_names = [n for n in results if n.startswith("node_")] or ["centre"]
     node_names.sort()
-    centre = "node_" + "_".join("1" for _ in dynamic) if dynamic else "centre"
+    centre = centre_name(nodes, dynamic)
     failed = {n: r["error"] for n, r in results.items() if r.get("error")}
     bad_nodes = [n for n in node_names if n in failed]
     if bad_nodes:
@@ -145,29 +103,20 @@ def combine(scene: Scene, uncertain: list[Uncertain], dynamic: list[Uncertain], 
     start = min(results[n]["clearance_m"][0] for n in node_names)
     levels = np.unique(np.concatenate([np.linspace(start, limit, LEVELS + 1)[1:],
                                        [v for v in levels_extra if start < v <= limit]]))
-    node_hours = np.array([hours_at(results[n], levels) for n in node_names])  # (nodes, levels)
+    node_hours = np.array([hours_at(results[n], levels) for n in node_names])  # (nodes, levels); inf: censored
     chaos_names = [centre] + sorted(n for n in results if n.startswith("chaos_") and n not in failed)
     chaos = np.array([hours_at(results[n], levels) for n in chaos_names])
     with np.errstate(invalid="ignore", divide="ignore"):
-        chaos_factor = np.where(chaos.mean(axis=0) > 0.0, chaos / chaos.mean(axis=0), 1.0)  # (runs, levels)
+        mean = chaos.mean(axis=0)
+        # a level some chaos run does not reach carries no chaotic factor (nothing wears there to scatter)
+        chaos_factor = np.where((mean > 0.0) & np.isfinite(mean), chaos / mean, 1.0)  # (runs, levels)
     # The design runs are one chaotic draw each; shift the design to pass through the chaos runs' mean at
     # the centre (the centre run is chaos run 0), so that the chaos factor is not counted twice there.
     node_hours = node_hours / chaos_factor[0]
-    # Log-hours are interpolated where every design point has started wearing; a level below some design
-    # point's starting clearance (hours 0 there: a clearance key is uncertain) is interpolated in hours.
-    positive = np.all(node_hours > 0.0, axis=0)
-    with np.errstate(divide="ignore"):
-        log_nodes = np.where(positive, np.log(node_hours), node_hours)
 
     rng = np.random.default_rng(seed)
     u = latin_hypercube(samples, len(uncertain) + 1, rng)
     values = {v.key: v.ppf(u[:, i]) for i, v in enumerate(uncertain)}
-    weights = np.ones((samples, 1))
-    for d, v in enumerate(dynamic):
-        w = _lagrange(np.array(sorted(set(nodes[:, d]))), values[v.key])
-        index = [sorted(set(nodes[:, d])).index(x) for x in nodes[:, d]]
-        weights = weights * w[:, index]
-    mixed = weights @ log_nodes if dynamic else np.repeat(log_nodes, samples, axis=0)
     base = to_file_keys(scene)
     share_b = results[centre]["bearing_share"]
     scale = np.ones(samples)
@@ -178,28 +127,49 @@ def combine(scene: Scene, uncertain: list[Uncertain], dynamic: list[Uncertain], 
     scale /= share_b * base["joint_e.wear.bearing_hardness_mpa"] / hb \
         + (1.0 - share_b) * base["joint_e.wear.journal_hardness_mpa"] / hj
     draw = np.minimum((u[:, -1] * len(chaos_names)).astype(int), len(chaos_names) - 1)
-    base_hours = np.where(positive, np.exp(mixed), np.maximum(mixed, 0.0))
+    base_hours = interpolate(node_hours, nodes, dynamic, values, samples)
     hours = base_hours * scale[:, None] * chaos_factor[draw]  # (samples, levels)
+    never = ~np.isfinite(hours)
+    hours = np.where(hours <= horizon, hours, math.inf)  # censored at the horizon
+    # a sample whose design points stopped at the jobs' horizon but which k / H rescales below the ensemble's
+    # horizon is not resolved: counted (the jobs' horizon is 10 H, so only k > 10 k0 can do it)
+    job_horizon = min((results[n].get("horizon_h") or MAX_HOURS) for n in node_names)
+    unresolved = int(np.sum(never[:, -1] & (job_horizon * scale < horizon)))
     at_limit = hours[:, -1]
     inputs = {**values, "chaotic scatter": chaos_factor[draw, -1]}
-    shares = rank_shares(inputs, np.log(at_limit))
+    with np.errstate(divide="ignore"):
+        shares = rank_shares(inputs, np.log(at_limit)) if np.any(np.isfinite(at_limit)) else \
+            {k: (0.0, 0.0) for k in inputs}
+    never_nodes = {n: results[n].get("never") for n in node_names if results[n].get("never")}
     return {"levels": levels, "hours": hours, "values": values, "chaos_draw": draw, "inputs": inputs,
-            "shares": shares, "chaos_hours_at_limit": chaos[:, -1], "failed": failed}
+            "shares": shares, "chaos_hours_at_limit": chaos[:, -1], "failed": failed, "unresolved": unresolved,
+            "never_nodes": never_nodes, "censored_nodes": [n for n in node_names if results[n].get("censored")]}
 
 
-def quantile_table(hours: np.ndarray) -> dict:
-    """{"p10": {"hours", "low", "high"}, ...} with CONFIDENCE order-statistic intervals."""
+def quantile_table(hours: np.ndarray, horizon: float = HORIZON_HOURS) -> dict:
+    """{"p10": {"hours", "low", "high", "censored", "beyond_hours"}, ...} with CONFIDENCE order-statistic
+    intervals; a quantile among the censored samples (``inf``) has ``hours`` None and ``censored`` True
+    (it lies beyond ``horizon``), an interval bound among them is None."""
     out = {}
     for p in QUANTILES:
-        est, low, high = quantile_interval(hours, p, CONFIDENCE)
-        out[f"p{round(100 * p)}"] = {"hours": est, "low": low, "high": high}
+        est, low, high = censored_quantile(hours, p, CONFIDENCE)
+        out[f"p{round(100 * p)}"] = {**json_hours(est, horizon), "low": low if math.isfinite(low) else None,
+                                     "high": high if math.isfinite(high) else None}
     return out
+
+
+def reaching(hours: np.ndarray, horizon: float) -> dict:
+    """The fraction of samples reaching a level within ``horizon`` h, with its CONFIDENCE interval."""
+    n_reached = int(np.sum(np.isfinite(hours)))
+    frac, low, high = fraction_interval(n_reached, hours.size, CONFIDENCE)
+    return {"fraction": frac, "low": low, "high": high, "samples_reaching": n_reached, "within_hours": horizon}
 
 
 def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: int, limit: float,
                   outdir: str | Path, jobs: int | None = None, scheduler: str | None = None, seed: int = 0,
                   figures: bool = True, force: bool = False, levels: tuple[float, ...] = (),
-                  chaos_runs: int = CHAOS_RUNS, announce: Callable[[str], None] | None = None) -> dict:
+                  chaos_runs: int = CHAOS_RUNS, announce: Callable[[str], None] | None = None,
+                  horizon: float = HORIZON_HOURS, design_points: dict[str, int] | None = None) -> dict:
     """Run a wear ensemble into ``outdir``; returns the summary (``ensemble.json``) with ``"files"``.
 
     Parameters
@@ -220,6 +190,12 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
         Extra clearance levels (m) to report quantiles at (besides the limit).
     chaos_runs : int
         Predictions of the centre design point differing in the last bits of k (1 to 50; 1 = no scatter).
+    horizon : float
+        Hours: a sample that does not reach a level within them is censored (reported as "> horizon h", or
+        "never" when its design points wear nothing); the design's predictions run to 10 x horizon (at
+        most 1e6 h).
+    design_points : dict, optional
+        ``{key: n}``: n design points (2 to 9) for a simulated key instead of 3 (docs/wear.md section 9).
     """
     from weftsim.output import begin_directory, prepare_directory, write_csv, write_figure, write_files, write_json
     from weftsim.wear import check_request
@@ -232,8 +208,13 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
         raise WearError(f"--samples must be a whole number from 10 to 1000000, got {samples!r}")
     if not (isinstance(chaos_runs, int) and 1 <= chaos_runs <= 50):
         raise WearError(f"--chaos-runs must be a whole number from 1 to 50, got {chaos_runs!r}")
+    from weftsim.wear.extrapolate import MAX_HOURS
+
+    if not (isinstance(horizon, (int, float)) and 1.0 <= horizon <= MAX_HOURS):
+        raise WearError(f"--hours (the ensemble's horizon) must be from 1 to {MAX_HOURS:g} h, got {horizon!r}")
     check_request(scene, 1.0, "reference", limit)
-    job_list, dynamic, nodes = plan(scene, parsed, chaos_runs)
+    job_list, dynamic, nodes = plan(scene, parsed, chaos_runs, design_points)
+    job_horizon = min(10.0 * horizon, MAX_HOURS)
     for name, s in job_list:
         if not limit > s.joint.clearance:
             raise WearError(f"the design point {name} starts at a clearance of {1e3 * s.joint.clearance:g} mm, not "
@@ -243,7 +224,7 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
         from weftsim.wear.extrapolate import update_time
 
         announce(f"ensemble: {len(job_list)} simulated predictions to {1e3 * limit:g} mm ("
-                 f"{3 ** len(dynamic) if dynamic else 1} design point(s) of {len(dynamic)} simulated key(s), "
+                 f"{len(nodes)} design point(s) of {len(dynamic)} simulated key(s), "
                  f"{chaos_runs - 1} more chaos run(s)); one update of the nominal scene ~{update_time(scene):.2g} s, "
                  f"~{math.log(limit / scene.joint.clearance) / math.log1p(scene.joint.wear.max_clearance_change):.0f} "
                  "updates a prediction; the samples cost no simulation")
@@ -251,15 +232,16 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
     what = {"kind": "wear ensemble", "scene": scene.name}
     begin_directory(outdir, what)
     wall0 = time.perf_counter()
-    results = _run_jobs(job_list, limit, outdir, jobs, scheduler, announce)
+    results = _run_jobs(job_list, limit, outdir, jobs, scheduler, announce, job_horizon)
     sim_wall = time.perf_counter() - wall0
-    ens = combine(scene, parsed, dynamic, nodes, results, samples, limit, seed, levels)
+    ens = combine(scene, parsed, dynamic, nodes, results, samples, limit, seed, levels, horizon)
     hours, lv = ens["hours"], ens["levels"]
     band = {"clearance_mm": 1e3 * lv}
-    for p in QUANTILES:
-        band[f"hours_p{round(100 * p)}"] = np.quantile(hours, p, axis=0)
-    by_level = {f"{1e3 * lv[i]:.6g}": quantile_table(hours[:, i]) for i in range(lv.size)
-                if i == lv.size - 1 or any(abs(lv[i] - v) < 1e-12 for v in levels)}
+    for p in QUANTILES:  # inf where the quantile falls among the censored samples
+        band[f"hours_p{round(100 * p)}"] = np.array([censored_quantile(hours[:, i], p)[0] for i in range(lv.size)])
+    band["fraction_reaching"] = np.mean(np.isfinite(hours), axis=0)
+    by_level = {f"{1e3 * lv[i]:.6g}": {**quantile_table(hours[:, i], horizon), "reaching": reaching(hours[:, i], horizon)}
+                for i in range(lv.size) if i == lv.size - 1 or any(abs(lv[i] - v) < 1e-12 for v in levels)}
     data = {
         "scene": scene.name,
         "joint": "E",  # wear at joint E (the wear prediction's joint so far)
@@ -270,23 +252,34 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
         "method": {"rescaled": [u.key for u in parsed if u.key in RESCALED],
                    "simulated": [u.key for u in dynamic],
                    "design_quantiles": list(DESIGN_QUANTILES) if dynamic else [],
+                   "design_points": {u.key: len(set(nodes[:, d])) for d, u in enumerate(dynamic)},
+                   "design_rule": "log-hours between design points that reach a level; inverse hours, piecewise "
+                                  "linear, where one does not (docs/wear.md section 9)",
                    "chaos_runs": len(ens["chaos_hours_at_limit"]),
                    "chaos_hours_at_limit": [float(v) for v in ens["chaos_hours_at_limit"]],
                    "chaos_relative_sd": float(np.std(ens["chaos_hours_at_limit"], ddof=1)
                                               / np.mean(ens["chaos_hours_at_limit"]))
                    if len(ens["chaos_hours_at_limit"]) > 1 else None,
                    "quantile_confidence": CONFIDENCE},
-        "hours_to_limit": quantile_table(hours[:, -1]),
+        "horizon_hours": horizon,
+        "hours_to_limit": quantile_table(hours[:, -1], horizon),
+        "reaching_limit": reaching(hours[:, -1], horizon),
+        # design points that wear nothing at all (a full film): why, in one clause each
+        "never": ens["never_nodes"],
+        "censored_design_points": ens["censored_nodes"],
+        "unresolved_samples": ens["unresolved"],
         "hours_by_clearance_mm": by_level,
         "shares": {k: {"rank_correlation": r, "share": s} for k, (r, s) in ens["shares"].items()},
         "jobs": {n: {"wall_s": r.get("wall_s"), "updates": r.get("updates"), "error": r.get("error"),
-                     "reused": bool(r.get("reused"))} for n, r in sorted(results.items())},
+                     "censored": bool(r.get("censored")), "reused": bool(r.get("reused"))}
+                 for n, r in sorted(results.items())},
         "simulation_wall_time_s": sim_wall,
         "wall_time_s": time.perf_counter() - wall0,
     }
     table = {f"{k}": np.asarray(v, dtype=float) for k, v in ens["values"].items()}
     table["chaos_run"] = ens["chaos_draw"].astype(float)
-    table["hours_to_limit"] = hours[:, -1]
+    table["hours_to_limit"] = hours[:, -1]  # inf: does not reach the limit within the horizon
+    table["reaches_limit"] = np.isfinite(hours[:, -1]).astype(float)
     files = {
         "samples": ("ensemble.csv", lambda p: write_csv(p, table)),
         "band": ("ensemble_band.csv", lambda p: write_csv(p, band)),

@@ -14,17 +14,34 @@ if TYPE_CHECKING:
 
 
 def cdf_figure(hours: np.ndarray, data: dict, title: str = "") -> Figure:
-    """Empirical distribution function of the hours to the limit, with p10/p50/p90 and their intervals."""
+    """Empirical distribution function of the hours to the limit, with p10/p50/p90 and their intervals.
+
+    Censored samples (``inf``: not reaching the limit within the horizon) count in the denominator: the
+    curve ends at the fraction that reaches the limit, drawn as a dashed line with the horizon."""
     fig = figure(figsize=(7, 4.5))
     ax = fig.add_subplot(1, 1, 1)
-    x = np.sort(hours)
-    ax.step(x, np.arange(1, x.size + 1) / x.size, where="post", color="C0")
+    x = np.sort(hours[np.isfinite(hours)])
+    n = hours.size
+    horizon = data.get("horizon_hours")
+    if x.size:
+        ax.step(x, np.arange(1, x.size + 1) / n, where="post", color="C0")
+    reach = x.size / n
+    if x.size < n:
+        right = horizon if horizon else (x.max() if x.size else 1.0)
+        ax.axhline(reach, color="C0", ls="--", lw=1)
+        ax.axvline(right, color="0.4", ls=":", lw=1)
+        ax.text(right, reach, f"{100 * reach:.3g} % reach it within {right:.3g} h;\n{100 * (1 - reach):.3g} % "
+                "later or never ", ha="right", va="bottom", fontsize=8)
     for name, q in data["hours_to_limit"].items():
+        if q["hours"] is None:  # among the censored
+            continue
         ax.axvline(q["hours"], color="C1", lw=1)
-        if np.isfinite(q["low"]) and np.isfinite(q["high"]):
+        if q["low"] is not None and q["high"] is not None and np.isfinite(q["low"]) and np.isfinite(q["high"]):
             ax.axvspan(q["low"], q["high"], color="C1", alpha=0.2)
         ax.text(q["hours"], 0.02, f" {name} {q['hours']:.4g} h", rotation=90, va="bottom", fontsize=8)
-    ax.set_xscale("log")
+    if x.size or horizon:
+        ax.set_xscale("log")
+    ax.set_ylim(0.0, 1.0)
     ax.set_xlabel(f"hours to an effective clearance of {data['limit_clearance_mm']:g} mm")
     ax.set_ylabel("probability of reaching it earlier")
     ax.set_title(title)
@@ -37,8 +54,16 @@ def band_figure(band: dict, title: str = "") -> Figure:
     fig = figure(figsize=(7, 4.5))
     ax = fig.add_subplot(1, 1, 1)
     c = band["clearance_mm"]
-    ax.fill_betweenx(c, band["hours_p10"], band["hours_p90"], color="C0", alpha=0.25, label="10-90 %")
-    ax.plot(band["hours_p50"], c, color="C0", label="median")
+    p10, p50, p90 = (np.asarray(band[f"hours_p{p}"], dtype=float) for p in (10, 50, 90))
+    right = np.isfinite(p90)  # beyond: p90 among the censored (does not reach that clearance in the horizon)
+    ax.fill_betweenx(c[right], p10[right], p90[right], color="C0", alpha=0.25, label="10-90 %")
+    if not np.all(right):
+        ok = np.isfinite(p10) & ~right
+        top = np.nanmax(np.where(np.isfinite(p90), p90, np.where(np.isfinite(p10), p10, np.nan))) \
+            if np.any(np.isfinite(p10)) else 1.0
+        ax.fill_betweenx(c[ok], p10[ok], np.full(ok.sum(), top), color="C0", alpha=0.1,
+                         label="10 % - (90 % later or never)")
+    ax.plot(np.where(np.isfinite(p50), p50, np.nan), c, color="C0", label="median")
     ax.set_xlabel("operating hours")
     ax.set_ylabel("effective clearance at E (mm)")
     ax.set_title(title)

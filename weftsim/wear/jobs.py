@@ -23,17 +23,22 @@ if TYPE_CHECKING:
 CURVE = "curve.json"
 
 
-def run_job(scene: Scene, limit: float, directory: str) -> dict:
+def run_job(scene: Scene, limit: float, directory: str, horizon: float | None = None) -> dict:
     """Predict the wear of ``scene`` until its effective clearance reaches ``limit`` (m).
 
     Returns a dict: ``hours`` and ``clearance_m`` (c_eff at each update, then at the limit),
     ``bearing_share`` (the bearing's part of max h_b + max h_j at the end), ``updates``,
-    ``wall_s``; ``error`` (text) when the prediction failed or never reaches the limit.
+    ``wall_s``; ``error`` (text) when the prediction failed.  A prediction that does not reach the
+    limit within ``horizon`` hours (default :data:`~weftsim.wear.extrapolate.MAX_HOURS`) is
+    **censored**, not failed: ``censored`` True, ``horizon_h``, and ``never`` (why it wears nothing,
+    :func:`weftsim.wear.censored.no_wear_reason`) when its last update wears nothing at all.
     """
     from weftsim.errors import WearError
     from weftsim.wear import store
+    from weftsim.wear.censored import no_wear_reason
     from weftsim.wear.extrapolate import MAX_HOURS, advance, effective_clearance, predict
 
+    horizon = MAX_HOURS if horizon is None else min(float(horizon), MAX_HOURS)
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     identity = store.scene_identity(scene)
@@ -41,7 +46,8 @@ def run_job(scene: Scene, limit: float, directory: str) -> dict:
     if done_file.exists():
         try:
             stored = json.loads(done_file.read_text())
-            if stored.get("scene") == identity and stored.get("limit") == limit:
+            if stored.get("scene") == identity and stored.get("limit") == limit \
+                    and stored.get("horizon", MAX_HOURS) == horizon:
                 return {**stored["result"], "reused": True}
         except (OSError, ValueError, KeyError, TypeError):
             pass  # damaged: run it again (the state below resumes it)
@@ -61,9 +67,9 @@ def run_job(scene: Scene, limit: float, directory: str) -> dict:
         latest[:] = updates
         store.save_state(directory, scene, updates)
 
-    result: dict = {"error": None}
+    result: dict = {"error": None, "censored": False, "never": None, "horizon_h": horizon}
     try:
-        updates = predict(scene, MAX_HOURS, done, on_update=on_update,
+        updates = predict(scene, horizon, done, on_update=on_update,
                           stop=lambda: bool(latest) and next_clearance() >= limit)
     except WearError as exc:
         updates = latest
@@ -79,19 +85,20 @@ def run_job(scene: Scene, limit: float, directory: str) -> dict:
         depth_b, depth_j = float(bearing.max()), float(journal.max())
         result.update(hours=hours, clearance_m=clearance, updates=len(updates),
                       bearing_share=depth_b / (depth_b + depth_j) if depth_b + depth_j > 0.0 else 0.5)
-        if result["error"] is None and clearance[-1] < limit:
-            result["error"] = (f"the effective clearance stays below the limit ({1e3 * clearance[-1]:.4g} mm after "
-                               f"{hours[-1]:.4g} h): the joint does not wear there (full film?)")
+        if result["error"] is None and clearance[-1] < limit:  # censored: beyond the horizon, or never
+            result["censored"] = True
+            result["never"] = no_wear_reason(scene, updates[-1])
     elif result["error"] is None:
         result["error"] = "no update was completed"
     result["wall_s"] = time.perf_counter() - wall0
     if result["error"] is None:
-        done_file.write_text(json.dumps({"scene": identity, "limit": limit, "result": result}))
+        done_file.write_text(json.dumps({"scene": identity, "limit": limit, "horizon": horizon, "result": result}))
     return result
 
 
 def hours_at(result: dict, levels: np.ndarray) -> np.ndarray:
-    """Hours at which the job's effective clearance reaches each of ``levels`` (m), linear between updates."""
+    """Hours at which the job's effective clearance reaches each of ``levels`` (m), linear between updates;
+    inf where it does not reach a level (censored at the job's horizon)."""
     c = np.maximum.accumulate(np.asarray(result["clearance_m"], dtype=float))
     h = np.asarray(result["hours"], dtype=float)
     out = np.interp(levels, c, h, left=0.0, right=math.inf)
