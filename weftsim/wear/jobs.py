@@ -21,6 +21,7 @@ if TYPE_CHECKING:
     from weftsim.params import Scene
 
 CURVE = "curve.json"
+CURVE_VERSION = 2  # 2: two-ended hours, one update simulated at the limit (older curves are run again)
 
 
 def run_job(scene: Scene, limit: float, directory: str, horizon: float | None = None) -> dict:
@@ -47,6 +48,7 @@ def run_job(scene: Scene, limit: float, directory: str, horizon: float | None = 
         try:
             stored = json.loads(done_file.read_text())
             if stored.get("scene") == identity and stored.get("limit") == limit \
+                    and stored.get("version") == CURVE_VERSION \
                     and stored.get("horizon", MAX_HOURS) == horizon:
                 return {**stored["result"], "reused": True}
         except (OSError, ValueError, KeyError, TypeError):
@@ -59,18 +61,19 @@ def run_job(scene: Scene, limit: float, directory: str, horizon: float | None = 
         done = []
     latest: list = list(done)
 
-    def next_clearance() -> float:
-        _, _, bearing, journal = advance(latest[-1], scene)
-        return effective_clearance(c0, bearing, journal)
-
     def on_update(updates):
         latest[:] = updates
         store.save_state(directory, scene, updates)
 
+    def start_clearance() -> float:
+        return effective_clearance(c0, latest[-1].bearing, latest[-1].journal)
+
+    # The prediction simulates one update at or beyond the limit, so that every update below it has the
+    # wear rate at both of its ends (:func:`two_ended_hours`).
     result: dict = {"error": None, "censored": False, "never": None, "horizon_h": horizon}
     try:
         updates = predict(scene, horizon, done, on_update=on_update,
-                          stop=lambda: bool(latest) and next_clearance() >= limit)
+                          stop=lambda: bool(latest) and start_clearance() >= limit)
     except WearError as exc:
         updates = latest
         result["error"] = str(exc)
@@ -83,7 +86,10 @@ def run_job(scene: Scene, limit: float, directory: str, horizon: float | None = 
             hours.append(end_hours)
             clearance.append(end_c)
         depth_b, depth_j = float(bearing.max()), float(journal.max())
-        result.update(hours=hours, clearance_m=clearance, updates=len(updates),
+        # None: unreachable (the wear stops before it, two_ended_hours); JSON holds no Infinity
+        result.update(hours=[v if math.isfinite(v) else None for v in two_ended_hours(hours, clearance)],
+                      hours_one_ended=hours, clearance_m=clearance,
+                      updates=len(updates),
                       bearing_share=depth_b / (depth_b + depth_j) if depth_b + depth_j > 0.0 else 0.5)
         if result["error"] is None and clearance[-1] < limit:  # censored: beyond the horizon, or never
             result["censored"] = True
@@ -92,14 +98,48 @@ def run_job(scene: Scene, limit: float, directory: str, horizon: float | None = 
         result["error"] = "no update was completed"
     result["wall_s"] = time.perf_counter() - wall0
     if result["error"] is None:
-        done_file.write_text(json.dumps({"scene": identity, "limit": limit, "horizon": horizon, "result": result}))
+        done_file.write_text(json.dumps({"scene": identity, "limit": limit, "horizon": horizon,
+                                          "version": CURVE_VERSION, "result": result}, allow_nan=False))
     return result
+
+
+def two_ended_hours(hours: list[float], clearance: list[float]) -> list[float]:
+    """The hours of a prediction's clearances from the wear rate at both ends of each update.
+
+    The extrapolation (docs/wear.md section 3) grows the clearance over an update at the rate of the
+    geometry it starts from (forward Euler in the geometry): accurate to O(f) with the update fraction f.
+    With the rates r_i = dc_i / dh_i of two consecutive updates, the hours of update i are instead
+    dc_i times the logarithmic mean of 1/r_i and 1/r_(i+1), exact when the rate changes exponentially with
+    the clearance and O(f^2) otherwise (the geometries stay those simulated).  The last update keeps its
+    one-ended hours; a rate of 0 at the far end of an update (the wear stops: a joint that runs in)
+    makes its far end, and everything after it, unreachable (inf).
+    """
+    h = np.asarray(hours, dtype=float)
+    c = np.asarray(clearance, dtype=float)
+    dh, dc = np.diff(h), np.diff(c)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inverse = np.where(dc > 0.0, dh / dc, math.inf)  # 1 / r_i, h per m
+    out = dh.copy()
+    for i in range(dh.size - 1):
+        if not dc[i] > 0.0:
+            continue
+        a, b = inverse[i], inverse[i + 1]
+        if math.isinf(b):
+            out[i] = math.inf
+        elif a != b:
+            out[i] = dc[i] * (b - a) / math.log(b / a)
+    return [float(v) for v in np.concatenate([[h[0]], h[0] + np.cumsum(out)])]
 
 
 def hours_at(result: dict, levels: np.ndarray) -> np.ndarray:
     """Hours at which the job's effective clearance reaches each of ``levels`` (m), linear between updates;
     inf where it does not reach a level (censored at the job's horizon)."""
     c = np.maximum.accumulate(np.asarray(result["clearance_m"], dtype=float))
-    h = np.asarray(result["hours"], dtype=float)
+    h = np.array([math.inf if v is None else v for v in result["hours"]], dtype=float)
+    finite = np.isfinite(h)  # the curve ends where it becomes unreachable (two_ended_hours)
+    last = int(np.argmin(finite)) if not np.all(finite) else h.size
+    c, h = c[:last], h[:last]
     out = np.interp(levels, c, h, left=0.0, right=math.inf)
+    if last < finite.size:
+        out[levels > c[-1]] = math.inf
     return out
