@@ -29,10 +29,15 @@ def no_wear_reason(scene: Scene, update: Update) -> str | None:
     """Why ``update`` (the last of a prediction) wears nothing, as one clause; None when it wears."""
     if float(np.max(update.rate_bearing, initial=0.0)) > 0.0 or float(np.max(update.rate_journal, initial=0.0)) > 0.0:
         return None
+    from weftsim.wear.extrapolate import effective_clearance
+
     ratio = update.response.get("film_ratio_min", math.nan)
+    c0 = scene.joint.clearance
+    c = effective_clearance(c0, update.bearing, update.journal)
+    ran_in = f" after running in from {1e3 * c0:.4g} to {1e3 * c:.4g} mm" if c > c0 else ""
     if scene.joint.is_lubricated and math.isfinite(ratio):
-        return (f"the asperities carry no load (film ratio min {ratio:.3g}: the oil film separates the surfaces "
-                "over the whole cycle)")
+        return (f"the asperities carry no load{ran_in} (film ratio min {ratio:.3g}: the oil film separates the "
+                "surfaces over the whole cycle)")
     return "the contact carries no load over the steady cycle"
 
 

@@ -35,6 +35,8 @@ def add_flags(p: argparse.ArgumentParser, positive: Callable[[Callable[[str], fl
     ens.add_argument("--seed", type=int, default=0, help="seed of the ensemble's sampling (default 0)")
     ens.add_argument("--chaos-runs", type=int, default=6, help="predictions of the nominal design point differing "
                      "in the last bits of k, sampling the chaotic scatter (default 6)")
+    ens.add_argument("--level-mm", action="append", type=positive(float), default=[], metavar="X",
+                     help="also give the hours to an effective clearance of X mm (below the limit); repeatable")
     ens.add_argument("--design-points", action="append", default=[], metavar="KEY=N",
                      help="N design points (2-9) for a simulated --uncertain key instead of 3; repeatable")
     ens.add_argument("--jobs", type=int, help="local worker processes for the ensemble's simulations (default: cores)")
@@ -147,6 +149,7 @@ def run_ensemble(args: argparse.Namespace, scene: Scene, outdir: str | Path,
         data = wear_ensemble(scene, args.uncertain, args.samples, limit, outdir, jobs=args.jobs,
                              scheduler=args.scheduler, seed=args.seed, figures=not args.no_plot, force=args.force,
                              chaos_runs=args.chaos_runs, design_points=design_points,
+                             levels=tuple(1e-3 * v for v in args.level_mm),
                              announce=lambda text: print(text, file=sys.stderr, flush=True),
                              **({} if args.hours is None else {"horizon": args.hours}))
     except WearError as exc:
@@ -164,6 +167,11 @@ def run_ensemble(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     print(f"  reaching it within {horizon:g} h: {100 * reach['fraction']:.3g} % of the samples "
           f"({100 * m['quantile_confidence']:g} % interval {100 * reach['low']:.3g} - {100 * reach['high']:.3g} %)"
           + (f"; design points that never wear: {', '.join(data['never'])}" if never else ""))
+    for level, table in data["hours_by_clearance_mm"].items():
+        if float(level) != args.limit_clearance_mm:
+            print(f"  to {level} mm: " + ", ".join(f"{name} {text_hours(table[name]['hours'], horizon)}"
+                                                   for name in ("p10", "p50", "p90"))
+                  + f" ({100 * table['reaching']['fraction']:.3g} % reach it within {horizon:g} h)")
     for name, q in data["hours_to_limit"].items():
         print(f"  {name}: {text_hours(q['hours'], horizon)} ({100 * m['quantile_confidence']:g} % interval "
               f"{text_hours(q['low'], horizon)} - {text_hours(q['high'], horizon)})")

@@ -270,10 +270,12 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
         "unresolved_samples": ens["unresolved"],
         "hours_by_clearance_mm": by_level,
         "shares": {k: {"rank_correlation": r, "share": s} for k, (r, s) in ens["shares"].items()},
-        "jobs": {n: {"wall_s": r.get("wall_s"), "updates": r.get("updates"), "error": r.get("error"),
+        "jobs": {n: {"wall_s": r.get("wall_s"), "cpu_s": r.get("cpu_s"), "updates": r.get("updates"),
+                     "error": r.get("error"),
                      "censored": bool(r.get("censored")), "reused": bool(r.get("reused"))}
                  for n, r in sorted(results.items())},
         "simulation_wall_time_s": sim_wall,
+        "simulation_cpu_time_s": float(sum(r.get("cpu_s") or 0.0 for r in results.values())),
         "wall_time_s": time.perf_counter() - wall0,
     }
     table = {f"{k}": np.asarray(v, dtype=float) for k, v in ens["values"].items()}

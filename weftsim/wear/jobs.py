@@ -53,7 +53,7 @@ def run_job(scene: Scene, limit: float, directory: str, horizon: float | None = 
                 return {**stored["result"], "reused": True}
         except (OSError, ValueError, KeyError, TypeError):
             pass  # damaged: run it again (the state below resumes it)
-    wall0 = time.perf_counter()
+    wall0, cpu0 = time.perf_counter(), time.process_time()
     c0 = scene.joint.clearance
     try:
         done = store.load_state(directory, scene)[:-1]  # the last update is simulated again (resume rule)
@@ -97,6 +97,7 @@ def run_job(scene: Scene, limit: float, directory: str, horizon: float | None = 
     elif result["error"] is None:
         result["error"] = "no update was completed"
     result["wall_s"] = time.perf_counter() - wall0
+    result["cpu_s"] = time.process_time() - cpu0  # the worker's CPU (user + sys): the cost on a shared machine
     if result["error"] is None:
         done_file.write_text(json.dumps({"scene": identity, "limit": limit, "horizon": horizon,
                                           "version": CURVE_VERSION, "result": result}, allow_nan=False))
