@@ -153,3 +153,19 @@ def test_ensemble_with_never_design_points_writes_censored_quantiles(oiled_loom,
     assert set(saved["never"]) == {"node_1", "node_2"}
     assert Path(data["files"]["cdf_figure"]).stat().st_size > 0
     assert np.mean(rows["reaches_limit"]) == pytest.approx(reach["fraction"], rel=1e-12)
+
+
+def test_ensemble_where_nothing_wears_says_so(oiled_loom, tmp_path, monkeypatch):
+    """Every design point on a full film: no sample reaches the limit, every quantile is censored, the
+    fraction is 0 with its one-sided interval, and the figures are still drawn."""
+    c0 = oiled_loom.joint.clearance
+    never = _fake([0.0, 1e6], [c0, c0], True, "the asperities carry no load (film ratio min 9)")
+    monkeypatch.setattr(ensemble, "_run_jobs", lambda jobs, *a, **k: {n: never for n, _ in jobs})
+    data = ensemble.wear_ensemble(oiled_loom, {"joint_e.lubrication.viscosity_mpa_s": "uniform(60,100)"},
+                                  100, 0.1e-3, tmp_path / "e", chaos_runs=1, levels=(0.05e-3,))
+    saved = json.loads(Path(data["files"]["summary"]).read_text())
+    assert saved["reaching_limit"]["fraction"] == 0.0 and saved["reaching_limit"]["low"] == 0.0
+    assert saved["reaching_limit"]["high"] == pytest.approx(1.0 - 0.05 ** (1 / 100), rel=1e-10)
+    assert all(q["censored"] and q["hours"] is None for q in saved["hours_to_limit"].values())
+    assert saved["hours_by_clearance_mm"]["0.05"]["reaching"]["fraction"] == 0.0
+    assert all(Path(data["files"][k]).stat().st_size > 0 for k in ("cdf_figure", "band_figure", "shares_figure"))
