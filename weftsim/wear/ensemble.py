@@ -128,6 +128,8 @@ def combine(scene: Scene, uncertain: list[Uncertain], dynamic: list[Uncertain], 
         + (1.0 - share_b) * base["joint_e.wear.journal_hardness_mpa"] / hj
     draw = np.minimum((u[:, -1] * len(chaos_names)).astype(int), len(chaos_names) - 1)
     base_hours = interpolate(node_hours, nodes, dynamic, values, samples)
+    if "joint_e.clearance_mm" in values:  # a sample that starts above a level is there at 0 h, whatever the rule
+        base_hours[1e-3 * values["joint_e.clearance_mm"][:, None] >= levels[None, :]] = 0.0
     hours = base_hours * scale[:, None] * chaos_factor[draw]  # (samples, levels)
     never = ~np.isfinite(hours)
     hours = np.where(hours <= horizon, hours, math.inf)  # censored at the horizon

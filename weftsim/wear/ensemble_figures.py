@@ -30,8 +30,9 @@ def cdf_figure(hours: np.ndarray, data: dict, title: str = "") -> Figure:
         right = horizon if horizon else (x.max() if x.size else 1.0)
         ax.axhline(reach, color="C0", ls="--", lw=1)
         ax.axvline(right, color="0.4", ls=":", lw=1)
-        ax.text(right, reach, f"{100 * reach:.3g} % reach it within {right:.3g} h;\n{100 * (1 - reach):.3g} % "
-                "later or never ", ha="right", va="bottom", fontsize=8)
+        ax.text(0.02, 0.97, f"{100 * reach:.3g} % reach it within {right:.3g} h (dotted);\n"
+                f"{100 * (1 - reach):.3g} % later or never (censored)", transform=ax.transAxes, ha="left", va="top",
+                fontsize=9)
     for name, q in data["hours_to_limit"].items():
         if q["hours"] is None:  # among the censored
             continue
@@ -50,25 +51,31 @@ def cdf_figure(hours: np.ndarray, data: dict, title: str = "") -> Figure:
 
 
 def band_figure(band: dict, title: str = "") -> Figure:
-    """Effective clearance against hours: median and the 10-90 % band."""
-    fig = figure(figsize=(7, 4.5))
-    ax = fig.add_subplot(1, 1, 1)
+    """Effective clearance against hours: median and the 10-90 % band; with censored samples (a quantile
+    beyond the horizon is inf) a second panel gives the fraction of samples reaching each clearance."""
+    censored = "fraction_reaching" in band and np.any(np.asarray(band["fraction_reaching"]) < 1.0)
+    fig = figure(figsize=(10 if censored else 7, 4.5))
+    ax = fig.add_subplot(1, 2 if censored else 1, 1)
     c = band["clearance_mm"]
     p10, p50, p90 = (np.asarray(band[f"hours_p{p}"], dtype=float) for p in (10, 50, 90))
-    right = np.isfinite(p90)  # beyond: p90 among the censored (does not reach that clearance in the horizon)
-    ax.fill_betweenx(c[right], p10[right], p90[right], color="C0", alpha=0.25, label="10-90 %")
-    if not np.all(right):
-        ok = np.isfinite(p10) & ~right
-        top = np.nanmax(np.where(np.isfinite(p90), p90, np.where(np.isfinite(p10), p10, np.nan))) \
-            if np.any(np.isfinite(p10)) else 1.0
-        ax.fill_betweenx(c[ok], p10[ok], np.full(ok.sum(), top), color="C0", alpha=0.1,
-                         label="10 % - (90 % later or never)")
-    ax.plot(np.where(np.isfinite(p50), p50, np.nan), c, color="C0", label="median")
-    ax.set_xlabel("operating hours")
+    both = np.isfinite(p10) & np.isfinite(p90)
+    ax.fill_betweenx(np.where(both, c, np.nan), np.where(both, p10, np.nan), np.where(both, p90, np.nan),
+                     color="C0", alpha=0.25, label="10-90 %")
+    for q, style, name in ((p10, ":", "10 %"), (p50, "-", "median"), (p90, "--", "90 %")):
+        if np.any(np.isfinite(q)):
+            ax.plot(np.where(np.isfinite(q), q, np.nan), c, color="C0", ls=style, label=name)
+    ax.set_xlabel("operating hours" + (" (where the quantile is reached within the horizon)" if censored else ""))
     ax.set_ylabel("effective clearance at E (mm)")
     ax.set_title(title)
     ax.legend(loc="lower right")
     ax.grid(True, alpha=0.3)
+    if censored:
+        ax2 = fig.add_subplot(1, 2, 2, sharey=ax)
+        ax2.plot(100.0 * np.asarray(band["fraction_reaching"]), c, color="C3")
+        ax2.set_xlim(0, 100)
+        ax2.set_xlabel("samples reaching the clearance within the horizon (%)")
+        ax2.grid(True, alpha=0.3)
+        fig.tight_layout()
     return fig
 
 
