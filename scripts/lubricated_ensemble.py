@@ -54,16 +54,24 @@ def main() -> None:
     ap.add_argument("outdir", nargs="?", default=str(ROOT / "out" / "loom-oil-ensemble"))
     ap.add_argument("--samples", type=int, default=1000)
     ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--max-clearance-change", type=float, default=SETTINGS["joint_e.wear.max_clearance_change"])
+    ap.add_argument("--resample-only", action="store_true", help="only resample the finished design predictions "
+                    "in OUTDIR (e.g. those of the docs' weftsim command, whose scene differs from this script's "
+                    "in the file keys it records, so that the script would not reuse them)")
     args = ap.parse_args()
-    scene = apply_overrides(load_scene(ROOT / "models" / "loom.toml"), SETTINGS, "script")
-    data = wear_ensemble(scene, UNCERTAIN, args.samples, LIMIT, args.outdir, jobs=args.jobs, levels=(LEVEL,),
-                         chaos_runs=1, design_points=DESIGN, force=True, announce=print)
+    scene = apply_overrides(load_scene(ROOT / "models" / "loom.toml"),
+                            {**SETTINGS, "joint_e.wear.max_clearance_change": args.max_clearance_change}, "script")
+    if args.resample_only:
+        data = json.loads((Path(args.outdir) / "ensemble.json").read_text())
+    else:
+        data = wear_ensemble(scene, UNCERTAIN, args.samples, LIMIT, args.outdir, jobs=args.jobs, levels=(LEVEL,),
+                             chaos_runs=1, design_points=DESIGN, force=True, announce=print)
     horizon = data["horizon_hours"]
     parsed = [parse_uncertain(f"{k}={v}") for k, v in UNCERTAIN.items()]
     jobs, dynamic, nodes = plan(scene, parsed, 1, DESIGN)
     results = {n: json.loads((Path(args.outdir) / "jobs" / n / CURVE).read_text())["result"] for n, _ in jobs}
     euler = {n: {**r, "hours": r["hours_one_ended"]} for n, r in results.items()}
-    print(f"design predictions: {len(jobs)}, simulation CPU {data['simulation_cpu_time_s']:.0f} s, "
+    print(f"design predictions: {len(jobs)}, simulation CPU {data.get('simulation_cpu_time_s') or math.nan:.0f} s, "
           f"wall {data['simulation_wall_time_s']:.0f} s; never: {len(data['never'])}, "
           f"censored: {len(data['censored_design_points'])}")
     for label, res, n, seed in (("1000 samples, seed 0", results, args.samples, 0),
