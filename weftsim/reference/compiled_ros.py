@@ -13,6 +13,9 @@ steps:
 
     y(t + s h) = h00(s) y + h10(s) h f(t, y) + h01(s) y_new + h11(s) h f(t + h, y_new).
 
+With a lubricated joint the dense output is RODAS's own continuous extension from the stages instead
+(:func:`dense_stiff`).
+
 Each step solves 6 linear systems with one LU decomposition of E, so its step size is set by
 accuracy, not by the stiffness of a lasting contact or of the friction ramp (the explicit DOP853
 steps at ~1e-9 s where the journal sticks: the ramp's slope mu F_N / (v1 - v0) ~ 1e7-1e8 N s/m).
@@ -85,6 +88,13 @@ CC[4, 0], CC[4, 1], CC[4, 2], CC[4, 3] = (0.7496443313967647e+01, -0.10246804314
 CC[5, 0], CC[5, 1], CC[5, 2], CC[5, 3], CC[5, 4] = (0.8083246795921522e+01, -0.7981132988064893e+01,
                                                     -0.3152159432874371e+02, 0.1631930543123136e+02,
                                                     -0.6058818238834054e+01)  # fmt: skip
+# Continuous extension of RODAS (Hairer & Wanner's code, its dense output of order 3): with the stages K of the
+# step, y(t + s h) = (1 - s) y + s (y_new + (1 - s) (sum DENSE_2[j] K_j + s sum DENSE_3[j] K_j)).
+DENSE_2 = np.array([0.1012623508344586e+02, -0.7487995877610167e+01, -0.3480091861555747e+02,
+                    -0.7992771707568823e+01, 0.1025137723295662e+01])  # fmt: skip
+DENSE_3 = np.array([-0.6762803392801253e+00, 0.6087714651680015e+01, 0.1643084320892478e+02,
+                    0.2476722511418386e+02, -0.6594389125716872e+01])  # fmt: skip
+RODAS4_STIFF_DENSE = 4  # code of the dense output from the stages (a code beside the methods', never a method)
 # Step-size control of the code RODAS: factor = 0.9 err^(-1/4) within [1/5, 6].
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 6.0
 
@@ -271,7 +281,30 @@ def step(prm, t, y, h, f0, J, f_t, contact, impact, ist, K, E, piv, y_new, F, tm
     for i in range(n):
         F[0, i] = y_new[i]
         F[1, i] = h * f0[i]
+        d2 = 0.0
+        d3 = 0.0
+        for r in range(5):
+            d2 += DENSE_2[r] * K[r, i]
+            d3 += DENSE_3[r] * K[r, i]
+        F[3, i] = d2
+        F[4, i] = d3
     return math.sqrt(err / n)
+
+
+@njit(cache=True, error_model="numpy")
+def dense_stiff(F, t_old, h, y_old, t, out):
+    """RODAS's own continuous extension of the last step at time t (``DENSE_2``, ``DENSE_3``; order 3).
+
+    Used with a lubricated joint (:func:`central_differences`): built from the stages, it follows the stiff
+    clearance rate where the cubic Hermite interpolant, which bends with f at both ends, does not.  A step that
+    starts off the slow manifold (from an event's state, itself interpolated) has a large psi'' (the squeeze
+    film relaxes psi' at ~1e7 1/s), and the Hermite interpolant carries h f / 8 of it to mid-step: a quarter
+    of psi' for a start 1 % off, against 0.2 % here (docs/performance.md, "The mixed regime").  Local error
+    O(h^4) on smooth solutions, as the Hermite interpolant's.
+    """
+    s = (t - t_old) / h
+    for i in range(y_old.size):
+        out[i] = (1.0 - s) * y_old[i] + s * (F[0, i] + (1.0 - s) * (F[3, i] + s * F[4, i]))
 
 
 @njit(cache=True, error_model="numpy")
