@@ -40,7 +40,10 @@ def _row(label: str, ens: dict, horizon: float) -> str:
     for i in (ens["levels"].searchsorted(LEVEL - 1e-12), -1):
         h = ens["hours"][:, i]
         q = [text_hours(censored_quantile(h, p)[0], horizon) for p in (0.1, 0.5, 0.9)]
-        cells.append(f"{100 * np.mean(np.isfinite(h)):.1f} % reach; p10/p50/p90 " + " / ".join(q))
+        r = h[np.isfinite(h)]
+        q_r = [text_hours(censored_quantile(r, p)[0], horizon) for p in (0.1, 0.5, 0.9)] if r.size > 1 else ["-"] * 3
+        cells.append(f"{100 * np.mean(np.isfinite(h)):.1f} % reach; p10/p50/p90 " + " / ".join(q)
+                     + "; of those: " + " / ".join(q_r))
     return f"{label:<34} 0.05 mm: {cells[0]}  |  0.1 mm: {cells[1]}"
 
 

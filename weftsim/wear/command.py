@@ -175,6 +175,9 @@ def run_ensemble(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     for name, q in data["hours_to_limit"].items():
         print(f"  {name}: {text_hours(q['hours'], horizon)} ({100 * m['quantile_confidence']:g} % interval "
               f"{text_hours(q['low'], horizon)} - {text_hours(q['high'], horizon)})")
+    if reach["fraction"] < 1.0 and data.get("hours_of_those_reaching"):
+        print("  of those reaching it: " + ", ".join(f"{name} {text_hours(q['hours'], horizon)}" for name, q in
+                                                     data["hours_of_those_reaching"].items()))
     print("  shares of the spread: " + ", ".join(f"{k} {100 * v['share']:.0f} %" for k, v in
                                                  sorted(data["shares"].items(), key=lambda kv: -kv[1]["share"])))
     for path in data["files"].values():

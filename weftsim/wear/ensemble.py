@@ -266,6 +266,9 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
         "horizon_hours": horizon,
         "hours_to_limit": quantile_table(hours[:, -1], horizon),
         "reaching_limit": reaching(hours[:, -1], horizon),
+        # the hours of the samples that reach the limit within the horizon (the conditional distribution)
+        "hours_of_those_reaching": quantile_table(hours[np.isfinite(hours[:, -1]), -1], horizon)
+        if np.sum(np.isfinite(hours[:, -1])) >= 2 else None,
         # design points that wear nothing at all (a full film): why, in one clause each
         "never": ens["never_nodes"],
         "censored_design_points": ens["censored_nodes"],
