@@ -199,7 +199,9 @@ def test_cli_wear_resumes_and_refuses_bad_input(tmp_path):
     forced = run_cli("wear", REFERENCE, "--hours", 1, "--speed-rpm", 500, "-o", out, "--no-plot", "--force")
     assert forced.returncode == 0, forced.stderr  # --force starts a prediction of the other scene over
     assert "resuming" not in forced.stderr and json.loads((out / "wear.json").read_text())["hours_reached"] == 1.0
-    for args, words in ((("--engine", "exudyn"), "Exudyn engine has no worn-geometry"),
+    for args, words in ((("--engine", "exudyn", "--set", "solver.exudyn.model=rigid_body"),
+                         "runs on the Exudyn engine's kinematic tree"),
+                        (("--engine", "exudin"), "--engine must be one of reference, exudyn"),
                         (("--limit-clearance-mm", 0.1), "must be larger than"),
                         (("--clearance-mm", 0), "ideal joint")):
         bad = run_cli("wear", REFERENCE, "--hours", 1, "-o", tmp_path / "x", *args)

@@ -170,7 +170,8 @@ def cmd_wear(args: argparse.Namespace) -> int:
     from weftsim.wear.command import run
 
     scene = scene_from_args(args)
-    return run(args, scene, output_directory(args, scene, "wear"), _stop_on_interrupt)
+    where = "wear" if args.engine == "reference" else f"wear-{args.engine}"  # engines' states apart
+    return run(args, scene, output_directory(args, scene, where), _stop_on_interrupt)
 
 
 def _check_fits(scene, outdir: Path, runs: int = 1) -> None:

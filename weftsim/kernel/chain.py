@@ -33,14 +33,14 @@ from typing import TYPE_CHECKING
 
 from numba import njit
 
-from weftsim.kernel.joint import connector_friction_force
+from weftsim.kernel.joint import connector_friction_force_at
 from weftsim.kernel.joint import (  # noqa: F401 - the joint block is part of this array
     BEARING_RADIUS, CLEARANCE, COEF, KIND, MU, N_JOINT, TRACK_MAX, V_MIN, clearance_force, clearance_force_at,
     tangential_velocity,
 )  # fmt: skip
 from weftsim.kernel.laws import elastic_force
 from weftsim.kernel.lubricated import L_DISSIPATED, L_FX, L_FY, L_MB, L_MJ, is_lubricated, lubricated_force
-from weftsim.kernel.lubricated import connector_lubricated_force
+from weftsim.kernel.lubricated import connector_lubricated_force_at
 from weftsim.kernel.wear import worn_clearance
 
 if TYPE_CHECKING:
@@ -96,15 +96,24 @@ def local_clearance(prm: np.ndarray, t: float, ecc_y: float, ecc_z: float, v_y: 
     The bearing turns with the rocker (theta_OE = theta_OE0 + phi, :func:`rocker_angle`), the journal
     with the rod (its axis E -> F along u(psi)); the direction of e turns at (e x e_dot) / |e|^2.
     """
-    if prm.size <= WEAR_E:
+    return clearance_along(prm, t, ecc_y, ecc_z, v_y, v_z, y[1], y[3])
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def clearance_along(prm: np.ndarray, t: float, ecc_y: float, ecc_z: float, v_y: float, v_z: float, psi: float,
+                    dpsi: float) -> tuple[float, float]:
+    """:func:`local_clearance` with the rod's angle psi (rad) and rate (rad/s) given (every engine's state
+    has them: the reference's y[1], y[3]; the kinematic tree's q0 + q1 - pi and its rate).  ``prm``: an array,
+    or a list on the plain-Python callback route (hence ``len``)."""
+    if len(prm) <= WEAR_E:
         return prm[CLEARANCE], 0.0
     direction = math.atan2(ecc_z, ecc_y)
     length2 = ecc_y * ecc_y + ecc_z * ecc_z
     turn = (ecc_y * v_z - ecc_z * v_y) / length2 if length2 > 0.0 else 0.0
     theta = prm[OMEGA] * t
     w_b = prm[OMEGA] * prm[TAN_BETA] * math.sin(theta) / (1.0 + (prm[TAN_BETA] * math.cos(theta)) ** 2)
-    return worn_clearance(prm, WEAR_E, prm[CLEARANCE], direction - rocker_angle(prm, t), direction - y[1],
-                          turn - w_b, turn - y[3])  # fmt: skip
+    return worn_clearance(prm, WEAR_E, prm[CLEARANCE], direction - rocker_angle(prm, t), direction - psi,
+                          turn - w_b, turn - dpsi)  # fmt: skip
 
 
 @njit(cache=True, error_model="numpy")
@@ -225,12 +234,16 @@ def tree_joint_force(prm: np.ndarray, t: float, a: float, q1: float, da: float, 
     omega = prm[OMEGA]
     # F_N = hypot of the normal force, as the channels computed it before friction: bit-identical at mu = 0.
     lub_power = asperity_energy = 0.0
+    ex, ey, evx, evy = px - b_y, py - b_z, vx - omega * db_y, vy - omega * db_z
+    # A worn joint E: the local clearance along e and its rate, the journal's frame turning with the rod
+    # (psi = b - pi); a round one: (c0, 0), the unchanged call below.
+    c, c_rate = clearance_along(prm, t, ex, ey, evx, evy, b - math.pi, db)
     if is_lubricated(prm):
-        fx, fy, delta, rate, f_n, f_t, m_j, m_b, v_t, lub_power, asperity_energy = connector_lubricated_force(
-            prm, px - b_y, py - b_z, vx - omega * db_y, vy - omega * db_z, held, delta0, rate0, db, omega * dphi)[:11]
+        fx, fy, delta, rate, f_n, f_t, m_j, m_b, v_t, lub_power, asperity_energy = connector_lubricated_force_at(
+            prm, c, c_rate, ex, ey, evx, evy, held, delta0, rate0, db, omega * dphi)[:11]
     else:
-        fx, fy, delta, rate, f_n, f_t, m_j, m_b, v_t = connector_friction_force(
-            prm, px - b_y, py - b_z, vx - omega * db_y, vy - omega * db_z, held, delta0, rate0, db, omega * dphi)
+        fx, fy, delta, rate, f_n, f_t, m_j, m_b, v_t = connector_friction_force_at(
+            prm, c, c_rate, ex, ey, evx, evy, held, delta0, rate0, db, omega * dphi)
     g1 = l_ef * (fx * sb - fy * cb) + m_j
     return (l_fg * (fx * sa - fy * ca) + g1, g1, delta, rate, fx, fy, f_n, m_b, f_t * v_t, v_t, lub_power,
             asperity_energy)  # fmt: skip

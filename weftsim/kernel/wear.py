@@ -104,7 +104,7 @@ def worn_clearance(prm: np.ndarray, start: int, c0: float, angle_b: float, angle
     penetration rate, delta_dot = e_dot . n - dc/dt, so that a contact which starts because the
     journal slides onto an unworn part of the wall has the approach rate it really has.
     """
-    if prm.size <= start:
+    if len(prm) <= start:  # len: a list on the Exudyn engine's plain-Python callback route
         return c0, 0.0
     n_b = int(prm[start])
     n_j = int(prm[start + 1])

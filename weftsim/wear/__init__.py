@@ -41,7 +41,7 @@ def __getattr__(name: str):
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-ENGINES = ("reference", "exudyn")
+ENGINES = ("reference", "exudyn")  # weftsim.wear.engines.ENGINES: the same names (not imported: no numba here)
 
 
 def check_request(scene: Scene, hours: float, engine: str, limit: float | None) -> None:
@@ -51,8 +51,12 @@ def check_request(scene: Scene, hours: float, engine: str, limit: float | None) 
     if engine not in ENGINES:
         raise WearError(f"--engine must be one of {', '.join(ENGINES)}, got {engine!r}")
     if engine == "exudyn":
-        raise WearError("--engine exudyn: the Exudyn engine has no worn-geometry contact yet; the wear prediction "
-                        "runs on the reference engine (--engine reference, the default)")
+        from weftsim.exudyn_engine.selection import select_model
+
+        if select_model(scene)[0] != "kinematic_tree":
+            raise WearError("--engine exudyn: the wear prediction runs on the Exudyn engine's kinematic tree, and "
+                            f"solver.exudyn.model = {scene.exudyn_solver.model!r} asks for another model; use "
+                            "'auto' or 'kinematic_tree'")
     from weftsim.wear.extrapolate import MAX_HOURS
 
     if not (0.0 < hours <= MAX_HOURS):
@@ -112,6 +116,7 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
     from weftsim.output import begin_directory, prepare_directory
     from weftsim.record import provenance
     from weftsim.wear import store
+    from weftsim.wear.engines import simulator
     from weftsim.wear.extrapolate import predict
 
     check_request(scene, hours, engine, limit)
@@ -136,23 +141,26 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
             progress(min(updates[-1].hours / hours, 1.0))
 
     try:
-        updates = predict(scene, hours, done, on_update=on_update, stop=stop)
+        updates = predict(scene, hours, done, on_update=on_update, stop=stop, simulate=simulator(engine))
         if not updates:  # stopped (Ctrl-C) before the first update was done: nothing to write
             raise KeyboardInterrupt
     except WearError as exc:
         if not latest:
             raise
-        _write_results(scene, latest, hours, limit, time.perf_counter() - wall0, outdir, what, figures, str(exc))
+        _write_results(scene, latest, hours, limit, time.perf_counter() - wall0, outdir, what, figures, str(exc),
+                       engine)
         raise WearError(f"{exc}; the prediction stopped there: the {len(latest)} updates before it "
                         f"(0 to {latest[-1].hours:.6g} h) are in {outdir}/wear.csv and wear.json") from None
-    return _write_results(scene, updates, hours, limit, time.perf_counter() - wall0, outdir, what, figures)
+    return _write_results(scene, updates, hours, limit, time.perf_counter() - wall0, outdir, what, figures,
+                          engine=engine)
 
 
 def _write_results(scene: Scene, updates: list, hours: float, limit: float | None, wall: float, outdir: Path,
-                   what: dict, figures: bool, failure: str | None = None) -> dict:
+                   what: dict, figures: bool, failure: str | None = None, engine: str = "reference") -> dict:
     """Write the tables, the summary and the figures of ``updates``; returns the summary with ``"files"``.
 
-    ``failure``: why the prediction stopped at an update that failed (``wear.json`` keeps it).
+    ``failure``: why the prediction stopped at an update that failed (``wear.json`` keeps it); ``engine``:
+    the engine the updates were simulated on (``wear.json``'s ``"engine"``).
     """
     from dataclasses import replace
 
@@ -161,6 +169,7 @@ def _write_results(scene: Scene, updates: list, hours: float, limit: float | Non
     from weftsim.wear.extrapolate import advance, effective_clearance, ended_by_limit, limit_hours
 
     data = store.summary(scene, updates, hours, limit, wall)
+    data["engine"] = engine
     ended = ended_by_limit(scene, updates)
     data["ended"] = ended
     data["failure"] = failure
@@ -188,7 +197,7 @@ def _write_results(scene: Scene, updates: list, hours: float, limit: float | Non
     if figures:
         from weftsim.wear.figures import growth_figure, profile_figure
 
-        title = f"{scene.name}: wear at E"
+        title = f"{scene.name}: wear at E" + ("" if engine == "reference" else f" ({engine} engine)")
         files["profile_figure"] = ("wear_profile.png", lambda p: write_figure(p, profile_figure(scene, updates, title)))
         files["growth_figure"] = ("wear_growth.png", lambda p: write_figure(p, growth_figure(columns, title)))
     written = write_files(outdir, what, files, scene=scene)

@@ -22,8 +22,8 @@ def add_flags(p: argparse.ArgumentParser, positive: Callable[[Callable[[str], fl
     scene and output flags."""
     p.add_argument("--hours", type=positive(float), help="operating hours to predict (not with --uncertain: an "
                    "ensemble runs each prediction to --limit-clearance-mm)")
-    p.add_argument("--engine", default="reference", help="reference (default); exudyn is refused (no worn "
-                   "geometry in its contact yet, docs/wear.md)")
+    p.add_argument("--engine", default="reference", help="engine of each update's simulation: reference (default) "
+                   "or exudyn (its kinematic tree; default output out/<scene name>/wear-exudyn; docs/wear.md)")
     p.add_argument("--limit-clearance-mm", type=positive(float),
                    help="clearance limit: wear.json gives the hours at which the effective clearance reaches it")
     p.add_argument("--no-plot", action="store_true", help="skip the figures")
@@ -62,9 +62,9 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     check_request(scene, args.hours, args.engine, limit)  # a WearError is one line, exit 2
     outdir = prepare_directory(outdir, args.force, scene)
     resumed = _stored_updates(outdir, scene, args.force)
-    print(f"scene {scene.name}, wear at E over {args.hours:g} h on the reference engine; each update simulates "
+    print(f"scene {scene.name}, wear at E over {args.hours:g} h on the {args.engine} engine; each update simulates "
           f"{scene.joint.wear.settle_revolutions} + {scene.joint.wear.revolutions_per_update} revolutions "
-          f"(~{_duration(update_time(scene))}), the update interval grows the clearance by at most "
+          f"(~{_duration(update_time(scene, args.engine))}), the update interval grows the clearance by at most "
           f"{100 * scene.joint.wear.max_clearance_change:g} %", file=sys.stderr, flush=True)
     if resumed:
         print(f"resuming the prediction stored in {outdir}: {len(resumed)} updates kept, up to "

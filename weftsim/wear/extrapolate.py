@@ -215,20 +215,31 @@ def simulate_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray) -> t
     t, y, contact, impact = rows["steps"]
     keep = t >= t0
     wear = run_wear(run_scene, pack_parameters(run_scene), t[keep], y[keep], contact[keep], impact[keep])
+    return wear, wear_response(scene, wear, result.steps, run_scene.reference_solver.rtol)
+
+
+def wear_response(scene: Scene, wear: RunWear, steps: dict, rtol: float) -> dict:
+    """The response of an update: statistics of the steady revolutions of the run's ``steps``, the solver's
+    relative tolerance ``rtol`` and the sliding of ``wear`` per revolution (any engine's run)."""
+    w = scene.joint.wear
     per_rev = 1.0 / w.revolutions_per_update
     sliding = {"sliding_distance_per_rev_m": wear.sliding_distance * per_rev,
                "sliding_work_per_rev_J": wear.sliding_work * per_rev,
                # Archard's load: the mean of F_N weighted by the sliding ds = |v_T| dt (not by dt)
                "contact_force_sliding_mean_N": wear.sliding_work / wear.sliding_distance
                if wear.sliding_distance > 0.0 else math.nan}
-    return wear, {**_response(result.steps, t0), "solver_rtol": run_scene.reference_solver.rtol, **sliding}
+    return {**_response(steps, w.settle_revolutions * scene.drive.period), "solver_rtol": rtol, **sliding}
 
 
 def next_update(scene: Scene, hours_done: float, revolutions_done: float, bearing: np.ndarray, journal: np.ndarray,
-                hours: float) -> Update:
-    """Simulate the current geometry and choose the revolutions of this update (module docstring)."""
+                hours: float, simulate: Callable | None = None) -> Update:
+    """Simulate the current geometry and choose the revolutions of this update (module docstring).
+
+    ``simulate(scene, bearing, journal) -> (RunWear, response)``: the engine's update
+    (:func:`weftsim.wear.engines.simulator`); None: :func:`simulate_update`, the reference engine.
+    """
     w = scene.joint.wear
-    wear, response = simulate_update(scene, bearing, journal)
+    wear, response = (simulate_update if simulate is None else simulate)(scene, bearing, journal)
     per_rev = 1.0 / w.revolutions_per_update
     rate_b, rate_j = wear.bearing * per_rev, wear.journal * per_rev
     growth = float(rate_b.max() + rate_j.max())
@@ -258,9 +269,11 @@ def advance(update: Update, scene: Scene) -> tuple[float, float, np.ndarray, np.
 
 def predict(scene: Scene, hours: float, updates: Sequence[Update] = (),
             on_update: Callable[[list[Update]], None] | None = None,
-            stop: Callable[[], bool] | None = None) -> list[Update]:
+            stop: Callable[[], bool] | None = None, simulate: Callable | None = None) -> list[Update]:
     """Run the cycle extrapolation to ``hours`` of operation; returns the list of :class:`Update`.
 
+    ``simulate``: the engine of each update's simulation (:func:`next_update`; :func:`weftsim.wear.engines.simulator`
+    gives it by the engine's name; None: the reference engine);
     ``updates``: updates already done (resume: the run continues after the last);
     ``on_update(updates)``: called after each update (storing, progress); ``stop()``: True asks to
     end after the current update.  The last update simulates the final geometry, with N = 0; or,
@@ -288,7 +301,7 @@ def predict(scene: Scene, hours: float, updates: Sequence[Update] = (),
         hours_done, revs_done, bearing, journal = state
         finished = hours_done >= hours * (1.0 - 1e-12)
         try:
-            update = next_update(scene, hours_done, revs_done, bearing, journal, hours)
+            update = next_update(scene, hours_done, revs_done, bearing, journal, hours, simulate)
         except WearInterrupted:
             return done  # the update in progress is dropped; the state holds the ones before it
         except UpdateFailed as exc:
@@ -328,14 +341,14 @@ def limit_hours(updates: Sequence[Update], c0: float, limit: float) -> float | N
     return None
 
 
-def update_time(scene: Scene) -> float:
-    """Estimated wall-clock seconds of one wear update: the reference engine's estimate
+def update_time(scene: Scene, engine: str = "reference") -> float:
+    """Estimated wall-clock seconds of one wear update: the engine's estimate
     (:func:`weftsim.progress.estimate_run_time`) for its settle + steady revolutions at the solver
-    tolerance of a worn geometry (:data:`WORN_RTOL`)."""
+    tolerance of a worn geometry (:data:`WORN_RTOL` on the reference engine)."""
     from weftsim.progress import estimate_run_time
 
     w = scene.joint.wear
     solver = replace(scene.reference_solver, rtol=min(scene.reference_solver.rtol, WORN_RTOL))
     one = replace(scene, drive=replace(scene.drive, revolutions=w.settle_revolutions + w.revolutions_per_update),
                   reference_solver=solver)
-    return estimate_run_time(one, "reference")
+    return estimate_run_time(one, engine)
