@@ -55,9 +55,6 @@ def check_settings(scene: Scene) -> str | None:
     s = scene.exudyn_solver
     if s.model not in MODELS:
         return f"`solver.exudyn.model` must be one of {MODELS}, got {s.model!r}"
-    if scene.joint.is_worn and select_model(scene)[0] != "kinematic_tree":
-        return ("a worn joint E (weftsim wear) runs on the Exudyn engine's kinematic tree only; the rigid-body "
-                "model has no worn profile: use `solver.exudyn.model` = 'auto' or 'kinematic_tree'")
     if select_model(scene)[0] == "kinematic_tree":
         from weftsim.exudyn_engine.tree_solve import check_tree_settings
 
