@@ -189,3 +189,24 @@ def test_cli_wear_on_exudyn_writes_its_prediction_and_agrees_on_the_first_update
     # (2e-4, measured at their default tolerances, 8e-5 on the journal)
     assert out["exudyn"]["hours_to_limit"] == pytest.approx(out["reference"]["hours_to_limit"], rel=1e-3)
     assert out["exudyn"]["updates"] == out["reference"]["updates"]
+
+
+def test_a_worn_lubricated_joint_agrees_between_the_engines():
+    """The loom with oil of 20 mPa s (the film ratio falls to ~3.9, the mixed regime's edge) on the worn joint,
+    half a revolution: the film sees the local clearance on both engines (the worn spots raise the smallest
+    film ratio from 3.86 to 3.91 on the reference engine), and the engines agree on the smallest film ratio and
+    the largest film force."""
+    from weftsim.scene import apply_overrides
+
+    scene = apply_overrides(load_scene("loom"), {"joint_e.lubrication.viscosity_mpa_s": 20.0})
+    worn = _worn(scene, 0.5)[0]
+    out = {}
+    for engine, solve in (("reference", reference.solve), ("exudyn", exudyn_engine.solve)):
+        result = solve(worn)
+        assert result.ok, result.message
+        out[engine] = (result.steps["film_ratio"].min(), result.steps["film_force_N"].max())
+    # 1e-3: 5x the measured difference of the film ratio (2.0e-4; the film force 2.3e-5)
+    assert out["exudyn"][0] == pytest.approx(out["reference"][0], rel=1e-3)
+    assert out["exudyn"][1] == pytest.approx(out["reference"][1], rel=1e-3)
+    round_scene = replace(scene, drive=replace(scene.drive, revolutions=0.5))
+    assert reference.solve(round_scene).steps["film_ratio"].min() < 0.995 * out["reference"][0]
