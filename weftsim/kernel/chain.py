@@ -206,7 +206,7 @@ def tree_joint_force(prm: np.ndarray, t: float, a: float, q1: float, da: float, 
         P_j = G + L_FG u(a) + L_EF u(b),  v_j = L_FG a' u'(a) + L_EF b' u'(b),
 
     less the bearing centre P_b(t) of :func:`crank_side` and its velocity, go through
-    :func:`weftsim.kernel.joint.connector_friction_force`: the normal force F_N n on the bearing and,
+    :func:`weftsim.kernel.joint.connector_friction_force_at`: the normal force F_N n on the bearing and,
     with friction (``prm[MU]`` > 0, in contact), F_T t on the journal (rod turning at b', rocker at
     omega phi') with the moments M_j = (R_b - |e|) F_T about P_j and M_b = -R_b F_T about P_b.  The force on the bearing is F_b = F_N n - F_T t; the journal's, -F_b,
     and M_j enter the joints by virtual work (db/dq0 = db/dq1 = 1):
@@ -215,7 +215,10 @@ def tree_joint_force(prm: np.ndarray, t: float, a: float, q1: float, da: float, 
         Q0 = L_FG (F_bx sin a - F_by cos a) + Q1.
 
     A lubricated joint adds its film and asperity force at every state
-    (:func:`weftsim.kernel.lubricated.connector_lubricated_force`; F_b, M_j and M_b include them).
+    (:func:`weftsim.kernel.lubricated.connector_lubricated_force`; F_b, M_j and M_b include them).  A worn
+    joint (the wear block at :data:`WEAR_E`) takes the local clearance c0 + h_b + h_j along e and its rate
+    (:func:`clearance_along`, the rod's angle psi = b - pi), as :func:`chain` does: delta and delta_dot are then
+    |e| - c and e_dot . n - dc/dt.
 
     Returns (Q0, Q1, delta, delta_dot, F_bx, F_by, F_N, M_b, F_T v_T, v_T, D'_lub, U_a): N m, N m, m, m/s,
     N, N, N, N m, W (the dry friction power on the pair, <= 0; 0 without friction), m/s (the sliding speed

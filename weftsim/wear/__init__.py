@@ -78,7 +78,8 @@ def check_request(scene: Scene, hours: float, engine: str, limit: float | None) 
 
 def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine: str = "reference",
                          limit: float | None = None, progress: Callable[[float], None] | None = None,
-                         stop: Callable[[], bool] | None = None, figures: bool = True, force: bool = False) -> dict:
+                         stop: Callable[[], bool] | None = None, figures: bool = True, force: bool = False,
+                         until_limit: bool = False) -> dict:
     """Predict the wear over ``hours`` of operation into ``outdir``, resuming a stored state.
 
     Parameters
@@ -98,6 +99,9 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
         Called with the fraction of the hours done.
     stop : callable, optional
         Returns True to end after the current update (Ctrl-C): the state is kept for a resume.
+    until_limit : bool
+        End where the effective clearance reaches ``limit`` (the update that crosses it extrapolates only up
+        to it, as at a geometric limit; ``"ended"`` says so), even before ``hours``.
 
     Returns
     -------
@@ -138,10 +142,28 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
         latest[:] = updates
         store.save_state(outdir, scene, updates)
         if progress is not None and updates[-1].hours > 0.0:  # no time-left estimate from a zero fraction
-            progress(min(updates[-1].hours / hours, 1.0))
+            if until_limit:  # the share of the clearance's way to the limit
+                from weftsim.wear.extrapolate import effective_clearance
+
+                c0 = scene.joint.clearance
+                grown = effective_clearance(c0, updates[-1].bearing, updates[-1].journal) - c0
+                progress(min(grown / (limit - c0), 1.0))
+            else:
+                progress(min(updates[-1].hours / hours, 1.0))
+
+    asked_stop = stop
+    if until_limit:
+        if limit is None:
+            raise WearError("until_limit needs a clearance limit (--limit-clearance-mm)")
+
+        def stop() -> bool:
+            return (asked_stop is not None and asked_stop()) or (bool(latest) and _beyond(scene, latest[-1], limit))
 
     try:
         updates = predict(scene, hours, done, on_update=on_update, stop=stop, simulate=simulator(engine))
+        if until_limit and updates and _beyond(scene, updates[-1], limit):
+            updates[-1] = _cut_at(scene, updates[-1], limit)
+            store.save_state(outdir, scene, updates)
         if not updates:  # stopped (Ctrl-C) before the first update was done: nothing to write
             raise KeyboardInterrupt
     except WearError as exc:
@@ -151,12 +173,36 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
                        engine)
         raise WearError(f"{exc}; the prediction stopped there: the {len(latest)} updates before it "
                         f"(0 to {latest[-1].hours:.6g} h) are in {outdir}/wear.csv and wear.json") from None
+    reached = until_limit and _beyond(scene, updates[-1], limit * (1.0 - 1e-12))
     return _write_results(scene, updates, hours, limit, time.perf_counter() - wall0, outdir, what, figures,
-                          engine=engine)
+                          engine=engine, reached_limit=reached)
+
+
+def _beyond(scene: Scene, update, limit: float) -> bool:
+    """True when ``update`` extrapolated over its N revolutions reaches the effective clearance ``limit`` (m)."""
+    from weftsim.wear.extrapolate import advance, effective_clearance
+
+    return update.step_revolutions > 0.0 and effective_clearance(scene.joint.clearance,
+                                                                 *advance(update, scene)[2:]) >= limit
+
+
+def _cut_at(scene: Scene, update, limit: float):
+    """``update`` with its N cut so that the effective clearance just reaches ``limit`` (bisection to 1e-18 of N)."""
+    from dataclasses import replace
+
+    inside, outside = 0.0, update.step_revolutions
+    for _ in range(60):
+        middle = 0.5 * (inside + outside)
+        if _beyond(scene, replace(update, step_revolutions=middle), limit):
+            outside = middle
+        else:
+            inside = middle
+    return replace(update, step_revolutions=outside)
 
 
 def _write_results(scene: Scene, updates: list, hours: float, limit: float | None, wall: float, outdir: Path,
-                   what: dict, figures: bool, failure: str | None = None, engine: str = "reference") -> dict:
+                   what: dict, figures: bool, failure: str | None = None, engine: str = "reference",
+                   reached_limit: bool = False) -> dict:
     """Write the tables, the summary and the figures of ``updates``; returns the summary with ``"files"``.
 
     ``failure``: why the prediction stopped at an update that failed (``wear.json`` keeps it); ``engine``:
@@ -171,6 +217,8 @@ def _write_results(scene: Scene, updates: list, hours: float, limit: float | Non
     data = store.summary(scene, updates, hours, limit, wall)
     data["engine"] = engine
     ended = ended_by_limit(scene, updates)
+    if ended is None and reached_limit:  # run until the clearance limit: the last update extrapolates up to it
+        ended = f"the effective clearance reaches the limit {limit * 1e3:g} mm (--limit-clearance-mm)"
     data["ended"] = ended
     data["failure"] = failure
     if ended is not None:  # the last update extrapolates up to the limit: report the state there

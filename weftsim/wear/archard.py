@@ -42,22 +42,13 @@ def contact_rows(prm: np.ndarray, time: np.ndarray, states: np.ndarray, contact:
     ``psi_b``, ``psi_j``: the contact direction n in the bearing's (rocker) and the journal's (rod)
     frame; ``phi0``: half the contact arc (:func:`weftsim.kernel.wear.contact_half_angle`).  Rows
     out of contact have F_N = 0.  The dry law's F_N is the reference kernel's (:func:`weftsim.kernel.chain.chain`
-    with the run's modes and held impact velocities), v_T the contact points' sliding velocity
-    (:func:`weftsim.kernel.joint.tangential_velocity`); the rest is :func:`rows_from_contact`.
+    with the run's modes and held impact velocities); the rest is :func:`rows_from_contact`.
     """
     d = np.empty(6)
     f_dry = np.zeros(time.size)
-    v_t = np.zeros(time.size)
     for i in range(time.size):
-        t = time[i]
-        y = states[i]
-        f_dry[i] = chain(prm, t, y, contact[i], impact[i], d)[1]
-        ecc_y, ecc_z, v_y, v_z, _, _, dphi = eccentricity(prm, t, y)[:7]
-        length = math.sqrt(ecc_y * ecc_y + ecc_z * ecc_z)
-        if length > 0.0:
-            v_t[i] = tangential_velocity(ecc_y, ecc_z, v_y, v_z, length, y[3], prm[OMEGA] * dphi,
-                                         prm[BEARING_RADIUS])  # fmt: skip
-    rows_from_contact(prm, time, states, f_dry, v_t, out)
+        f_dry[i] = chain(prm, time[i], states[i], contact[i], impact[i], d)[1]
+    rows_from_contact(prm, time, states, f_dry, np.full(time.size, np.nan), out)
 
 
 @njit(cache=True, error_model="numpy")
@@ -65,6 +56,8 @@ def rows_from_contact(prm: np.ndarray, time: np.ndarray, states: np.ndarray, f_d
                       out: np.ndarray) -> None:
     """:func:`contact_rows` from an engine's own contact channels: the dry law's normal force ``f_dry`` (n,) N
     and the sliding velocity ``v_t`` (n,) m/s at the states (n, >= 4: a, psi, a', psi') and times given.
+    A NaN in ``v_t`` (a row where the engine applied no dry contact, e.g. the asperities of a lubricated joint
+    alone): the contact points' sliding velocity at the state (:func:`weftsim.kernel.joint.tangential_velocity`).
 
     The contact angles, the arc and, for a lubricated joint, the asperity load come from the state at the
     local clearance (:func:`weftsim.kernel.chain.local_clearance`): every engine's run goes through the
@@ -74,7 +67,7 @@ def rows_from_contact(prm: np.ndarray, time: np.ndarray, states: np.ndarray, f_d
         t = time[i]
         y = states[i]
         f_n = f_dry[i]
-        ecc_y, ecc_z, v_y, v_z = eccentricity(prm, t, y)[:4]
+        ecc_y, ecc_z, v_y, v_z, _, _, dphi = eccentricity(prm, t, y)[:7]
         length = math.sqrt(ecc_y * ecc_y + ecc_z * ecc_z)
         out[i, :] = 0.0
         c = local_clearance(prm, t, ecc_y, ecc_z, v_y, v_z, y)[0]
@@ -90,7 +83,10 @@ def rows_from_contact(prm: np.ndarray, time: np.ndarray, states: np.ndarray, f_d
         if f_n > 0.0 and length > 0.0:
             direction = math.atan2(ecc_z, ecc_y)
             out[i, 0] = f_n
-            out[i, 1] = v_t[i]
+            v = v_t[i]
+            if v != v:  # NaN: from the state
+                v = tangential_velocity(ecc_y, ecc_z, v_y, v_z, length, y[3], prm[OMEGA] * dphi, prm[BEARING_RADIUS])
+            out[i, 1] = v
             out[i, 2] = direction - rocker_angle(prm, t)
             out[i, 3] = direction - y[1]
             out[i, 4] = half_angle

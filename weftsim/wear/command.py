@@ -20,7 +20,8 @@ if TYPE_CHECKING:
 def add_flags(p: argparse.ArgumentParser, positive: Callable[[Callable[[str], float]], Callable[[str], float]]) -> None:
     """Flags of ``weftsim wear SCENE --hours H [--engine E] [--limit-clearance-mm X]`` beside the shared
     scene and output flags."""
-    p.add_argument("--hours", type=positive(float), help="operating hours to predict (not with --uncertain: an "
+    p.add_argument("--hours", type=positive(float), help="operating hours to predict (without it, with "
+                   "--limit-clearance-mm: until the clearance reaches the limit; not with --uncertain: an "
                    "ensemble runs each prediction to --limit-clearance-mm)")
     p.add_argument("--engine", default="reference", help="engine of each update's simulation: reference (default) "
                    "or exudyn (its kinematic tree; default output out/<scene name>/wear-exudyn; docs/wear.md)")
@@ -50,19 +51,22 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     from weftsim.output import prepare_directory
     from weftsim.progress import Progress
     from weftsim.wear import WearError, check_request, predict_to_directory
-    from weftsim.wear.extrapolate import update_time
+    from weftsim.wear.extrapolate import MAX_HOURS, update_time
     from weftsim.wear.store import StateMismatch
 
     limit = None if args.limit_clearance_mm is None else args.limit_clearance_mm * 1e-3
     if args.uncertain:
         return run_ensemble(args, scene, outdir, stop_on_interrupt)
-    if args.hours is None:
-        raise CliError("--hours is required (or --uncertain KEY=DISTRIBUTION with --limit-clearance-mm for an "
-                       "ensemble)")
-    check_request(scene, args.hours, args.engine, limit)  # a WearError is one line, exit 2
+    if args.hours is None and limit is None:
+        raise CliError("--hours or --limit-clearance-mm is required (or --uncertain KEY=DISTRIBUTION with "
+                       "--limit-clearance-mm for an ensemble)")
+    until_limit = args.hours is None  # predict until the clearance limit
+    hours = MAX_HOURS if until_limit else args.hours
+    check_request(scene, hours, args.engine, limit)  # a WearError is one line, exit 2
     outdir = prepare_directory(outdir, args.force, scene)
     resumed = _stored_updates(outdir, scene, args.force)
-    print(f"scene {scene.name}, wear at E over {args.hours:g} h on the {args.engine} engine; each update simulates "
+    span = f"until the clearance reaches {args.limit_clearance_mm:g} mm" if until_limit else f"over {hours:g} h"
+    print(f"scene {scene.name}, wear at E {span} on the {args.engine} engine; each update simulates "
           f"{scene.joint.wear.settle_revolutions} + {scene.joint.wear.revolutions_per_update} revolutions "
           f"(~{_duration(update_time(scene, args.engine))}), the update interval grows the clearance by at most "
           f"{100 * scene.joint.wear.max_clearance_change:g} %", file=sys.stderr, flush=True)
@@ -72,9 +76,9 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     progress = Progress(f"wear {scene.name}")
     with stop_on_interrupt("wear") as state:
         try:
-            data = predict_to_directory(scene, args.hours, outdir, args.engine, limit, progress,
+            data = predict_to_directory(scene, hours, outdir, args.engine, limit, progress,
                                         stop=lambda: state["signal"] is not None, figures=not args.no_plot,
-                                        force=args.force)
+                                        force=args.force, until_limit=until_limit)
         except StateMismatch as exc:
             raise CliError(str(exc)) from None
         except WearError as exc:  # the updates before it are written (the message says where)
@@ -98,8 +102,9 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     for path in data["files"].values():
         print(f"  wrote {path}")
     if data.get("ended"):
-        print(f"  the prediction ends at {data['hours_reached']:.6g} h of the {args.hours:g} asked for: "
-              f"{data['ended']}; nothing beyond it is predicted")
+        asked = "" if until_limit else f" of the {hours:g} asked for"
+        print(f"  the prediction ends at {data['hours_reached']:.6g} h{asked}: {data['ended']}; nothing beyond "
+              "it is predicted")
         return 0
     if not data["complete"]:
         raise CliError(f"interrupted: stopped after {data['hours_reached']:.6g} h; the state is in {outdir}: run the "

@@ -53,14 +53,11 @@ def engine_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray, engine
 def exudyn_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray) -> tuple[RunWear, dict]:
     """:func:`engine_update` on the Exudyn engine (module docstring); raises
     :class:`~weftsim.wear.extrapolate.UpdateFailed` when every attempt of the run fails."""
-    from weftsim.exudyn_engine.worn import solve_worn
+    from weftsim.exudyn_engine.worn import ATTEMPTS, solve_worn
+    from weftsim.guards import stop_requested
     from weftsim.reference.dynamics import pack_parameters
     from weftsim.wear.archard import rows_from_contact, wear_from_rows
-    from weftsim.wear.extrapolate import wear_response, worn_scene
-
-    from weftsim.exudyn_engine.worn import ATTEMPTS
-    from weftsim.guards import stop_requested
-    from weftsim.wear.extrapolate import UpdateFailed, WearInterrupted
+    from weftsim.wear.extrapolate import UpdateFailed, WearInterrupted, wear_response, worn_scene
 
     w = scene.joint.wear
     run_scene = worn_scene(scene, bearing, journal, w.settle_revolutions + w.revolutions_per_update)
@@ -75,7 +72,10 @@ def exudyn_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray) -> tup
                            f"{ATTEMPTS[1][1]:g} and on the implicit tree): {result.message}")
     keep = t >= w.settle_revolutions * scene.drive.period
     rows = np.zeros((int(keep.sum()), 5))
+    # The callback's v_T where it applied a dry contact; elsewhere (a lubricated joint's asperities alone) the
+    # sliding velocity at the state, as on the reference engine
+    sliding = np.ascontiguousarray(np.where(f_n[keep] > 0.0, v_t[keep], np.nan))
     rows_from_contact(pack_parameters(run_scene), np.ascontiguousarray(t[keep]), np.ascontiguousarray(states[keep]),
-                      np.ascontiguousarray(f_n[keep]), np.ascontiguousarray(v_t[keep]), rows)  # fmt: skip
+                      np.ascontiguousarray(f_n[keep]), sliding, rows)  # fmt: skip
     wear = wear_from_rows(run_scene.joint, t[keep], rows)
     return wear, wear_response(scene, wear, result.steps, rtol)
