@@ -210,3 +210,23 @@ def test_a_worn_lubricated_joint_agrees_between_the_engines():
     assert out["exudyn"][1] == pytest.approx(out["reference"][1], rel=1e-3)
     round_scene = replace(scene, drive=replace(scene.drive, revolutions=0.5))
     assert reference.solve(round_scene).steps["film_ratio"].min() < 0.995 * out["reference"][0]
+
+
+def test_cli_wear_to_the_limit_without_hours_ends_exactly_at_it(tmp_path):
+    """``weftsim wear SCENE --limit-clearance-mm X`` (no --hours) predicts until the effective clearance reaches
+    X: the crossing update is cut there, so the final clearance is X and the hours at the limit are the hours
+    reached; run again, it resumes and ends at the same point."""
+    out = tmp_path / "w"
+    runs = []
+    for _ in range(2):
+        run = subprocess.run([sys.executable, "-m", "weftsim.cli", "wear", "reference", "--limit-clearance-mm", "0.26",
+                              "--no-plot", "-o", str(out)], capture_output=True, text=True)  # fmt: skip
+        assert run.returncode == 0, run.stderr
+        assert "until the clearance reaches 0.26 mm" in run.stderr
+        runs.append(json.loads((out / "wear.json").read_text()))
+    for data in runs:
+        assert data["final_effective_clearance_mm"] == pytest.approx(0.26, rel=1e-12)
+        assert data["hours_to_limit"] == pytest.approx(data["hours_reached"], rel=1e-12)
+        assert "reaches the limit 0.26 mm" in data["ended"]
+        assert data["profile_volume_mm3"] == pytest.approx(data["archard_volume_mm3"], rel=1e-9)
+    assert runs[1]["hours_reached"] == runs[0]["hours_reached"]  # the resume re-simulates the last update
