@@ -230,3 +230,14 @@ def test_cli_wear_to_the_limit_without_hours_ends_exactly_at_it(tmp_path):
         assert "reaches the limit 0.26 mm" in data["ended"]
         assert data["profile_volume_mm3"] == pytest.approx(data["archard_volume_mm3"], rel=1e-9)
     assert runs[1]["hours_reached"] == runs[0]["hours_reached"]  # the resume re-simulates the last update
+
+
+def test_a_state_of_one_engine_is_not_resumed_on_the_other(tmp_path):
+    out = tmp_path / "w"
+    first = subprocess.run([sys.executable, "-m", "weftsim.cli", "wear", "reference", "--hours", "0.5", "--no-plot",
+                            "-o", str(out)], capture_output=True, text=True)  # fmt: skip
+    assert first.returncode == 0, first.stderr
+    other = subprocess.run([sys.executable, "-m", "weftsim.cli", "wear", "reference", "--hours", "1", "--engine",
+                            "exudyn", "--no-plot", "-o", str(out)], capture_output=True, text=True)  # fmt: skip
+    assert other.returncode == 2 and "on the reference engine" in other.stderr and "--engine reference" in other.stderr
+    assert len(other.stderr.strip().splitlines()) == 1 and "Traceback" not in other.stderr

@@ -28,7 +28,7 @@ if TYPE_CHECKING:
 
     from weftsim.params import Scene
 
-__all__ = ["ENGINES", "WearError", "predict", "predict_to_directory"]
+__all__ = ["ENGINES", "WearError", "check_engine", "predict", "predict_to_directory"]
 
 
 def __getattr__(name: str):
@@ -74,6 +74,32 @@ def check_request(scene: Scene, hours: float, engine: str, limit: float | None) 
                         "(docs/wear.md); set joint_f.clearance_mm = 0 or leave out [joint_f]")
     if scene.joint.is_ideal:
         raise WearError("joint_e.clearance_mm is 0 (ideal joint): there is no contact to wear; give a clearance > 0")
+
+
+def check_engine(outdir: str | Path, engine: str, force: bool = False) -> None:
+    """Refuse to resume a wear state that ``outdir`` holds from another engine (its record names the engine;
+    a record without one is the reference engine's); with ``force`` that state is deleted (starting over)."""
+    import json
+
+    from weftsim.record import MANIFEST
+    from weftsim.wear.store import STATE, StateMismatch
+
+    outdir = Path(outdir)
+    if not ((outdir / MANIFEST).is_file() and (outdir / STATE).is_file()):
+        return
+    try:
+        record = json.loads((outdir / MANIFEST).read_text())
+    except (OSError, ValueError):
+        return  # a damaged record is refused where it is read (weftsim.output, weftsim.record)
+    stored = record.get("engine", "reference") if isinstance(record, dict) and record.get("kind") == "wear" else engine
+    if stored == engine:
+        return
+    if force:
+        (outdir / STATE).unlink(missing_ok=True)
+        return
+    raise StateMismatch(f"{outdir / STATE} holds a wear prediction on the {stored} engine, not the {engine} engine "
+                        f"asked for: use --engine {stored} to resume it, another output directory with -o, or "
+                        "--force to start over")
 
 
 def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine: str = "reference",
@@ -125,7 +151,8 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
 
     check_request(scene, hours, engine, limit)
     outdir = prepare_directory(outdir, force, scene)
-    what = {"kind": "wear", "scene": scene.name, **provenance(scene)}  # recorded from the first update on
+    check_engine(outdir, engine, force)
+    what = {"kind": "wear", "scene": scene.name, "engine": engine, **provenance(scene)}  # from the first update on
     begin_directory(outdir, what)  # ours from the first update on: an interrupted prediction resumes here
     wall0 = time.perf_counter()
     done = store.load_state(outdir, scene)

@@ -50,7 +50,7 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     from weftsim.cli_grammar import CliError
     from weftsim.output import prepare_directory
     from weftsim.progress import Progress
-    from weftsim.wear import WearError, check_request, predict_to_directory
+    from weftsim.wear import WearError, check_engine, check_request, predict_to_directory
     from weftsim.wear.extrapolate import MAX_HOURS, update_time
     from weftsim.wear.store import StateMismatch
 
@@ -64,6 +64,10 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     hours = MAX_HOURS if until_limit else args.hours
     check_request(scene, hours, args.engine, limit)  # a WearError is one line, exit 2
     outdir = prepare_directory(outdir, args.force, scene)
+    try:
+        check_engine(outdir, args.engine, args.force)  # a state of the other engine: one line, or --force
+    except StateMismatch as exc:
+        raise CliError(str(exc)) from None
     resumed = _stored_updates(outdir, scene, args.force)
     span = f"until the clearance reaches {args.limit_clearance_mm:g} mm" if until_limit else f"over {hours:g} h"
     print(f"scene {scene.name}, wear at E {span} on the {args.engine} engine; each update simulates "
