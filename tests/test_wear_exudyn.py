@@ -241,3 +241,57 @@ def test_a_state_of_one_engine_is_not_resumed_on_the_other(tmp_path):
                             "exudyn", "--no-plot", "-o", str(out)], capture_output=True, text=True)  # fmt: skip
     assert other.returncode == 2 and "on the reference engine" in other.stderr and "--engine reference" in other.stderr
     assert len(other.stderr.strip().splitlines()) == 1 and "Traceback" not in other.stderr
+
+
+def _free_impact(joint, law, start: float, speed: float, end_time: float = 2e-4):
+    """A mass-point journal moving along +x from (start, 0) at ``speed`` into a bearing on the ground (the reusable
+    connector, generalized-alpha at rho = 1, h = 1e-7 s); returns (first contact time, largest F_N, final velocity)."""
+    import exudyn as exu
+    from exudyn.itemInterface import MarkerBodyPosition, MarkerNodePosition, NodePoint2D, ObjectMassPoint2D, SensorObject
+
+    from weftsim.exudyn_engine import add_clearance_joint
+
+    sc = exu.SystemContainer()
+    mbs = sc.AddSystem()
+    ground = mbs.CreateGround()
+    node = mbs.AddNode(NodePoint2D(referenceCoordinates=[start, 0.0], initialVelocities=[speed, 0.0]))
+    mbs.AddObject(ObjectMassPoint2D(nodeNumber=node, mass=1.0))
+    bearing = mbs.AddMarker(MarkerBodyPosition(bodyNumber=ground, localPosition=[0.0, 0.0, 0.0]))
+    model = add_clearance_joint(mbs, bearing, mbs.AddMarker(MarkerNodePosition(nodeNumber=node)), joint, law=law)
+    force = mbs.AddSensor(SensorObject(objectNumber=model.connector, outputVariableType=exu.OutputVariableType.Force,
+                                       storeInternal=True, writeToFile=False))  # fmt: skip
+    mbs.Assemble()
+    model.reset(mbs)
+    ss = exu.SimulationSettings()
+    ti = ss.timeIntegration
+    ti.endTime, ti.numberOfSteps = end_time, round(end_time / 1e-7)
+    ti.generalizedAlpha.spectralRadius = 1.0
+    ti.discontinuous.ignoreMaxIterations = False
+    ti.verboseMode = 0
+    ss.solution.file.write = False
+    ss.solution.sensors.writePeriod = 0.0
+    ss.solution.solverInformationFileName = ""
+    assert exu.MainSolverImplicitSecondOrder().SolveSystem(mbs, ss)
+    f = mbs.GetSensorStoredData(force)
+    velocity = mbs.GetNodeOutput(node, exu.OutputVariableType.Velocity)[0]
+    return model.tracker.first_contact_time, float(np.hypot(f[:, 1], f[:, 2]).max()), velocity
+
+
+def test_the_reusable_connector_sees_a_worn_spot_as_the_clearance_there():
+    """``add_clearance_joint`` on a joint worn at one spot of the bearing (0.5 c0 deep at 0 deg of the ground's
+    frame): a journal moving straight into the spot meets the wall at c0 + h and rebounds as from a round joint
+    of clearance c0 + h with the same law, to round-off (a mass point and the ground: both frames at angle 0)."""
+    from weftsim.contact import make_law
+    from weftsim.params import ClearanceJoint
+
+    c0, speed, gap = 0.25e-3, 0.5, 1e-6
+    joint = ClearanceJoint(clearance=c0, law="variable_kd")
+    psi = 2.0 * np.pi * np.arange(360) / 360
+    spot = 0.5 * c0 * np.exp(-0.5 * (np.angle(np.exp(1j * psi)) / 0.3) ** 2)  # h(0) = 0.5 c0 exactly
+    law = make_law(joint)
+    worn = _free_impact(replace(joint, bearing_wear=tuple(spot)), law, 1.5 * c0 - gap, speed)
+    wider = _free_impact(replace(joint, clearance=1.5 * c0), law, 1.5 * c0 - gap, speed)
+    assert worn[0] == pytest.approx(gap / speed, rel=1e-9)  # the onset interpolation is exact in free flight
+    for a, b in zip(worn, wider):
+        assert a == pytest.approx(b, rel=1e-9)  # Catmull-Rom at a knot returns the knot's depth to round-off
+    assert worn[2] < 0.0  # the journal came back from the worn wall
