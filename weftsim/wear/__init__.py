@@ -150,6 +150,8 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
     from weftsim.wear.extrapolate import predict
 
     check_request(scene, hours, engine, limit)
+    if until_limit and limit is None:
+        raise WearError("until_limit needs a clearance limit (--limit-clearance-mm)")
     outdir = prepare_directory(outdir, force, scene)
     check_engine(outdir, engine, force)
     what = {"kind": "wear", "scene": scene.name, "engine": engine, **provenance(scene)}  # from the first update on
@@ -180,8 +182,6 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
 
     asked_stop = stop
     if until_limit:
-        if limit is None:
-            raise WearError("until_limit needs a clearance limit (--limit-clearance-mm)")
 
         def stop() -> bool:
             return (asked_stop is not None and asked_stop()) or (bool(latest) and _beyond(scene, latest[-1], limit))
