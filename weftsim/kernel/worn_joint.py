@@ -18,16 +18,12 @@ the same functions as the loom's reference chain and kinematic tree.  The parame
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
 from numba import njit
 
 from weftsim.kernel.joint import CLEARANCE, N_JOINT, connector_friction_force_at
 from weftsim.kernel.lubricated import connector_lubricated_force_at
 from weftsim.kernel.wear import worn_clearance
-
-if TYPE_CHECKING:
-    import numpy as np
 
 WEAR_BLOCK = N_JOINT  # the wear block's start in the connector's parameters
 
