@@ -3,7 +3,7 @@ keys that describe a joint which is ideal in the scene (and so would change noth
 
 Joint F (rod 4 - sector 5) is ideal unless a scene gives ``joint_f.clearance_mm > 0``.  Given a
 clearance on its own, F takes every other key of ``[joint_e]`` (pin, bearing, law, restitution,
-friction, materials; not the wear table) unless the scene or the command line gives it for F:
+friction, materials, the wear table) unless the scene or the command line gives it for F:
 :func:`inherit_joint_f`.  The scene remembers which keys F took (``Scene.joint_f_inherits``), so an
 override of E's pin in a sweep cell moves F's pin with it (:func:`resync_joint_f`).
 

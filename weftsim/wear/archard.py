@@ -133,6 +133,8 @@ class RunWear:
     journal_volume: float
     sliding_work: float
     sliding_distance: float  # int |v_T| dt in contact, m
+    joint: str = "e"  # the joint worn ("e" or "f")
+    second: RunWear | None = None  # joint F's wear when E and F wear in the same run
 
 
 def wear_from_rows(joint: ClearanceJoint, time: np.ndarray, rows: np.ndarray) -> RunWear:
