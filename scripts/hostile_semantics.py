@@ -98,7 +98,7 @@ CASES = [
                           "joint_e.wear.bearing_hardness_mpa=1", "--hours", "1", "--no-plot"], "fail", ["too fast"]),
     ("wear-slope-limit", ["wear", "reference", "--set", "joint_e.journal_radius_mm=3", "--set",
                           "joint_e.wear.wear_coefficient=1e-4", "--hours", "1e5", "--no-plot"], "ok",
-     lambda d, o, e: wearjson(d)["ended"] and "ends at" in o and wearjson(d)["final_effective_clearance_mm"] < 3),
+     lambda d, o, e: wearjson(d)["ended"] and "ends at" in o and wearjson(d)["final_effective_clearance_e_mm"] < 3),
     ("wear-limit-beyond-radius", ["wear", "reference", "--limit-clearance-mm", "100", "--hours", "1"], "refuse",
      ["--limit-clearance-mm", "journal radius"]),
     ("wear-1mm-journal", ["wear", "reference", "--set", "joint_e.journal_radius_mm=1", "--hours", "100", "--no-plot"],

@@ -233,6 +233,9 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
     if not (isinstance(chaos_runs, int) and 1 <= chaos_runs <= 50):
         raise WearError(f"--chaos-runs must be a whole number from 1 to 50, got {chaos_runs!r}")
     check_request(scene, 1.0, "reference", limit)
+    if not scene.joint_f.is_ideal:  # its H/k rescaling and its clearance curve are joint E's
+        raise WearError("an ensemble predicts the wear at E with F ideal so far; `weftsim wear SCENE --hours H` "
+                        "predicts F and E with F (docs/wear.md); set joint_f.clearance_mm = 0 for the ensemble")
     job_list, dynamic, nodes = plan(scene, parsed, chaos_runs)
     for name, s in job_list:
         if not limit > s.joint.clearance:
