@@ -295,3 +295,14 @@ def test_joint_f_wear_keys_in_a_scene(tmp_path):
     ideal.write_text(f'extends = "{base}"\nname = "ideal"\n[joint_f.wear]\nwear_coefficient = 3e-7\n')
     with pytest.raises(SceneError, match="joint_f"):
         load_scene(ideal)
+
+
+def test_an_ensemble_of_a_scene_with_clearance_at_f_is_refused_in_one_line(tmp_path):
+    """The ensemble's H/k rescaling and its clearance curve are joint E's: a clearance at F is refused up front."""
+    from weftsim.errors import WearError
+    from weftsim.wear.ensemble import wear_ensemble
+
+    with pytest.raises(WearError) as caught:
+        wear_ensemble(_scene("ef"), ["joint_e.wear.wear_coefficient=lognormal(1e-7,0.5)"], 100, 0.3e-3,
+                      tmp_path / "ens")
+    assert "F ideal" in str(caught.value) and "\n" not in str(caught.value)
