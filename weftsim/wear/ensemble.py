@@ -258,7 +258,7 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
     sim_wall = time.perf_counter() - wall0
     ens = combine(scene, parsed, dynamic, nodes, results, samples, limit, seed, levels)
     hours, lv = ens["hours"], ens["levels"]
-    band = {"clearance_mm": 1e3 * lv}
+    band = {"clearance_e_mm": 1e3 * lv}  # the joint in the name, as in wear.csv
     for p in QUANTILES:
         band[f"hours_p{round(100 * p)}"] = np.quantile(hours, p, axis=0)
     by_level = {f"{1e3 * lv[i]:.6g}": quantile_table(hours[:, i]) for i in range(lv.size)
@@ -289,7 +289,7 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
     }
     table = {f"{k}": np.asarray(v, dtype=float) for k, v in ens["values"].items()}
     table["chaos_run"] = ens["chaos_draw"].astype(float)
-    table["hours_to_limit"] = hours[:, -1]
+    table["hours_to_limit_e"] = hours[:, -1]
     files = {
         "samples": ("ensemble.csv", lambda p: write_csv(p, table)),
         "band": ("ensemble_band.csv", lambda p: write_csv(p, band)),
