@@ -122,5 +122,6 @@ def inheritance_note(scene: Scene) -> str | None:
         return None
     names = scene.joint_f_inherits
     listed = ", ".join(names) if len(names) <= 4 else f"{', '.join(names[:4])} and {len(names) - 4} more"
-    return (f"joint F (clearance {scene.joint_f.clearance * 1e3:g} mm) takes the pin, law and materials of "
+    what = "pin, law, materials and wear keys" if any(n.startswith("wear.") for n in names) else "pin, law and materials"
+    return (f"joint F (clearance {scene.joint_f.clearance * 1e3:g} mm) takes the {what} of "
             f"joint E where [joint_f] does not give them: {listed}; set joint_f.<key> to differ")
