@@ -306,3 +306,16 @@ def test_an_ensemble_of_a_scene_with_clearance_at_f_is_refused_in_one_line(tmp_p
         wear_ensemble(_scene("ef"), ["joint_e.wear.wear_coefficient=lognormal(1e-7,0.5)"], 100, 0.3e-3,
                       tmp_path / "ens")
     assert "F ideal" in str(caught.value) and "\n" not in str(caught.value)
+
+
+@pytest.mark.parametrize("topology", ["f", "ef"])
+def test_round_chains_with_clearance_at_f_are_unchanged_bit_for_bit(topology):
+    """Half a revolution of clearance_ef (F alone, E and F) without wear: the channels main gave before F could
+    wear, to the last bit (the worn-clearance reads return the round clearance unchanged)."""
+    before = json.loads((REGRESSION / "clearance_f_round_before_joint_f_wear.json").read_text())
+    result = reference.solve(_scene(topology, revolutions=0.5))
+    assert result.ok
+    for key, digest in before.items():
+        name, _, channel = key.partition(":")
+        if name == topology:
+            assert _sha(result.steps[channel]) == digest, channel

@@ -189,6 +189,8 @@ def local_clearances(prm: np.ndarray, t: float, y: np.ndarray, q: tuple) -> tupl
     bearing is the sector's eye (a = theta_FG) and the journal the rod's pin (psi).  Profiles are tables
     over each body's own frame, so the same wear tables serve E in either chain.
     """
+    if prm.size <= kc.WEAR_E:  # no wear tables (every run but a wear update's): the round clearances
+        return prm[CLEARANCE], 0.0, prm[JOINT_F + CLEARANCE], 0.0
     psi = y[3] if prm[TOPOLOGY] == E_AND_F else y[1]
     w_rocker, dpsi, da = q[8], q[9], q[10]
     c_e, rate_e = prm[CLEARANCE], 0.0
