@@ -319,3 +319,23 @@ def test_round_chains_with_clearance_at_f_are_unchanged_bit_for_bit(topology):
         name, _, channel = key.partition(":")
         if name == topology:
             assert _sha(result.steps[channel]) == digest, channel
+
+
+def test_a_worn_lubricated_f_has_its_film_on_the_worn_clearance():
+    """With an oil film at F, the film thickness channel is h_min = max(c - |e_F|, 0) with the worn c of the
+    hand-computed lobe (the film, its asperity load and their energy see the worn wall, as the contact does)."""
+    scene = load_scene(MODELS / "clearance_ef.toml", {"joint_e.clearance_mm": 0.0, "drive.revolutions": 0.2,
+                                                       "joint_f.lubrication.viscosity_mpa_s": 20.0})
+    bearing, h_b, _ = _lobe(20e-6, 1.0)
+    worn = dc.replace(scene, joint_f=dc.replace(scene.joint_f, bearing_wear=tuple(bearing), journal_wear=(0.0,) * N))
+    rows = {}
+    result = reference.solve(worn, step_states=lambda *a: rows.update(steps=a))
+    assert result.ok, result.message
+    t, y = rows["steps"][:2]
+    prm = pack_parameters(scene)
+    film = result.steps["film_thickness_f_m"]
+    for i in np.linspace(0, t.size - 1, 30).astype(int):
+        e_y, e_z = kf.eccentricities(prm, t[i], y[i])[4:6]
+        c = scene.joint_f.clearance + h_b(math.atan2(e_z, e_y) - y[i][0])
+        # The Hermite table is within 8.5e-13 m of the lobe (above); 1e-10 m holds it with margin.
+        assert film[i] == pytest.approx(max(c - math.hypot(e_y, e_z), 0.0), abs=1e-10)
