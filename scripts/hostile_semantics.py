@@ -52,8 +52,11 @@ CASES = [
      ["joint_f.friction_coefficient"]),
     ("f-on-ideal-scene", ["run", "ideal", "--set", "joint_f.clearance_mm=0.25", R, "0.05", "--engine", "reference"],
      "ok", lambda d, o, e: summary(d)["scene"]["joint_f.clearance_mm"] == 0.25),
-    ("wear-clearance-f", ["wear", "clearance_f", "--hours", "1"], "refuse", ["clearance at F"]),
-    ("wear-set-f", ["wear", "reference", "--set", "joint_f.clearance_mm=0.25", "--hours", "1"], "refuse", ["clearance at F"]),
+    # Wear at F exists now (issue 26, part 3): both wear, and wear.json names the joints.
+    ("wear-clearance-f", ["wear", "clearance_f", "--hours", "1", "--no-plot"], "ok",
+     lambda d, o, e: wearjson(d)["joints"] == ["f"]),
+    ("wear-set-f", ["wear", "reference", "--set", "joint_f.clearance_mm=0.25", "--hours", "1", "--no-plot"], "ok",
+     lambda d, o, e: wearjson(d)["joints"] == ["e", "f"]),
     ("sweep-f-0-and-loose", ["sweep", "reference", "--vary", "joint_f.clearance_mm=0,0.25", R, "0.1", "--engine", "reference"],
      "ok", lambda d, o, e: [r.get("contact_force_f_N_rev1_peak", "x") == "" for r in table(d)] == [True, False]),
     ("sweep-ef", ["sweep", "clearance_ef", "--vary", "joint_f.clearance_mm=0.1,0.25", R, "0.1", "--engine", "reference"],
