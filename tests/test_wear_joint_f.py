@@ -339,3 +339,20 @@ def test_a_worn_lubricated_f_has_its_film_on_the_worn_clearance():
         c = scene.joint_f.clearance + h_b(math.atan2(e_z, e_y) - y[i][0])
         # The Hermite table is within 8.5e-13 m of the lobe (above); 1e-10 m holds it with margin.
         assert film[i] == pytest.approx(max(c - math.hypot(e_y, e_z), 0.0), abs=1e-10)
+
+
+def test_the_command_line_wears_f_and_says_which_joint_reaches_the_limit(tmp_path):
+    import subprocess
+    import sys
+
+    out = tmp_path / "w"
+    done = subprocess.run([sys.executable, "-m", "weftsim.cli", "wear", str(MODELS / "clearance_f.toml"), "--hours",
+                           "1", "--limit-clearance-mm", "0.252", "-o", str(out), "--no-plot"],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert "wear at F over 1 h" in done.stderr and "Traceback" not in done.stderr
+    assert "at F: effective clearance 0.25 ->" in done.stdout
+    assert "reached first at F after" in done.stdout
+    data = json.loads((out / "wear.json").read_text())
+    assert data["joints"] == ["f"] and data["limit_joint"] == "f" and 0.0 < data["hours_to_limit_f"] < 1.0
+    assert (out / "wear_profile_f.csv").exists() and not (out / "wear_profile_e.csv").exists()
