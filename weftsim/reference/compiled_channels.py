@@ -23,7 +23,7 @@ from numba import njit
 
 from weftsim.params import Geometry, Inertia, Scene
 from weftsim.kernel.chain import (
-    CLEARANCE, COEF, COUPLING, GRAVITY, KIND, L_EF, L_FG, M11, M22, OMEGA, ROD_MASS, chain, local_clearance, penetration,
+    COEF, COUPLING, GRAVITY, KIND, L_EF, L_FG, M11, M22, OMEGA, ROD_MASS, chain, local_clearance, penetration,
 )  # fmt: skip
 from weftsim.kernel import chain_f as kf
 from weftsim.kernel.laws import elastic_energy

@@ -8,6 +8,7 @@ Public entry::
   contact arc (compiled; the reference engine's right-hand side reads the worn geometry);
 - :mod:`.archard`: the wear of one run from its step rows;
 - :mod:`.extrapolate`: the cycle extrapolation with the adaptive update interval;
+- :mod:`.updates`: the updates (each joint's profiles and rates) and their advance;
 - :mod:`.store`: the resumable state and the tables; :mod:`.figures`: the figures.
 
 Every loose joint wears, each with its own ``[joint_e.wear]`` / ``[joint_f.wear]`` numbers: E, F, or E
