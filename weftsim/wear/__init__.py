@@ -12,9 +12,9 @@ Public entry::
 - :mod:`.store`: the resumable state and the tables; :mod:`.figures`: the figures.
 
 Every loose joint wears, each with its own ``[joint_e.wear]`` / ``[joint_f.wear]`` numbers: E, F, or E
-and F together (one run simulates both; :func:`~.extrapolate.wearing_joints`).  A worn F's tables
+and F together (one run simulates both; :func:`~.updates.wearing_joints`).  A worn F's tables
 follow E's in the kernel parameter array (:mod:`weftsim.kernel.chain_f`), its profiles are
-:attr:`~.extrapolate.Update.second` (or the first when E is ideal), and every output names the joint
+:attr:`~.updates.Update.second` (or the first when E is ideal), and every output names the joint
 (``effective_clearance_f_mm``, ``wear_profile_f.png``).  A ``--limit-clearance-mm`` applies to every
 wearing joint: ``hours_to_limit`` is the first joint's to reach it (``limit_joint``), each joint's is
 ``hours_to_limit_<j>``.

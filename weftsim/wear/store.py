@@ -5,7 +5,7 @@ Every name of a joint's quantity carries the joint's letter (docs/wear.md sectio
 ``wear_profile_journal_f.csv``; summary keys ``hours_to_limit_e``.  The mechanism's (hours, rapier,
 torque) carry none.
 
-The state (``wear_state.npz``) holds every :class:`~weftsim.wear.extrapolate.Update` and the scene
+The state (``wear_state.npz``) holds every :class:`~weftsim.wear.updates.Update` and the scene
 it belongs to; it is rewritten (atomically) after each update, so an interrupted prediction
 resumes at its last update (docs/wear.md section 4).
 """
