@@ -41,7 +41,7 @@ from weftsim.kernel.joint import (  # noqa: F401 - the joint block is part of th
 from weftsim.kernel.laws import elastic_force
 from weftsim.kernel.lubricated import L_DISSIPATED, L_FX, L_FY, L_MB, L_MJ, is_lubricated, lubricated_force
 from weftsim.kernel.lubricated import connector_lubricated_force
-from weftsim.kernel.wear import worn_clearance
+from weftsim.kernel.wear import clearance_along
 
 if TYPE_CHECKING:
     import numpy as np
@@ -98,13 +98,9 @@ def local_clearance(prm: np.ndarray, t: float, ecc_y: float, ecc_z: float, v_y: 
     """
     if prm.size <= WEAR_E:
         return prm[CLEARANCE], 0.0
-    direction = math.atan2(ecc_z, ecc_y)
-    length2 = ecc_y * ecc_y + ecc_z * ecc_z
-    turn = (ecc_y * v_z - ecc_z * v_y) / length2 if length2 > 0.0 else 0.0
     theta = prm[OMEGA] * t
     w_b = prm[OMEGA] * prm[TAN_BETA] * math.sin(theta) / (1.0 + (prm[TAN_BETA] * math.cos(theta)) ** 2)
-    return worn_clearance(prm, WEAR_E, prm[CLEARANCE], direction - rocker_angle(prm, t), direction - y[1],
-                          turn - w_b, turn - y[3])  # fmt: skip
+    return clearance_along(prm, WEAR_E, prm[CLEARANCE], ecc_y, ecc_z, v_y, v_z, rocker_angle(prm, t), w_b, y[1], y[3])
 
 
 @njit(cache=True, error_model="numpy")
