@@ -1,4 +1,4 @@
-"""The wear prediction on both engines side by side (docs/wear.md section 10).
+"""The wear prediction on both engines side by side (docs/wear.md section 11).
 
 For each engine, ``--runs`` predictions of SCENE until the effective clearance reaches ``--limit-mm``, the
 j-th with the wear coefficient j units in the last place larger (the ensemble's chaos runs), printing the

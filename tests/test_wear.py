@@ -193,7 +193,7 @@ def test_cli_wear_resumes_and_refuses_bad_input(tmp_path):
     assert data["updates"] > n1 and data["hours_reached"] == pytest.approx(4.0)
     assert 0.0 < data["hours_to_limit"] < 4.0
     table = np.genfromtxt(out / "wear.csv", delimiter=",", names=True)
-    assert table["hours"][0] == 0.0 and np.all(np.diff(table["effective_clearance_mm"]) >= 0.0)
+    assert table["hours"][0] == 0.0 and np.all(np.diff(table["effective_clearance_e_mm"]) >= 0.0)
     other = run_cli("wear", REFERENCE, "--hours", 4, "--speed-rpm", 500, "-o", out)
     assert other.returncode == 2 and "another scene" in other.stderr
     forced = run_cli("wear", REFERENCE, "--hours", 1, "--speed-rpm", 500, "-o", out, "--no-plot", "--force")

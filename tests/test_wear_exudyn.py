@@ -16,6 +16,7 @@ import pytest
 
 from weftsim import exudyn_engine, reference
 from weftsim.kernel import chain as kc
+from weftsim.kernel.wear import worn_clearance
 from weftsim.reference.dynamics import pack_parameters
 from weftsim.scene import load_scene
 from weftsim.wear import WearError, check_request
@@ -59,7 +60,7 @@ def test_the_tree_contact_reads_the_same_worn_clearance_as_the_reference_chain()
         assert tree[2] == pytest.approx(delta, abs=1e-15) and tree[3] == pytest.approx(rate, rel=1e-9, abs=1e-12)
         ecc_y, ecc_z = kc.eccentricity(prm, t, y)[:2]
         direction = math.atan2(ecc_z, ecc_y)
-        depth = (kc.worn_clearance(prm, kc.WEAR_E, 0.0, direction - kc.rocker_angle(prm, t), direction - y[1], 0.0,
+        depth = (worn_clearance(prm, kc.WEAR_E, 0.0, direction - kc.rocker_angle(prm, t), direction - y[1], 0.0,
                                    0.0)[0])  # fmt: skip
         # the profile's own value at the direction: linear interpolation is within the table's curvature
         psi_b = (direction - kc.rocker_angle(prm, t)) % (2 * math.pi)
@@ -122,7 +123,7 @@ def test_the_exudyn_update_integrates_archard_over_its_own_contact_channels():
     volume_b = ex.bearing.sum() * scene.joint.bearing_length * scene.joint.bearing_radius * dpsi
     assert volume_b == pytest.approx(cell_b * ex.sliding_work, rel=1e-12)
     assert ex.bearing_volume == pytest.approx(cell_b * ex.sliding_work, rel=1e-15)
-    assert response["sliding_work_per_rev_J"] == pytest.approx(ex.sliding_work, rel=1e-15)
+    assert response["sliding_work_per_rev_e_J"] == pytest.approx(ex.sliding_work, rel=1e-15)
     # the engines: 1e-3 is 5x the difference measured on this update (1.8e-4, the two integrators' error at
     # their default tolerances).  Not the sliding distance: it counts rows of any load, and where the journal
     # crosses the worn spot under a few N the engines end the light contact at different steps (4e-3 apart
@@ -187,7 +188,7 @@ def test_cli_wear_on_exudyn_writes_its_prediction_and_agrees_on_the_first_update
         out[engine] = json.loads((tmp_path / engine / "wear.json").read_text())
         assert out[engine]["engine"] == engine
         # the result checks itself on either engine: the profiles hold Archard's volume
-        assert out[engine]["profile_volume_mm3"] == pytest.approx(out[engine]["archard_volume_mm3"], rel=1e-9)
+        assert out[engine]["profile_volume_e_mm3"] == pytest.approx(out[engine]["archard_volume_e_mm3"], rel=1e-9)
     # 0.0201 mm is reached in the first update: its wear rate alone sets the hours (0.146215 h on the reference
     # engine, 0.146225 h on Exudyn: 7e-5).  1e-3: 5x the engines' difference in the first update's deepest wear
     # (2e-4, measured at their default tolerances, 8e-5 on the journal)
@@ -229,10 +230,10 @@ def test_cli_wear_to_the_limit_without_hours_ends_exactly_at_it(tmp_path):
         assert "until the clearance reaches 0.26 mm" in run.stderr
         runs.append(json.loads((out / "wear.json").read_text()))
     for data in runs:
-        assert data["final_effective_clearance_mm"] == pytest.approx(0.26, rel=1e-12)
+        assert data["final_effective_clearance_e_mm"] == pytest.approx(0.26, rel=1e-12)
         assert data["hours_to_limit"] == pytest.approx(data["hours_reached"], rel=1e-12)
         assert "reaches the limit 0.26 mm" in data["ended"]
-        assert data["profile_volume_mm3"] == pytest.approx(data["archard_volume_mm3"], rel=1e-9)
+        assert data["profile_volume_e_mm3"] == pytest.approx(data["archard_volume_e_mm3"], rel=1e-9)
     assert runs[1]["hours_reached"] == runs[0]["hours_reached"]  # the resume re-simulates the last update
 
 

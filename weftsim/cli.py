@@ -408,7 +408,7 @@ def cmd_animate(args: argparse.Namespace) -> int:
     from weftsim.animate import animated_window, check_format, check_frames, write_animation
     from weftsim.api import resolve_engine
     from weftsim.output import check_file_target
-    from weftsim.record import check_same_scene
+    from weftsim.record import check_same_scene, scene_toml
 
     scene = scene_from_args(args)
     engine = resolve_engine(args.engine)
@@ -430,7 +430,8 @@ def cmd_animate(args: argparse.Namespace) -> int:
         raise CliError(f"simulation failed: {result.message}; nothing animated", EXIT_FAILED)
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
-        frames = write_animation(result, target, frames=args.frames)
+        # The file records its own scene and command: -o may put it where no manifest is written.
+        frames = write_animation(result, target, frames=args.frames, comment=scene_toml(scene))
     except OSError as exc:
         raise CliError(f"cannot write {target}: {exc.strerror or exc}") from None
     from weftsim.animate import clearance_magnification, joint_caption

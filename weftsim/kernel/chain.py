@@ -41,7 +41,7 @@ from weftsim.kernel.joint import (  # noqa: F401 - the joint block is part of th
 from weftsim.kernel.laws import elastic_force
 from weftsim.kernel.lubricated import L_DISSIPATED, L_FX, L_FY, L_MB, L_MJ, is_lubricated, lubricated_force
 from weftsim.kernel.lubricated import connector_lubricated_force_at
-from weftsim.kernel.wear import worn_clearance
+from weftsim.kernel.wear import clearance_along
 
 if TYPE_CHECKING:
     import numpy as np
@@ -96,24 +96,20 @@ def local_clearance(prm: np.ndarray, t: float, ecc_y: float, ecc_z: float, v_y: 
     The bearing turns with the rocker (theta_OE = theta_OE0 + phi, :func:`rocker_angle`), the journal
     with the rod (its axis E -> F along u(psi)); the direction of e turns at (e x e_dot) / |e|^2.
     """
-    return clearance_along(prm, t, ecc_y, ecc_z, v_y, v_z, y[1], y[3])
+    return rod_clearance(prm, t, ecc_y, ecc_z, v_y, v_z, y[1], y[3])
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def clearance_along(prm: np.ndarray, t: float, ecc_y: float, ecc_z: float, v_y: float, v_z: float, psi: float,
-                    dpsi: float) -> tuple[float, float]:
+def rod_clearance(prm: np.ndarray, t: float, ecc_y: float, ecc_z: float, v_y: float, v_z: float, psi: float,
+                  dpsi: float) -> tuple[float, float]:
     """:func:`local_clearance` with the rod's angle psi (rad) and rate (rad/s) given (every engine's state
     has them: the reference's y[1], y[3]; the kinematic tree's q0 + q1 - pi and its rate).  ``prm``: an array,
-    or a list on the plain-Python callback route (hence ``len``)."""
+    or a list on the Exudyn engine's plain-Python callback route (hence ``len``)."""
     if len(prm) <= WEAR_E:
         return prm[CLEARANCE], 0.0
-    direction = math.atan2(ecc_z, ecc_y)
-    length2 = ecc_y * ecc_y + ecc_z * ecc_z
-    turn = (ecc_y * v_z - ecc_z * v_y) / length2 if length2 > 0.0 else 0.0
     theta = prm[OMEGA] * t
     w_b = prm[OMEGA] * prm[TAN_BETA] * math.sin(theta) / (1.0 + (prm[TAN_BETA] * math.cos(theta)) ** 2)
-    return worn_clearance(prm, WEAR_E, prm[CLEARANCE], direction - rocker_angle(prm, t), direction - psi,
-                          turn - w_b, turn - dpsi)  # fmt: skip
+    return clearance_along(prm, WEAR_E, prm[CLEARANCE], ecc_y, ecc_z, v_y, v_z, rocker_angle(prm, t), w_b, psi, dpsi)
 
 
 @njit(cache=True, error_model="numpy")
@@ -217,7 +213,7 @@ def tree_joint_force(prm: np.ndarray, t: float, a: float, q1: float, da: float, 
     A lubricated joint adds its film and asperity force at every state
     (:func:`weftsim.kernel.lubricated.connector_lubricated_force`; F_b, M_j and M_b include them).  A worn
     joint (the wear block at :data:`WEAR_E`) takes the local clearance c0 + h_b + h_j along e and its rate
-    (:func:`clearance_along`, the rod's angle psi = b - pi), as :func:`chain` does: delta and delta_dot are then
+    (:func:`rod_clearance`, the rod's angle psi = b - pi), as :func:`chain` does: delta and delta_dot are then
     |e| - c and e_dot . n - dc/dt.
 
     Returns (Q0, Q1, delta, delta_dot, F_bx, F_by, F_N, M_b, F_T v_T, v_T, D'_lub, U_a): N m, N m, m, m/s,
@@ -240,7 +236,7 @@ def tree_joint_force(prm: np.ndarray, t: float, a: float, q1: float, da: float, 
     ex, ey, evx, evy = px - b_y, py - b_z, vx - omega * db_y, vy - omega * db_z
     # A worn joint E: the local clearance along e and its rate, the journal's frame turning with the rod
     # (psi = b - pi); a round one: (c0, 0), the unchanged call below.
-    c, c_rate = clearance_along(prm, t, ex, ey, evx, evy, b - math.pi, db)
+    c, c_rate = rod_clearance(prm, t, ex, ey, evx, evy, b - math.pi, db)
     if is_lubricated(prm):
         fx, fy, delta, rate, f_n, f_t, m_j, m_b, v_t, lub_power, asperity_energy = connector_lubricated_force_at(
             prm, c, c_rate, ex, ey, evx, evy, held, delta0, rate0, db, omega * dphi)[:11]

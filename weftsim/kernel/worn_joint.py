@@ -6,7 +6,7 @@ direction n from the body's own x axis, about the joint axis.  With the bodies t
 theta_j (rad, their rotation about the joint axis) and turning at omega_b, omega_j::
 
     psi_b = angle(e) - theta_b,   psi_j = angle(e) - theta_j
-    c     = c0 + h_b(psi_b) + h_j(psi_j)                   (weftsim.kernel.wear.worn_clearance)
+    c     = c0 + h_b(psi_b) + h_j(psi_j)                   (weftsim.kernel.wear.clearance_along)
     dc/dt = h_b'(psi_b) (turn - omega_b) + h_j'(psi_j) (turn - omega_j),   turn = (e x e_dot) / |e|^2
 
 and the force is the round connector's at that clearance (:func:`weftsim.kernel.joint.connector_force_at`):
@@ -17,13 +17,11 @@ the same functions as the loom's reference chain and kinematic tree.  The parame
 
 from __future__ import annotations
 
-import math
-
 from numba import njit
 
 from weftsim.kernel.joint import CLEARANCE, N_JOINT, connector_friction_force_at
 from weftsim.kernel.lubricated import connector_lubricated_force_at
-from weftsim.kernel.wear import worn_clearance
+from weftsim.kernel.wear import clearance_along
 
 WEAR_BLOCK = N_JOINT  # the wear block's start in the connector's parameters
 
@@ -31,12 +29,9 @@ WEAR_BLOCK = N_JOINT  # the wear block's start in the connector's parameters
 @njit(cache=True, error_model="numpy", inline="always")
 def body_frame_clearance(prm, ex: float, ey: float, vx: float, vy: float, omega_j: float, omega_b: float,
                          theta_j: float, theta_b: float) -> tuple[float, float]:
-    """(c, dc/dt) along e of a worn connector (module docstring); (c0, 0) without a wear block."""
-    length2 = ex * ex + ey * ey
-    direction = math.atan2(ey, ex)
-    turn = (ex * vy - ey * vx) / length2 if length2 > 0.0 else 0.0
-    return worn_clearance(prm, WEAR_BLOCK, prm[CLEARANCE], direction - theta_b, direction - theta_j, turn - omega_b,
-                          turn - omega_j)  # fmt: skip
+    """(c, dc/dt) along e of a worn connector (module docstring; :func:`weftsim.kernel.wear.clearance_along`
+    with the wear block at :data:`WEAR_BLOCK`); (c0, 0) without a wear block."""
+    return clearance_along(prm, WEAR_BLOCK, prm[CLEARANCE], ex, ey, vx, vy, theta_b, omega_b, theta_j, omega_j)
 
 
 @njit(cache=True, error_model="numpy")

@@ -1,4 +1,4 @@
-"""Wear prediction at the clearance joint E: how the clearance grows over operating hours (docs/wear.md).
+"""Wear prediction at the clearance joints E and F: how the clearances grow over operating hours (docs/wear.md).
 
 Public entry::
 
@@ -8,11 +8,16 @@ Public entry::
   contact arc (compiled; the reference engine's right-hand side reads the worn geometry);
 - :mod:`.archard`: the wear of one run from its step rows;
 - :mod:`.extrapolate`: the cycle extrapolation with the adaptive update interval;
+- :mod:`.updates`: the updates (each joint's profiles and rates) and their advance;
 - :mod:`.store`: the resumable state and the tables; :mod:`.figures`: the figures.
 
-Joint E only (``[joint_e.wear]``).  A second clearance joint adds its own wear block after E's in
-the kernel parameter array and its own profiles in :class:`~.extrapolate.Update`; the Archard and
-extrapolation code takes the joint's numbers as arguments and is reused as it is.
+Every loose joint wears, each with its own ``[joint_e.wear]`` / ``[joint_f.wear]`` numbers: E, F, or E
+and F together (one run simulates both; :func:`~.updates.wearing_joints`).  A worn F's tables
+follow E's in the kernel parameter array (:mod:`weftsim.kernel.chain_f`), its profiles are
+:attr:`~.updates.Update.second` (or the first when E is ideal), and every output names the joint
+(``effective_clearance_f_mm``, ``wear_profile_f.png``).  A ``--limit-clearance-mm`` applies to every
+wearing joint: ``hours_to_limit`` is the first joint's to reach it (``limit_joint``), each joint's is
+``hours_to_limit_<j>``.
 """
 
 from __future__ import annotations
@@ -50,7 +55,10 @@ def check_request(scene: Scene, hours: float, engine: str, limit: float | None) 
 
     if engine not in ENGINES:
         raise WearError(f"--engine must be one of {', '.join(ENGINES)}, got {engine!r}")
-    if engine == "exudyn":
+    if engine == "exudyn" and not scene.joint_f.is_ideal:
+        raise WearError("--engine exudyn: the Exudyn wear prediction covers joint E alone (the kinematic tree carries "
+                        "the clearance at E only), and the scene gives a clearance at F; use --engine reference")
+    if engine == "exudyn" and not scene.joint.is_ideal:
         from weftsim.exudyn_engine.selection import select_model
 
         if select_model(scene)[0] != "kinematic_tree":
@@ -62,18 +70,20 @@ def check_request(scene: Scene, hours: float, engine: str, limit: float | None) 
     if not (0.0 < hours <= MAX_HOURS):
         raise WearError(f"--hours must be > 0 and at most {MAX_HOURS:g} h (114 years of continuous running), "
                         f"got {hours:g}")
-    if limit is not None and not (limit > scene.joint.clearance and math.isfinite(limit)):
-        raise WearError(f"--limit-clearance-mm must be larger than the scene's clearance "
-                        f"{scene.joint.clearance * 1e3:g} mm, got {limit * 1e3:g}")
-    if limit is not None and limit >= scene.joint.journal_radius:
+    joints = [(name, scene.joint if name == "e" else scene.joint_f) for name in scene.loose_joints]
+    if not joints:
+        raise WearError("joint_e.clearance_mm is 0 (ideal joint) and F has no clearance: there is no contact to "
+                        "wear; give joint_e.clearance_mm (or joint_f.clearance_mm) > 0")
+    widest = max(joints, key=lambda nj: nj[1].clearance)
+    if limit is not None and not (limit > widest[1].clearance and math.isfinite(limit)):
+        raise WearError(f"--limit-clearance-mm must be larger than the clearance of every wearing joint (the "
+                        f"limit applies to each; joint_{widest[0]}.clearance_mm = {widest[1].clearance * 1e3:g} mm), "
+                        f"got {limit * 1e3:g}")
+    smallest = min(joints, key=lambda nj: nj[1].journal_radius)
+    if limit is not None and limit >= smallest[1].journal_radius:
         raise WearError(f"--limit-clearance-mm must be smaller than the journal radius "
-                        f"{scene.joint.journal_radius * 1e3:g} mm (the prediction ends before the clearance "
-                        f"reaches it, docs/wear.md), got {limit * 1e3:g}")
-    if not scene.joint_f.is_ideal:  # first: a scene with F alone loose is refused for F, not for E's 0
-        raise WearError("the scene gives a clearance at F: the wear prediction covers joint E with F ideal so far "
-                        "(docs/wear.md); set joint_f.clearance_mm = 0 or leave out [joint_f]")
-    if scene.joint.is_ideal:
-        raise WearError("joint_e.clearance_mm is 0 (ideal joint): there is no contact to wear; give a clearance > 0")
+                        f"{smallest[1].journal_radius * 1e3:g} mm at {smallest[0].upper()} (the prediction ends before "
+                        f"the clearance reaches it, docs/wear.md), got {limit * 1e3:g}")
 
 
 def check_engine(outdir: str | Path, engine: str, force: bool = False) -> None:
@@ -120,7 +130,9 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
         same scene and passes :func:`weftsim.wear.resume.read_state` (:class:`~.store.StateMismatch`
         otherwise, as for a request of fewer hours than it holds).
     limit : float, optional
-        Clearance limit, m: ``wear.json`` gives the hours at which the effective clearance reaches it.
+        Clearance limit, m, for every wearing joint: ``wear.json`` gives the hours at which each joint's
+        effective clearance reaches it (``hours_to_limit_e``, ``hours_to_limit_f``) and the first of them
+        (``hours_to_limit``, ``limit_joint``).
     progress : callable, optional
         Called with the fraction of the hours done.
     stop : callable, optional
@@ -172,11 +184,7 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
         store.save_state(outdir, scene, updates)
         if progress is not None and updates[-1].hours > 0.0:  # no time-left estimate from a zero fraction
             if until_limit:  # the share of the clearance's way to the limit
-                from weftsim.wear.extrapolate import effective_clearance
-
-                c0 = scene.joint.clearance
-                grown = effective_clearance(c0, updates[-1].bearing, updates[-1].journal) - c0
-                progress(min(grown / (limit - c0), 1.0))
+                progress(min(_grown(scene, updates[-1], share=limit), 1.0))
             else:
                 progress(min(updates[-1].hours / hours, 1.0))
 
@@ -206,11 +214,23 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
 
 
 def _beyond(scene: Scene, update, limit: float) -> bool:
-    """True when ``update`` extrapolated over its N revolutions reaches the effective clearance ``limit`` (m)."""
-    from weftsim.wear.extrapolate import advance, effective_clearance
+    """True when ``update`` extrapolated over its N revolutions brings a wearing joint's effective clearance to
+    ``limit`` (m)."""
+    return update.step_revolutions > 0.0 and _grown(scene, update, advance=True) >= limit
 
-    return update.step_revolutions > 0.0 and effective_clearance(scene.joint.clearance,
-                                                                 *advance(update, scene)[2:]) >= limit
+
+def _grown(scene: Scene, update, advance: bool = False, share: float | None = None) -> float:
+    """The largest effective clearance of the wearing joints (m) at the start of ``update`` (or after its N
+    revolutions with ``advance``); with ``share`` = limit, the largest share of the way from c0 to it."""
+    from weftsim.wear.extrapolate import advance_update, effective_clearance, joint_of, wearing_joints
+
+    state = advance_update(update, scene) if advance else update
+    values = []
+    for joint in wearing_joints(scene):
+        c0, part = joint_of(scene, joint).clearance, state.part(joint)
+        c = effective_clearance(c0, part.bearing, part.journal)
+        values.append(c if share is None else (c - c0) / (share - c0))
+    return max(values)
 
 
 def _cut_at(scene: Scene, update, limit: float):
@@ -239,7 +259,7 @@ def _write_results(scene: Scene, updates: list, hours: float, limit: float | Non
 
     from weftsim.output import write_figure, write_files, write_json
     from weftsim.wear import store
-    from weftsim.wear.extrapolate import advance, effective_clearance, ended_by_limit, limit_hours
+    from weftsim.wear.extrapolate import advance_update, effective_clearance, ended_by_limit, joint_of, wearing_joints
 
     data = store.summary(scene, updates, hours, limit, wall)
     data["engine"] = engine
@@ -248,33 +268,47 @@ def _write_results(scene: Scene, updates: list, hours: float, limit: float | Non
         ended = f"the effective clearance reaches the limit {limit * 1e3:g} mm (--limit-clearance-mm)"
     data["ended"] = ended
     data["failure"] = failure
+    joints = wearing_joints(scene)
     if ended is not None:  # the last update extrapolates up to the limit: report the state there
-        end_hours, end_revolutions, bearing, journal = advance(updates[-1], scene)
-        end = replace(updates[-1], hours=end_hours, revolutions=end_revolutions, bearing=bearing, journal=journal,
-                      step_revolutions=0.0)
+        end = replace(advance_update(updates[-1], scene), step_revolutions=0.0)
         data.update(store.archard_check(scene, [*updates, end]))  # the volumes at the limit
         if limit is not None:
-            data["hours_to_limit"] = limit_hours([*updates, end], scene.joint.clearance, limit)
-        data.update(hours_reached=end_hours,
-                    final_effective_clearance_mm=1e3 * effective_clearance(scene.joint.clearance, bearing, journal),
-                    final_bearing_wear_max_mm=1e3 * float(bearing.max()),
-                    final_journal_wear_max_mm=1e3 * float(journal.max()),
-                    wear_volume_mm3=data["wear_volume_mm3"] + 1e9 * updates[-1].volume_rate
+            data.pop("note", None)
+            data.update(store.limit_summary(scene, [*updates, end], limit))
+        data.update(hours_reached=end.hours,
+                    wear_volume_mm3=data["wear_volume_mm3"] + 1e9 * updates[-1].total_volume_rate
                     * updates[-1].step_revolutions)
+        for joint in joints:
+            part, grown = end.part(joint), updates[-1].part(joint).volume_rate * updates[-1].step_revolutions
+            data.update({
+                f"final_effective_clearance_{joint}_mm": 1e3 * effective_clearance(joint_of(scene, joint).clearance,
+                                                                                   part.bearing, part.journal),
+                f"final_bearing_wear_max_{joint}_mm": 1e3 * float(part.bearing.max()),
+                f"final_journal_wear_max_{joint}_mm": 1e3 * float(part.journal.max()),
+                f"wear_volume_{joint}_mm3": data[f"wear_volume_{joint}_mm3"] + 1e9 * grown})
     columns = store.table(scene, updates)
     files = {
         "state": (store.STATE, lambda p: p),
         "table": ("wear.csv", lambda p: store.write_table(p, scene, updates)),
-        "profile": ("wear_profile.csv", lambda p: store.write_profiles(p, updates, "bearing")),
-        "journal_profile": ("wear_profile_journal.csv", lambda p: store.write_profiles(p, updates, "journal")),
         "summary": ("wear.json", lambda p: write_json(p, data)),
     }
+    for joint in joints:
+        files[f"profile_{joint}"] = (f"wear_profile_{joint}.csv",
+                                     lambda p, j=joint: store.write_profiles(p, updates, "bearing", j))
+        files[f"journal_profile_{joint}"] = (f"wear_profile_journal_{joint}.csv",
+                                             lambda p, j=joint: store.write_profiles(p, updates, "journal", j))
     if figures:
         from weftsim.wear.figures import growth_figure, profile_figure
 
-        title = f"{scene.name}: wear at E" + ("" if engine == "reference" else f" ({engine} engine)")
-        files["profile_figure"] = ("wear_profile.png", lambda p: write_figure(p, profile_figure(scene, updates, title)))
-        files["growth_figure"] = ("wear_growth.png", lambda p: write_figure(p, growth_figure(columns, title)))
+        engine_tag = "" if engine == "reference" else f" ({engine} engine)"
+        for joint in joints:
+            title = f"{scene.name}: wear at {joint.upper()}{engine_tag}"
+            files[f"profile_figure_{joint}"] = (
+                f"wear_profile_{joint}.png", lambda p, j=joint, t=title: write_figure(p, profile_figure(scene, updates, t, j)))
+        name = "".join(joints)
+        title = f"{scene.name}: wear at {' and '.join(j.upper() for j in joints)}{engine_tag}"
+        files["growth_figure"] = (f"wear_growth_{name}.png",
+                                  lambda p: write_figure(p, growth_figure(columns, title, joints)))
     written = write_files(outdir, what, files, scene=scene)
     data["files"] = {k: str(v) for k, v in written.items()}
     return data

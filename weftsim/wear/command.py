@@ -26,7 +26,8 @@ def add_flags(p: argparse.ArgumentParser, positive: Callable[[Callable[[str], fl
     p.add_argument("--engine", default="reference", help="engine of each update's simulation: reference (default) "
                    "or exudyn (its kinematic tree; default output out/<scene name>/wear-exudyn; docs/wear.md)")
     p.add_argument("--limit-clearance-mm", type=positive(float),
-                   help="clearance limit: wear.json gives the hours at which the effective clearance reaches it")
+                   help="clearance limit for every wearing joint: wear.json gives the hours at which each joint's "
+                        "effective clearance reaches it and the first of them (the joint to service first)")
     p.add_argument("--no-plot", action="store_true", help="skip the figures")
     ens = p.add_argument_group("ensemble (docs/wear.md section 7)")
     ens.add_argument("--uncertain", action="append", default=[], metavar="KEY=DISTRIBUTION",
@@ -69,11 +70,17 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     except StateMismatch as exc:
         raise CliError(str(exc)) from None
     resumed = _stored_updates(outdir, scene, args.force)
+    from weftsim.wear.extrapolate import joint_of, wearing_joints
+
+    joints = wearing_joints(scene)
+    first = joint_of(scene, joints[0]).wear
+    at = " and ".join(j.upper() for j in joints)
     span = f"until the clearance reaches {args.limit_clearance_mm:g} mm" if until_limit else f"over {hours:g} h"
-    print(f"scene {scene.name}, wear at E {span} on the {args.engine} engine; each update simulates "
-          f"{scene.joint.wear.settle_revolutions} + {scene.joint.wear.revolutions_per_update} revolutions "
-          f"(~{_duration(update_time(scene, args.engine))}), the update interval grows the clearance by at most "
-          f"{100 * scene.joint.wear.max_clearance_change:g} %", file=sys.stderr, flush=True)
+    print(f"scene {scene.name}, wear at {at} {span} on the {args.engine} engine; each update simulates "
+          f"{first.settle_revolutions} + {first.revolutions_per_update} revolutions "
+          f"(~{_duration(update_time(scene, args.engine))}), the update interval grows each clearance by at most "
+          + ", ".join(f"{100 * joint_of(scene, j).wear.max_clearance_change:g} % at {j.upper()}" for j in joints),
+          file=sys.stderr, flush=True)
     if resumed:
         print(f"resuming the prediction stored in {outdir}: {len(resumed)} updates kept, up to "
               f"{resumed[-1].hours:.6g} h", file=sys.stderr, flush=True)
@@ -90,19 +97,27 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
         finally:
             progress.close()
     print(f"scene {scene.name}: {data['hours_reached']:.6g} h in {data['updates']} updates "
-          f"({data['wall_time_s']:.1f} s); effective clearance {data['initial_clearance_mm']:g} -> "
-          f"{data['final_effective_clearance_mm']:.4g} mm, wear volume {data['wear_volume_mm3']:.4g} mm^3")
+          f"({data['wall_time_s']:.1f} s); wear volume {data['wear_volume_mm3']:.4g} mm^3")
+    for j in joints:
+        print(f"  at {j.upper()}: effective clearance {data[f'initial_clearance_{j}_mm']:g} -> "
+              f"{data[f'final_effective_clearance_{j}_mm']:.4g} mm, wear volume {data[f'wear_volume_{j}_mm3']:.4g} mm^3")
     if data.get("backoffs"):
         print(f"  {data['backoffs']} hard cycle(s) (an update whose simulation failed at every tolerance and "
               "integrator) were passed by halving the update before them (docs/wear.md section 3)")
-    if data.get("sliding_distance_m"):
-        print(f"  Archard's check: sliding {data['sliding_distance_m']:.4g} m under the sliding-weighted mean load "
-              f"{data['sliding_weighted_mean_load_N']:.4g} N (the time mean is {data['time_mean_load_N']:.4g} N) gives "
-              f"{data['archard_volume_mm3']:.4g} mm^3; the profiles hold {data['profile_volume_mm3']:.4g} mm^3")
+    for j in joints:
+        if data.get(f"sliding_distance_{j}_m"):
+            print(f"  Archard's check at {j.upper()}: sliding {data[f'sliding_distance_{j}_m']:.4g} m under the "
+                  f"sliding-weighted mean load {data[f'sliding_weighted_mean_load_{j}_N']:.4g} N (the time mean is "
+                  f"{data[f'time_mean_load_{j}_N']:.4g} N) gives {data[f'archard_volume_{j}_mm3']:.4g} mm^3; the "
+                  f"profiles hold {data[f'profile_volume_{j}_mm3']:.4g} mm^3")
     if limit is not None:
         reached = data.get("hours_to_limit")
+        each = ", ".join(f"{j.upper()} " + (f"{data[f'hours_to_limit_{j}']:.6g} h"
+                                           if data.get(f"hours_to_limit_{j}") is not None else "not reached")
+                         for j in joints)
         print(f"  clearance limit {args.limit_clearance_mm:g} mm: " +
-              (f"reached after {reached:.6g} h" if reached is not None else data["note"]))
+              (f"reached first at {data['limit_joint'].upper()} after {reached:.6g} h ({each})" if reached is not None
+               else data["note"]))
     for path in data["files"].values():
         print(f"  wrote {path}")
     if data.get("ended"):

@@ -233,6 +233,9 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
     if not (isinstance(chaos_runs, int) and 1 <= chaos_runs <= 50):
         raise WearError(f"--chaos-runs must be a whole number from 1 to 50, got {chaos_runs!r}")
     check_request(scene, 1.0, "reference", limit)
+    if not scene.joint_f.is_ideal:  # its H/k rescaling and its clearance curve are joint E's
+        raise WearError("an ensemble predicts the wear at E with F ideal so far; `weftsim wear SCENE --hours H` "
+                        "predicts F and E with F (docs/wear.md); set joint_f.clearance_mm = 0 for the ensemble")
     job_list, dynamic, nodes = plan(scene, parsed, chaos_runs)
     for name, s in job_list:
         if not limit > s.joint.clearance:
@@ -255,7 +258,7 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
     sim_wall = time.perf_counter() - wall0
     ens = combine(scene, parsed, dynamic, nodes, results, samples, limit, seed, levels)
     hours, lv = ens["hours"], ens["levels"]
-    band = {"clearance_mm": 1e3 * lv}
+    band = {"clearance_e_mm": 1e3 * lv}  # the joint in the name, as in wear.csv
     for p in QUANTILES:
         band[f"hours_p{round(100 * p)}"] = np.quantile(hours, p, axis=0)
     by_level = {f"{1e3 * lv[i]:.6g}": quantile_table(hours[:, i]) for i in range(lv.size)
@@ -286,7 +289,7 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
     }
     table = {f"{k}": np.asarray(v, dtype=float) for k, v in ens["values"].items()}
     table["chaos_run"] = ens["chaos_draw"].astype(float)
-    table["hours_to_limit"] = hours[:, -1]
+    table["hours_to_limit_e"] = hours[:, -1]
     files = {
         "samples": ("ensemble.csv", lambda p: write_csv(p, table)),
         "band": ("ensemble_band.csv", lambda p: write_csv(p, band)),

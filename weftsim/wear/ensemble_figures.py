@@ -36,7 +36,7 @@ def band_figure(band: dict, title: str = "") -> Figure:
     """Effective clearance against hours: median and the 10-90 % band."""
     fig = figure(figsize=(7, 4.5))
     ax = fig.add_subplot(1, 1, 1)
-    c = band["clearance_mm"]
+    c = band["clearance_e_mm"]
     ax.fill_betweenx(c, band["hours_p10"], band["hours_p90"], color="C0", alpha=0.25, label="10-90 %")
     ax.plot(band["hours_p50"], c, color="C0", label="median")
     ax.set_xlabel("operating hours")
