@@ -140,6 +140,8 @@ def test_wear_on_exudyn_refuses_what_it_cannot_run_in_one_line():
         check_request(rigid, 1.0, "exudyn", None)
     with pytest.raises(WearError, match="--engine must be one of reference, exudyn"):
         check_request(scene, 1.0, "exudin", None)
+    with pytest.raises(WearError, match="covers joint E alone"):  # the tree carries the clearance at E only
+        check_request(load_scene("clearance_ef"), 1.0, "exudyn", None)
 
 
 def _hours_to(scene, limit: float, engine: str) -> float:
