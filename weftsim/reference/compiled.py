@@ -81,6 +81,8 @@ def _dense_any(method, F, t_old, h, y_old, t, out):
     """Dense output of the last step of ``method`` (an explicit one or RODAS4) at time t into out."""
     if method == RODAS4:
         ros.dense(F, t_old, h, y_old, t, out)
+    elif method == ros.RODAS4_STIFF_DENSE:
+        ros.dense_stiff(F, t_old, h, y_old, t, out)
     else:
         _dense(method, F, t_old, h, y_old, t, out)
 
@@ -197,6 +199,7 @@ def advance(prm: np.ndarray, method: int, rtol: float, atol: float, max_step: fl
     grid_r = np.empty(SAMPLES + 1)
     peak_t = np.empty(SAMPLES + 2)
     peak_r = np.empty(SAMPLES + 2)
+    stiff_dense = ros.central_differences(prm)  # a lubricated joint: RODAS4's dense output from its stages
     t = fst[T]
     while t < t_end:
         contact = ist[CONTACT]
@@ -205,6 +208,7 @@ def advance(prm: np.ndarray, method: int, rtol: float, atol: float, max_step: fl
         m = method
         if method == HYBRID:
             m = RODAS4 if contact != 0 else DOP853
+        md = ros.RODAS4_STIFF_DENSE if (m == RODAS4 and stiff_dense) else m  # the dense output's code
         order = 7 if m == DOP853 else 4
         f_row = 12 if m == DOP853 else 6
         if m == RODAS4:  # the error estimate k_6 is O(h^4): exponent -1/4 as in the code RODAS
@@ -306,7 +310,7 @@ def advance(prm: np.ndarray, method: int, rtol: float, atol: float, max_step: fl
             if not dense and m != RODAS4:
                 _dense_coefficients(prm, m, t, y, y_new, f_new, h, K, contact, impact, ist, F, tmp)
             dense = True
-            j_kind, j_stop, j_value = _events_of_joint(prm, m, F, t, h, y, tmp, j, in_contact, impact[j],
+            j_kind, j_stop, j_value = _events_of_joint(prm, md, F, t, h, y, tmp, j, in_contact, impact[j],
                                                        g_old[j], r_old[j], g_new[j], r_new[j], t_new, grid_t, grid_d,
                                                        grid_r, peak_t, peak_r)  # fmt: skip
             if j_kind != NO_EVENT and (kind == NO_EVENT or j_stop < t_stop):
@@ -316,21 +320,21 @@ def advance(prm: np.ndarray, method: int, rtol: float, atol: float, max_step: fl
             if not dense and m != RODAS4:
                 _dense_coefficients(prm, m, t, y, y_new, f_new, h, K, contact, impact, ist, F, tmp)
             dense = True
-            _dense_any(m, F, t, h, y, sample_times[k], tmp)
+            _dense_any(md, F, t, h, y, sample_times[k], tmp)
             _record(smp_t, smp_y, smp_c, smp_i, k, sample_times[k], tmp, contact, impact)
             k += 1
         ist[NEXT_SAMPLE] = k
         if contact != 0 and m == RODAS4:  # its steps are 3-5x shorter than DOP853's: the midpoint only
             t_sub = 0.5 * (t + t_stop)
-            _dense_any(m, F, t, h, y, t_sub, tmp)
+            _dense_any(md, F, t, h, y, t_sub, tmp)
             n_rows = _record(stp_t, stp_y, stp_c, stp_i, n_rows, t_sub, tmp, contact, impact)
         elif contact != 0 and _CONTACT_SUBSTEPS > 0:
             for i in range(_CONTACT_SUBSTEPS):
                 t_sub = t + (t_stop - t) * _SUBSTEPS[i]
-                _dense_any(m, F, t, h, y, t_sub, tmp)
+                _dense_any(md, F, t, h, y, t_sub, tmp)
                 n_rows = _record(stp_t, stp_y, stp_c, stp_i, n_rows, t_sub, tmp, contact, impact)
         if kind != NO_EVENT:
-            _dense_any(m, F, t, h, y, t_stop, tmp)
+            _dense_any(md, F, t, h, y, t_stop, tmp)
             t = t_stop
             y[:] = tmp
             ist[EVENTS] += 1

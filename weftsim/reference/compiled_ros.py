@@ -13,6 +13,9 @@ steps:
 
     y(t + s h) = h00(s) y + h10(s) h f(t, y) + h01(s) y_new + h11(s) h f(t + h, y_new).
 
+With a lubricated joint the dense output is RODAS's own continuous extension from the stages instead
+(:func:`dense_stiff`).
+
 Each step solves 6 linear systems with one LU decomposition of E, so its step size is set by
 accuracy, not by the stiffness of a lasting contact or of the friction ramp (the explicit DOP853
 steps at ~1e-9 s where the journal sticks: the ramp's slope mu F_N / (v1 - v0) ~ 1e7-1e8 N s/m).
@@ -25,6 +28,9 @@ D are not read by the right-hand side, so their columns are zero and are not per
 contact with friction (central differences: 2e-8-8e-7, at twice the evaluations and no measurable gain in
 steps or peaks; docs/reference-solver.md section 3, "Linearly implicit path").  At delta = 0 and at the kinks
 of the friction ramp no difference is a derivative; the step's error control rejects what that spoils.
+With a lubricated joint the Jacobian is a central difference (:func:`central_differences`, 2 (n - 1)
+evaluations): there the forward differences' error of ~1e-4 held the step at a few microseconds in the
+mixed regime (docs/performance.md, "The mixed regime").
 
 Every function is module-level ``@njit(cache=True, error_model="numpy")``;
 :mod:`weftsim.reference.compiled` drives them in its event-driven loop.
@@ -53,6 +59,13 @@ ORDER = 4  # of the solution; the error estimate k_6 is O(h^4), so the step-size
 JAC_STEP_Q = 1e-9
 JAC_STEP_V = 1e-9
 JAC_STEP_T = 1e-10
+# Central differences with a lubricated joint (:func:`central_differences`): 3e-10 rad (0.1 nm at the journal),
+# 3e-9 rad/s, 3e-11 s.  Against Richardson-extrapolated differences over 40 states of the mixed loom (10 mPa s,
+# film ratio 0.37-23): median relative error 1.6e-7 of the rows of the accelerations (forward differences of
+# the fixed steps above: 1e-4); 10x larger steps 2e-4 (truncation), 10x smaller 9e-7 (round-off).
+JAC_CENTRAL_Q = 3e-10
+JAC_CENTRAL_V = 3e-9
+JAC_CENTRAL_T = 3e-11
 N_QUADRATURES = 2  # W3 and D at the end of the state: not read by the right-hand side
 
 GAMMA = 0.25
@@ -75,16 +88,28 @@ CC[4, 0], CC[4, 1], CC[4, 2], CC[4, 3] = (0.7496443313967647e+01, -0.10246804314
 CC[5, 0], CC[5, 1], CC[5, 2], CC[5, 3], CC[5, 4] = (0.8083246795921522e+01, -0.7981132988064893e+01,
                                                     -0.3152159432874371e+02, 0.1631930543123136e+02,
                                                     -0.6058818238834054e+01)  # fmt: skip
+# Continuous extension of RODAS (Hairer & Wanner's code, its dense output of order 3): with the stages K of the
+# step, y(t + s h) = (1 - s) y + s (y_new + (1 - s) (sum DENSE_2[j] K_j + s sum DENSE_3[j] K_j)).
+DENSE_2 = np.array([0.1012623508344586e+02, -0.7487995877610167e+01, -0.3480091861555747e+02,
+                    -0.7992771707568823e+01, 0.1025137723295662e+01])  # fmt: skip
+DENSE_3 = np.array([-0.6762803392801253e+00, 0.6087714651680015e+01, 0.1643084320892478e+02,
+                    0.2476722511418386e+02, -0.6594389125716872e+01])  # fmt: skip
+RODAS4_STIFF_DENSE = 4  # code of the dense output from the stages (a code beside the methods', never a method)
 # Step-size control of the code RODAS: factor = 0.9 err^(-1/4) within [1/5, 6].
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 6.0
 
 
 @njit(cache=True, error_model="numpy")
 def jacobian(prm, t, y, f0, contact, impact, ist, J, f_t, plus, minus, tmp):
-    """J = df/dy (n, n) and f_t = df/dt (n,) at (t, y) by forward differences of the kernel from f0 = f(t, y).
+    """J = df/dy (n, n) and f_t = df/dt (n,) at (t, y): central differences of the kernel with a lubricated
+    joint (:func:`central_differences`), else forward differences from f0 = f(t, y).
 
-    Columns of W3 and D stay zero (the right-hand side does not read them).  n - 1 evaluations.
+    Columns of W3 and D stay zero (the right-hand side does not read them).  n - 1 evaluations forward,
+    2 (n - 1) central.
     """
+    if central_differences(prm):
+        _jacobian_central(prm, t, y, contact, impact, ist, J, f_t, plus, minus, tmp)
+        return
     n = y.size
     n_mech = n - N_QUADRATURES
     half = n_mech // 2
@@ -101,6 +126,45 @@ def jacobian(prm, t, y, f0, contact, impact, ist, J, f_t, plus, minus, tmp):
     _f(prm, t + JAC_STEP_T, y, contact, impact, plus, ist)
     for i in range(n):
         f_t[i] = (plus[i] - f0[i]) * (1.0 / JAC_STEP_T)
+
+
+@njit(cache=True, error_model="numpy")
+def central_differences(prm) -> bool:
+    """True when a joint is lubricated (film or asperities): RODAS4's Jacobian is then taken by central
+    differences (:func:`_jacobian_central`).
+
+    The film's squeeze and the asperities' load vary on the scale of the film thickness (down to 0.1 um),
+    and the stiff clearance rate (Jacobian eigenvalues to -4e7 1/s, h lambda 10-100 at the accepted steps)
+    follows its quasi-static value only as well as the Jacobian is known: the forward differences' relative
+    error of 1e-4 left an error estimate of order 1 on psi' that did not shrink with the step (docs/performance.md,
+    "The mixed regime").  Dry and friction runs keep the forward differences (their arithmetic is unchanged).
+    """
+    joint_f = prm[JOINT_F:JOINT_F + N_JOINT]
+    return is_lubricated(prm) or is_lubricated(joint_f)
+
+
+@njit(cache=True, error_model="numpy")
+def _jacobian_central(prm, t, y, contact, impact, ist, J, f_t, plus, minus, tmp):
+    """J and f_t by central differences with the steps JAC_CENTRAL_* (2 (n - 1) evaluations)."""
+    n = y.size
+    n_mech = n - N_QUADRATURES
+    half = n_mech // 2
+    J[:, :] = 0.0
+    tmp[:] = y
+    for j in range(n_mech):
+        step = JAC_CENTRAL_Q if j < half else JAC_CENTRAL_V
+        tmp[j] = y[j] + step
+        _f(prm, t, tmp, contact, impact, plus, ist)
+        tmp[j] = y[j] - step
+        _f(prm, t, tmp, contact, impact, minus, ist)
+        tmp[j] = y[j]
+        inv = 0.5 / step
+        for i in range(n):
+            J[i, j] = (plus[i] - minus[i]) * inv
+    _f(prm, t + JAC_CENTRAL_T, y, contact, impact, plus, ist)
+    _f(prm, t - JAC_CENTRAL_T, y, contact, impact, minus, ist)
+    for i in range(n):
+        f_t[i] = (plus[i] - minus[i]) * (0.5 / JAC_CENTRAL_T)
 
 
 @njit(cache=True, error_model="numpy")
@@ -217,7 +281,30 @@ def step(prm, t, y, h, f0, J, f_t, contact, impact, ist, K, E, piv, y_new, F, tm
     for i in range(n):
         F[0, i] = y_new[i]
         F[1, i] = h * f0[i]
+        d2 = 0.0
+        d3 = 0.0
+        for r in range(5):
+            d2 += DENSE_2[r] * K[r, i]
+            d3 += DENSE_3[r] * K[r, i]
+        F[3, i] = d2
+        F[4, i] = d3
     return math.sqrt(err / n)
+
+
+@njit(cache=True, error_model="numpy")
+def dense_stiff(F, t_old, h, y_old, t, out):
+    """RODAS's own continuous extension of the last step at time t (``DENSE_2``, ``DENSE_3``; order 3).
+
+    Used with a lubricated joint (:func:`central_differences`): built from the stages, it follows the stiff
+    clearance rate where the cubic Hermite interpolant, which bends with f at both ends, does not.  A step that
+    starts off the slow manifold (from an event's state, itself interpolated) has a large psi'' (the squeeze
+    film relaxes psi' at ~1e7 1/s), and the Hermite interpolant carries h f / 8 of it to mid-step: a quarter
+    of psi' for a start 1 % off, against 0.2 % here (docs/performance.md, "The mixed regime").  Local error
+    O(h^4) on smooth solutions, as the Hermite interpolant's.
+    """
+    s = (t - t_old) / h
+    for i in range(y_old.size):
+        out[i] = (1.0 - s) * y_old[i] + s * (F[0, i] + (1.0 - s) * (F[3, i] + s * F[4, i]))
 
 
 @njit(cache=True, error_model="numpy")
