@@ -39,7 +39,7 @@ UNITS: tuple[tuple[str, str, float], ...] = (
 SECTIONS: tuple[tuple[str, str, str], ...] = (
     ("mechanism.", "physics.md#1-the-mechanism-paper-fig-1-fig-10", "physics §1"),
     ("inertia.", "physics.md#reference-mechanism", "physics §1, §4"),
-    ("joint_e.wear.", "wear.md#5-parameters-and-their-sources", "wear §5"),
+    ("joint_*.wear.", "wear.md#5-parameters-and-their-sources", "wear §5"),
     ("joint_*.lubrication.", "lubrication.md", "lubrication"),
     ("joint_*.bearing_material.yield_strength", "plausibility.md#the-checks-their-limits-and-their-sources",
      "plausibility: Hertz"),
@@ -81,6 +81,8 @@ TABLES: dict[str, str] = {
                "Absent: the ideal joint; with a clearance > 0 it needs every key `[joint_e]` needs.",
     "joint_f.journal_material": "The pin's material at F.",
     "joint_f.bearing_material": "The bushing's material at F.",
+    "joint_f.wear": "Archard wear at F (`weftsim wear`), all optional; with a clearance at F alone, F takes "
+                    "the keys `[joint_e.wear]` gives that it does not give itself.",
     "drive": "The crank's constant speed and the length of a run. Required.",
     "solver.reference": "The reference engine's integrator; the defaults are the fast path "
                         "([Performance](performance.md)).",

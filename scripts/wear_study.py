@@ -93,7 +93,7 @@ def main() -> None:
     write_figure(img / "wear_profile.png", profile_figure(scene, updates, "reference loom, 400 rpm: wear at E"))
     columns = {rpm: table(*kept[rpm]) for rpm in (400.0, 800.0)}
     fig = growth_figure(columns[400.0], "reference loom: 400 rpm (dots), 800 rpm (crosses)")
-    for ax, name in zip(fig.axes, ("effective_clearance_mm", "contact_force_p99_N", "rapier_acceleration_p99_m_s2",
+    for ax, name in zip(fig.axes, ("effective_clearance_e_mm", "contact_force_e_p99_N", "rapier_acceleration_p99_m_s2",
                                    "driving_torque_p99_Nm")):
         ax.plot(columns[800.0]["hours"], columns[800.0][name], "x-", ms=3, label="800 rpm " + statistic_label(name))
         ax.legend(fontsize=7)

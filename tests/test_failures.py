@@ -492,6 +492,10 @@ def test_a_stop_request_ends_the_run_as_interrupted_and_keeps_what_was_computed(
     # steps one ahead of the last stored one (measured 0.29976): one 2e-6 s step is 2.4e-4 of the run.
     assert 0.299 <= reached < 0.35, reached
     assert r.samples["time_s"][-1] <= r.steps["time_s"][-1] + 1e-12
+    # The record ends within one output sample of where the run stopped: the step that saw the request was
+    # accepted, and its samples are kept with it (a long free-flight step used to lose them).
+    period = np.diff(r.samples["time_s"]).max()
+    assert r.steps["time_s"][-1] - r.samples["time_s"][-1] < period * (1.0 + 1e-9), (r.steps["time_s"][-1], period)
     for name in CHANNELS:
         assert np.all(np.isfinite(r.steps[name])), name
     # The next run is not affected: the request was withdrawn.

@@ -78,12 +78,13 @@ def test_a_damaged_state_file_is_one_line(finished, tmp_path, kind, words):
 
 
 @pytest.mark.parametrize("name, change, words", [
-    ("bearing", lambda a: a.pop("bearing"), ["lacks bearing"]),
+    ("bearing", lambda a: a.pop("bearing_e"), ["lacks bearing_e"]),
     ("response", lambda a: a.pop("response"), ["lacks response"]),
-    ("shape", lambda a: a.update(bearing=a["bearing"][:, :100]), ["'bearing' has shape", "profile_points"]),
+    ("shape", lambda a: a.update(bearing_e=a["bearing_e"][:, :100]), ["'bearing_e' has shape", "profile_points"]),
     ("hours", lambda a: a.update(hours=a["hours"][:-1]), ["has shape"]),
     ("scalar", lambda a: a.update(hours=np.array(3.0)), ["'hours' has shape ()"]),
-    ("text", lambda a: a.update(bearing=a["bearing"].astype(str)), ["not numbers"]),
+    ("text", lambda a: a.update(bearing_e=a["bearing_e"].astype(str)), ["not numbers"]),
+    ("other joint", lambda a: a.update(bearing_f=a["bearing_e"]), ["bearing_f", "does not wear"]),
 ])
 def test_a_state_missing_an_array_or_of_the_wrong_shape(finished, tmp_path, name, change, words):
     arrays = dict(finished[2])
@@ -92,18 +93,18 @@ def test_a_state_missing_an_array_or_of_the_wrong_shape(finished, tmp_path, name
 
 
 def test_a_nan_profile_is_named_not_blamed_on_the_materials(finished, tmp_path):
-    arrays = _edited(finished[2], "bearing", lambda b: b.__setitem__((-1, 5), np.nan))
-    _refused(finished[0], _copy(finished, tmp_path, arrays), "'bearing' holds a value that is not finite")
+    arrays = _edited(finished[2], "bearing_e", lambda b: b.__setitem__((-1, 5), np.nan))
+    _refused(finished[0], _copy(finished, tmp_path, arrays), "'bearing_e' holds a value that is not finite")
 
 
 @pytest.mark.parametrize("name, change, words", [
     # The last update's worn depth raised 10 %: not what the update before it implies.
-    ("bearing", lambda b: b.__setitem__(-1, 1.1 * b[-1]), ["update", "bearing is not what update"]),
+    ("bearing_e", lambda b: b.__setitem__(-1, 1.1 * b[-1]), ["update", "bearing_e is not what update"]),
     ("hours", lambda h: h.__setitem__(-1, 0.5 * h[-1]), ["hours is not what update"]),
     ("step_revolutions", lambda n: n.__setitem__(1, 1e9), ["is not what update 1 implies"]),
-    ("rate_bearing", lambda r: r.__setitem__(1, 1.1 * r[1]), ["bearing is not what update 1 implies"]),
-    ("volume_rate", lambda v: v.__setitem__(1, 2.0 * v[1]), ["volume_rate is not the volume"]),
-    ("bearing", lambda b: b.__setitem__(1, -b[1]), ["negative value"]),
+    ("rate_bearing_e", lambda r: r.__setitem__(1, 1.1 * r[1]), ["bearing_e is not what update 1 implies"]),
+    ("volume_rate_e", lambda v: v.__setitem__(1, 2.0 * v[1]), ["volume_rate_e is not the volume"]),
+    ("bearing_e", lambda b: b.__setitem__(1, -b[1]), ["negative value"]),
 ])
 def test_a_hand_edited_state_is_refused_by_its_own_history(finished, tmp_path, name, change, words):
     arrays = _edited(finished[2], name, change)
@@ -119,21 +120,21 @@ def test_consistently_scaled_rates_break_the_update_rule(finished, tmp_path):
     """All three rates of an update whose N the update rule set, scaled by 1.1 (volumes and the hardness
     ratio still agree): its N is then more than max_clearance_change allows."""
     arrays = _interrupted(finished[2], 2)
-    for name in ("rate_bearing", "rate_journal", "volume_rate"):
+    for name in ("rate_bearing_e", "rate_journal_e", "volume_rate_e"):
         arrays[name] = arrays[name].copy()
         arrays[name][-1] *= 1.1
-    _refused(finished[0], _copy(finished, tmp_path, arrays), "more revolutions than max_clearance_change")
+    _refused(finished[0], _copy(finished, tmp_path, arrays), "more revolutions than joint_e.wear.max_clearance_change")
 
 
 def test_edited_last_rates_are_not_extrapolated(finished, tmp_path):
     """The last update's rates scaled consistently where its N was cut to the hours left (the update rule
     cannot tell): the resume simulates that update again, so the answer is the uninterrupted one."""
     arrays = _interrupted(finished[2], 1)
-    for name in ("rate_bearing", "rate_journal", "volume_rate"):
+    for name in ("rate_bearing_e", "rate_journal_e", "volume_rate_e"):
         arrays[name] = arrays[name].copy()
         arrays[name][-1] *= 1.1
     summary = predict_to_directory(finished[0], HOURS, _copy(finished, tmp_path, arrays), figures=False)
-    assert summary["final_effective_clearance_mm"] == finished[3]["final_effective_clearance_mm"]
+    assert summary["final_effective_clearance_e_mm"] == finished[3]["final_effective_clearance_e_mm"]
     assert summary["wear_volume_mm3"] == finished[3]["wear_volume_mm3"]
 
 
@@ -162,7 +163,7 @@ def test_an_interrupted_state_resumes_to_the_uninterrupted_answer(finished, tmp_
     """The two last updates dropped, as after a Ctrl-C: the resume recomputes them, bit for bit."""
     arrays = _interrupted(finished[2], 2)
     summary = predict_to_directory(finished[0], HOURS, _copy(finished, tmp_path, arrays), figures=False)
-    for key in ("final_effective_clearance_mm", "wear_volume_mm3", "updates", "hours_reached"):
+    for key in ("final_effective_clearance_e_mm", "wear_volume_mm3", "updates", "hours_reached"):
         assert summary[key] == finished[3][key], key
 
 

@@ -213,3 +213,13 @@ def test_animate_names_the_revolution_and_crank_angles_it_draws(tmp_path, capsys
                             "--frames", "6", "-o", target)
     assert status == 0, err
     assert f"wrote {target}: 6 frames of revolution 2, crank angles 0.0..300.0 deg" in out
+    # A single file written anywhere (-o): it records its own resolved scene and command in its metadata, and
+    # that text is a scene file that loads back to the scene animated.
+    from PIL import Image
+
+    with Image.open(target) as gif:
+        recorded = gif.info["comment"].decode("utf-8")
+    assert "weftsim animate reference --engine reference --revolutions 2" in recorded.splitlines()[0]
+    path = tmp_path / "recorded.toml"
+    path.write_text(recorded)
+    assert resolved_scene(load_scene(path)) == resolved_scene(load_scene("reference", {"drive.revolutions": 2}))

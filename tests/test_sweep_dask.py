@@ -12,6 +12,7 @@ directory: the scene went out as data and the results came back to the client.  
 prove: workers on another machine (another Python, another weftsim version) behave the same.
 """
 
+import json
 import os
 import shutil
 import subprocess
@@ -23,6 +24,7 @@ from pathlib import Path
 import pytest
 
 from weftsim.cli import EXIT_FAILED, main
+from weftsim.record import MANIFEST
 from weftsim.sweep import plan_sweep, run_sweep
 from weftsim.sweep.cell import CELL_FILE, is_finished, read_record
 from weftsim.sweep.store import TABLE_FILE, read_table
@@ -135,6 +137,10 @@ def test_reference_engine_cells_on_the_cluster_match_the_local_pool(tmp_path, sc
     # Same deterministic engine, same machine: identical to the last printed digit.
     assert rows == _table(tmp_path / "local")
     assert float(rows[0]["rapier_acceleration_m_s2_rev1_peak"]) > 0
+    # A cluster's worker was not started by this command: every cell still records the sweep's command line.
+    for row in rows:
+        command = json.loads((tmp_path / "dask" / row["cell"] / MANIFEST).read_text())["command"]
+        assert command.startswith("weftsim sweep ") and command.endswith(scheduler), command
 
 
 def test_workers_in_another_directory_without_the_sweep_directory(tmp_path, scheduler, monkeypatch):

@@ -193,13 +193,15 @@ def test_cli_wear_resumes_and_refuses_bad_input(tmp_path):
     assert data["updates"] > n1 and data["hours_reached"] == pytest.approx(4.0)
     assert 0.0 < data["hours_to_limit"] < 4.0
     table = np.genfromtxt(out / "wear.csv", delimiter=",", names=True)
-    assert table["hours"][0] == 0.0 and np.all(np.diff(table["effective_clearance_mm"]) >= 0.0)
+    assert table["hours"][0] == 0.0 and np.all(np.diff(table["effective_clearance_e_mm"]) >= 0.0)
     other = run_cli("wear", REFERENCE, "--hours", 4, "--speed-rpm", 500, "-o", out)
     assert other.returncode == 2 and "another scene" in other.stderr
     forced = run_cli("wear", REFERENCE, "--hours", 1, "--speed-rpm", 500, "-o", out, "--no-plot", "--force")
     assert forced.returncode == 0, forced.stderr  # --force starts a prediction of the other scene over
     assert "resuming" not in forced.stderr and json.loads((out / "wear.json").read_text())["hours_reached"] == 1.0
-    for args, words in ((("--engine", "exudyn"), "Exudyn engine has no worn-geometry"),
+    for args, words in ((("--engine", "exudyn", "--set", "solver.exudyn.model=rigid_body"),
+                         "runs on the Exudyn engine's kinematic tree"),
+                        (("--engine", "exudin"), "--engine must be one of reference, exudyn"),
                         (("--limit-clearance-mm", 0.1), "must be larger than"),
                         (("--clearance-mm", 0), "ideal joint")):
         bad = run_cli("wear", REFERENCE, "--hours", 1, "-o", tmp_path / "x", *args)

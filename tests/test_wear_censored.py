@@ -141,10 +141,10 @@ def test_ensemble_with_never_design_points_writes_censored_quantiles(oiled_loom,
     with np.errstate(divide="ignore"):
         expected = 2000.0 / (1.0 - t) * 1e-7 / rows["joint_e.wear.wear_coefficient"]
     expected = np.where(expected <= 1e5, expected, math.inf)
-    assert np.isfinite(rows["hours_to_limit"]).tolist() == np.isfinite(expected).tolist()
+    assert np.isfinite(rows["hours_to_limit_e"]).tolist() == np.isfinite(expected).tolist()
     ok = np.isfinite(expected)
     # the CSV holds 10 significant digits of v and k; 1 / (1 - t) amplifies them up to ~50x near v1
-    assert rows["hours_to_limit"][ok] == pytest.approx(expected[ok], rel=1e-7)
+    assert rows["hours_to_limit_e"][ok] == pytest.approx(expected[ok], rel=1e-7)
     assert reach["fraction"] == pytest.approx(np.mean(ok), rel=1e-12) and 0.3 < reach["fraction"] < 0.5
     assert reach["low"] < reach["fraction"] < reach["high"]
     assert saved["hours_to_limit"]["p90"] == {**saved["hours_to_limit"]["p90"], "hours": None, "censored": True,
@@ -152,7 +152,7 @@ def test_ensemble_with_never_design_points_writes_censored_quantiles(oiled_loom,
     assert saved["hours_to_limit"]["p10"]["censored"] is False and saved["hours_to_limit"]["p10"]["hours"] > 2000.0
     assert set(saved["never"]) == {"node_1", "node_2"}
     assert Path(data["files"]["cdf_figure"]).stat().st_size > 0
-    assert np.mean(rows["reaches_limit"]) == pytest.approx(reach["fraction"], rel=1e-12)
+    assert np.mean(rows["reaches_limit_e"]) == pytest.approx(reach["fraction"], rel=1e-12)
 
 
 def test_ensemble_where_nothing_wears_says_so(oiled_loom, tmp_path, monkeypatch):

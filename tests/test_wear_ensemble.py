@@ -165,9 +165,9 @@ def test_wear_result_checks_itself(tmp_path):
     scene = load_scene(REFERENCE)
     data = predict_to_directory(scene, 1.0, tmp_path / "w", figures=False)
     # Sums of a few thousand positive terms per update over 360-point profiles: round-off ~1e-13.
-    assert data["profile_volume_mm3"] == pytest.approx(data["wear_volume_mm3"], rel=1e-9)
-    assert data["archard_volume_mm3"] == pytest.approx(data["wear_volume_mm3"], rel=1e-9)
-    assert data["sliding_weighted_mean_load_N"] > 1.5 * data["time_mean_load_N"]
+    assert data["profile_volume_e_mm3"] == pytest.approx(data["wear_volume_e_mm3"], rel=1e-9)
+    assert data["archard_volume_e_mm3"] == pytest.approx(data["wear_volume_e_mm3"], rel=1e-9)
+    assert data["sliding_weighted_mean_load_e_N"] > 1.5 * data["time_mean_load_e_N"]
 
 
 def test_a_hard_cycle_backs_off_and_goes_on(monkeypatch, tmp_path):
@@ -193,7 +193,7 @@ def test_a_hard_cycle_backs_off_and_goes_on(monkeypatch, tmp_path):
                                       usecols=[7], ndmin=1)]
     c_free = [1e3 * extrapolate.effective_clearance(scene.joint.clearance, u.bearing, u.journal) for u in updates]
     assert c[2] - c[1] < 0.75 * (c_free[2] - c_free[1])
-    assert data["profile_volume_mm3"] == pytest.approx(data["wear_volume_mm3"], rel=1e-9)
+    assert data["profile_volume_e_mm3"] == pytest.approx(data["wear_volume_e_mm3"], rel=1e-9)
 
     def always(scene, bearing, journal):
         calls["n"] += 1

@@ -404,19 +404,20 @@ def render_frames(fig: Figure, draw: Callable[[int], None], moving: tuple[Artist
         yield np.asarray(canvas.buffer_rgba())[..., :3].copy()
 
 
-def _gif(frames, fps: float, target: Path) -> None:
-    """Save RGB frames as one looping GIF (Pillow ships with matplotlib)."""
+def _gif(frames, fps: float, target: Path, comment: str = "") -> None:
+    """Save RGB frames as one looping GIF (Pillow ships with matplotlib), ``comment`` in its comment extension."""
     from PIL import Image
 
     images = (Image.fromarray(rgb).quantize(colors=128, method=Image.Quantize.FASTOCTREE) for rgb in frames)
     first = next(images)
+    extra = {"comment": comment.encode("utf-8")} if comment else {}
     # A generator: Pillow keeps its own copy of each frame until the file is written; a list here held a second.
     first.save(target, format="GIF", save_all=True, append_images=images, duration=int(round(1000.0 / fps)), loop=0,
-               disposal=1)
+               disposal=1, **extra)
 
 
-def _mp4(frames, fps: float, target: Path) -> None:
-    """Pipe RGB frames to ffmpeg as H.264 in an MP4 container."""
+def _mp4(frames, fps: float, target: Path, comment: str = "") -> None:
+    """Pipe RGB frames to ffmpeg as H.264 in an MP4 container, ``comment`` in its comment tag."""
     import subprocess
 
     frames = iter(frames)
@@ -425,7 +426,8 @@ def _mp4(frames, fps: float, target: Path) -> None:
     # libx264 with yuv420p needs even sizes: crop a pixel row or column if needed.
     height, width = height - height % 2, width - width % 2
     command = ["ffmpeg", "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", f"{width}x{height}",
-               "-r", f"{fps:g}", "-i", "pipe:", "-vcodec", "libx264", "-pix_fmt", "yuv420p", "-f", "mp4", str(target)]
+               "-r", f"{fps:g}", "-i", "pipe:", "-vcodec", "libx264", "-pix_fmt", "yuv420p",
+               *(["-metadata", f"comment={comment}"] if comment else []), "-f", "mp4", str(target)]
     with subprocess.Popen(command, stdin=subprocess.PIPE, stderr=subprocess.PIPE) as ffmpeg:
         for rgb in (first, *frames):
             ffmpeg.stdin.write(np.ascontiguousarray(rgb[:height, :width]).tobytes())
@@ -449,11 +451,13 @@ def check_format(path: str | Path) -> str:
 
 
 def write_animation(result: RunResult, path: str | Path, frames: int = DEFAULT_FRAMES, fps: float = DEFAULT_FPS,
-                    magnification: float | None = None) -> MechanismFrames:
+                    magnification: float | None = None, comment: str = "") -> MechanismFrames:
     """Write the animation of ``result`` over a revolution to ``path`` (.gif, or .mp4 with ffmpeg).
 
     The file is written atomically (:func:`weftsim.output.write_atomic`): a failed or interrupted
-    write leaves no partial file.
+    write leaves no partial file.  ``comment`` goes into the file's own metadata (the GIF comment
+    extension, the MP4 comment tag): the command line writes the resolved scene there
+    (:func:`weftsim.record.scene_toml`), so a single animation file says how it was made.
 
     Parameters
     ----------
@@ -467,6 +471,8 @@ def write_animation(result: RunResult, path: str | Path, frames: int = DEFAULT_F
         Frames per second of the file.
     magnification : float, optional
         Scale of the clearance drawing; default :func:`clearance_magnification`.
+    comment : str
+        Text stored in the file's metadata; empty for none.
 
     Returns
     -------
@@ -482,5 +488,5 @@ def write_animation(result: RunResult, path: str | Path, frames: int = DEFAULT_F
     points = mechanism_frames(result, frames)
     fig, draw, moving = animation_figure(result, points, magnification)
     save = _gif if suffix == ".gif" else _mp4
-    write_atomic(Path(path), lambda tmp: save(render_frames(fig, draw, moving, frames), fps, tmp))
+    write_atomic(Path(path), lambda tmp: save(render_frames(fig, draw, moving, frames), fps, tmp, comment))
     return points

@@ -170,7 +170,8 @@ def cmd_wear(args: argparse.Namespace) -> int:
     from weftsim.wear.command import run
 
     scene = scene_from_args(args)
-    return run(args, scene, output_directory(args, scene, "wear"), _stop_on_interrupt)
+    where = "wear" if args.engine == "reference" else f"wear-{args.engine}"  # engines' states apart
+    return run(args, scene, output_directory(args, scene, where), _stop_on_interrupt)
 
 
 def _check_fits(scene, outdir: Path, runs: int = 1) -> None:
@@ -407,7 +408,7 @@ def cmd_animate(args: argparse.Namespace) -> int:
     from weftsim.animate import animated_window, check_format, check_frames, write_animation
     from weftsim.api import resolve_engine
     from weftsim.output import check_file_target
-    from weftsim.record import check_same_scene
+    from weftsim.record import check_same_scene, scene_toml
 
     scene = scene_from_args(args)
     engine = resolve_engine(args.engine)
@@ -429,7 +430,8 @@ def cmd_animate(args: argparse.Namespace) -> int:
         raise CliError(f"simulation failed: {result.message}; nothing animated", EXIT_FAILED)
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
-        frames = write_animation(result, target, frames=args.frames)
+        # The file records its own scene and command: -o may put it where no manifest is written.
+        frames = write_animation(result, target, frames=args.frames, comment=scene_toml(scene))
     except OSError as exc:
         raise CliError(f"cannot write {target}: {exc.strerror or exc}") from None
     from weftsim.animate import clearance_magnification, joint_caption

@@ -3,7 +3,7 @@ keys that describe a joint which is ideal in the scene (and so would change noth
 
 Joint F (rod 4 - sector 5) is ideal unless a scene gives ``joint_f.clearance_mm > 0``.  Given a
 clearance on its own, F takes every other key of ``[joint_e]`` (pin, bearing, law, restitution,
-friction, materials; not the wear table) unless the scene or the command line gives it for F:
+friction, materials, the wear table) unless the scene or the command line gives it for F:
 :func:`inherit_joint_f`.  The scene remembers which keys F took (``Scene.joint_f_inherits``), so an
 override of E's pin in a sweep cell moves F's pin with it (:func:`resync_joint_f`).
 
@@ -122,5 +122,6 @@ def inheritance_note(scene: Scene) -> str | None:
         return None
     names = scene.joint_f_inherits
     listed = ", ".join(names) if len(names) <= 4 else f"{', '.join(names[:4])} and {len(names) - 4} more"
-    return (f"joint F (clearance {scene.joint_f.clearance * 1e3:g} mm) takes the pin, law and materials of "
+    what = "pin, law, materials and wear keys" if any(n.startswith("wear.") for n in names) else "pin, law and materials"
+    return (f"joint F (clearance {scene.joint_f.clearance * 1e3:g} mm) takes the {what} of "
             f"joint E where [joint_f] does not give them: {listed}; set joint_f.<key> to differ")

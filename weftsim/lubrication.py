@@ -57,10 +57,12 @@ def lubrication_rows(prm: np.ndarray, time: np.ndarray, states: np.ndarray, out_
             c = kc.local_clearance(prm, t, e_y, e_z, v_y, v_z, y)[0]
             _row(prm, c, e_y, e_z, v_y, v_z, y[3], prm[kc.OMEGA] * dphi, out_e, i)
             continue
-        e_y, e_z, ve_y, ve_z, f_y, f_z, vf_y, vf_z, w_rocker, dpsi, da = kf.eccentricities(prm, t, y)
+        q = kf.eccentricities(prm, t, y)
+        e_y, e_z, ve_y, ve_z, f_y, f_z, vf_y, vf_z, w_rocker, dpsi, da = q
+        c_e, _, c_f, _ = kf.local_clearances(prm, t, y, q)  # a worn joint's clearance along e (round: c0)
         if prm[kf.TOPOLOGY] == kf.E_AND_F:
-            _row(prm, prm[kc.CLEARANCE], e_y, e_z, ve_y, ve_z, dpsi, w_rocker, out_e, i)
-        _row(jf, jf[kc.CLEARANCE], f_y, f_z, vf_y, vf_z, dpsi, da, out_f, i)
+            _row(prm, c_e, e_y, e_z, ve_y, ve_z, dpsi, w_rocker, out_e, i)
+        _row(jf, c_f, f_y, f_z, vf_y, vf_z, dpsi, da, out_f, i)
 
 
 def lubrication_table(scene: Scene, prm: np.ndarray, time: np.ndarray,

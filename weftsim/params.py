@@ -276,7 +276,7 @@ class ClearanceJoint:
         contact: xi delta_dot / delta_dot^- <= xi); ``"onset"``, the approach rate at the onset
         alone (Lankarani-Nikravesh, Flores), for comparison with published results.
     wear : WearModel
-        Archard wear parameters (``[joint_e.wear]``), used by ``weftsim wear`` only.
+        Archard wear parameters (``[joint_e.wear]`` or ``[joint_f.wear]``), used by ``weftsim wear`` only.
     design_clearance : tuple of float
         (low, high): the design range of the radial clearance over the journal diameter, c / (2 R_j)
         (dimensionless).  Default (0.5e-3, 1.0e-3): a bushed pin in oscillating motion (docs/plausibility.md);

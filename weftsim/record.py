@@ -14,6 +14,7 @@ elsewhere and ``--force`` to replace them.  A rerun of the same scene replaces i
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import shlex
@@ -31,6 +32,7 @@ SCENE_FILE = "scene.toml"
 SHOWN_DIFFERENCES = 3  # keys named in the refusal; the rest are counted
 
 _command: list[str] | None = None
+_command_text: str | None = None  # set by written_by()
 
 
 def set_command(argv: list[str]) -> None:
@@ -39,9 +41,23 @@ def set_command(argv: list[str]) -> None:
     _command = list(argv)
 
 
+@contextlib.contextmanager
+def written_by(command: str):
+    """Within the block, :func:`command_line` is ``command``: a sweep's worker process writes its cell's
+    record with the command that started the sweep, not its own arguments."""
+    global _command_text
+    before, _command_text = _command_text, command
+    try:
+        yield
+    finally:
+        _command_text = before
+
+
 def command_line() -> str:
     """The command that is writing: ``weftsim run reference --clearance-mm 0.5``, or for the Python
     interface the interpreter's own arguments (the script and its arguments)."""
+    if _command_text is not None:
+        return _command_text
     if _command is not None:
         return shlex.join(["weftsim", *_command])
     return shlex.join(sys.argv) if sys.argv and sys.argv[0] else "python"
@@ -127,7 +143,10 @@ def check_same_scene(outdir: str | Path, scene: Scene, force: bool = False) -> N
     old = recorded_scene(outdir)
     if old is None or force:
         return
-    changed = differences(old, resolved_scene(scene))
+    new = resolved_scene(scene)
+    if scene.joint_f.is_ideal:  # keys of an ideal F added to weftsim after ``old`` was written change nothing
+        new = {k: v for k, v in new.items() if k in old or not k.startswith("joint_f.")}
+    changed = differences(old, new)
     if not changed:
         return
     shown = ", ".join(changed[:SHOWN_DIFFERENCES])

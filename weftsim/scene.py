@@ -245,10 +245,10 @@ SCHEMA: tuple[Key, ...] = (
 
 def _joint_f_keys() -> tuple[Key, ...]:
     """The keys of [joint_f] (joint F, rod 4 - sector 5): those of [joint_e], for the scene's ``joint_f``,
-    without its wear table (``weftsim wear`` predicts the wear at E; docs/wear.md)."""
+    its wear table ``[joint_f.wear]`` included (``weftsim wear`` wears every loose joint; docs/wear.md)."""
     out = []
     for key in SCHEMA:
-        if key.path.startswith("joint_e.") and not key.path.startswith("joint_e.wear."):
+        if key.path.startswith("joint_e."):
             doc = "joint F: " + (key.doc or key.path.partition(".")[2])
             out.append(replace(key, path="joint_f." + key.path.partition(".")[2],
                                target="joint_f." + key.target.partition(".")[2], doc=doc))

@@ -38,6 +38,12 @@ not, through the same connector and torque loads as friction (:mod:`.joint_frict
 records (t, D'_lub, U_a, |f_film|, F_a, T_j) at every accepted state.  Build the joint with
 ``ClearanceJoint(..., lubrication=Lubrication(viscosity=...))``.
 
+A worn joint (``ClearanceJoint(..., bearing_wear=..., journal_wear=...)``: worn depth tables, m, at equally
+spaced angles over one turn of each body's frame, i.e. from the body's own x axis about Z): the contact
+sees the local clearance c0 + h_b(psi_b) + h_j(psi_j) along the eccentricity
+(:mod:`weftsim.kernel.worn_joint`, the same worn clearance as weftsim's own engines), through the same
+connector and loads as friction (the bodies' angles are read at every trial state).
+
 A restitution outside the law's valid range (``law.valid_restitution``) is a warning.
 """
 
@@ -48,6 +54,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import exudyn as exu
+import numpy as np
 from exudyn.itemInterface import ObjectConnectorCartesianSpringDamper
 
 from weftsim.contact import make_law
@@ -55,6 +62,7 @@ from weftsim.exudyn_engine import callbacks
 from weftsim.exudyn_engine.joint_friction import JointFriction
 from weftsim.exudyn_engine.onset import OnsetTracker, penetration_state
 from weftsim.kernel.joint import joint_parameters
+from weftsim.kernel.wear import wear_block
 from weftsim.params import ClearanceJoint
 
 if TYPE_CHECKING:
@@ -144,7 +152,9 @@ class ClearanceJointModel:
     friction: JointFriction | None = None
 
     def state(self, mbs: exu.MainSystem) -> tuple[float, float]:
-        """Current (delta, delta_dot) of the joint, m and m/s."""
+        """Current (delta, delta_dot) of the joint, m and m/s (a worn joint: at the local clearance)."""
+        if self.joint.is_worn:
+            return self.friction.penetration(mbs)
         u = mbs.GetObjectOutput(self.connector, exu.OutputVariableType.Displacement)
         v = mbs.GetObjectOutput(self.connector, exu.OutputVariableType.Velocity)
         return penetration_state(u[0], u[1], v[0], v[1], self.joint.clearance)
@@ -213,14 +223,18 @@ def add_clearance_joint(mbs: exu.MainSystem, marker_bearing: exu.MarkerIndex, ma
                       f"'{law.name}' law's damping was derived for: its contacts will not return this restitution; "
                       "choose a law valid there (e.g. 'flores' for any ce)", UserWarning, stacklevel=2)
     route = callbacks.resolve_route(callback)
-    if call_counter is not None and (route != "python" or joint.friction_coefficient > 0.0 or joint.is_lubricated):
-        raise ValueError("`call_counter` works with callback='python', no friction and no lubrication only")
+    if call_counter is not None and (route != "python" or joint.friction_coefficient > 0.0 or joint.is_lubricated
+                                     or joint.is_worn):
+        raise ValueError("`call_counter` works with callback='python', no friction, no lubrication and no wear only")
     c, v_min = joint.clearance, joint.min_impact_velocity
     max_approach = joint.impact_velocity_rule == "max_approach"
     tracker = OnsetTracker(c, v_min, rule=joint.impact_velocity_rule)  # checks the rule's name
     friction = None
-    if joint.friction_coefficient > 0.0 or joint.is_lubricated:
-        friction = JointFriction(mbs, marker_bearing, marker_journal, joint_parameters(joint, law), route,
+    if joint.friction_coefficient > 0.0 or joint.is_lubricated or joint.is_worn:
+        prm = joint_parameters(joint, law)
+        if joint.is_worn:  # the wear block after the joint block (weftsim.kernel.worn_joint)
+            prm = np.concatenate([prm, wear_block(joint.bearing_wear, joint.journal_wear)])
+        friction = JointFriction(mbs, marker_bearing, marker_journal, prm, route,
                                  lambda: model.tracker.callback_state)  # fmt: skip
         force = friction.spring_force
     elif route == "python":
@@ -260,7 +274,10 @@ def add_clearance_joint(mbs: exu.MainSystem, marker_bearing: exu.MarkerIndex, ma
         trial[0] = min(trial[0], t)
         if friction is not None:
             friction.accept(mbs, t)
-        delta, rate = penetration_state(u[0], u[1], v[0], v[1], c)
+        if joint.is_worn:
+            delta, rate = friction.penetration(mbs)
+        else:
+            delta, rate = penetration_state(u[0], u[1], v[0], v[1], c)
         model.tracker.accept(t, delta, rate)
         mbs.SetObjectParameter(connector, "stiffness", model.tracker.callback_state)
         return True

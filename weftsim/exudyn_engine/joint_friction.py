@@ -25,10 +25,16 @@ journal from sliding into sticking (ramp slope mu F_N / (v1 - v0) ~ 1e8 N s/m on
 rigid-body model sets both (solver.py, with what failed without them); a user's own settings need them too.
 
 A body without rotation (ground, mass point) turns at 0 and takes no moment.
+
+A worn joint (``joint.bearing_wear``, ``joint.journal_wear``: the wear block after the joint block in
+``prm``) also reads the bodies' angles about Z (``RotationMatrix``, reference rotation included): its
+profiles are in each body's frame, and the force is :func:`weftsim.kernel.worn_joint.connector_worn_force`
+(or its lubricated form) at the local clearance.
 """
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 import exudyn as exu
@@ -37,6 +43,7 @@ from exudyn.itemInterface import LoadTorqueVector, MarkerBodyRigid
 from weftsim.exudyn_engine import callbacks
 from weftsim.kernel import joint as kernel_joint
 from weftsim.kernel.lubricated import connector_lubricated_force
+from weftsim.kernel.worn_joint import connector_worn_force, connector_worn_lubricated_force
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -44,6 +51,7 @@ if TYPE_CHECKING:
 _ROTATING = ("RigidBody", "RigidBody2D")
 _FIXED = ("Ground", "MassPoint", "MassPoint2D")
 _OMEGA = exu.OutputVariableType.AngularVelocity
+_ROTATION = exu.OutputVariableType.RotationMatrix
 
 
 def _body_of(mbs, marker) -> tuple[int | None, list, bool]:
@@ -90,11 +98,15 @@ class JointFriction:
         # A lubricated joint (the block's LUBRICATED flag): the same nine values with the film and the
         # asperities added, then their power, potential and channels (weftsim.kernel.lubricated).
         self.lubricated = bool(prm[kernel_joint.LUBRICATED] != 0.0)
-        function = connector_lubricated_force if self.lubricated else kernel_joint.connector_friction_force
+        self.worn = len(prm) > kernel_joint.N_JOINT  # a wear block follows the joint block
+        if self.worn:
+            function = connector_worn_lubricated_force if self.lubricated else connector_worn_force
+        else:
+            function = connector_lubricated_force if self.lubricated else kernel_joint.connector_friction_force
         self.kernel = callbacks.kernel_form(function, route)
         self.prm = callbacks.parameters_for_route(prm, route)
-        if route == "numba":
-            self.kernel(self.prm, 1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0)  # load (or compile) now
+        if route == "numba":  # load (or compile) now
+            self.kernel(self.prm, 1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0, *((0.0, 0.0) if self.worn else ()))
         self.memory = memory
         self.connector = None
         self._key = None
@@ -108,15 +120,29 @@ class JointFriction:
         w_b = mbs.GetObjectOutputBody(self.bearing, _OMEGA, [0.0, 0.0, 0.0])[2] if self.bearing_rotates else 0.0
         return w_j, w_b
 
+    def angles(self, mbs: exu.MainSystem) -> tuple[float, float]:
+        """(theta_j, theta_b), rad about Z, of the current (trial) state (0 for a body that does not rotate)."""
+        out = []
+        for rotates, body in ((self.journal_rotates, self.journal), (self.bearing_rotates, self.bearing)):
+            r = mbs.GetObjectOutputBody(body, _ROTATION, [0.0, 0.0, 0.0]) if rotates else (1.0, 0.0, 0.0, 0.0)
+            out.append(math.atan2(r[3], r[0]))
+        return out[0], out[1]
+
     def evaluate(self, mbs: exu.MainSystem, ex: float, ey: float, vx: float, vy: float) -> tuple[float, ...]:
         """The kernel's (f_x, f_y, delta, delta_dot, F_N, F_T, M_j, M_b, v_T) at this state (memoized)."""
         w_j, w_b = self.rates(mbs)
         held, delta0, rate0 = self.memory()
-        key = (ex, ey, vx, vy, w_j, w_b, held, delta0, rate0)
+        turned = self.angles(mbs) if self.worn else ()
+        key = (ex, ey, vx, vy, w_j, w_b, held, delta0, rate0, *turned)
         if key != self._key:
             self._key = key
-            self._value = self.kernel(self.prm, ex, ey, vx, vy, held, delta0, rate0, w_j, w_b)
+            self._value = self.kernel(self.prm, ex, ey, vx, vy, held, delta0, rate0, w_j, w_b, *turned)
         return self._value
+
+    def penetration(self, mbs: exu.MainSystem) -> tuple[float, float]:
+        """(delta, delta_dot) of the current state as the force saw them (a worn joint: at the local clearance)."""
+        out = self._state(mbs)
+        return out[2], out[3]
 
     def spring_force(self, mbs: exu.MainSystem, t: float, itemNumber: int, displacement: Sequence[float],
                      velocity: Sequence[float], stiffness: Sequence[float], damping: Sequence[float],
@@ -140,9 +166,12 @@ class JointFriction:
         def bearing_moment(mbs, t, load):
             return [0.0, 0.0, self._state(mbs)[7]]
 
+        # A worn joint without friction or film has no moments (M_j = M_b = 0): no loads (their user functions
+        # at every Newton iteration took the worn loom's rigid-body model 13.5 s for 0.05 revolution, 2.4 s without).
+        moments = self.lubricated or self.prm[kernel_joint.MU] > 0.0
         for rotates, body, local, moment in ((self.journal_rotates, self.journal, self.journal_local, journal_moment),
                                              (self.bearing_rotates, self.bearing, self.bearing_local, bearing_moment)):
-            if rotates:
+            if rotates and moments:
                 marker = mbs.AddMarker(MarkerBodyRigid(bodyNumber=body, localPosition=local))
                 mbs.AddLoad(LoadTorqueVector(markerNumber=marker, loadVector=[0.0, 0.0, 0.0],
                                              loadVectorUserFunction=moment))  # fmt: skip

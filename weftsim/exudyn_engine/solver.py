@@ -149,7 +149,8 @@ def _what_to_try(scene: Scene, h: float) -> str:
             f"(now {s.newton_max_iterations})")  # fmt: skip
 
 
-def solve(scene: Scene, progress: Callable[[float], None] | None = None, callback: str | None = None) -> RunResult:
+def solve(scene: Scene, progress: Callable[[float], None] | None = None, callback: str | None = None,
+          step_states: Callable[..., None] | None = None) -> RunResult:
     """Simulate a scene with Exudyn.
 
     Parameters
@@ -159,6 +160,11 @@ def solve(scene: Scene, progress: Callable[[float], None] | None = None, callbac
         Called with the completed fraction in [0, 1] about 100 times per run.
     callback : str, optional
         Override of ``scene.exudyn_solver.callback`` (clearance force route).
+    step_states : callable, optional
+        Kinematic tree only (a failed result on another model): called once after the run as
+        ``step_states(t, states, f_n, v_t)`` with the rows behind ``result.steps``
+        (:func:`weftsim.exudyn_engine.tree_solve.solve_tree`), as the reference engine's
+        ``solve(step_states=...)``; the wear prediction's Archard integral reads them.
 
     Returns
     -------
@@ -174,16 +180,20 @@ def solve(scene: Scene, progress: Callable[[float], None] | None = None, callbac
     if problem is not None:
         return _failed(scene, problem, 0.0)
     path = select_path(scene)
-    result = _solve_model(scene, path["model"], progress, None, wall0)
+    if step_states is not None and path["model"] != "kinematic_tree":
+        return _failed(scene, "step_states: the Exudyn engine gives the step rows of the kinematic tree only, and "
+                              f"this scene runs on the {path['model']} model", 0.0)
+    result = _solve_model(scene, path["model"], progress, None, wall0, step_states)
     object.__setattr__(result, "path", path)
     return result
 
 
-def _solve_model(scene: Scene, model: str, progress, callback: str | None, wall0: float) -> RunResult:
+def _solve_model(scene: Scene, model: str, progress, callback: str | None, wall0: float,
+                 step_states: Callable[..., None] | None = None) -> RunResult:
     if model == "kinematic_tree":
         from weftsim.exudyn_engine.tree_solve import solve_tree
 
-        return solve_tree(scene, progress, callback)
+        return solve_tree(scene, progress, callback, step_states)
     h, n_steps = step_plan(scene)
     omega = scene.drive.speed
     sc = exu.SystemContainer()

@@ -66,6 +66,7 @@ OVT = exu.OutputVariableType
 EXPLICIT_METHODS = {"DOPRI5": exu.DynamicSolverType.DOPRI5, "ODE23": exu.DynamicSolverType.ODE23}
 _PROGRESS_EVERY = 0.001  # every 0.1 % of the run: a long run shows its first line soon (issue 16)
 END_OF_STEP_ACCELERATIONS = False
+RECORD_COLUMNS = 9  # TreeModel.bearing_force: t, F_b,x, F_b,y, F_N, M_b, F_T v_T, D'_lub, U_a, v_T
 
 
 def check_tree_settings(scene: Scene) -> str | None:
@@ -141,6 +142,19 @@ def contact_work(y: np.ndarray, t: np.ndarray, delta: np.ndarray) -> np.ndarray:
     return out
 
 
+def worn_channels(scene: Scene, t: np.ndarray, a: np.ndarray, psi: np.ndarray, da: np.ndarray,
+                  dpsi: np.ndarray) -> tuple[np.ndarray, ...]:
+    """(delta, delta_dot, F_el, U_el) of a worn joint E at the tree's steps: at the local clearance
+    c0 + h_b + h_j along e (:func:`weftsim.kernel.worn_rows.worn_contact_rows`), delta_dot = e_dot . n - dc/dt."""
+    from weftsim.kernel.worn_rows import worn_contact_rows
+    from weftsim.reference.dynamics import pack_parameters
+
+    states = np.ascontiguousarray(np.column_stack([a, psi, da, dpsi]), dtype=float)
+    out = np.zeros((t.size, 5))
+    worn_contact_rows(pack_parameters(scene), np.ascontiguousarray(t, dtype=float), states, out)
+    return out[:, 1], out[:, 2], out[:, 3], out[:, 4]
+
+
 def tree_settings(scene: Scene) -> exu.SimulationSettings:
     """Explicit solver with automatic step size; no files, no console output."""
     s = scene.exudyn_solver
@@ -158,6 +172,17 @@ def tree_settings(scene: Scene) -> exu.SimulationSettings:
     ti.explicit.computeEndOfStepAccelerations = END_OF_STEP_ACCELERATIONS
     silence(ss)
     return ss
+
+
+def tree_states(data: dict, n: int) -> tuple[np.ndarray, ...]:
+    """(t, states (n, 4) [a, psi, a', psi'], F_N, v_T) of the first ``n`` stored steps (:func:`solve_tree`)."""
+    q, q_t, force = (np.asarray(data[k])[:n] for k in ("q", "q_t", "force"))
+    states = np.zeros((n, 4))
+    if n:
+        states[:, 0], states[:, 1] = q[:, 1], q[:, 1] + q[:, 2] - math.pi
+        states[:, 2], states[:, 3] = q_t[:, 1], q_t[:, 1] + q_t[:, 2]
+        return q[:, 0].copy(), states, force[:, 3].copy(), force[:, 8].copy()
+    return np.zeros(0), states, np.zeros(0), np.zeros(0)
 
 
 def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
@@ -191,6 +216,8 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
     energy = np.zeros(n)
     f_el[inside] = law.elastic_force(delta[inside])
     energy[inside] = law.elastic_energy(delta[inside])
+    if scene.joint.is_worn:  # the local clearance the callback saw (weftsim.kernel.worn_rows), as the reference's
+        delta, rate, f_el, energy = worn_channels(scene, t, a, psi, da, dpsi)
     # A lubricated joint: the film and boundary friction dissipate at every step (the quadratic rule of
     # contact_work over all steps: the squeeze film's power peaks within a few steps, where trapezoids
     # left 1 % of the kinetic energy in a revolution at 80 mPa s), the asperities store U_a.
@@ -234,8 +261,15 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
     }
 
 
-def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, callback: str | None = None) -> RunResult:
-    """Simulate a scene with the kinematic-tree model (settings checked by the caller)."""
+def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, callback: str | None = None,
+               step_states: Callable[..., None] | None = None) -> RunResult:
+    """Simulate a scene with the kinematic-tree model (settings checked by the caller).
+
+    ``step_states``: called once after the run as ``step_states(t, states, f_n, v_t)`` with the rows behind
+    ``result.steps`` (times (n,) s; states (n, 4) [a, psi, a', psi']; the callback's normal force F_N (n,) N
+    and sliding velocity v_T (n,) m/s, 0 out of contact): the contact channels the wear's Archard integral
+    reads (:mod:`weftsim.wear.engines`).
+    """
     wall0 = _time.perf_counter()
     omega, t_end = scene.drive.speed, scene.drive.end_time
     sc = exu.SystemContainer()
@@ -299,8 +333,10 @@ def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, ca
         kind = "non_finite" if isinstance(exc, exu.SolverError) else "model" if isinstance(exc, exu.ModelError) else "solver"
     wall_solve = _time.perf_counter() - wall_solve
     data = {k: mbs.GetSensorStoredData(v) for k, v in sensors.items()}
-    data["force"] = np.array(model.bearing_force).reshape(-1, 8)
+    data["force"] = np.array(model.bearing_force).reshape(-1, RECORD_COLUMNS)
     steps = tree_channels(model, data) if min(len(v) for v in data.values()) else empty_channels()
+    if step_states is not None:
+        step_states(*tree_states(data, len(steps["time_s"])))
     bad = first_nonfinite_row(steps)
     if bad is not None:
         steps = {k: v[:bad] for k, v in steps.items()}

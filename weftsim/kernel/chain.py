@@ -33,15 +33,15 @@ from typing import TYPE_CHECKING
 
 from numba import njit
 
-from weftsim.kernel.joint import connector_friction_force
+from weftsim.kernel.joint import connector_friction_force_at
 from weftsim.kernel.joint import (  # noqa: F401 - the joint block is part of this array
     BEARING_RADIUS, CLEARANCE, COEF, KIND, MU, N_JOINT, TRACK_MAX, V_MIN, clearance_force, clearance_force_at,
     tangential_velocity,
 )  # fmt: skip
 from weftsim.kernel.laws import elastic_force
 from weftsim.kernel.lubricated import L_DISSIPATED, L_FX, L_FY, L_MB, L_MJ, is_lubricated, lubricated_force
-from weftsim.kernel.lubricated import connector_lubricated_force
-from weftsim.kernel.wear import worn_clearance
+from weftsim.kernel.lubricated import connector_lubricated_force_at
+from weftsim.kernel.wear import clearance_along
 
 if TYPE_CHECKING:
     import numpy as np
@@ -96,15 +96,20 @@ def local_clearance(prm: np.ndarray, t: float, ecc_y: float, ecc_z: float, v_y: 
     The bearing turns with the rocker (theta_OE = theta_OE0 + phi, :func:`rocker_angle`), the journal
     with the rod (its axis E -> F along u(psi)); the direction of e turns at (e x e_dot) / |e|^2.
     """
-    if prm.size <= WEAR_E:
+    return rod_clearance(prm, t, ecc_y, ecc_z, v_y, v_z, y[1], y[3])
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def rod_clearance(prm: np.ndarray, t: float, ecc_y: float, ecc_z: float, v_y: float, v_z: float, psi: float,
+                  dpsi: float) -> tuple[float, float]:
+    """:func:`local_clearance` with the rod's angle psi (rad) and rate (rad/s) given (every engine's state
+    has them: the reference's y[1], y[3]; the kinematic tree's q0 + q1 - pi and its rate).  ``prm``: an array,
+    or a list on the Exudyn engine's plain-Python callback route (hence ``len``)."""
+    if len(prm) <= WEAR_E:
         return prm[CLEARANCE], 0.0
-    direction = math.atan2(ecc_z, ecc_y)
-    length2 = ecc_y * ecc_y + ecc_z * ecc_z
-    turn = (ecc_y * v_z - ecc_z * v_y) / length2 if length2 > 0.0 else 0.0
     theta = prm[OMEGA] * t
     w_b = prm[OMEGA] * prm[TAN_BETA] * math.sin(theta) / (1.0 + (prm[TAN_BETA] * math.cos(theta)) ** 2)
-    return worn_clearance(prm, WEAR_E, prm[CLEARANCE], direction - rocker_angle(prm, t), direction - y[1],
-                          turn - w_b, turn - y[3])  # fmt: skip
+    return clearance_along(prm, WEAR_E, prm[CLEARANCE], ecc_y, ecc_z, v_y, v_z, rocker_angle(prm, t), w_b, psi, dpsi)
 
 
 @njit(cache=True, error_model="numpy")
@@ -197,7 +202,7 @@ def tree_joint_force(prm: np.ndarray, t: float, a: float, q1: float, da: float, 
         P_j = G + L_FG u(a) + L_EF u(b),  v_j = L_FG a' u'(a) + L_EF b' u'(b),
 
     less the bearing centre P_b(t) of :func:`crank_side` and its velocity, go through
-    :func:`weftsim.kernel.joint.connector_friction_force`: the normal force F_N n on the bearing and,
+    :func:`weftsim.kernel.joint.connector_friction_force_at`: the normal force F_N n on the bearing and,
     with friction (``prm[MU]`` > 0, in contact), F_T t on the journal (rod turning at b', rocker at
     omega phi') with the moments M_j = (R_b - |e|) F_T about P_j and M_b = -R_b F_T about P_b.  The force on the bearing is F_b = F_N n - F_T t; the journal's, -F_b,
     and M_j enter the joints by virtual work (db/dq0 = db/dq1 = 1):
@@ -206,7 +211,10 @@ def tree_joint_force(prm: np.ndarray, t: float, a: float, q1: float, da: float, 
         Q0 = L_FG (F_bx sin a - F_by cos a) + Q1.
 
     A lubricated joint adds its film and asperity force at every state
-    (:func:`weftsim.kernel.lubricated.connector_lubricated_force`; F_b, M_j and M_b include them).
+    (:func:`weftsim.kernel.lubricated.connector_lubricated_force`; F_b, M_j and M_b include them).  A worn
+    joint (the wear block at :data:`WEAR_E`) takes the local clearance c0 + h_b + h_j along e and its rate
+    (:func:`rod_clearance`, the rod's angle psi = b - pi), as :func:`chain` does: delta and delta_dot are then
+    |e| - c and e_dot . n - dc/dt.
 
     Returns (Q0, Q1, delta, delta_dot, F_bx, F_by, F_N, M_b, F_T v_T, v_T, D'_lub, U_a): N m, N m, m, m/s,
     N, N, N, N m, W (the dry friction power on the pair, <= 0; 0 without friction), m/s (the sliding speed
@@ -225,12 +233,16 @@ def tree_joint_force(prm: np.ndarray, t: float, a: float, q1: float, da: float, 
     omega = prm[OMEGA]
     # F_N = hypot of the normal force, as the channels computed it before friction: bit-identical at mu = 0.
     lub_power = asperity_energy = 0.0
+    ex, ey, evx, evy = px - b_y, py - b_z, vx - omega * db_y, vy - omega * db_z
+    # A worn joint E: the local clearance along e and its rate, the journal's frame turning with the rod
+    # (psi = b - pi); a round one: (c0, 0), the unchanged call below.
+    c, c_rate = rod_clearance(prm, t, ex, ey, evx, evy, b - math.pi, db)
     if is_lubricated(prm):
-        fx, fy, delta, rate, f_n, f_t, m_j, m_b, v_t, lub_power, asperity_energy = connector_lubricated_force(
-            prm, px - b_y, py - b_z, vx - omega * db_y, vy - omega * db_z, held, delta0, rate0, db, omega * dphi)[:11]
+        fx, fy, delta, rate, f_n, f_t, m_j, m_b, v_t, lub_power, asperity_energy = connector_lubricated_force_at(
+            prm, c, c_rate, ex, ey, evx, evy, held, delta0, rate0, db, omega * dphi)[:11]
     else:
-        fx, fy, delta, rate, f_n, f_t, m_j, m_b, v_t = connector_friction_force(
-            prm, px - b_y, py - b_z, vx - omega * db_y, vy - omega * db_z, held, delta0, rate0, db, omega * dphi)
+        fx, fy, delta, rate, f_n, f_t, m_j, m_b, v_t = connector_friction_force_at(
+            prm, c, c_rate, ex, ey, evx, evy, held, delta0, rate0, db, omega * dphi)
     g1 = l_ef * (fx * sb - fy * cb) + m_j
     return (l_fg * (fx * sa - fy * ca) + g1, g1, delta, rate, fx, fy, f_n, m_b, f_t * v_t, v_t, lub_power,
             asperity_energy)  # fmt: skip

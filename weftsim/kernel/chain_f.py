@@ -30,6 +30,12 @@ The parameter array is that of :mod:`.chain` followed by joint F's block (same l
 :func:`weftsim.kernel.joint.joint_parameters`) and the constants below.  Topology E_ONLY is the chain
 of :mod:`.chain` itself: :func:`rhs_any` and :func:`penetration_at` call it unchanged there, so a
 scene with clearance at E alone integrates bit for bit as before.
+
+Worn joints (``weftsim wear``; docs/wear.md) append their wear tables after :data:`N_PARAMETERS`
+(= :data:`weftsim.kernel.chain.WEAR_E`): joint E's block (:func:`weftsim.kernel.wear.wear_block`; the
+empty ``[0, 0]`` when only F wears), then joint F's (:func:`wear_start_f`).  Each joint's contact then
+sees its own worn clearance c(n) (:func:`local_clearances`), in the forces, the penetration the event
+search follows and the energy balance, as the chain with E alone does.
 """
 
 from __future__ import annotations
@@ -40,9 +46,10 @@ from typing import TYPE_CHECKING
 from numba import njit
 
 from weftsim.kernel import chain as kc
-from weftsim.kernel.joint import BEARING_RADIUS, CLEARANCE, KIND, COEF, MU, N_JOINT, clearance_force, tangential_velocity
+from weftsim.kernel.joint import BEARING_RADIUS, CLEARANCE, KIND, COEF, MU, N_JOINT, clearance_force_at, tangential_velocity
 from weftsim.kernel.laws import elastic_force
 from weftsim.kernel.lubricated import L_DISSIPATED, L_FX, L_FY, L_MB, L_MJ, is_lubricated, lubricated_force
+from weftsim.kernel.wear import block_end, clearance_along
 
 if TYPE_CHECKING:
     import numpy as np
@@ -96,9 +103,12 @@ def crank_side_acceleration(prm: np.ndarray, t: float) -> tuple[float, ...]:
 
 
 @njit(cache=True, error_model="numpy")
-def contact_terms(jp: np.ndarray, ecc_y: float, ecc_z: float, v_y: float, v_z: float, w_j: float, w_b: float,
-                  impact_velocity: float) -> tuple[float, ...]:
+def contact_terms(jp: np.ndarray, c: float, c_rate: float, ecc_y: float, ecc_z: float, v_y: float, v_z: float,
+                  w_j: float, w_b: float, impact_velocity: float) -> tuple[float, ...]:
     """Force of one joint in contact (block ``jp``) on its journal, and the power it dissipates.
+
+    ``c``, ``c_rate``: the clearance along e and its rate (m, m/s; a round joint's (c0, 0), a worn
+    one's :func:`local_clearances`); as in :func:`weftsim.kernel.chain.chain`, delta_dot holds -dc/dt.
 
     ``w_j``, ``w_b``: angular velocities of the journal's and the bearing's bodies (rad/s).
     v_T = e_dot.t + w_j (R_b - |e|) - w_b R_b (:func:`weftsim.kernel.joint.tangential_velocity`);
@@ -108,14 +118,15 @@ def contact_terms(jp: np.ndarray, ecc_y: float, ecc_z: float, v_y: float, v_z: f
     Returns (f_Y, f_Z, F_N, delta, M_j, M_b, dissipated): N, N, N, m, N m, N m, W.
     """
     length = math.sqrt(ecc_y * ecc_y + ecc_z * ecc_z)
-    delta = length - jp[CLEARANCE]
+    delta = length - c
     if length <= 0.0:
         return 0.0, 0.0, 0.0, delta, 0.0, 0.0, 0.0
     v_t = 0.0
     if jp[MU] > 0.0:
         v_t = tangential_velocity(ecc_y, ecc_z, v_y, v_z, length, w_j, w_b, jp[BEARING_RADIUS])
-    f_y, f_z, f_n, _, delta, delta_dot, m_j, m_b = clearance_force(jp, ecc_y, ecc_z, v_y, v_z, v_t, impact_velocity)
-    f_el = elastic_force(jp[KIND], jp[COEF], jp[CLEARANCE], delta)
+    f_y, f_z, f_n, _, delta, delta_dot, m_j, m_b = clearance_force_at(jp, c, c_rate, ecc_y, ecc_z, v_y, v_z, v_t,
+                                                                      impact_velocity)  # fmt: skip
+    f_el = elastic_force(jp[KIND], jp[COEF], c, delta)
     dissipated = -(f_y * v_y + f_z * v_z + m_j * w_j + m_b * w_b) - f_el * delta_dot
     return f_y, f_z, f_n, delta, m_j, m_b, dissipated
 
@@ -162,16 +173,47 @@ def _rate(e_y, e_z, v_y, v_z):
 
 
 @njit(cache=True, error_model="numpy")
+def wear_start_f(prm: np.ndarray) -> int:
+    """Index of joint F's wear block: after joint E's (``[0, 0]`` when E does not wear) at
+    :data:`weftsim.kernel.chain.WEAR_E`; ``prm.size`` or beyond when F has none (a round F)."""
+    return block_end(prm, kc.WEAR_E)
+
+
+@njit(cache=True, error_model="numpy")
+def local_clearances(prm: np.ndarray, t: float, y: np.ndarray, q: tuple) -> tuple[float, float, float, float]:
+    """(c_E, dc_E/dt, c_F, dc_F/dt) along each joint's eccentricity (topologies F_ONLY, E_AND_F), m and m/s.
+
+    ``q``: :func:`eccentricities` of (t, y).  A round joint gives (c0, 0); a worn one c0 + h_b + h_j
+    (:func:`weftsim.kernel.wear.clearance_along`) with its bodies' frames: at E the bearing is the
+    rocker (theta_OE, :func:`weftsim.kernel.chain.rocker_angle`) and the journal the rod (psi); at F the
+    bearing is the sector's eye (a = theta_FG) and the journal the rod's pin (psi).  Profiles are tables
+    over each body's own frame, so the same wear tables serve E in either chain.
+    """
+    if prm.size <= kc.WEAR_E:  # no wear tables (every run but a wear update's): the round clearances
+        return prm[CLEARANCE], 0.0, prm[JOINT_F + CLEARANCE], 0.0
+    psi = y[3] if prm[TOPOLOGY] == E_AND_F else y[1]
+    w_rocker, dpsi, da = q[8], q[9], q[10]
+    c_e, rate_e = prm[CLEARANCE], 0.0
+    if prm[TOPOLOGY] == E_AND_F:
+        c_e, rate_e = clearance_along(prm, kc.WEAR_E, prm[CLEARANCE], q[0], q[1], q[2], q[3], kc.rocker_angle(prm, t),
+                                      w_rocker, psi, dpsi)  # fmt: skip
+    c_f, rate_f = clearance_along(prm, wear_start_f(prm), prm[JOINT_F + CLEARANCE], q[4], q[5], q[6], q[7], y[0], da,
+                                  psi, dpsi)  # fmt: skip
+    return c_e, rate_e, c_f, rate_f
+
+
+@njit(cache=True, error_model="numpy")
 def penetration_at(prm: np.ndarray, t: float, y: np.ndarray, joint: int) -> tuple[float, float]:
     """(delta, delta_dot) of ``joint`` (0 = E, 1 = F) of state y at time t (m, m/s)."""
     if prm[TOPOLOGY] == E_ONLY:
         return kc.penetration(prm, t, y)
     q = eccentricities(prm, t, y)
+    c_e, rate_e, c_f, rate_f = local_clearances(prm, t, y, q)
     if joint == JOINT_E_INDEX:
         length, rate = _rate(q[0], q[1], q[2], q[3])
-        return length - prm[CLEARANCE], rate
+        return length - c_e, rate - rate_e
     length, rate = _rate(q[4], q[5], q[6], q[7])
-    return length - prm[JOINT_F + CLEARANCE], rate
+    return length - c_f, rate - rate_f
 
 
 @njit(cache=True, error_model="numpy")
@@ -186,28 +228,31 @@ def chain_f(prm: np.ndarray, t: float, y: np.ndarray, contact: int, impact: np.n
     -------
     q3 (N m), then for E and for F: F_N (N), delta (m), e_Y, e_Z (m); the rapier side's a'' (rad/s^2).
     """
-    e_y, e_z, ve_y, ve_z, ef_y, ef_z, vf_y, vf_z, w_rocker, dpsi, da = eccentricities(prm, t, y)
+    q = eccentricities(prm, t, y)
+    e_y, e_z, ve_y, ve_z, ef_y, ef_z, vf_y, vf_z, w_rocker, dpsi, da = q
+    c_e, rate_e, c_f, rate_f = local_clearances(prm, t, y, q)
     b_y, b_z, db_y, db_z, dd_y, dd_z, dphi = crank_side_acceleration(prm, t)
     fe_y = fe_z = fe_n = m_je = m_be = diss_e = 0.0
     ff_y = ff_z = ff_n = m_jf = m_bf = diss_f = 0.0
     both = prm[TOPOLOGY] == E_AND_F
     delta_e = -prm[CLEARANCE]
     if both:
-        delta_e = math.sqrt(e_y * e_y + e_z * e_z) - prm[CLEARANCE]
+        delta_e = math.sqrt(e_y * e_y + e_z * e_z) - c_e
         if contact & 1:
-            fe_y, fe_z, fe_n, delta_e, m_je, m_be, diss_e = contact_terms(prm, e_y, e_z, ve_y, ve_z, dpsi, w_rocker,
-                                                                          impact[0])  # fmt: skip
+            fe_y, fe_z, fe_n, delta_e, m_je, m_be, diss_e = contact_terms(prm, c_e, rate_e, e_y, e_z, ve_y, ve_z, dpsi,
+                                                                          w_rocker, impact[0])  # fmt: skip
     jf = prm[JOINT_F:JOINT_F + N_JOINT]
-    delta_f = math.sqrt(ef_y * ef_y + ef_z * ef_z) - jf[CLEARANCE]
+    delta_f = math.sqrt(ef_y * ef_y + ef_z * ef_z) - c_f
     if contact & 2:
-        ff_y, ff_z, ff_n, delta_f, m_jf, m_bf, diss_f = contact_terms(jf, ef_y, ef_z, vf_y, vf_z, dpsi, da, impact[1])
+        ff_y, ff_z, ff_n, delta_f, m_jf, m_bf, diss_f = contact_terms(jf, c_f, rate_f, ef_y, ef_z, vf_y, vf_z, dpsi, da,
+                                                                      impact[1])  # fmt: skip
     # Lubricated joints carry their film at every state (weftsim.kernel.lubricated).
     if both and is_lubricated(prm):
-        lub = lubricated_force(prm, prm[CLEARANCE], e_y, e_z, ve_y, ve_z, dpsi, w_rocker)
+        lub = lubricated_force(prm, c_e, e_y, e_z, ve_y, ve_z, dpsi, w_rocker)
         fe_y, fe_z, m_je, m_be = fe_y + lub[L_FX], fe_z + lub[L_FY], m_je + lub[L_MJ], m_be + lub[L_MB]
         diss_e += lub[L_DISSIPATED]
     if is_lubricated(jf):
-        lub = lubricated_force(jf, jf[CLEARANCE], ef_y, ef_z, vf_y, vf_z, dpsi, da)
+        lub = lubricated_force(jf, c_f, ef_y, ef_z, vf_y, vf_z, dpsi, da)
         ff_y, ff_z, m_jf, m_bf = ff_y + lub[L_FX], ff_z + lub[L_FY], m_jf + lub[L_MJ], m_bf + lub[L_MB]
         diss_f += lub[L_DISSIPATED]
     a = y[0]

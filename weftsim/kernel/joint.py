@@ -159,21 +159,32 @@ def connector_force(prm: np.ndarray, ex: float, ey: float, vx: float, vy: float,
     :func:`~weftsim.kernel.hold.callback_impact_velocity`, the damping rate has the resting-contact
     dead zone of :func:`~weftsim.kernel.hold.damping_rate` (+-``prm[DEAD_RATE]``).
 
+    The round joint: :func:`connector_force_at` with the clearance ``prm[CLEARANCE]``.
+
     Returns
     -------
     (f_x, f_y, delta, delta_dot): force (N), penetration (m) and its rate (m/s, 0 at e = 0).
     """
+    return connector_force_at(prm, prm[CLEARANCE], 0.0, ex, ey, vx, vy, held, delta0, rate0)
+
+
+@njit(cache=True, error_model="numpy")
+def connector_force_at(prm: np.ndarray, clearance: float, clearance_rate: float, ex: float, ey: float, vx: float,
+                       vy: float, held: float, delta0: float, rate0: float) -> tuple[float, ...]:
+    """:func:`connector_force` with the clearance ``clearance`` along e (m) changing at ``clearance_rate``
+    (m/s): a worn joint's local values (:func:`weftsim.kernel.wear.worn_clearance`), as
+    :func:`clearance_force_at` takes them; delta = |e| - c, delta_dot = e_dot . n - dc/dt."""
     length = math.sqrt(ex * ex + ey * ey)
-    delta = length - prm[CLEARANCE]
+    delta = length - clearance
     if length <= 0.0:
         return 0.0, 0.0, delta, 0.0
     nx = ex / length
     ny = ey / length
-    rate = vx * nx + vy * ny
+    rate = vx * nx + vy * ny - clearance_rate
     if delta <= 0.0:
         return 0.0, 0.0, delta, rate
     v_imp = callback_impact_velocity(held, delta0, rate0, delta, rate, prm[V_MIN], prm[TRACK_MAX] != 0.0)
-    f = normal_force(prm[KIND], prm[COEF], prm[CLEARANCE], prm[XI], delta, damping_rate(rate, prm[DEAD_RATE]),
+    f = normal_force(prm[KIND], prm[COEF], clearance, prm[XI], delta, damping_rate(rate, prm[DEAD_RATE]),
                      v_imp)  # fmt: skip
     return f * nx, f * ny, delta, rate
 
@@ -186,14 +197,24 @@ def connector_friction_force(prm: np.ndarray, ex: float, ey: float, vx: float, v
     ``omega_j``, ``omega_b``: angular velocities (rad/s, about +z) of the journal's and the bearing's
     body.  The normal force is :func:`connector_force`'s; in contact the journal also gets F_T t
     (:func:`friction_force` at :func:`tangential_velocity`) and the moment M_j = (R_b - |e|) F_T about
-    P_j, the bearing -F_T t and M_b = -R_b F_T about P_b.
+    P_j, the bearing -F_T t and M_b = -R_b F_T about P_b.  The round joint:
+    :func:`connector_friction_force_at` with the clearance ``prm[CLEARANCE]``.
 
     Returns
     -------
     (f_x, f_y, delta, delta_dot, F_N, F_T, M_j, M_b, v_T): the force on the bearing F_N n - F_T t (N),
     penetration (m) and rate (m/s), normal and friction force (N), moments (N m), sliding speed (m/s).
     """
-    fx, fy, delta, rate = connector_force(prm, ex, ey, vx, vy, held, delta0, rate0)
+    return connector_friction_force_at(prm, prm[CLEARANCE], 0.0, ex, ey, vx, vy, held, delta0, rate0, omega_j,
+                                       omega_b)  # fmt: skip
+
+
+@njit(cache=True, error_model="numpy")
+def connector_friction_force_at(prm: np.ndarray, clearance: float, clearance_rate: float, ex: float, ey: float,
+                                vx: float, vy: float, held: float, delta0: float, rate0: float, omega_j: float,
+                                omega_b: float) -> tuple[float, ...]:
+    """:func:`connector_friction_force` with a local clearance and its rate (:func:`connector_force_at`)."""
+    fx, fy, delta, rate = connector_force_at(prm, clearance, clearance_rate, ex, ey, vx, vy, held, delta0, rate0)
     if delta <= 0.0:
         return fx, fy, delta, rate, 0.0, 0.0, 0.0, 0.0, 0.0
     length = math.sqrt(ex * ex + ey * ey)

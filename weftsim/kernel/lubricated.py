@@ -38,7 +38,7 @@ from weftsim.kernel.asperity import asperity_load
 from weftsim.kernel.film import film_force
 from weftsim.kernel.joint import (
     ASPERITY_COEF, BEARING_LENGTH, BEARING_RADIUS, BOUNDARY_MU, CLEARANCE, FILM_FLOOR, FILM_MODEL, JOURNAL_RADIUS,
-    LUBRICATED, ROUGHNESS, V0, V1, VISCOSITY, connector_friction_force, tangential_velocity,
+    LUBRICATED, ROUGHNESS, V0, V1, VISCOSITY, connector_friction_force_at, tangential_velocity,
 )  # fmt: skip
 from weftsim.kernel.laws import friction_factor
 
@@ -123,10 +123,22 @@ def connector_lubricated_force(prm, ex: float, ey: float, vx: float, vy: float, 
     Returns the same nine values (the force on the bearing, now - f_journal of :func:`lubricated_force`
     added; M_j, M_b including the film's torques and the boundary friction), then the lubricated part's
     dissipated power D' (W), the asperity potential U_a (J), the film force's magnitude (N), the
-    asperity load F_a (N) and the film's shear torque on the journal T_j (N m).
+    asperity load F_a (N) and the film's shear torque on the journal T_j (N m).  The round joint:
+    :func:`connector_lubricated_force_at` with the clearance ``prm[CLEARANCE]``.
     """
-    fx, fy, delta, rate, f_n, f_t, m_j, m_b, v_t = connector_friction_force(prm, ex, ey, vx, vy, held, delta0,
-                                                                            rate0, omega_j, omega_b)  # fmt: skip
-    lub = lubricated_force(prm, prm[CLEARANCE], ex, ey, vx, vy, omega_j, omega_b)
+    return connector_lubricated_force_at(prm, prm[CLEARANCE], 0.0, ex, ey, vx, vy, held, delta0, rate0, omega_j,
+                                         omega_b)  # fmt: skip
+
+
+@njit(cache=True, error_model="numpy")
+def connector_lubricated_force_at(prm, clearance: float, clearance_rate: float, ex: float, ey: float, vx: float,
+                                  vy: float, held: float, delta0: float, rate0: float, omega_j: float,
+                                  omega_b: float) -> tuple[float, ...]:
+    """:func:`connector_lubricated_force` with a local clearance and its rate (a worn joint,
+    :func:`weftsim.kernel.joint.connector_force_at`): the film and the asperities see the local clearance
+    too, as on the reference engine's chain."""
+    fx, fy, delta, rate, f_n, f_t, m_j, m_b, v_t = connector_friction_force_at(
+        prm, clearance, clearance_rate, ex, ey, vx, vy, held, delta0, rate0, omega_j, omega_b)
+    lub = lubricated_force(prm, clearance, ex, ey, vx, vy, omega_j, omega_b)
     return (fx - lub[L_FX], fy - lub[L_FY], delta, rate, f_n, f_t, m_j + lub[L_MJ], m_b + lub[L_MB], v_t,
             lub[L_DISSIPATED], lub[L_ASPERITY_ENERGY], lub[L_FILM], lub[L_ASPERITY], lub[L_FILM_TORQUE])  # fmt: skip

@@ -104,7 +104,7 @@ def worn_clearance(prm: np.ndarray, start: int, c0: float, angle_b: float, angle
     penetration rate, delta_dot = e_dot . n - dc/dt, so that a contact which starts because the
     journal slides onto an unworn part of the wall has the approach rate it really has.
     """
-    if prm.size <= start:
+    if len(prm) <= start:  # len: a list on the Exudyn engine's plain-Python callback route
         return c0, 0.0
     n_b = int(prm[start])
     n_j = int(prm[start + 1])
@@ -117,6 +117,36 @@ def worn_clearance(prm: np.ndarray, start: int, c0: float, angle_b: float, angle
         c += periodic_value(prm, start + WEAR_HEADER + n_b, n_j, angle_j)
         rate += periodic_slope(prm, start + WEAR_HEADER + n_b, n_j, angle_j) * rate_j
     return c, rate
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def block_end(prm: np.ndarray, start: int) -> int:
+    """Index just after the wear block at ``prm[start:]`` (``start`` itself when there is none).
+
+    The blocks of several joints follow each other (E's, then F's: :func:`weftsim.reference.dynamics.pack_parameters`);
+    a joint that does not wear but precedes one that does has the empty block ``[0, 0]``.
+    """
+    if len(prm) <= start:
+        return start
+    return start + WEAR_HEADER + int(prm[start]) + int(prm[start + 1])
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def clearance_along(prm: np.ndarray, start: int, c0: float, ecc_y: float, ecc_z: float, v_y: float, v_z: float,
+                    frame_b: float, rate_b: float, frame_j: float, rate_j: float) -> tuple[float, float]:
+    """(c, dc/dt) of a joint along its eccentricity e = (ecc_y, ecc_z) with rate (v_y, v_z), m and m/s.
+
+    ``frame_b``, ``frame_j``: angles of the bearing's and the journal's body frames (rad), ``rate_b``,
+    ``rate_j`` their rates (rad/s); the direction of e turns at (e x e_dot) / |e|^2.  The contact
+    direction in each frame is the direction of e less the frame's angle (:func:`worn_clearance`,
+    block at ``prm[start:]``); (c0, 0) when there is no block.
+    """
+    if len(prm) <= start:  # len: as in worn_clearance
+        return c0, 0.0
+    direction = math.atan2(ecc_z, ecc_y)
+    length2 = ecc_y * ecc_y + ecc_z * ecc_z
+    turn = (ecc_y * v_z - ecc_z * v_y) / length2 if length2 > 0.0 else 0.0
+    return worn_clearance(prm, start, c0, direction - frame_b, direction - frame_j, turn - rate_b, turn - rate_j)
 
 
 @njit(cache=True, error_model="numpy", inline="always")

@@ -23,7 +23,7 @@ from numba import njit
 
 from weftsim.params import Geometry, Inertia, Scene
 from weftsim.kernel.chain import (
-    CLEARANCE, COEF, COUPLING, GRAVITY, KIND, L_EF, L_FG, M11, M22, OMEGA, ROD_MASS, chain, local_clearance, penetration,
+    COEF, COUPLING, GRAVITY, KIND, L_EF, L_FG, M11, M22, OMEGA, ROD_MASS, chain, local_clearance, penetration,
 )  # fmt: skip
 from weftsim.kernel import chain_f as kf
 from weftsim.kernel.laws import elastic_energy
@@ -166,9 +166,10 @@ def _fill_f(prm, table, a0, ratio, time, states, contact, impact, out):
         out[i, 11] = 1.0 if (mask & 1 and delta_e > 0.0) else 0.0
         out[i, 12] = kin13 + kin48
         out[i, 13] = crank[2] + pot48
-        out[i, 14] = elastic_energy(prm[jf + KIND], prm[jf + COEF], prm[jf + CLEARANCE], delta_f)
+        c_e, _, c_f, _ = kf.local_clearances(prm, t, y, kf.eccentricities(prm, t, y))  # c0 at a round joint
+        out[i, 14] = elastic_energy(prm[jf + KIND], prm[jf + COEF], c_f, delta_f)
         if loose_e:
-            out[i, 14] += elastic_energy(prm[KIND], prm[COEF], prm[CLEARANCE], delta_e)
+            out[i, 14] += elastic_energy(prm[KIND], prm[COEF], c_e, delta_e)
         out[i, 15] = kin13 + crank[2] - work0 + y[2 * n_dof]
         out[i, 16] = y[2 * n_dof + 1]
         out[i, 17] = kf.penetration_at(prm, t, y, kf.JOINT_E_INDEX)[1] if loose_e else 0.0

@@ -105,8 +105,9 @@ def topology(scene: Scene) -> int:
 
 def pack_parameters(scene: Scene) -> np.ndarray:
     """Every number the kernel needs for this scene: the joint block at E, the chain's constants,
-    the joint block at F (zeros while F is ideal), the topology, J_FG and J4; then, for a worn
-    joint E, its wear tables (:mod:`weftsim.kernel.wear`, at ``kc.WEAR_E``)."""
+    the joint block at F (zeros while F is ideal), the topology, J_FG and J4; then the wear tables
+    of the worn joints (:mod:`weftsim.kernel.wear`): E's at ``kc.WEAR_E``, then F's (E's block is the
+    empty ``[0, 0]`` when only F is worn; :func:`weftsim.kernel.chain_f.wear_start_f`)."""
     out = np.zeros(kf.N_PARAMETERS)
     out[:kc.N_PARAMETERS] = _chain_block(ChainConstants.from_scene(scene))
     if not scene.joint.is_ideal or scene.joint_f.is_ideal:
@@ -116,11 +117,14 @@ def pack_parameters(scene: Scene) -> np.ndarray:
     out[kf.TOPOLOGY] = topology(scene)
     out[kf.SECTOR_CHAIN] = sector_chain_inertia(scene)
     out[kf.ROD_INERTIA] = scene.inertia.rod_inertia
-    if scene.joint.is_worn:
-        if topology(scene) != kf.E_ONLY:
-            raise ValueError("a worn joint E (weftsim.wear) needs joint F ideal: the worn contact is written for "
-                             "the chain with clearance at E alone")
-        out = np.concatenate([out, wear_block(scene.joint.bearing_wear, scene.joint.journal_wear)])
+    if scene.joint_f.is_worn and scene.joint_f.is_ideal:
+        raise ValueError("a worn joint F (weftsim.wear) needs a clearance at F")
+    if scene.joint.is_worn or scene.joint_f.is_worn:
+        block_e = wear_block(scene.joint.bearing_wear, scene.joint.journal_wear)
+        if scene.joint_f.is_worn:
+            block_e = block_e if block_e.size else np.zeros(2)  # n_b = n_j = 0: E round, F's block follows
+            block_e = np.concatenate([block_e, wear_block(scene.joint_f.bearing_wear, scene.joint_f.journal_wear)])
+        out = np.concatenate([out, block_e])
     return out
 
 

@@ -266,6 +266,21 @@ def _integrate(scene: Scene, progress) -> Trajectory:
                     f"the right-hand side turned non-finite (NaN or inf) in the trials of this step, which "
                     f"shrank to {h:.3g} s (below limits.min_step_s = {scene.limits.min_step:.3g} s)"
                 )  # fmt: skip
+            if breach is not None and breach.kind == "interrupted":
+                # A stop asked for from outside: the accepted step is kept with its output samples, so that
+                # the record ends within one sample of where the run says it stopped; a step in which a contact
+                # event may lie is dropped instead (the run then ends where it began).
+                event_inside = (sign * g_new > 0.0 or sign * r_old > 0.0 > sign * r_new) and not joint.is_ideal
+                if finite and not event_inside:
+                    stop = int(np.searchsorted(sample_times, t_new, side="right"))
+                    if stop > next_sample:
+                        ts = sample_times[next_sample:stop]
+                        traj.add_samples(ts, solver.dense_output()(ts).T, contact, impact)
+                        next_sample = stop
+                    t = t_new
+                    traj.add_step(t, y_new, contact, impact)
+                fail(breach.what, breach.hint, breach.kind)
+                break
             if breach is not None:
                 t = t_new
                 if finite:

@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import Any
 from typing import TYPE_CHECKING
 
+from weftsim.record import written_by
 from weftsim.version import __version__
 
 if TYPE_CHECKING:
@@ -161,7 +162,8 @@ def render_run(result: RunResult, figure: bool) -> dict[str, bytes]:
     raise error
 
 
-def solve_cell(name: str, scene_keys: dict, engine: str, figure: bool = False) -> dict[str, Any]:
+def solve_cell(name: str, scene_keys: dict, engine: str, figure: bool = False, command: str | None = None
+               ) -> dict[str, Any]:
     """Solve one cell in a worker and return its outcome with the bytes of its run files.
 
     Parameters
@@ -175,6 +177,9 @@ def solve_cell(name: str, scene_keys: dict, engine: str, figure: bool = False) -
         ``reference``, ``exudyn`` or ``module:function`` (checked by the sweep before it starts).
     figure : bool
         Also render the run's ``channels.png``.
+    command : str, optional
+        The command line that started the sweep, recorded in the cell's manifest and ``scene.toml``
+        (a worker's own arguments say nothing); None records the worker's.
 
     Returns
     -------
@@ -194,7 +199,11 @@ def solve_cell(name: str, scene_keys: dict, engine: str, figure: bool = False) -
     try:
         scene = scene_from_keys(scene_keys, f"sweep cell {name}")
         result = engine_solve(engine)(scene, progress=None)
-        files = render_run(result, figure)
+        if command is None:
+            files = render_run(result, figure)
+        else:
+            with written_by(command):
+                files = render_run(result, figure)
         metrics = cell_metrics(result)
         status, error = result.status, result.message
         if status != "success" and not error:

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from weftsim.record import command_line
 from weftsim.sweep.cell import CELL_FILE, cell_record, is_finished, solve_cell, store_cell, write_cell_record
 from weftsim.sweep.grid import SweepError
 from weftsim.sweep.lock import SweepLock
@@ -204,6 +205,7 @@ def _run_cells(plan, outdir, todo, keys, remaining, report, jobs, scheduler, cel
     pool, window, stop = executor(jobs, scheduler, len(todo), plan.engine)
     in_flight: dict[cf.Future, PlannedCell] = {}
     last_table = time.perf_counter()
+    command = command_line()  # the sweep's, recorded in every cell (a worker's own arguments say nothing)
 
     def submit(planned: PlannedCell):
         name = planned.cell.name
@@ -211,7 +213,7 @@ def _run_cells(plan, outdir, todo, keys, remaining, report, jobs, scheduler, cel
             keys[name] = plan.scene_keys(planned)
         # The resolved scene travels, not the file's path: the stored keys without the absent optional ones.
         data = {key: value for key, value in keys[name].items() if value is not None}
-        in_flight[pool.submit(solve_cell, name, data, plan.engine, cell_figures)] = planned
+        in_flight[pool.submit(solve_cell, name, data, plan.engine, cell_figures, command)] = planned
 
     def finish(planned: PlannedCell, record: dict) -> None:
         del remaining[planned.cell.name]

@@ -1,4 +1,4 @@
-"""Wear prediction at the clearance joint E: how the clearance grows over operating hours (docs/wear.md).
+"""Wear prediction at the clearance joints E and F: how the clearances grow over operating hours (docs/wear.md).
 
 Public entry::
 
@@ -8,11 +8,16 @@ Public entry::
   contact arc (compiled; the reference engine's right-hand side reads the worn geometry);
 - :mod:`.archard`: the wear of one run from its step rows;
 - :mod:`.extrapolate`: the cycle extrapolation with the adaptive update interval;
+- :mod:`.updates`: the updates (each joint's profiles and rates) and their advance;
 - :mod:`.store`: the resumable state and the tables; :mod:`.figures`: the figures.
 
-Joint E only (``[joint_e.wear]``).  A second clearance joint adds its own wear block after E's in
-the kernel parameter array and its own profiles in :class:`~.extrapolate.Update`; the Archard and
-extrapolation code takes the joint's numbers as arguments and is reused as it is.
+Every loose joint wears, each with its own ``[joint_e.wear]`` / ``[joint_f.wear]`` numbers: E, F, or E
+and F together (one run simulates both; :func:`~.updates.wearing_joints`).  A worn F's tables
+follow E's in the kernel parameter array (:mod:`weftsim.kernel.chain_f`), its profiles are
+:attr:`~.updates.Update.second` (or the first when E is ideal), and every output names the joint
+(``effective_clearance_f_mm``, ``wear_profile_f.png``).  A ``--limit-clearance-mm`` applies to every
+wearing joint: ``hours_to_limit`` is the first joint's to reach it (``limit_joint``), each joint's is
+``hours_to_limit_<j>``.
 """
 
 from __future__ import annotations
@@ -28,7 +33,7 @@ if TYPE_CHECKING:
 
     from weftsim.params import Scene
 
-__all__ = ["ENGINES", "WearError", "predict", "predict_to_directory"]
+__all__ = ["ENGINES", "WearError", "check_engine", "predict", "predict_to_directory"]
 
 
 def __getattr__(name: str):
@@ -41,7 +46,7 @@ def __getattr__(name: str):
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-ENGINES = ("reference", "exudyn")
+ENGINES = ("reference", "exudyn")  # weftsim.wear.engines.ENGINES: the same names (not imported: no numba here)
 
 
 def check_request(scene: Scene, hours: float, engine: str, limit: float | None) -> None:
@@ -50,31 +55,67 @@ def check_request(scene: Scene, hours: float, engine: str, limit: float | None) 
 
     if engine not in ENGINES:
         raise WearError(f"--engine must be one of {', '.join(ENGINES)}, got {engine!r}")
-    if engine == "exudyn":
-        raise WearError("--engine exudyn: the Exudyn engine has no worn-geometry contact yet; the wear prediction "
-                        "runs on the reference engine (--engine reference, the default)")
+    if engine == "exudyn" and not scene.joint_f.is_ideal:
+        raise WearError("--engine exudyn: the Exudyn wear prediction covers joint E alone (the kinematic tree carries "
+                        "the clearance at E only), and the scene gives a clearance at F; use --engine reference")
+    if engine == "exudyn" and not scene.joint.is_ideal:
+        from weftsim.exudyn_engine.selection import select_model
+
+        if select_model(scene)[0] != "kinematic_tree":
+            raise WearError("--engine exudyn: the wear prediction runs on the Exudyn engine's kinematic tree, and "
+                            f"solver.exudyn.model = {scene.exudyn_solver.model!r} asks for another model; use "
+                            "'auto' or 'kinematic_tree'")
     from weftsim.wear.extrapolate import MAX_HOURS
 
     if not (0.0 < hours <= MAX_HOURS):
         raise WearError(f"--hours must be > 0 and at most {MAX_HOURS:g} h (114 years of continuous running), "
                         f"got {hours:g}")
-    if limit is not None and not (limit > scene.joint.clearance and math.isfinite(limit)):
-        raise WearError(f"--limit-clearance-mm must be larger than the scene's clearance "
-                        f"{scene.joint.clearance * 1e3:g} mm, got {limit * 1e3:g}")
-    if limit is not None and limit >= scene.joint.journal_radius:
+    joints = [(name, scene.joint if name == "e" else scene.joint_f) for name in scene.loose_joints]
+    if not joints:
+        raise WearError("joint_e.clearance_mm is 0 (ideal joint) and F has no clearance: there is no contact to "
+                        "wear; give joint_e.clearance_mm (or joint_f.clearance_mm) > 0")
+    widest = max(joints, key=lambda nj: nj[1].clearance)
+    if limit is not None and not (limit > widest[1].clearance and math.isfinite(limit)):
+        raise WearError(f"--limit-clearance-mm must be larger than the clearance of every wearing joint (the "
+                        f"limit applies to each; joint_{widest[0]}.clearance_mm = {widest[1].clearance * 1e3:g} mm), "
+                        f"got {limit * 1e3:g}")
+    smallest = min(joints, key=lambda nj: nj[1].journal_radius)
+    if limit is not None and limit >= smallest[1].journal_radius:
         raise WearError(f"--limit-clearance-mm must be smaller than the journal radius "
-                        f"{scene.joint.journal_radius * 1e3:g} mm (the prediction ends before the clearance "
-                        f"reaches it, docs/wear.md), got {limit * 1e3:g}")
-    if not scene.joint_f.is_ideal:  # first: a scene with F alone loose is refused for F, not for E's 0
-        raise WearError("the scene gives a clearance at F: the wear prediction covers joint E with F ideal so far "
-                        "(docs/wear.md); set joint_f.clearance_mm = 0 or leave out [joint_f]")
-    if scene.joint.is_ideal:
-        raise WearError("joint_e.clearance_mm is 0 (ideal joint): there is no contact to wear; give a clearance > 0")
+                        f"{smallest[1].journal_radius * 1e3:g} mm at {smallest[0].upper()} (the prediction ends before "
+                        f"the clearance reaches it, docs/wear.md), got {limit * 1e3:g}")
+
+
+def check_engine(outdir: str | Path, engine: str, force: bool = False) -> None:
+    """Refuse to resume a wear state that ``outdir`` holds from another engine (its record names the engine;
+    a record without one is the reference engine's); with ``force`` that state is deleted (starting over)."""
+    import json
+
+    from weftsim.record import MANIFEST
+    from weftsim.wear.store import STATE, StateMismatch
+
+    outdir = Path(outdir)
+    if not ((outdir / MANIFEST).is_file() and (outdir / STATE).is_file()):
+        return
+    try:
+        record = json.loads((outdir / MANIFEST).read_text())
+    except (OSError, ValueError):
+        return  # a damaged record is refused where it is read (weftsim.output, weftsim.record)
+    stored = record.get("engine", "reference") if isinstance(record, dict) and record.get("kind") == "wear" else engine
+    if stored == engine:
+        return
+    if force:
+        (outdir / STATE).unlink(missing_ok=True)
+        return
+    raise StateMismatch(f"{outdir / STATE} holds a wear prediction on the {stored} engine, not the {engine} engine "
+                        f"asked for: use --engine {stored} to resume it, another output directory with -o, or "
+                        "--force to start over")
 
 
 def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine: str = "reference",
                          limit: float | None = None, progress: Callable[[float], None] | None = None,
-                         stop: Callable[[], bool] | None = None, figures: bool = True, force: bool = False) -> dict:
+                         stop: Callable[[], bool] | None = None, figures: bool = True, force: bool = False,
+                         until_limit: bool = False) -> dict:
     """Predict the wear over ``hours`` of operation into ``outdir``, resuming a stored state.
 
     Parameters
@@ -89,11 +130,16 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
         same scene and passes :func:`weftsim.wear.resume.read_state` (:class:`~.store.StateMismatch`
         otherwise, as for a request of fewer hours than it holds).
     limit : float, optional
-        Clearance limit, m: ``wear.json`` gives the hours at which the effective clearance reaches it.
+        Clearance limit, m, for every wearing joint: ``wear.json`` gives the hours at which each joint's
+        effective clearance reaches it (``hours_to_limit_e``, ``hours_to_limit_f``) and the first of them
+        (``hours_to_limit``, ``limit_joint``).
     progress : callable, optional
         Called with the fraction of the hours done.
     stop : callable, optional
         Returns True to end after the current update (Ctrl-C): the state is kept for a resume.
+    until_limit : bool
+        End where the effective clearance reaches ``limit`` (the update that crosses it extrapolates only up
+        to it, as at a geometric limit; ``"ended"`` says so), even before ``hours``.
 
     Returns
     -------
@@ -112,11 +158,15 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
     from weftsim.output import begin_directory, prepare_directory
     from weftsim.record import provenance
     from weftsim.wear import store
+    from weftsim.wear.engines import simulator
     from weftsim.wear.extrapolate import predict
 
     check_request(scene, hours, engine, limit)
+    if until_limit and limit is None:
+        raise WearError("until_limit needs a clearance limit (--limit-clearance-mm)")
     outdir = prepare_directory(outdir, force, scene)
-    what = {"kind": "wear", "scene": scene.name, **provenance(scene)}  # recorded from the first update on
+    check_engine(outdir, engine, force)
+    what = {"kind": "wear", "scene": scene.name, "engine": engine, **provenance(scene)}  # from the first update on
     begin_directory(outdir, what)  # ours from the first update on: an interrupted prediction resumes here
     wall0 = time.perf_counter()
     done = store.load_state(outdir, scene)
@@ -133,68 +183,136 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
         latest[:] = updates
         store.save_state(outdir, scene, updates)
         if progress is not None and updates[-1].hours > 0.0:  # no time-left estimate from a zero fraction
-            progress(min(updates[-1].hours / hours, 1.0))
+            if until_limit:  # the share of the clearance's way to the limit
+                progress(min(_grown(scene, updates[-1], share=limit), 1.0))
+            else:
+                progress(min(updates[-1].hours / hours, 1.0))
+
+    asked_stop = stop
+    if until_limit:
+
+        def stop() -> bool:
+            return (asked_stop is not None and asked_stop()) or (bool(latest) and _beyond(scene, latest[-1], limit))
 
     try:
-        updates = predict(scene, hours, done, on_update=on_update, stop=stop)
+        updates = predict(scene, hours, done, on_update=on_update, stop=stop, simulate=simulator(engine))
+        if until_limit and updates and _beyond(scene, updates[-1], limit):
+            updates[-1] = _cut_at(scene, updates[-1], limit)
+            store.save_state(outdir, scene, updates)
         if not updates:  # stopped (Ctrl-C) before the first update was done: nothing to write
             raise KeyboardInterrupt
     except WearError as exc:
         if not latest:
             raise
-        _write_results(scene, latest, hours, limit, time.perf_counter() - wall0, outdir, what, figures, str(exc))
+        _write_results(scene, latest, hours, limit, time.perf_counter() - wall0, outdir, what, figures, str(exc),
+                       engine)
         raise WearError(f"{exc}; the prediction stopped there: the {len(latest)} updates before it "
                         f"(0 to {latest[-1].hours:.6g} h) are in {outdir}/wear.csv and wear.json") from None
-    return _write_results(scene, updates, hours, limit, time.perf_counter() - wall0, outdir, what, figures)
+    reached = until_limit and _beyond(scene, updates[-1], limit * (1.0 - 1e-12))
+    return _write_results(scene, updates, hours, limit, time.perf_counter() - wall0, outdir, what, figures,
+                          engine=engine, reached_limit=reached)
+
+
+def _beyond(scene: Scene, update, limit: float) -> bool:
+    """True when ``update`` extrapolated over its N revolutions brings a wearing joint's effective clearance to
+    ``limit`` (m)."""
+    return update.step_revolutions > 0.0 and _grown(scene, update, advance=True) >= limit
+
+
+def _grown(scene: Scene, update, advance: bool = False, share: float | None = None) -> float:
+    """The largest effective clearance of the wearing joints (m) at the start of ``update`` (or after its N
+    revolutions with ``advance``); with ``share`` = limit, the largest share of the way from c0 to it."""
+    from weftsim.wear.extrapolate import advance_update, effective_clearance, joint_of, wearing_joints
+
+    state = advance_update(update, scene) if advance else update
+    values = []
+    for joint in wearing_joints(scene):
+        c0, part = joint_of(scene, joint).clearance, state.part(joint)
+        c = effective_clearance(c0, part.bearing, part.journal)
+        values.append(c if share is None else (c - c0) / (share - c0))
+    return max(values)
+
+
+def _cut_at(scene: Scene, update, limit: float):
+    """``update`` with its N cut so that the effective clearance just reaches ``limit`` (bisection to 1e-18 of N)."""
+    from dataclasses import replace
+
+    inside, outside = 0.0, update.step_revolutions
+    for _ in range(60):
+        middle = 0.5 * (inside + outside)
+        if _beyond(scene, replace(update, step_revolutions=middle), limit):
+            outside = middle
+        else:
+            inside = middle
+    return replace(update, step_revolutions=outside)
 
 
 def _write_results(scene: Scene, updates: list, hours: float, limit: float | None, wall: float, outdir: Path,
-                   what: dict, figures: bool, failure: str | None = None) -> dict:
+                   what: dict, figures: bool, failure: str | None = None, engine: str = "reference",
+                   reached_limit: bool = False) -> dict:
     """Write the tables, the summary and the figures of ``updates``; returns the summary with ``"files"``.
 
-    ``failure``: why the prediction stopped at an update that failed (``wear.json`` keeps it).
+    ``failure``: why the prediction stopped at an update that failed (``wear.json`` keeps it); ``engine``:
+    the engine the updates were simulated on (``wear.json``'s ``"engine"``).
     """
     from dataclasses import replace
 
     from weftsim.output import write_figure, write_files, write_json
     from weftsim.wear import store
-    from weftsim.wear.extrapolate import advance, effective_clearance, ended_by_limit, limit_hours
+    from weftsim.wear.extrapolate import advance_update, effective_clearance, ended_by_limit, joint_of, wearing_joints
 
     data = store.summary(scene, updates, hours, limit, wall)
+    data["engine"] = engine
+    ended = ended_by_limit(scene, updates)
+    if ended is None and reached_limit:  # run until the clearance limit: the last update extrapolates up to it
+        ended = f"the effective clearance reaches the limit {limit * 1e3:g} mm (--limit-clearance-mm)"
+    data["ended"] = ended
+    data["failure"] = failure
+    joints = wearing_joints(scene)
+    if ended is not None:  # the last update extrapolates up to the limit: report the state there
+        end = replace(advance_update(updates[-1], scene), step_revolutions=0.0)
+        data.update(store.archard_check(scene, [*updates, end]))  # the volumes at the limit
+        if limit is not None:
+            data.pop("note", None)
+            data.update(store.limit_summary(scene, [*updates, end], limit))
+        data.update(hours_reached=end.hours,
+                    wear_volume_mm3=data["wear_volume_mm3"] + 1e9 * updates[-1].total_volume_rate
+                    * updates[-1].step_revolutions)
+        for joint in joints:
+            part, grown = end.part(joint), updates[-1].part(joint).volume_rate * updates[-1].step_revolutions
+            data.update({
+                f"final_effective_clearance_{joint}_mm": 1e3 * effective_clearance(joint_of(scene, joint).clearance,
+                                                                                   part.bearing, part.journal),
+                f"final_bearing_wear_max_{joint}_mm": 1e3 * float(part.bearing.max()),
+                f"final_journal_wear_max_{joint}_mm": 1e3 * float(part.journal.max()),
+                f"wear_volume_{joint}_mm3": data[f"wear_volume_{joint}_mm3"] + 1e9 * grown})
     if limit is not None:  # censored: not reaching the limit within the hours, or never (wears nothing)
         from weftsim.wear.censored import limit_note
 
         data.update(limit_note(scene, updates, limit, data.get("hours_to_limit")))
-    ended = ended_by_limit(scene, updates)
-    data["ended"] = ended
-    data["failure"] = failure
-    if ended is not None:  # the last update extrapolates up to the limit: report the state there
-        end_hours, end_revolutions, bearing, journal = advance(updates[-1], scene)
-        end = replace(updates[-1], hours=end_hours, revolutions=end_revolutions, bearing=bearing, journal=journal,
-                      step_revolutions=0.0)
-        data.update(store.archard_check(scene, [*updates, end]))  # the volumes at the limit
-        if limit is not None:
-            data["hours_to_limit"] = limit_hours([*updates, end], scene.joint.clearance, limit)
-        data.update(hours_reached=end_hours,
-                    final_effective_clearance_mm=1e3 * effective_clearance(scene.joint.clearance, bearing, journal),
-                    final_bearing_wear_max_mm=1e3 * float(bearing.max()),
-                    final_journal_wear_max_mm=1e3 * float(journal.max()),
-                    wear_volume_mm3=data["wear_volume_mm3"] + 1e9 * updates[-1].volume_rate
-                    * updates[-1].step_revolutions)
     columns = store.table(scene, updates)
     files = {
         "state": (store.STATE, lambda p: p),
         "table": ("wear.csv", lambda p: store.write_table(p, scene, updates)),
-        "profile": ("wear_profile.csv", lambda p: store.write_profiles(p, updates, "bearing")),
-        "journal_profile": ("wear_profile_journal.csv", lambda p: store.write_profiles(p, updates, "journal")),
         "summary": ("wear.json", lambda p: write_json(p, data)),
     }
+    for joint in joints:
+        files[f"profile_{joint}"] = (f"wear_profile_{joint}.csv",
+                                     lambda p, j=joint: store.write_profiles(p, updates, "bearing", j))
+        files[f"journal_profile_{joint}"] = (f"wear_profile_journal_{joint}.csv",
+                                             lambda p, j=joint: store.write_profiles(p, updates, "journal", j))
     if figures:
         from weftsim.wear.figures import growth_figure, profile_figure
 
-        title = f"{scene.name}: wear at E"
-        files["profile_figure"] = ("wear_profile.png", lambda p: write_figure(p, profile_figure(scene, updates, title)))
-        files["growth_figure"] = ("wear_growth.png", lambda p: write_figure(p, growth_figure(columns, title)))
+        engine_tag = "" if engine == "reference" else f" ({engine} engine)"
+        for joint in joints:
+            title = f"{scene.name}: wear at {joint.upper()}{engine_tag}"
+            files[f"profile_figure_{joint}"] = (
+                f"wear_profile_{joint}.png", lambda p, j=joint, t=title: write_figure(p, profile_figure(scene, updates, t, j)))
+        name = "".join(joints)
+        title = f"{scene.name}: wear at {' and '.join(j.upper() for j in joints)}{engine_tag}"
+        files["growth_figure"] = (f"wear_growth_{name}.png",
+                                  lambda p: write_figure(p, growth_figure(columns, title, joints)))
     written = write_files(outdir, what, files, scene=scene)
     data["files"] = {k: str(v) for k, v in written.items()}
     return data

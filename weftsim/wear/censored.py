@@ -26,16 +26,22 @@ if TYPE_CHECKING:
 
 
 def no_wear_reason(scene: Scene, update: Update) -> str | None:
-    """Why ``update`` (the last of a prediction) wears nothing, as one clause; None when it wears."""
-    if float(np.max(update.rate_bearing, initial=0.0)) > 0.0 or float(np.max(update.rate_journal, initial=0.0)) > 0.0:
+    """Why ``update`` (the last of a prediction) wears nothing at any wearing joint, as one clause; None when
+    it wears."""
+    parts = update.worn() if hasattr(update, "worn") else (update,)
+    if any(float(np.max(p.rate_bearing, initial=0.0)) > 0.0 or float(np.max(p.rate_journal, initial=0.0)) > 0.0
+           for p in parts):
         return None
     from weftsim.wear.extrapolate import effective_clearance
 
-    ratio = update.response.get("film_ratio_min", math.nan)
-    c0 = scene.joint.clearance
+    joint_name = getattr(update, "joint", "e")
+    ratios = [update.response.get(f"film_ratio_min_{p.joint}", math.nan) for p in parts if hasattr(p, "joint")]
+    ratio = min((r for r in ratios if math.isfinite(r)), default=update.response.get("film_ratio_min", math.nan))
+    joint = scene.joint_f if joint_name == "f" else scene.joint
+    c0 = joint.clearance
     c = effective_clearance(c0, update.bearing, update.journal)
     ran_in = f" after running in from {1e3 * c0:.4g} to {1e3 * c:.4g} mm" if c > c0 else ""
-    if scene.joint.is_lubricated and math.isfinite(ratio):
+    if math.isfinite(ratio):  # a film ratio is recorded: a lubricated joint
         return (f"the asperities carry no load{ran_in} (film ratio min {ratio:.3g}: the oil film separates the "
                 "surfaces over the whole cycle)")
     return "the contact carries no load over the steady cycle"

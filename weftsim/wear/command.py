@@ -20,12 +20,14 @@ if TYPE_CHECKING:
 def add_flags(p: argparse.ArgumentParser, positive: Callable[[Callable[[str], float]], Callable[[str], float]]) -> None:
     """Flags of ``weftsim wear SCENE --hours H [--engine E] [--limit-clearance-mm X]`` beside the shared
     scene and output flags."""
-    p.add_argument("--hours", type=positive(float), help="operating hours to predict; with --uncertain the horizon "
+    p.add_argument("--hours", type=positive(float), help="operating hours to predict (without it, with "
+                   "--limit-clearance-mm: until the clearance reaches the limit); with --uncertain the horizon "
                    "(default 1e5): samples not reaching --limit-clearance-mm within it are reported as censored")
-    p.add_argument("--engine", default="reference", help="reference (default); exudyn is refused (no worn "
-                   "geometry in its contact yet, docs/wear.md)")
+    p.add_argument("--engine", default="reference", help="engine of each update's simulation: reference (default) "
+                   "or exudyn (its kinematic tree; default output out/<scene name>/wear-exudyn; docs/wear.md)")
     p.add_argument("--limit-clearance-mm", type=positive(float),
-                   help="clearance limit: wear.json gives the hours at which the effective clearance reaches it")
+                   help="clearance limit for every wearing joint: wear.json gives the hours at which each joint's "
+                        "effective clearance reaches it and the first of them (the joint to service first)")
     p.add_argument("--no-plot", action="store_true", help="skip the figures")
     ens = p.add_argument_group("ensemble (docs/wear.md section 7)")
     ens.add_argument("--uncertain", action="append", default=[], metavar="KEY=DISTRIBUTION",
@@ -53,32 +55,45 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     from weftsim.cli_grammar import CliError
     from weftsim.output import prepare_directory
     from weftsim.progress import Progress
-    from weftsim.wear import WearError, check_request, predict_to_directory
-    from weftsim.wear.extrapolate import update_time
+    from weftsim.wear import WearError, check_engine, check_request, predict_to_directory
+    from weftsim.wear.extrapolate import MAX_HOURS, update_time
     from weftsim.wear.store import StateMismatch
 
     limit = None if args.limit_clearance_mm is None else args.limit_clearance_mm * 1e-3
     if args.uncertain:
         return run_ensemble(args, scene, outdir, stop_on_interrupt)
-    if args.hours is None:
-        raise CliError("--hours is required (or --uncertain KEY=DISTRIBUTION with --limit-clearance-mm for an "
-                       "ensemble)")
-    check_request(scene, args.hours, args.engine, limit)  # a WearError is one line, exit 2
+    if args.hours is None and limit is None:
+        raise CliError("--hours or --limit-clearance-mm is required (or --uncertain KEY=DISTRIBUTION with "
+                       "--limit-clearance-mm for an ensemble)")
+    until_limit = args.hours is None  # predict until the clearance limit
+    hours = MAX_HOURS if until_limit else args.hours
+    check_request(scene, hours, args.engine, limit)  # a WearError is one line, exit 2
     outdir = prepare_directory(outdir, args.force, scene)
+    try:
+        check_engine(outdir, args.engine, args.force)  # a state of the other engine: one line, or --force
+    except StateMismatch as exc:
+        raise CliError(str(exc)) from None
     resumed = _stored_updates(outdir, scene, args.force)
-    print(f"scene {scene.name}, wear at E over {args.hours:g} h on the reference engine; each update simulates "
-          f"{scene.joint.wear.settle_revolutions} + {scene.joint.wear.revolutions_per_update} revolutions "
-          f"(~{_duration(update_time(scene))}), the update interval grows the clearance by at most "
-          f"{100 * scene.joint.wear.max_clearance_change:g} %", file=sys.stderr, flush=True)
+    from weftsim.wear.extrapolate import joint_of, wearing_joints
+
+    joints = wearing_joints(scene)
+    first = joint_of(scene, joints[0]).wear
+    at = " and ".join(j.upper() for j in joints)
+    span = f"until the clearance reaches {args.limit_clearance_mm:g} mm" if until_limit else f"over {hours:g} h"
+    print(f"scene {scene.name}, wear at {at} {span} on the {args.engine} engine; each update simulates "
+          f"{first.settle_revolutions} + {first.revolutions_per_update} revolutions "
+          f"(~{_duration(update_time(scene, args.engine))}), the update interval grows each clearance by at most "
+          + ", ".join(f"{100 * joint_of(scene, j).wear.max_clearance_change:g} % at {j.upper()}" for j in joints),
+          file=sys.stderr, flush=True)
     if resumed:
         print(f"resuming the prediction stored in {outdir}: {len(resumed)} updates kept, up to "
               f"{resumed[-1].hours:.6g} h", file=sys.stderr, flush=True)
     progress = Progress(f"wear {scene.name}")
     with stop_on_interrupt("wear") as state:
         try:
-            data = predict_to_directory(scene, args.hours, outdir, args.engine, limit, progress,
+            data = predict_to_directory(scene, hours, outdir, args.engine, limit, progress,
                                         stop=lambda: state["signal"] is not None, figures=not args.no_plot,
-                                        force=args.force)
+                                        force=args.force, until_limit=until_limit)
         except StateMismatch as exc:
             raise CliError(str(exc)) from None
         except WearError as exc:  # the updates before it are written (the message says where)
@@ -86,24 +101,32 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
         finally:
             progress.close()
     print(f"scene {scene.name}: {data['hours_reached']:.6g} h in {data['updates']} updates "
-          f"({data['wall_time_s']:.1f} s); effective clearance {data['initial_clearance_mm']:g} -> "
-          f"{data['final_effective_clearance_mm']:.4g} mm, wear volume {data['wear_volume_mm3']:.4g} mm^3")
+          f"({data['wall_time_s']:.1f} s); wear volume {data['wear_volume_mm3']:.4g} mm^3")
+    for j in joints:
+        print(f"  at {j.upper()}: effective clearance {data[f'initial_clearance_{j}_mm']:g} -> "
+              f"{data[f'final_effective_clearance_{j}_mm']:.4g} mm, wear volume {data[f'wear_volume_{j}_mm3']:.4g} mm^3")
     if data.get("backoffs"):
         print(f"  {data['backoffs']} hard cycle(s) (an update whose simulation failed at every tolerance and "
               "integrator) were passed by halving the update before them (docs/wear.md section 3)")
-    if data.get("sliding_distance_m"):
-        print(f"  Archard's check: sliding {data['sliding_distance_m']:.4g} m under the sliding-weighted mean load "
-              f"{data['sliding_weighted_mean_load_N']:.4g} N (the time mean is {data['time_mean_load_N']:.4g} N) gives "
-              f"{data['archard_volume_mm3']:.4g} mm^3; the profiles hold {data['profile_volume_mm3']:.4g} mm^3")
+    for j in joints:
+        if data.get(f"sliding_distance_{j}_m"):
+            print(f"  Archard's check at {j.upper()}: sliding {data[f'sliding_distance_{j}_m']:.4g} m under the "
+                  f"sliding-weighted mean load {data[f'sliding_weighted_mean_load_{j}_N']:.4g} N (the time mean is "
+                  f"{data[f'time_mean_load_{j}_N']:.4g} N) gives {data[f'archard_volume_{j}_mm3']:.4g} mm^3; the "
+                  f"profiles hold {data[f'profile_volume_{j}_mm3']:.4g} mm^3")
     if limit is not None:
         reached = data.get("hours_to_limit")
-        print(f"  clearance limit {args.limit_clearance_mm:g} mm: reached after {reached:.6g} h" if reached is not None
-              else f"  {data['note']}")
+        each = ", ".join(f"{j.upper()} " + (f"{data[f'hours_to_limit_{j}']:.6g} h"
+                                           if data.get(f"hours_to_limit_{j}") is not None else "not reached")
+                         for j in joints)
+        print(f"  clearance limit {args.limit_clearance_mm:g} mm: reached first at {data['limit_joint'].upper()} "
+              f"after {reached:.6g} h ({each})" if reached is not None else f"  {data['note']}")
     for path in data["files"].values():
         print(f"  wrote {path}")
     if data.get("ended"):
-        print(f"  the prediction ends at {data['hours_reached']:.6g} h of the {args.hours:g} asked for: "
-              f"{data['ended']}; nothing beyond it is predicted")
+        asked = "" if until_limit else f" of the {hours:g} asked for"
+        print(f"  the prediction ends at {data['hours_reached']:.6g} h{asked}: {data['ended']}; nothing beyond "
+              "it is predicted")
         return 0
     if not data["complete"]:
         raise CliError(f"interrupted: stopped after {data['hours_reached']:.6g} h; the state is in {outdir}: run the "

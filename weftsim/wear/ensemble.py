@@ -215,6 +215,9 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
     if not (isinstance(horizon, (int, float)) and 1.0 <= horizon <= MAX_HOURS):
         raise WearError(f"--hours (the ensemble's horizon) must be from 1 to {MAX_HOURS:g} h, got {horizon!r}")
     check_request(scene, 1.0, "reference", limit)
+    if not scene.joint_f.is_ideal:  # its H/k rescaling and its clearance curve are joint E's
+        raise WearError("an ensemble predicts the wear at E with F ideal so far; `weftsim wear SCENE --hours H` "
+                        "predicts F and E with F (docs/wear.md); set joint_f.clearance_mm = 0 for the ensemble")
     job_list, dynamic, nodes = plan(scene, parsed, chaos_runs, design_points)
     job_horizon = min(10.0 * horizon, MAX_HOURS)
     for name, s in job_list:
@@ -238,7 +241,7 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
     sim_wall = time.perf_counter() - wall0
     ens = combine(scene, parsed, dynamic, nodes, results, samples, limit, seed, levels, horizon)
     hours, lv = ens["hours"], ens["levels"]
-    band = {"clearance_mm": 1e3 * lv}
+    band = {"clearance_e_mm": 1e3 * lv}  # the joint in the name, as in wear.csv
     for p in QUANTILES:  # inf where the quantile falls among the censored samples
         band[f"hours_p{round(100 * p)}"] = np.array([censored_quantile(hours[:, i], p)[0] for i in range(lv.size)])
     band["fraction_reaching"] = np.mean(np.isfinite(hours), axis=0)
@@ -285,8 +288,8 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
     }
     table = {f"{k}": np.asarray(v, dtype=float) for k, v in ens["values"].items()}
     table["chaos_run"] = ens["chaos_draw"].astype(float)
-    table["hours_to_limit"] = hours[:, -1]  # inf: does not reach the limit within the horizon
-    table["reaches_limit"] = np.isfinite(hours[:, -1]).astype(float)
+    table["hours_to_limit_e"] = hours[:, -1]  # inf: does not reach the limit within the horizon
+    table["reaches_limit_e"] = np.isfinite(hours[:, -1]).astype(float)
     files = {
         "samples": ("ensemble.csv", lambda p: write_csv(p, table)),
         "band": ("ensemble_band.csv", lambda p: write_csv(p, band)),

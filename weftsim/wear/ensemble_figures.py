@@ -56,7 +56,7 @@ def band_figure(band: dict, title: str = "") -> Figure:
     censored = "fraction_reaching" in band and np.any(np.asarray(band["fraction_reaching"]) < 1.0)
     fig = figure(figsize=(10 if censored else 7, 4.5))
     ax = fig.add_subplot(1, 2 if censored else 1, 1)
-    c = band["clearance_mm"]
+    c = band["clearance_e_mm"]
     p10, p50, p90 = (np.asarray(band[f"hours_p{p}"], dtype=float) for p in (10, 50, 90))
     both = np.isfinite(p10) & np.isfinite(p90)
     ax.fill_betweenx(np.where(both, c, np.nan), np.where(both, p10, np.nan), np.where(both, p90, np.nan),

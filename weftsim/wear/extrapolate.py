@@ -1,4 +1,8 @@
-"""Cycle extrapolation of the wear at joint E (docs/wear.md section 3).
+"""Cycle extrapolation of the wear at the clearance joints E and F (docs/wear.md section 3).
+
+Every loose joint of the scene wears (:func:`wearing_joints`: E, F, or E and F), each with its own
+``[joint_*.wear]`` numbers and profiles, simulated together in one run; the update rule below holds
+for each joint's own effective clearance and the interval is the smallest the joints allow.
 
 One **update**: simulate the mechanism on the current worn geometry for ``settle_revolutions``
 (not counted: the start from the centred journal) plus ``revolutions_per_update`` steady
@@ -9,7 +13,8 @@ fraction ``max_clearance_change`` of its value per update,
 
     N = f c_eff / (max dh_b + max dh_j)        (dh per revolution; an upper bound of dc_eff/rev),
 
-cut to the hours left.  Each update is one :class:`Update`: the state a run resumes from.
+cut to the hours left.  Each update is one :class:`~weftsim.wear.updates.Update` (the data model of
+:mod:`weftsim.wear.updates`, re-exported here): the state a run resumes from.
 
 The prediction ends early, with one line saying why, where the worn geometry leaves the model
 (:func:`geometric_limit`): the effective clearance reaches the journal radius (the bound a scene
@@ -23,7 +28,7 @@ extrapolated at all and is refused (:class:`~weftsim.errors.WearError`).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -31,6 +36,10 @@ import numpy as np
 from weftsim.analysis import channel_statistics, time_weights
 from weftsim.errors import WearError
 from weftsim.wear.archard import run_wear
+from weftsim.wear.updates import (  # noqa: F401 - the data model of a prediction, used here and re-exported
+    SECONDS_PER_HOUR, JointWear, Update, _with_parts, advance, advance_update, effective_clearance, joint_of,
+    limit_hours, wearing_joints,
+)  # fmt: skip
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
@@ -38,7 +47,6 @@ if TYPE_CHECKING:
     from weftsim.params import Scene
     from weftsim.wear.archard import RunWear
 
-SECONDS_PER_HOUR = 3600.0
 # Film ratio h_min / sigma below which a lubricated joint runs mixed (asperities carry part of the load;
 # above ~3 the film separates the surfaces: hydrodynamic).  The response's ``mixed_fraction`` is the time
 # share of the steady cycle below it.
@@ -78,33 +86,6 @@ IMPLICIT_METHOD = "numba_DOP853_RODAS4"  # the last attempt: DOP853 in free flig
 
 
 
-@dataclass(frozen=True)
-class Update:
-    """One geometry update: the geometry simulated, the response on it, the wear it predicts.
-
-    ``bearing``, ``journal``: worn depth profiles (m) *at the start* of the update (the geometry
-    that was simulated); ``revolutions`` (crank revolutions before it, float) and ``hours``;
-    ``step_revolutions``: N, the revolutions it extrapolates over; ``rate_bearing``,
-    ``rate_journal``: worn depth per revolution (m); ``volume_rate``: bearing + journal wear
-    volume per revolution (m^3); ``response``: statistics of the steady revolutions.
-    """
-
-    hours: float
-    revolutions: float
-    bearing: np.ndarray
-    journal: np.ndarray
-    step_revolutions: float
-    rate_bearing: np.ndarray
-    rate_journal: np.ndarray
-    volume_rate: float
-    response: dict
-
-
-def effective_clearance(c0: float, bearing: np.ndarray, journal: np.ndarray) -> float:
-    """c0 + max h_b + max h_j, m: the clearance where the two worn spots face each other (the load line)."""
-    return c0 + float(np.max(bearing, initial=0.0)) + float(np.max(journal, initial=0.0))
-
-
 def wall_slope(profile: np.ndarray, radius: float) -> float:
     """Largest slope |dh/dpsi| / R of a periodic worn-depth table (central differences), rad."""
     if profile.size < 3:
@@ -113,17 +94,28 @@ def wall_slope(profile: np.ndarray, radius: float) -> float:
     return float(np.max(np.abs(np.roll(profile, -1) - np.roll(profile, 1)))) / (2.0 * dpsi * radius)
 
 
-def geometric_limit(scene: Scene, bearing: np.ndarray, journal: np.ndarray) -> str | None:
-    """Why the worn geometry (bearing, journal; m) is beyond the model, as one clause, or None."""
-    joint = scene.joint
+def geometric_limit(scene: Scene, bearing: np.ndarray, journal: np.ndarray, joint: str = "e") -> str | None:
+    """Why the worn geometry (bearing, journal; m) of ``joint`` is beyond the model, as one clause, or None."""
+    table = f"joint_{joint}"
+    joint = joint_of(scene, joint)
     c_eff = effective_clearance(joint.clearance, bearing, journal)
     if c_eff >= joint.journal_radius * (1.0 - 1e-9):
-        return (f"the effective clearance reaches the journal radius {joint.journal_radius * 1e3:g} mm (the bound "
-                f"of joint_e.clearance_mm; the journal would be worn through)")
+        return (f"the effective clearance at {table[-1].upper()} reaches the journal radius "
+                f"{joint.journal_radius * 1e3:g} mm (the bound of {table}.clearance_mm; the journal would be worn "
+                "through)")
     slope = max(wall_slope(bearing, joint.bearing_radius), wall_slope(journal, joint.journal_radius))
     if slope >= MAX_WALL_SLOPE * (1.0 - 1e-9):
-        return (f"a worn wall's slope reaches {MAX_WALL_SLOPE:g} rad (the small-wear geometry the contact "
-                "model assumes, docs/wear.md section 2)")
+        return (f"a worn wall's slope at {table[-1].upper()} reaches {MAX_WALL_SLOPE:g} rad (the small-wear "
+                "geometry the contact model assumes, docs/wear.md section 2)")
+    return None
+
+
+def state_limit(scene: Scene, update: Update) -> str | None:
+    """The first :func:`geometric_limit` any joint of ``update``'s geometry is beyond (E before F), or None."""
+    for part in update.worn():
+        why = geometric_limit(scene, part.bearing, part.journal, part.joint)
+        if why is not None:
+            return why
     return None
 
 
@@ -131,33 +123,46 @@ def ended_by_limit(scene: Scene, updates: Sequence[Update]) -> str | None:
     """The :func:`geometric_limit` that ended the prediction ``updates`` at its last update, or None."""
     if not updates or updates[-1].step_revolutions == 0.0:
         return None
-    return geometric_limit(scene, *advance(updates[-1], scene)[2:])
+    return state_limit(scene, advance_update(updates[-1], scene))
 
 
 def _cut_to_limit(update: Update, scene: Scene) -> Update:
     """``update`` with its revolutions cut so the geometry just reaches :func:`geometric_limit` (unchanged if
     its whole extrapolation stays inside)."""
-    if geometric_limit(scene, *advance(update, scene)[2:]) is None:
+    if state_limit(scene, advance_update(update, scene)) is None:
         return update
     inside, outside = 0.0, update.step_revolutions
     for _ in range(60):  # bisection to a relative 1e-18 of N: the limit is reached to round-off
         middle = 0.5 * (inside + outside)
-        if geometric_limit(scene, *advance(replace(update, step_revolutions=middle), scene)[2:]) is None:
+        if state_limit(scene, advance_update(replace(update, step_revolutions=middle), scene)) is None:
             inside = middle
         else:
             outside = middle
     return replace(update, step_revolutions=outside)
 
 
+def _worn_joint(joint, bearing: np.ndarray, journal: np.ndarray):
+    worn = bool(np.any(bearing) or np.any(journal))
+    return replace(joint, bearing_wear=tuple(map(float, bearing)) if worn else (),
+                   journal_wear=tuple(map(float, journal)) if worn else ())
+
+
 def worn_scene(scene: Scene, bearing: np.ndarray, journal: np.ndarray, revolutions: float,
-               retry: bool = False, method: str | None = None) -> Scene:
+               retry: bool = False, method: str | None = None, second: tuple | None = None) -> Scene:
     """``scene`` on the worn geometry (unworn when both profiles are zero) for ``revolutions``.
 
-    The solver tolerance of a worn geometry is at most WORN_RTOL, WORN_ATOL; ``retry``: RETRY_*.
+    ``bearing``, ``journal``: the profiles of the first wearing joint (:func:`wearing_joints`: E, or F
+    when E is ideal); ``second``: (bearing, journal) of F when E and F both wear.  The solver tolerance
+    of a worn geometry is at most WORN_RTOL, WORN_ATOL; ``retry``: RETRY_*.
     """
-    worn = bool(np.any(bearing) or np.any(journal))
-    joint = replace(scene.joint, bearing_wear=tuple(map(float, bearing)) if worn else (),
-                    journal_wear=tuple(map(float, journal)) if worn else ())
+    joints = wearing_joints(scene)
+    profiles = {joints[0]: (bearing, journal)}
+    if second is not None:
+        profiles["f"] = second
+    worn = any(bool(np.any(b) or np.any(j)) for b, j in profiles.values())
+    changes = {"joint" if name == "e" else "joint_f": _worn_joint(joint_of(scene, name), *pair)
+               for name, pair in profiles.items()}
+    scene = replace(scene, **changes)
     solver = scene.reference_solver
     if worn:
         solver = replace(solver, rtol=min(solver.rtol, WORN_RTOL), atol=min(solver.atol, WORN_ATOL))
@@ -166,42 +171,60 @@ def worn_scene(scene: Scene, bearing: np.ndarray, journal: np.ndarray, revolutio
                          max_step=min(solver.max_step, RETRY_MAX_STEP))
     if method is not None:
         solver = replace(solver, method=method)
-    return replace(scene, joint=joint, drive=replace(scene.drive, revolutions=revolutions), reference_solver=solver)
+    return replace(scene, drive=replace(scene.drive, revolutions=revolutions), reference_solver=solver)
 
 
-def _response(steps: dict, t0: float) -> dict:
+def _response(steps: dict, t0: float, joints: Sequence[str] = ("e",)) -> dict:
+    """Statistics of the steady cycle: the mechanism's (rapier, torque) and each wearing joint's contact force
+    and film (keys with the joint's letter, :data:`weftsim.wear.store.RESPONSE`)."""
     keep = steps["time_s"] >= t0
     t = steps["time_s"][keep]
     acc = channel_statistics(t, steps["rapier_acceleration_m_s2"][keep])
     torque = channel_statistics(t, steps["driving_torque_Nm"][keep])
-    force = channel_statistics(t, steps["contact_force_N"][keep])
-    film = {"film_ratio_min": math.nan, "film_ratio_mean": math.nan, "mixed_fraction": math.nan}
-    if "film_ratio" in steps:  # a lubricated joint E: the film ratio over the steady cycle
-        ratio = steps["film_ratio"][keep]
-        weights = time_weights(t)
-        film = {"film_ratio_min": float(ratio.min()), "film_ratio_mean": float(np.dot(weights, ratio) / weights.sum()),
-                "mixed_fraction": float(np.dot(weights, ratio < MIXED_FILM_RATIO) / weights.sum())}
-    return {"rapier_acceleration_rms_m_s2": acc["rms"], "rapier_acceleration_p99_m_s2": acc["p99_abs"],
-            "driving_torque_rms_Nm": torque["rms"], "driving_torque_p99_Nm": torque["p99_abs"],
-            "contact_force_mean_N": force["mean"], "contact_force_p99_N": force["p99"],
-            "contact_force_max_N": force["max"], **film}
+    out = {"rapier_acceleration_rms_m_s2": acc["rms"], "rapier_acceleration_p99_m_s2": acc["p99_abs"],
+           "driving_torque_rms_Nm": torque["rms"], "driving_torque_p99_Nm": torque["p99_abs"]}
+    for joint in joints:
+        tail = "" if joint == "e" else "_f"  # the channels' names (weftsim.results)
+        force = channel_statistics(t, steps[f"contact_force{tail}_N"][keep])
+        film = {"film_ratio_min": math.nan, "film_ratio_mean": math.nan, "mixed_fraction": math.nan}
+        if f"film_ratio{tail}" in steps:  # a lubricated joint: the film ratio over the steady cycle
+            ratio = steps[f"film_ratio{tail}"][keep]
+            weights = time_weights(t)
+            film = {"film_ratio_min": float(ratio.min()),
+                    "film_ratio_mean": float(np.dot(weights, ratio) / weights.sum()),
+                    "mixed_fraction": float(np.dot(weights, ratio < MIXED_FILM_RATIO) / weights.sum())}
+        out.update({f"contact_force_{joint}_mean_N": force["mean"], f"contact_force_{joint}_p99_N": force["p99"],
+                    f"contact_force_{joint}_max_N": force["max"],
+                    **{f"{name}_{joint}": value for name, value in film.items()}})
+    return out
 
 
-def simulate_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray) -> tuple[RunWear, dict]:
+def _sliding(wear: RunWear, per_rev: float, joint: str) -> dict:
+    return {f"sliding_distance_per_rev_{joint}_m": wear.sliding_distance * per_rev,
+            f"sliding_work_per_rev_{joint}_J": wear.sliding_work * per_rev,
+            # Archard's load: the mean of F_N weighted by the sliding ds = |v_T| dt (not by dt)
+            f"contact_force_sliding_mean_{joint}_N": wear.sliding_work / wear.sliding_distance
+            if wear.sliding_distance > 0.0 else math.nan}
+
+
+def simulate_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray,
+                    second: tuple | None = None) -> tuple[RunWear, dict]:
     """Run the reference engine on the worn geometry; returns (wear per steady revolution, response).
 
-    Raises WearError when the run fails.
+    ``bearing``, ``journal``: the first wearing joint's profiles; ``second``: F's (bearing, journal) when E
+    and F both wear, whose wear is then the returned RunWear's ``second``.  Raises WearError when the run fails.
     """
     from weftsim import reference
     from weftsim.reference.dynamics import pack_parameters
 
     from weftsim.guards import stop_requested
 
-    w = scene.joint.wear
+    joints = wearing_joints(scene)
+    w = joint_of(scene, joints[0]).wear  # the run's revolutions: the first wearing joint's table
     attempts = ((False, None), (True, None), (True, IMPLICIT_METHOD))
     for retry, method in attempts:
         run_scene = worn_scene(scene, bearing, journal, w.settle_revolutions + w.revolutions_per_update, retry,
-                               method)
+                               method, second)
         rows = {}
         result = reference.solve(run_scene, step_states=lambda *a: rows.update(steps=a))
         if result.ok:
@@ -214,81 +237,114 @@ def simulate_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray) -> t
     t0 = w.settle_revolutions * scene.drive.period
     t, y, contact, impact = rows["steps"]
     keep = t >= t0
-    wear = run_wear(run_scene, pack_parameters(run_scene), t[keep], y[keep], contact[keep], impact[keep])
+    prm = pack_parameters(run_scene)
     per_rev = 1.0 / w.revolutions_per_update
-    sliding = {"sliding_distance_per_rev_m": wear.sliding_distance * per_rev,
-               "sliding_work_per_rev_J": wear.sliding_work * per_rev,
-               # Archard's load: the mean of F_N weighted by the sliding ds = |v_T| dt (not by dt)
-               "contact_force_sliding_mean_N": wear.sliding_work / wear.sliding_distance
-               if wear.sliding_distance > 0.0 else math.nan}
-    return wear, {**_response(result.steps, t0), "solver_rtol": run_scene.reference_solver.rtol, **sliding}
+    wears = [run_wear(run_scene, prm, t[keep], y[keep], contact[keep], impact[keep], joint) for joint in joints]
+    sliding = {key: value for joint, wear in zip(joints, wears) for key, value in _sliding(wear, per_rev, joint).items()}
+    wear = replace(wears[0], joint=joints[0], second=replace(wears[1], joint=joints[1]) if len(wears) > 1 else None)
+    return wear, {**_response(result.steps, t0, joints), "solver_rtol": run_scene.reference_solver.rtol, **sliding}
+
+
+def wear_response(scene: Scene, wear: RunWear, steps: dict, rtol: float) -> dict:
+    """The response of an update of joint E alone on any engine's run: statistics of the steady revolutions of
+    the run's ``steps``, the solver's relative tolerance ``rtol`` and the sliding of ``wear`` per revolution
+    (:func:`simulate_update`'s keys)."""
+    w = scene.joint.wear
+    t0 = w.settle_revolutions * scene.drive.period
+    return {**_response(steps, t0, ("e",)), "solver_rtol": rtol, **_sliding(wear, 1.0 / w.revolutions_per_update, "e")}
+
+
+def _part(scene: Scene, joint: str, wear: RunWear, bearing: np.ndarray, journal: np.ndarray, per_rev: float,
+          revolutions: int) -> tuple[JointWear, float, float]:
+    """(the joint's part of the update, the revolutions its update rule allows, the growth of c_eff over
+    ``revolutions`` as a fraction)."""
+    w = joint_of(scene, joint).wear
+    rate_b, rate_j = wear.bearing * per_rev, wear.journal * per_rev
+    growth = float(rate_b.max() + rate_j.max())
+    c_eff = effective_clearance(joint_of(scene, joint).clearance, bearing, journal)
+    allowed = math.inf if growth <= 0.0 else w.max_clearance_change * c_eff / growth
+    part = JointWear(joint, bearing.copy(), journal.copy(), rate_b, rate_j,
+                     (wear.bearing_volume + wear.journal_volume) * per_rev)
+    return part, allowed, revolutions * growth / c_eff
 
 
 def next_update(scene: Scene, hours_done: float, revolutions_done: float, bearing: np.ndarray, journal: np.ndarray,
-                hours: float) -> Update:
-    """Simulate the current geometry and choose the revolutions of this update (module docstring)."""
-    w = scene.joint.wear
-    wear, response = simulate_update(scene, bearing, journal)
+                hours: float, second: tuple | None = None, simulate: Callable | None = None) -> Update:
+    """Simulate the current geometry and choose the revolutions of this update (module docstring).
+
+    ``bearing``, ``journal``: the first wearing joint's profiles; ``second``: F's when E and F both wear.
+    ``simulate(scene, bearing, journal[, second]) -> (RunWear, response)``: the engine's update
+    (:func:`weftsim.wear.engines.simulator`); None: :func:`simulate_update`, the reference engine.
+    """
+    joints = wearing_joints(scene)
+    w = joint_of(scene, joints[0]).wear
+    run = simulate_update if simulate is None else simulate
+    if second is None:
+        wear, response = run(scene, bearing, journal)
+    else:
+        wear, response = run(scene, bearing, journal, second)
     per_rev = 1.0 / w.revolutions_per_update
-    rate_b, rate_j = wear.bearing * per_rev, wear.journal * per_rev
-    growth = float(rate_b.max() + rate_j.max())
+    profiles = [(bearing, journal)] + ([second] if second is not None else [])
+    runs = [wear] + ([wear.second] if second is not None else [])
     revs_per_hour = scene.drive.speed / (2.0 * math.pi) * SECONDS_PER_HOUR
     left = (hours - hours_done) * revs_per_hour
-    c_eff = effective_clearance(scene.joint.clearance, bearing, journal)
-    allowed = math.inf if growth <= 0.0 else w.max_clearance_change * c_eff / growth
-    if allowed < w.revolutions_per_update and left > allowed:
-        raise WearError(
-            f"the wear is too fast to extrapolate: the {w.revolutions_per_update} revolutions of an update alone "
-            f"grow the clearance by {100 * w.revolutions_per_update * growth / c_eff:.3g} %, more than "
-            f"joint_e.wear.max_clearance_change = {100 * w.max_clearance_change:g} % (wear_coefficient "
-            f"{w.wear_coefficient:g}, hardness {w.bearing_hardness / 1e6:g} / {w.journal_hardness / 1e6:g} MPa: "
-            "check [joint_e.wear])")
-    n = min(left, allowed)
-    return Update(hours_done, revolutions_done, bearing.copy(), journal.copy(), n, rate_b, rate_j,
-                  (wear.bearing_volume + wear.journal_volume) * per_rev, response)
-
-
-def advance(update: Update, scene: Scene) -> tuple[float, float, np.ndarray, np.ndarray]:
-    """(hours, revolutions, bearing, journal) after the update's N revolutions."""
-    revs_per_hour = scene.drive.speed / (2.0 * math.pi) * SECONDS_PER_HOUR
-    n = update.step_revolutions
-    return (update.hours + n / revs_per_hour, update.revolutions + n,
-            update.bearing + n * update.rate_bearing, update.journal + n * update.rate_journal)
+    parts, n = [], left
+    for joint, run, (b, j) in zip(joints, runs, profiles):
+        part, allowed, grown = _part(scene, joint, run, b, j, per_rev, w.revolutions_per_update)
+        jw = joint_of(scene, joint).wear
+        if allowed < w.revolutions_per_update and left > allowed:
+            raise WearError(
+                f"the wear is too fast to extrapolate: the {w.revolutions_per_update} revolutions of an update alone "
+                f"grow the clearance at {joint.upper()} by {100 * grown:.3g} %, more than "
+                f"joint_{joint}.wear.max_clearance_change = {100 * jw.max_clearance_change:g} % (wear_coefficient "
+                f"{jw.wear_coefficient:g}, hardness {jw.bearing_hardness / 1e6:g} / {jw.journal_hardness / 1e6:g} MPa: "
+                f"check [joint_{joint}.wear])")
+        parts.append(part)
+        n = min(n, allowed)
+    first = parts[0]
+    return Update(hours_done, revolutions_done, first.bearing, first.journal, n, first.rate_bearing,
+                  first.rate_journal, first.volume_rate, response, first.joint, parts[1] if len(parts) > 1 else None)
 
 
 def predict(scene: Scene, hours: float, updates: Sequence[Update] = (),
             on_update: Callable[[list[Update]], None] | None = None,
-            stop: Callable[[], bool] | None = None) -> list[Update]:
+            stop: Callable[[], bool] | None = None, simulate: Callable | None = None) -> list[Update]:
     """Run the cycle extrapolation to ``hours`` of operation; returns the list of :class:`Update`.
 
+    ``simulate``: the engine of each update's simulation (:func:`next_update`;
+    :func:`weftsim.wear.engines.simulator` gives it by the engine's name; None: the reference engine);
     ``updates``: updates already done (resume: the run continues after the last);
     ``on_update(updates)``: called after each update (storing, progress); ``stop()``: True asks to
     end after the current update.  The last update simulates the final geometry, with N = 0; or,
     when the prediction ends at a geometric limit (:func:`ended_by_limit`), extrapolates up to it.
     A stop asked for while an update is simulated (:func:`weftsim.guards.request_stop`) drops it.
+    Every loose joint wears (:func:`wearing_joints`).
     """
     if not (0.0 < hours <= MAX_HOURS):
         raise WearError(f"--hours must be > 0 and at most {MAX_HOURS:g} h (114 years of continuous running), "
                         f"got {hours:g}")
-    if scene.joint.is_ideal:
+    joints = wearing_joints(scene)
+    if not joints:
         raise WearError("joint_e.clearance_mm is 0 (ideal joint): there is no contact to wear; give a clearance > 0")
-    n = scene.joint.wear.profile_points
     done = list(updates)
     if ended_by_limit(scene, done) is not None:  # resumed after the geometric limit: nothing to add
         return done
     if done:
-        state = advance(done[-1], scene)
+        state = advance_update(done[-1], scene)
         if done[-1].step_revolutions == 0.0:  # the run had finished: nothing left but a longer request
-            state = (done[-1].hours, done[-1].revolutions, done[-1].bearing, done[-1].journal)
+            state = done[-1]
             done.pop()
     else:
-        state = (0.0, 0.0, np.zeros(n), np.zeros(n))
+        zeros = [np.zeros(joint_of(scene, joint).wear.profile_points) for joint in joints]
+        parts = [JointWear(joint, z, z, z, z, 0.0) for joint, z in zip(joints, zeros)]
+        state = _with_parts(Update(0.0, 0.0, zeros[0], zeros[0], 0.0, zeros[0], zeros[0], 0.0, {}), parts)
     backoffs = 0
     while True:
-        hours_done, revs_done, bearing, journal = state
-        finished = hours_done >= hours * (1.0 - 1e-12)
+        finished = state.hours >= hours * (1.0 - 1e-12)
+        second = None if state.second is None else (state.second.bearing, state.second.journal)
         try:
-            update = next_update(scene, hours_done, revs_done, bearing, journal, hours)
+            update = next_update(scene, state.hours, state.revolutions, state.bearing, state.journal, hours, second,
+                                 simulate)
         except WearInterrupted:
             return done  # the update in progress is dropped; the state holds the ones before it
         except UpdateFailed as exc:
@@ -301,7 +357,7 @@ def predict(scene: Scene, hours: float, updates: Sequence[Update] = (),
                                response={**done[-1].response, "backoffs_after": float(backoffs)})
             if on_update is not None:
                 on_update(done)
-            state = advance(done[-1], scene)
+            state = advance_update(done[-1], scene)
             continue
         backoffs = 0
         if finished:
@@ -313,29 +369,17 @@ def predict(scene: Scene, hours: float, updates: Sequence[Update] = (),
             on_update(done)
         if finished or ended_by_limit(scene, done) is not None or (stop is not None and stop()):
             return done
-        state = advance(update, scene)
+        state = advance_update(update, scene)
 
 
-def limit_hours(updates: Sequence[Update], c0: float, limit: float) -> float | None:
-    """Operating hours at which c_eff first reaches ``limit`` (m), linear between updates; None if never."""
-    c = [effective_clearance(c0, u.bearing, u.journal) for u in updates]
-    h = [u.hours for u in updates]
-    for i in range(1, len(c)):
-        if c[i] >= limit > c[i - 1]:
-            return h[i - 1] + (h[i] - h[i - 1]) * (limit - c[i - 1]) / (c[i] - c[i - 1])
-    if c and c[0] >= limit:
-        return 0.0
-    return None
-
-
-def update_time(scene: Scene) -> float:
-    """Estimated wall-clock seconds of one wear update: the reference engine's estimate
+def update_time(scene: Scene, engine: str = "reference") -> float:
+    """Estimated wall-clock seconds of one wear update: the engine's estimate
     (:func:`weftsim.progress.estimate_run_time`) for its settle + steady revolutions at the solver
-    tolerance of a worn geometry (:data:`WORN_RTOL`)."""
+    tolerance of a worn geometry (:data:`WORN_RTOL` on the reference engine)."""
     from weftsim.progress import estimate_run_time
 
-    w = scene.joint.wear
+    w = joint_of(scene, (wearing_joints(scene) or ("e",))[0]).wear
     solver = replace(scene.reference_solver, rtol=min(scene.reference_solver.rtol, WORN_RTOL))
     one = replace(scene, drive=replace(scene.drive, revolutions=w.settle_revolutions + w.revolutions_per_update),
                   reference_solver=solver)
-    return estimate_run_time(one, "reference")
+    return estimate_run_time(one, engine)

@@ -24,23 +24,30 @@ def _chosen(updates, count: int = 6):
     return [updates[i] for i in idx]
 
 
-def profile_figure(scene: Scene, updates: Sequence[Update], title: str = "") -> Figure:
-    """Bearing clearance c0 + h_b(psi) (mm) and journal wear, polar, at several updates."""
+# The bodies whose frames the profiles are tabulated in (weftsim.kernel.chain_f.local_clearances).
+FRAMES = {"e": ("rocker", "rod"), "f": ("sector", "rod")}
+
+
+def profile_figure(scene: Scene, updates: Sequence[Update], title: str = "", joint: str = "e") -> Figure:
+    """Bearing clearance c0 + h_b(psi) (mm) and journal wear of ``joint``, polar, at several updates."""
     from matplotlib.ticker import MaxNLocator
 
     fig = figure(figsize=(10, 5))
-    c0 = scene.joint.clearance * 1e3
-    n = updates[0].bearing.size
+    c0 = (scene.joint if joint == "e" else scene.joint_f).clearance * 1e3
+    parts = [u.part(joint) for u in updates]
+    n = parts[0].bearing.size
     psi = np.append(np.arange(n), 0) * (2.0 * np.pi / n)
+    frames = FRAMES[joint]
     for k, which in enumerate(("bearing", "journal")):
         ax = fig.add_subplot(1, 2, k + 1, projection="polar")
         radii = []
-        for u in _chosen(updates):
-            h = np.append(getattr(u, which), getattr(u, which)[0]) * 1e3
+        for u in _chosen(list(zip(updates, parts))):
+            u, part = u
+            h = np.append(getattr(part, which), getattr(part, which)[0]) * 1e3
             radii.append((c0 if which == "bearing" else 0.0) + h)
             ax.plot(psi, radii[-1], label=f"{u.hours:.4g} h")
-        ax.set_title(("bearing: c0 + h_b(psi) [mm], rocker frame" if which == "bearing"
-                      else "journal: h_j(psi) [mm], rod frame"), fontsize=9, pad=14)
+        ax.set_title((f"bearing at {joint.upper()}: c0 + h_b(psi) [mm], {frames[0]} frame" if which == "bearing"
+                      else f"journal at {joint.upper()}: h_j(psi) [mm], {frames[1]} frame"), fontsize=9, pad=14)
         ax.set_rlabel_position(label_angle(psi, np.max(radii, axis=0)))
         ax.yaxis.set_major_locator(MaxNLocator(4))
         ax.tick_params(labelsize=7)
@@ -64,15 +71,22 @@ def label_angle(psi: np.ndarray, radius: np.ndarray) -> float:
 
 def statistic_label(name: str) -> str:
     """``mean``, ``rms``, ``p99`` or ``max`` out of a ``wear.csv`` column name."""
-    return next((word for word in ("mean", "rms", "p99", "max") if f"_{word}_" in name), name)
+    word = next((word for word in ("mean", "rms", "p99", "max") if f"_{word}_" in name), None)
+    joint = next((j for j in ("e", "f") if name.startswith(("effective_clearance_", "contact_force_"))
+                  and f"_{j}_" in name), None)
+    if word is None:
+        return f"at {joint.upper()}" if joint else name
+    return f"{word} at {joint.upper()}" if joint else word
 
 
-def growth_figure(columns: dict, title: str = "") -> Figure:
-    """Effective clearance, contact force and rapier acceleration against operating hours (``wear.csv`` columns)."""
+def growth_figure(columns: dict, title: str = "", joints: Sequence[str] = ("e",)) -> Figure:
+    """Effective clearance, contact force and rapier acceleration against operating hours (``wear.csv`` columns),
+    the clearance and contact force of each wearing joint."""
     fig = figure(figsize=(7, 8))
     hours = columns["hours"]
-    panels = (("effective_clearance_mm", "effective clearance [mm]"),
-              (("contact_force_mean_N", "contact_force_p99_N"), "contact force at E [N]"),
+    at = " and ".join(j.upper() for j in joints)
+    panels = ((tuple(f"effective_clearance_{j}_mm" for j in joints), f"effective clearance at {at} [mm]"),
+              (tuple(f"contact_force_{j}_{s}_N" for j in joints for s in ("mean", "p99")), f"contact force at {at} [N]"),
               (("rapier_acceleration_rms_m_s2", "rapier_acceleration_p99_m_s2"), "rapier acceleration [m/s²]"),
               (("driving_torque_rms_Nm", "driving_torque_p99_Nm"), "driving torque [N·m]"))
     for k, (names, label) in enumerate(panels):

@@ -1,0 +1,306 @@
+"""Wear on the Exudyn engine (issue 26, point 2): the kinematic tree's contact sees a worn profile exactly as
+the reference engine's does (the same kernel functions), a worn scene's contact agrees between the engines
+to the tolerances of ``weftsim compare``, and the Archard integral over the Exudyn run's own contact
+channels (F_N, v_T, contact angles) holds the worn volume."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from weftsim import exudyn_engine, reference
+from weftsim.kernel import chain as kc
+from weftsim.kernel.wear import worn_clearance
+from weftsim.reference.dynamics import pack_parameters
+from weftsim.scene import load_scene
+from weftsim.wear import WearError, check_request
+from weftsim.wear.engines import engine_update, exudyn_update
+from weftsim.wear.extrapolate import worn_scene
+
+
+def _profiles(n: int, c0: float) -> tuple[np.ndarray, np.ndarray]:
+    """A worn spot on the bearing (0.5 c0 deep at 250 deg of its frame) and on the journal (0.3 c0 at 90 deg)."""
+    psi = 2.0 * np.pi * np.arange(n) / n
+
+    def spot(centre, width, depth):
+        d = np.angle(np.exp(1j * (psi - centre)))
+        return depth * np.exp(-0.5 * (d / width) ** 2)
+
+    return spot(math.radians(250.0), 0.4, 0.5 * c0), spot(math.radians(90.0), 0.5, 0.3 * c0)
+
+
+def _worn(scene, revolutions: float):
+    bearing, journal = _profiles(scene.joint.wear.profile_points, scene.joint.clearance)
+    return worn_scene(scene, bearing, journal, revolutions), bearing, journal
+
+
+def test_the_tree_contact_reads_the_same_worn_clearance_as_the_reference_chain():
+    """At any state, the Exudyn tree's force kernel (:func:`tree_joint_force`) and the reference chain
+    (:func:`penetration`) give the same penetration and rate on a worn joint, and it is the round joint's
+    less h_b(psi_b) + h_j(psi_j) read from the profiles at the contact direction in each body's frame."""
+    scene = load_scene("loom")
+    worn, bearing, journal = _worn(scene, 1.0)
+    prm, round_prm = pack_parameters(worn), pack_parameters(scene)
+    rng = np.random.default_rng(3)
+    a0, psi0 = reference.dynamics.initial_state(scene)[:2]
+    c0 = scene.joint.clearance
+    depths = []
+    for t in rng.uniform(0.0, 2e-4, 40):
+        # states around the ideal one at time 0, early in the start-up: |e| = 0.07-1.7 c0, in every direction
+        y = np.array([a0 + rng.normal(0.0, 3e-5), psi0 + rng.normal(0.0, 3e-5), rng.normal(0.0, 5.0),
+                      rng.normal(0.0, 5.0), 0.0, 0.0])  # fmt: skip
+        tree = kc.tree_joint_force(prm, t, y[0], y[1] + math.pi - y[0], y[2], y[3] - y[2], 1e-4, -1.0, 0.0)
+        delta, rate = kc.penetration(prm, t, y)
+        assert tree[2] == pytest.approx(delta, abs=1e-15) and tree[3] == pytest.approx(rate, rel=1e-9, abs=1e-12)
+        ecc_y, ecc_z = kc.eccentricity(prm, t, y)[:2]
+        direction = math.atan2(ecc_z, ecc_y)
+        depth = (worn_clearance(prm, kc.WEAR_E, 0.0, direction - kc.rocker_angle(prm, t), direction - y[1], 0.0,
+                                   0.0)[0])  # fmt: skip
+        # the profile's own value at the direction: linear interpolation is within the table's curvature
+        psi_b = (direction - kc.rocker_angle(prm, t)) % (2 * math.pi)
+        psi_j = (direction - y[1]) % (2 * math.pi)
+        grid = 2 * math.pi * np.arange(bearing.size + 1) / bearing.size
+        near = (np.interp(psi_b, grid, np.append(bearing, bearing[0]))
+                + np.interp(psi_j, grid, np.append(journal, journal[0])))
+        # 1e-3 c0: a Catmull-Rom spline against linear interpolation of 1-deg cells of a spot 23-29 deg wide
+        assert depth == pytest.approx(near, abs=1e-3 * c0)
+        round_tree = kc.tree_joint_force(round_prm, t, y[0], y[1] + math.pi - y[0], y[2], y[3] - y[2], 1e-4, -1.0, 0.0)
+        assert round_tree[2] - tree[2] == pytest.approx(depth, abs=1e-15)
+        depths.append(depth)
+    assert max(depths) > 0.3 * c0 and min(depths) < 0.01 * c0  # the states meet the worn spots and unworn wall
+
+
+def test_a_worn_scene_agrees_between_the_engines_to_the_compare_tolerances():
+    """The loom's start-up impact on the worn joint: the worn spots move the first contact by more than
+    ``compare``'s first-contact tolerance and the peak force by more than its peak tolerance, and the
+    engines agree on both within those tolerances (the round joint's criteria): the reference engine, the
+    Exudyn kinematic tree and the Exudyn rigid-body model, whose joint E is the reusable clearance connector
+    (:func:`weftsim.exudyn_engine.add_clearance_joint`) reading the profiles in the rocker's and the rod's
+    body frames."""
+    scene = load_scene("loom")
+    worn = _worn(scene, 0.05)[0]
+    round_scene = replace(scene, drive=replace(scene.drive, revolutions=0.05))
+    tol = scene.compare
+    omega = scene.drive.speed
+    out = {}
+    for name, s in (("round", round_scene), ("worn", worn)):
+        rigid = replace(s, exudyn_solver=replace(s.exudyn_solver, model="rigid_body"))
+        for engine, solve, run in (("reference", reference.solve, s), ("exudyn", exudyn_engine.solve, s),
+                                   ("rigid_body", exudyn_engine.solve, rigid)):
+            result = solve(run)
+            assert result.ok, result.message
+            out[name, engine] = (result.events["first_contact_time_s"], result.steps["contact_force_N"].max())
+    for engine in ("reference", "exudyn", "rigid_body"):  # the wear changes the contact beyond the tolerances
+        assert omega * abs(out["worn", engine][0] - out["round", engine][0]) > tol.first_contact_angle
+        assert abs(out["worn", engine][1] / out["round", engine][1] - 1.0) > tol.first_revolution_peaks
+    for name in ("round", "worn"):
+        t_r, f_r = out[name, "reference"]
+        for engine in ("exudyn", "rigid_body"):
+            t_x, f_x = out[name, engine]
+            assert omega * abs(t_x - t_r) < tol.first_contact_angle
+            assert abs(f_x / f_r - 1.0) < tol.first_revolution_peaks
+
+
+def test_the_exudyn_update_integrates_archard_over_its_own_contact_channels():
+    """An update on Exudyn of a worn geometry: the profiles hold k/H times the sliding work (Archard's
+    volume), the sliding work is its rows' integral of F_N |v_T| dt, and the update agrees with the
+    reference engine's (the same deposit): sliding work within 1e-3, the deepest wear at the same cell."""
+    scene = load_scene("loom")
+    scene = replace(scene, joint=replace(scene.joint, wear=replace(scene.joint.wear, revolutions_per_update=1)))
+    bearing, journal = _profiles(scene.joint.wear.profile_points, scene.joint.clearance)
+    w = scene.joint.wear
+    ex, response = exudyn_update(scene, bearing, journal)
+    ref = engine_update(scene, bearing, journal, "reference")[0]
+    cell_b = w.bearing_hardness ** -1 * w.wear_coefficient
+    # the profiles' volume: sum(h) L R dpsi = (k / H) W to round-off (the deposit conserves it)
+    dpsi = 2 * math.pi / w.profile_points
+    volume_b = ex.bearing.sum() * scene.joint.bearing_length * scene.joint.bearing_radius * dpsi
+    assert volume_b == pytest.approx(cell_b * ex.sliding_work, rel=1e-12)
+    assert ex.bearing_volume == pytest.approx(cell_b * ex.sliding_work, rel=1e-15)
+    assert response["sliding_work_per_rev_e_J"] == pytest.approx(ex.sliding_work, rel=1e-15)
+    # the engines: 1e-3 is 5x the difference measured on this update (1.8e-4, the two integrators' error at
+    # their default tolerances).  Not the sliding distance: it counts rows of any load, and where the journal
+    # crosses the worn spot under a few N the engines end the light contact at different steps (4e-3 apart
+    # at every tolerance down to 1e-9, while the work there, F_N |v_T| dt, differs by 2e-6).
+    assert ex.sliding_work == pytest.approx(ref.sliding_work, rel=1e-3)
+    assert int(np.argmax(ex.bearing)) == int(np.argmax(ref.bearing))
+    assert int(np.argmax(ex.journal)) == int(np.argmax(ref.journal))
+
+
+def test_wear_on_exudyn_refuses_what_it_cannot_run_in_one_line():
+    scene = load_scene("loom")
+    rigid = replace(scene, exudyn_solver=replace(scene.exudyn_solver, model="rigid_body"))
+    with pytest.raises(WearError, match="kinematic tree"):
+        check_request(rigid, 1.0, "exudyn", None)
+    with pytest.raises(WearError, match="--engine must be one of reference, exudyn"):
+        check_request(scene, 1.0, "exudin", None)
+    with pytest.raises(WearError, match="covers joint E alone"):  # the tree carries the clearance at E only
+        check_request(load_scene("clearance_ef"), 1.0, "exudyn", None)
+
+
+def _hours_to(scene, limit: float, engine: str) -> float:
+    """Hours at which the prediction of ``scene`` on ``engine`` reaches the effective clearance ``limit`` (m)."""
+    from weftsim.wear.engines import simulator
+    from weftsim.wear.extrapolate import MAX_HOURS, advance, effective_clearance, limit_hours, predict
+
+    c0, latest = scene.joint.clearance, []
+
+    def beyond() -> bool:
+        return bool(latest) and effective_clearance(c0, *advance(latest[-1], scene)[2:]) >= limit
+
+    updates = predict(scene, MAX_HOURS, on_update=lambda u: latest.__setitem__(slice(None), u), stop=beyond,
+                      simulate=simulator(engine))  # fmt: skip
+    end_hours, end_revolutions, bearing, journal = advance(updates[-1], scene)
+    end = replace(updates[-1], hours=end_hours, revolutions=end_revolutions, bearing=bearing, journal=journal)
+    return limit_hours([*updates, end], c0, limit)
+
+
+@pytest.mark.slow
+def test_both_engines_agree_on_the_hours_to_a_limit_within_the_chaotic_scatter():
+    """The reference mechanism (c0 = 0.25 mm, 400 rpm) to 0.3 mm, ten updates: its cycle is chaotic, and
+    predictions differing only in the last bits of k (the ensemble's chaos runs) scatter by percents; the
+    Exudyn engine's predictions fall within that scatter of the reference engine's."""
+    from weftsim.wear.ensemble import _last_bits
+
+    scene, limit = load_scene("reference"), 0.3e-3
+    ref = np.array([_hours_to(_last_bits(scene, j), limit, "reference") for j in range(4)])
+    exu = np.array([_hours_to(_last_bits(scene, j), limit, "exudyn") for j in range(2)])
+    spread = ref.max() - ref.min()
+    assert spread > 0.005 * ref.mean()  # the scatter is there (measured: 1.1-3.4 %)
+    # every Exudyn prediction within the reference engine's chaos band widened by its own width
+    assert np.all(np.abs(exu - ref.mean()) <= spread), (ref, exu)
+
+
+def test_cli_wear_on_exudyn_writes_its_prediction_and_agrees_on_the_first_update(tmp_path):
+    """``weftsim wear --engine exudyn`` runs (its own default directory, the engine in wear.json), and its first
+    update (the unworn joint, before any chaos from the wear) agrees with the reference engine's."""
+    out = {}
+    for engine in ("reference", "exudyn"):
+        run = subprocess.run([sys.executable, "-m", "weftsim.cli", "wear", "loom", "--engine", engine, "--hours", "0.3",
+                              "--limit-clearance-mm", "0.0201", "--no-plot", "-o", str(tmp_path / engine)],
+                             capture_output=True, text=True)  # fmt: skip
+        assert run.returncode == 0, run.stderr
+        assert f"on the {engine} engine" in run.stderr
+        out[engine] = json.loads((tmp_path / engine / "wear.json").read_text())
+        assert out[engine]["engine"] == engine
+        # the result checks itself on either engine: the profiles hold Archard's volume
+        assert out[engine]["profile_volume_e_mm3"] == pytest.approx(out[engine]["archard_volume_e_mm3"], rel=1e-9)
+    # 0.0201 mm is reached in the first update: its wear rate alone sets the hours (0.146215 h on the reference
+    # engine, 0.146225 h on Exudyn: 7e-5).  1e-3: 5x the engines' difference in the first update's deepest wear
+    # (2e-4, measured at their default tolerances, 8e-5 on the journal)
+    assert out["exudyn"]["hours_to_limit"] == pytest.approx(out["reference"]["hours_to_limit"], rel=1e-3)
+    assert out["exudyn"]["updates"] == out["reference"]["updates"]
+
+
+def test_a_worn_lubricated_joint_agrees_between_the_engines():
+    """The loom with oil of 20 mPa s (the film ratio falls to ~3.9, the mixed regime's edge) on the worn joint,
+    half a revolution: the film sees the local clearance on both engines (the worn spots raise the smallest
+    film ratio from 3.86 to 3.91 on the reference engine), and the engines agree on the smallest film ratio and
+    the largest film force."""
+    from weftsim.scene import apply_overrides
+
+    scene = apply_overrides(load_scene("loom"), {"joint_e.lubrication.viscosity_mpa_s": 20.0})
+    worn = _worn(scene, 0.5)[0]
+    out = {}
+    for engine, solve in (("reference", reference.solve), ("exudyn", exudyn_engine.solve)):
+        result = solve(worn)
+        assert result.ok, result.message
+        out[engine] = (result.steps["film_ratio"].min(), result.steps["film_force_N"].max())
+    # 1e-3: 5x the measured difference of the film ratio (2.0e-4; the film force 2.3e-5)
+    assert out["exudyn"][0] == pytest.approx(out["reference"][0], rel=1e-3)
+    assert out["exudyn"][1] == pytest.approx(out["reference"][1], rel=1e-3)
+    round_scene = replace(scene, drive=replace(scene.drive, revolutions=0.5))
+    assert reference.solve(round_scene).steps["film_ratio"].min() < 0.995 * out["reference"][0]
+
+
+def test_cli_wear_to_the_limit_without_hours_ends_exactly_at_it(tmp_path):
+    """``weftsim wear SCENE --limit-clearance-mm X`` (no --hours) predicts until the effective clearance reaches
+    X: the crossing update is cut there, so the final clearance is X and the hours at the limit are the hours
+    reached; run again, it resumes and ends at the same point."""
+    out = tmp_path / "w"
+    runs = []
+    for _ in range(2):
+        run = subprocess.run([sys.executable, "-m", "weftsim.cli", "wear", "reference", "--limit-clearance-mm", "0.26",
+                              "--no-plot", "-o", str(out)], capture_output=True, text=True)  # fmt: skip
+        assert run.returncode == 0, run.stderr
+        assert "until the clearance reaches 0.26 mm" in run.stderr
+        runs.append(json.loads((out / "wear.json").read_text()))
+    for data in runs:
+        assert data["final_effective_clearance_e_mm"] == pytest.approx(0.26, rel=1e-12)
+        assert data["hours_to_limit"] == pytest.approx(data["hours_reached"], rel=1e-12)
+        assert "reaches the limit 0.26 mm" in data["ended"]
+        assert data["profile_volume_e_mm3"] == pytest.approx(data["archard_volume_e_mm3"], rel=1e-9)
+    assert runs[1]["hours_reached"] == runs[0]["hours_reached"]  # the resume re-simulates the last update
+
+
+def test_a_state_of_one_engine_is_not_resumed_on_the_other(tmp_path):
+    out = tmp_path / "w"
+    first = subprocess.run([sys.executable, "-m", "weftsim.cli", "wear", "reference", "--hours", "0.5", "--no-plot",
+                            "-o", str(out)], capture_output=True, text=True)  # fmt: skip
+    assert first.returncode == 0, first.stderr
+    other = subprocess.run([sys.executable, "-m", "weftsim.cli", "wear", "reference", "--hours", "1", "--engine",
+                            "exudyn", "--no-plot", "-o", str(out)], capture_output=True, text=True)  # fmt: skip
+    assert other.returncode == 2 and "on the reference engine" in other.stderr and "--engine reference" in other.stderr
+    assert len(other.stderr.strip().splitlines()) == 1 and "Traceback" not in other.stderr
+
+
+def _free_impact(joint, law, start: float, speed: float, end_time: float = 2e-4):
+    """A mass-point journal moving along +x from (start, 0) at ``speed`` into a bearing on the ground (the reusable
+    connector, generalized-alpha at rho = 1, h = 1e-7 s); returns (first contact time, largest F_N, final velocity)."""
+    import exudyn as exu
+    from exudyn.itemInterface import (
+        MarkerBodyPosition, MarkerNodePosition, NodePoint2D, ObjectMassPoint2D, SensorObject,
+    )  # fmt: skip
+
+    from weftsim.exudyn_engine import add_clearance_joint
+
+    sc = exu.SystemContainer()
+    mbs = sc.AddSystem()
+    ground = mbs.CreateGround()
+    node = mbs.AddNode(NodePoint2D(referenceCoordinates=[start, 0.0], initialVelocities=[speed, 0.0]))
+    mbs.AddObject(ObjectMassPoint2D(nodeNumber=node, mass=1.0))
+    bearing = mbs.AddMarker(MarkerBodyPosition(bodyNumber=ground, localPosition=[0.0, 0.0, 0.0]))
+    model = add_clearance_joint(mbs, bearing, mbs.AddMarker(MarkerNodePosition(nodeNumber=node)), joint, law=law)
+    force = mbs.AddSensor(SensorObject(objectNumber=model.connector, outputVariableType=exu.OutputVariableType.Force,
+                                       storeInternal=True, writeToFile=False))  # fmt: skip
+    mbs.Assemble()
+    model.reset(mbs)
+    ss = exu.SimulationSettings()
+    ti = ss.timeIntegration
+    ti.endTime, ti.numberOfSteps = end_time, round(end_time / 1e-7)
+    ti.generalizedAlpha.spectralRadius = 1.0
+    ti.discontinuous.ignoreMaxIterations = False
+    ti.verboseMode = 0
+    ss.solution.file.write = False
+    ss.solution.sensors.writePeriod = 0.0
+    ss.solution.solverInformationFileName = ""
+    assert exu.MainSolverImplicitSecondOrder().SolveSystem(mbs, ss)
+    f = mbs.GetSensorStoredData(force)
+    velocity = mbs.GetNodeOutput(node, exu.OutputVariableType.Velocity)[0]
+    return model.tracker.first_contact_time, float(np.hypot(f[:, 1], f[:, 2]).max()), velocity
+
+
+def test_the_reusable_connector_sees_a_worn_spot_as_the_clearance_there():
+    """``add_clearance_joint`` on a joint worn at one spot of the bearing (0.5 c0 deep at 0 deg of the ground's
+    frame): a journal moving straight into the spot meets the wall at c0 + h and rebounds as from a round joint
+    of clearance c0 + h with the same law, to round-off (a mass point and the ground: both frames at angle 0)."""
+    from weftsim.contact import make_law
+    from weftsim.params import ClearanceJoint
+
+    c0, speed, gap = 0.25e-3, 0.5, 1e-6
+    joint = ClearanceJoint(clearance=c0, law="variable_kd")
+    psi = 2.0 * np.pi * np.arange(360) / 360
+    spot = 0.5 * c0 * np.exp(-0.5 * (np.angle(np.exp(1j * psi)) / 0.3) ** 2)  # h(0) = 0.5 c0 exactly
+    law = make_law(joint)
+    worn = _free_impact(replace(joint, bearing_wear=tuple(spot)), law, 1.5 * c0 - gap, speed)
+    wider = _free_impact(replace(joint, clearance=1.5 * c0), law, 1.5 * c0 - gap, speed)
+    assert worn[0] == pytest.approx(gap / speed, rel=1e-9)  # the onset interpolation is exact in free flight
+    for a, b in zip(worn, wider):
+        assert a == pytest.approx(b, rel=1e-9)  # Catmull-Rom at a knot returns the knot's depth to round-off
+    assert worn[2] < 0.0  # the journal came back from the worn wall
