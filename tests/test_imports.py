@@ -110,10 +110,6 @@ def test_the_graph_sees_deferred_and_type_checking_imports():
 # Circles known and left for the regrouping of the modules into subpackages (issue 25), each with why.  A circle
 # not listed fails the test; a listed one that is gone must be taken off the list.
 KNOWN_CYCLES = [
-    # joint_keys.py is the part of scene.py split off for its size (which keys of a joint take effect): it reads
-    # the schema of scene.py, which calls it while it validates; both import the other inside functions.  The
-    # schema's own module (a scene subpackage) ends it.
-    ["weftsim.joint_keys", "weftsim.scene"],
     # Brought by the merge of h-files at the end of this session (result.npz checks and the wear resume),
     # deferred imports both ways; not yet untangled.
     ["weftsim.analysis", "weftsim.npz_guard", "weftsim.output", "weftsim.plausibility", "weftsim.plots",
