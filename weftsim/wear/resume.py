@@ -72,11 +72,11 @@ def read_state(path: Path, scene: Scene) -> list[Update]:
 
     Raises
     ------
-    weftsim.wear.store.StateMismatch
+    weftsim.wear.state.StateMismatch
         One line naming the problem, the file, and what to do.
     """
     from weftsim.npz_guard import DAMAGE, array_headers, open_archive, read_array
-    from weftsim.wear.store import RESPONSE, StateMismatch, scene_identity
+    from weftsim.wear.state import RESPONSE, StateMismatch, scene_identity
 
     expected = {"scene", *SERIES, *PROFILES, "response", "digest"}
     try:
@@ -144,7 +144,7 @@ def _value_problem(data: dict, response: np.ndarray) -> str:
             return f"'{name}' holds a value that is not finite"
         if np.any(values < 0.0):
             return f"'{name}' holds a negative value (times, revolutions, depths and rates are >= 0)"
-    from weftsim.wear.store import RESPONSE
+    from weftsim.wear.state import RESPONSE
 
     # NaN is allowed: the film statistics of a dry joint (store.RESPONSE)
     if np.any(np.isinf(response)) or not np.all(response[:, RESPONSE.index("solver_rtol")] > 0.0):
@@ -203,7 +203,7 @@ def _model_problem(data: dict, scene: Scene) -> str:
 
 def _updates(data: dict, response: np.ndarray) -> list[Update]:
     from weftsim.wear.extrapolate import Update
-    from weftsim.wear.store import RESPONSE
+    from weftsim.wear.state import RESPONSE
 
     return [Update(float(data["hours"][i]), float(data["revolutions"][i]), data["bearing"][i].copy(),
                    data["journal"][i].copy(), float(data["step_revolutions"][i]), data["rate_bearing"][i].copy(),
@@ -215,7 +215,7 @@ def _updates(data: dict, response: np.ndarray) -> list[Update]:
 def check_resume(updates: list[Update], scene: Scene, hours: float, outdir: Path) -> None:
     """Refuse a resume asking for fewer hours than the stored state already reaches."""
     from weftsim.wear.extrapolate import SECONDS_PER_HOUR
-    from weftsim.wear.store import STATE, StateMismatch
+    from weftsim.wear.state import STATE, StateMismatch
 
     if not updates:
         return

@@ -7,38 +7,20 @@ resumes at its last update (docs/wear.md section 4).
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.errors import WearError
 from weftsim.output import write_atomic, write_csv
 from weftsim.wear.extrapolate import Update, effective_clearance, limit_hours
+# What a stored state is (the file's name, its response columns, its scene identity, the error of one that cannot
+# be resumed) lives in weftsim.wear.state, read by weftsim.wear.resume too; re-exported here as before.
+from weftsim.wear.state import RESPONSE, STATE, StateMismatch, scene_identity  # noqa: F401
 
 if TYPE_CHECKING:
     from weftsim.params import Scene
-
-STATE = "wear_state.npz"
-RESPONSE = ("rapier_acceleration_rms_m_s2", "rapier_acceleration_p99_m_s2", "driving_torque_rms_Nm",
-            "driving_torque_p99_Nm", "contact_force_mean_N", "contact_force_p99_N", "contact_force_max_N",
-            "solver_rtol", "film_ratio_min", "film_ratio_mean", "mixed_fraction", "sliding_distance_per_rev_m",
-            "sliding_work_per_rev_J", "contact_force_sliding_mean_N", "backoffs_after")
-
-
-class StateMismatch(WearError):
-    """The directory's stored state cannot be resumed: another scene or other wear settings, a damaged
-    or edited file (:mod:`weftsim.wear.resume`), or more hours than asked for."""
-
-
-def scene_identity(scene: Scene) -> str:
-    """The scene's file keys as canonical JSON: what a stored state must match to be resumed."""
-    from weftsim.scene import to_file_keys
-
-    return json.dumps(to_file_keys(scene), sort_keys=True, default=str)
-
 
 def save_state(outdir: Path, scene: Scene, updates: list[Update]) -> Path:
     arrays = {
