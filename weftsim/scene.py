@@ -53,6 +53,7 @@ from weftsim.schema import (  # noqa: F401
     _set,
     shown,
 )
+from weftsim.version import package_directory
 
 # A scene file is a few kilobytes (models/reference.toml: 2.5 kB).  Anything beyond this bound
 # is not a scene (a log, an image, /dev/zero): it is refused before it is read into memory.
@@ -128,7 +129,7 @@ def bundled_directory() -> Path | None:
     the repository's ``models/`` there, see ``setup.py``); a source checkout, run from the tree
     or installed in editable mode, reads ``models/`` beside the package itself.
     """
-    package = Path(__file__).resolve().parent
+    package = package_directory()
     installed, checkout = package / "scenes", package.parent / "models"
     if (installed / "reference.toml").is_file():
         return installed
