@@ -108,11 +108,12 @@ def test_the_graph_sees_deferred_and_type_checking_imports():
 
 
 def test_weftsim_imports_have_no_cycle():
-    """No circle at all.  The last three (issue 25) were broken so: the schema of a scene file has its own
-    module (weftsim.schema), read by the scene reader and the joint keys alike; a result file is read by
-    weftsim.result_file alone (weftsim.results only writes it) and the memory check the archive guard needs
-    lives in weftsim.npz_guard, not in weftsim.output, which writes results; a stored wear state's definitions
-    (weftsim.wear.state) are read by both the store and the resume check, so the store calls the check one way."""
+    """No circle at all.  The last three (issue 25) were broken so: the schema of a scene file has
+    its own module (weftsim.schema), read by the scene reader and the joint keys alike; a result
+    file is read by weftsim.result_file alone (weftsim.results only writes it) and the memory
+    check the archive guard needs lives in weftsim.npz_guard, not in weftsim.output, which writes
+    results; a stored wear state's definitions (weftsim.wear.state) are read by both the store
+    and the resume check, so the store calls the check one way."""
     assert cycles(import_graph()) == []
 
 
@@ -125,10 +126,15 @@ def test_errors_is_the_bottom_of_the_hierarchy_and_selection_needs_no_solver():
     assert "weftsim.design_checks" not in graph["weftsim.plausibility"]
 
 
-@pytest.mark.parametrize("module", ["weftsim.results", "weftsim.errors", "weftsim.exudyn_engine.selection",
-                                    "weftsim.design_checks", "weftsim.sweep.store", "weftsim.joint_keys",
-                                    "weftsim.scene", "weftsim.result_file", "weftsim.npz_guard", "weftsim.output",
-                                    "weftsim.plots", "weftsim.wear.resume", "weftsim.wear.store"])
+FORMER_CIRCLES = [
+    "weftsim.results", "weftsim.errors", "weftsim.exudyn_engine.selection",
+    "weftsim.design_checks", "weftsim.sweep.store", "weftsim.joint_keys",
+    "weftsim.scene", "weftsim.result_file", "weftsim.npz_guard",
+    "weftsim.output", "weftsim.plots", "weftsim.wear.resume", "weftsim.wear.store",
+]
+
+
+@pytest.mark.parametrize("module", FORMER_CIRCLES)
 def test_a_module_of_a_former_circle_imports_first_in_a_fresh_interpreter(module):
     """Each module of the former circles imported first, in a new process, succeeds."""
     subprocess.run([sys.executable, "-c", f"import {module}"], cwd=PACKAGE.parent, check=True)

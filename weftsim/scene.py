@@ -26,7 +26,7 @@ from typing import Any
 
 from weftsim import params
 from weftsim.errors import SceneError
-# The schema (weftsim.schema) is read here and re-exported: weftsim.scene.SCHEMA, .Key, .shown, ... as before.
+# The schema (weftsim.schema), read here and re-exported (SCHEMA, Key, shown, ...) as before.
 from weftsim.schema import (  # noqa: F401
     _BY_PATH,
     BRANCHES,
