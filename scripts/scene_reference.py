@@ -1,4 +1,4 @@
-"""Print the scene-file key reference (Markdown) from weftsim.scene.SCHEMA, for the README."""
+"""Print the scene-file key reference (Markdown) from weftsim.schema.SCHEMA, for the README."""
 
 import dataclasses
 

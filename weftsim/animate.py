@@ -68,12 +68,12 @@ def check_frames(frames: int) -> None:
 
     Raises ValueError with one line naming the limit.
     """
-    from weftsim.output import _available_memory
+    from weftsim.npz_guard import available_memory
 
     if isinstance(frames, bool) or not isinstance(frames, int) or not 2 <= frames <= MAX_FRAMES:
         raise ValueError(f"--frames must be a whole number from 2 to {MAX_FRAMES} (one frame per 0.25 deg of crank; "
                          f"a GIF holds every frame in memory while it is written), got {frames!r}")
-    available = _available_memory()
+    available = available_memory()
     if available is not None and frames * FRAME_BYTES > available:
         raise ValueError(f"--frames {frames}: the frames need ~{frames * FRAME_BYTES / 1e6:.0f} MB of memory, more "
                          f"than the {available / 1e6:.0f} MB available; ask for fewer")

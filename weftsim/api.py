@@ -266,11 +266,11 @@ def load_result(path: str | os.PathLike) -> RunResult:
     weftsim.errors.ArgumentError
         ``path`` is not a path.
     """
-    from weftsim.results import load_npz
+    from weftsim.result_file import read_npz
 
     if not isinstance(path, (str, os.PathLike)):
         raise ArgumentError(f"load_result: path must be a file path, got {type(path).__name__}")
-    return load_npz(path)
+    return read_npz(path)
 
 
 def load_sweep(directory: str | os.PathLike) -> xarray.Dataset:

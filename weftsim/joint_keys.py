@@ -19,6 +19,8 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
+from weftsim.schema import _BY_PATH, SCHEMA, _set, shown
+
 if TYPE_CHECKING:
     from weftsim.params import Scene
 
@@ -40,8 +42,6 @@ def describes_joint(path: str) -> bool:
 
 def _f_keys() -> tuple[str, ...]:
     """The keys of [joint_f] without the table name, except ``clearance_mm``, in schema order."""
-    from weftsim.scene import SCHEMA
-
     return tuple(key.path.partition(".")[2] for key in SCHEMA
                  if key.path.startswith("joint_f.") and key.path != "joint_f." + CLEARANCE)
 
@@ -74,8 +74,6 @@ def resync_joint_f(scene: Scene, overridden: set[str] | dict) -> Scene:
 
     ``overridden``: the dotted keys just applied.  A key given for F stops being taken from E.
     """
-    from weftsim.scene import _BY_PATH, _set
-
     inherits = tuple(rest for rest in scene.joint_f_inherits if "joint_f." + rest not in overridden)
     if any(str(key).startswith("joint_e.") for key in overridden):
         for rest in inherits:
@@ -94,8 +92,6 @@ def ideal_joint_keys(scene: Scene, keys) -> list[str]:
 
 def ideal_key_message(key: str, where: str = "command line") -> str:
     """The one line refusing ``key`` on an ideal joint, the same for ``run --set``, ``--vary`` and the API."""
-    from weftsim.scene import shown
-
     table = joint_table(key)
     letter = JOINTS[table][0]
     return (f"{where}: key '{shown(key)}' describes the clearance joint at {letter}, but joint {letter} is ideal "
@@ -110,8 +106,6 @@ def wear_only_keys(keys) -> list[str]:
 
 def wear_only_message(key: str, command: str) -> str:
     """The one line refusing a wear key where it would change nothing (any command but ``weftsim wear``)."""
-    from weftsim.scene import shown
-
     return (f"key '{shown(key)}' is read by `weftsim wear` only: `weftsim {command}` does not depend on it, so it "
             "would change nothing (every cell of a sweep would be the same run); leave it out or run `weftsim wear`")
 

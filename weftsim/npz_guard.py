@@ -14,6 +14,7 @@ Every refusal is one :class:`weftsim.errors.OutputError` line: ``{path}: cannot 
 from __future__ import annotations
 
 import math
+import os
 import stat
 import zipfile
 import zlib
@@ -94,10 +95,18 @@ def _array_header(archive: zipfile.ZipFile, member: zipfile.ZipInfo) -> tuple[tu
         return tuple(shape), dtype, handle.tell()
 
 
-def _available_memory() -> int | None:
-    from weftsim.output import _available_memory as available
-
-    return available()
+def available_memory() -> int | None:
+    """Bytes of memory a new allocation can get without swapping (Linux MemAvailable), or None."""
+    try:
+        for line in Path("/proc/meminfo").read_text().splitlines():
+            if line.startswith("MemAvailable:"):
+                return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):
+        return None
 
 
 def array_headers(path: Path, archive: zipfile.ZipFile, expected: set[str], what: str
@@ -122,7 +131,7 @@ def array_headers(path: Path, archive: zipfile.ZipFile, expected: set[str], what
     if declared > INFLATION_FLOOR_BYTES and declared > MAX_INFLATION * file_size:
         raise fail(path, what, f"its {size_text(file_size)} declare {size_text(declared)} of arrays, more than "
                                f"{MAX_INFLATION:g} times the file (a ZIP bomb or a damaged archive); nothing was read")
-    available = _available_memory()
+    available = available_memory()
     if available is not None and declared > available:
         raise fail(path, what, f"its arrays need {size_text(declared)} of memory, more than the "
                                f"{size_text(available)} available; nothing was read")

@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from weftsim.errors import OutputError, WriteFailed
+from weftsim.npz_guard import available_memory
 from weftsim.record import MANIFEST, SCENE_FILE, check_same_scene, provenance, scene_toml
 from weftsim.results import RunResult
 
@@ -332,20 +333,6 @@ def write_files(outdir: Path, what: dict, files: dict[str, tuple[str, Callable[[
     raise WriteFailed(text)
 
 
-def _available_memory() -> int | None:
-    """Bytes of memory a new allocation can get without swapping (Linux MemAvailable), or None."""
-    try:
-        for line in Path("/proc/meminfo").read_text().splitlines():
-            if line.startswith("MemAvailable:"):
-                return int(line.split()[1]) * 1024
-    except (OSError, ValueError, IndexError):
-        pass
-    try:
-        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
-    except (ValueError, OSError, AttributeError):
-        return None
-
-
 def _free_disk(path: Path) -> int | None:
     """Free bytes on the file system that would hold ``path`` (its nearest existing ancestor), or
     None where that says nothing (a pseudo file system such as /proc reports a size of 0)."""
@@ -379,7 +366,7 @@ def check_output_fits(rows: float, columns: int, outdir: Path, what: str, runs: 
     """
     values = float(rows) * columns * runs
     memory, disk = values * MEMORY_BYTES_PER_VALUE, values * CSV_BYTES_PER_VALUE
-    available, free = _available_memory(), _free_disk(outdir)
+    available, free = available_memory(), _free_disk(outdir)
     short = []
     if available is not None and memory > available:
         short.append(f"~{_size(memory)} of memory (available: {_size(available)})")

@@ -11,7 +11,8 @@ import functools
 import platform
 import subprocess
 from importlib import metadata
-from pathlib import Path
+
+from weftsim.version import package_directory
 
 PACKAGES = ("weftsim", "exudyn", "numpy", "scipy", "numba", "matplotlib")
 
@@ -32,7 +33,7 @@ def versions() -> dict[str, str | None]:
 def commit() -> str | None:
     """The git commit of the weftsim source in use (``+dirty`` with uncommitted changes), or None when
     weftsim is not run from a git checkout (an installed wheel) or git is missing."""
-    source = Path(__file__).resolve().parent
+    source = package_directory()
     try:
         head = subprocess.run(["git", "-C", str(source), "rev-parse", "HEAD"], capture_output=True, text=True,
                               timeout=5)  # fmt: skip

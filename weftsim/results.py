@@ -5,7 +5,7 @@ uniform crank-angle output grid (``samples``) and at every accepted solver step
 (``steps``).  Peaks and statistics are taken from ``steps`` because an impact
 lasts about 0.1 ms, a fraction of a degree, and falls between output samples.
 
-:func:`save_npz` / :func:`load_npz` keep a result losslessly (both tables bit for bit,
+:func:`save_npz` / :func:`weftsim.result_file.read_npz` keep a result losslessly (both tables bit for bit,
 the scene in SI units, the solver statistics, events, plausibility and path), so
 the per-step data behind the peaks can be studied after the run; ``weftsim run``
 writes it as ``result.npz`` beside ``channels.csv``.
@@ -303,7 +303,7 @@ def angle_grid(end_time: float, omega: float, step_angle: float) -> np.ndarray:
     return t
 
 
-# Format tag of a saved result; :func:`load_npz` refuses others (a later layout gets a new number).
+# Format tag of a saved result; weftsim.result_file.read_npz refuses others (a later layout gets a new number).
 NPZ_FORMAT = "weftsim-result/1"
 
 
@@ -325,7 +325,8 @@ def _plain(value: Any) -> Any:
 
 
 def save_npz(result: RunResult, path: str | os.PathLike) -> Path:
-    """Write ``result`` to one NPZ file from which :func:`load_npz` rebuilds it exactly.
+    """Write ``result`` to one NPZ file from which :func:`weftsim.result_file.read_npz` rebuilds it
+    exactly (reading it as untrusted input).
 
     The file holds ``samples/<channel>`` and ``steps/<channel>`` (float64 arrays, bit for bit)
     and ``meta``: one JSON text with the format tag, the scene (SI values of
@@ -348,21 +349,3 @@ def save_npz(result: RunResult, path: str | os.PathLike) -> Path:
     with path.open("wb") as file:
         np.savez_compressed(file, **arrays)
     return path
-
-
-def load_npz(path: str | os.PathLike) -> RunResult:
-    """The :class:`RunResult` saved by :func:`save_npz`, read as untrusted input.
-
-    The archive's directory and every array's header are checked before any array is read
-    (:mod:`weftsim.result_file`), so a damaged or crafted file is refused with one line and
-    never allocates what its headers claim.
-
-    Raises
-    ------
-    weftsim.errors.OutputError
-        The file cannot be read, is not a weftsim result, lacks or has malformed channels, or its
-        ``meta`` (scene, engine, status, ...) is not what :func:`save_npz` writes.
-    """
-    from weftsim.result_file import read_npz
-
-    return read_npz(path)

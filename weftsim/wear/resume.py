@@ -92,7 +92,7 @@ def read_state(path: Path, scene: Scene) -> list[Update]:
     """
     from weftsim.npz_guard import DAMAGE, array_headers, open_archive, read_array
     from weftsim.wear.extrapolate import joint_of, wearing_joints
-    from weftsim.wear.store import LEGACY_RESPONSE, RESPONSE, StateMismatch, scene_identity
+    from weftsim.wear.state import LEGACY_RESPONSE, RESPONSE, StateMismatch, scene_identity
 
     joints = wearing_joints(scene)
     allowed = {"scene", "response", "digest", *SERIES, *LEGACY,
@@ -148,7 +148,7 @@ def read_state(path: Path, scene: Scene) -> list[Update]:
 
 def _legacy_response(response: np.ndarray) -> np.ndarray:
     """A legacy state's response columns (:data:`~weftsim.wear.store.LEGACY_RESPONSE`) in today's layout."""
-    from weftsim.wear.store import LEGACY_NAMES, LEGACY_RESPONSE, RESPONSE
+    from weftsim.wear.state import LEGACY_NAMES, LEGACY_RESPONSE, RESPONSE
 
     out = np.full((response.shape[0], len(RESPONSE)), math.nan)
     for k, name in enumerate(LEGACY_RESPONSE):
@@ -193,7 +193,7 @@ def _value_problem(data: dict, response: np.ndarray) -> str:
             return f"'{name}' holds a value that is not finite"
         if np.any(values < 0.0):
             return f"'{name}' holds a negative value (times, revolutions, depths and rates are >= 0)"
-    from weftsim.wear.store import RESPONSE
+    from weftsim.wear.state import RESPONSE
 
     # NaN is allowed: the film statistics of a dry joint (store.RESPONSE)
     if np.any(np.isinf(response)) or not np.all(response[:, RESPONSE.index("solver_rtol")] > 0.0):
@@ -255,7 +255,7 @@ def _model_problem(data: dict, scene: Scene, joints: tuple[str, ...]) -> str:
 
 def _updates(data: dict, response: np.ndarray, joints: tuple[str, ...]) -> list[Update]:
     from weftsim.wear.extrapolate import JointWear, Update
-    from weftsim.wear.store import RESPONSE
+    from weftsim.wear.state import RESPONSE
 
     out = []
     for i in range(data["hours"].size):
@@ -273,7 +273,7 @@ def _updates(data: dict, response: np.ndarray, joints: tuple[str, ...]) -> list[
 def check_resume(updates: list[Update], scene: Scene, hours: float, outdir: Path) -> None:
     """Refuse a resume asking for fewer hours than the stored state already reaches."""
     from weftsim.wear.extrapolate import SECONDS_PER_HOUR
-    from weftsim.wear.store import STATE, StateMismatch
+    from weftsim.wear.state import STATE, StateMismatch
 
     if not updates:
         return
