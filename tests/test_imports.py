@@ -103,15 +103,15 @@ def test_the_graph_sees_deferred_and_type_checking_imports():
     kinds (checked on edges that exist today), so a circle of either kind would be found."""
     graph = import_graph()
     assert "weftsim.exudyn_engine.callbacks" in graph["weftsim.exudyn_engine.selection"]  # inside a function
-    assert "weftsim.results" in graph["weftsim.design_checks"]  # under TYPE_CHECKING
-    assert "weftsim.errors" in graph["weftsim.results"]
+    assert "weftsim.post.results" in graph["weftsim.run.design_checks"]  # under TYPE_CHECKING
+    assert "weftsim.errors" in graph["weftsim.post.results"]
 
 
 def test_weftsim_imports_have_no_cycle():
     """No circle at all.  The last three (issue 25) were broken so: the schema of a scene file has
-    its own module (weftsim.schema), read by the scene reader and the joint keys alike; a result
-    file is read by weftsim.result_file alone (weftsim.results only writes it) and the memory
-    check the archive guard needs lives in weftsim.npz_guard, not in weftsim.output, which writes
+    its own module (weftsim.input.schema), read by the scene reader and the joint keys alike; a result
+    file is read by weftsim.post.result_file alone (weftsim.post.results only writes it) and the memory
+    check the archive guard needs lives in weftsim.post.npz_guard, not in weftsim.post.output, which writes
     results; a stored wear state's definitions (weftsim.wear.state) are read by both the store
     and the resume check, so the store calls the check one way."""
     assert cycles(import_graph()) == []
@@ -121,16 +121,16 @@ def test_errors_is_the_bottom_of_the_hierarchy_and_selection_needs_no_solver():
     """``weftsim.errors`` names no weftsim module but the exit codes (every module raises its errors), and the
     Exudyn path's step plan (:mod:`weftsim.exudyn_engine.selection`) is plain arithmetic, no solver."""
     graph = import_graph()
-    assert graph["weftsim.errors"] == {"weftsim.exitcodes"}
+    assert graph["weftsim.errors"] == {"weftsim.cli.exitcodes"}
     assert "weftsim.exudyn_engine.solver" not in graph["weftsim.exudyn_engine.selection"]
-    assert "weftsim.design_checks" not in graph["weftsim.plausibility"]
+    assert "weftsim.run.design_checks" not in graph["weftsim.run.plausibility"]
 
 
 FORMER_CIRCLES = [
-    "weftsim.results", "weftsim.errors", "weftsim.exudyn_engine.selection",
-    "weftsim.design_checks", "weftsim.sweep.store", "weftsim.joint_keys",
-    "weftsim.scene", "weftsim.result_file", "weftsim.npz_guard",
-    "weftsim.output", "weftsim.plots", "weftsim.wear.resume", "weftsim.wear.store",
+    "weftsim.post.results", "weftsim.errors", "weftsim.exudyn_engine.selection",
+    "weftsim.run.design_checks", "weftsim.sweep.store", "weftsim.input.joint_keys",
+    "weftsim.input.scene", "weftsim.post.result_file", "weftsim.post.npz_guard",
+    "weftsim.post.output", "weftsim.post.plots", "weftsim.wear.resume", "weftsim.wear.store",
 ]
 
 

@@ -40,7 +40,7 @@ from weftsim.wear.uncertain import Uncertain, latin_hypercube, parse_uncertain, 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from weftsim.params import Scene
+    from weftsim.input.params import Scene
 
 RESCALED = ("joint_e.wear.wear_coefficient", "joint_e.wear.bearing_hardness_mpa", "joint_e.wear.journal_hardness_mpa")
 DESIGN_QUANTILES = (0.05, 0.5, 0.95)
@@ -72,7 +72,7 @@ def _lagrange(nodes: np.ndarray, x: np.ndarray) -> np.ndarray:
 def plan(scene: Scene, uncertain: list[Uncertain], chaos_runs: int = CHAOS_RUNS
          ) -> tuple[list[tuple[str, Scene]], list[Uncertain], np.ndarray]:
     """(jobs as (name, scene), the dynamic inputs, their design values (nodes, dims)); checks every design scene."""
-    from weftsim.scene import SceneError, apply_overrides, to_file_keys
+    from weftsim.input.scene import SceneError, apply_overrides, to_file_keys
 
     keys = to_file_keys(scene)
     seen = set()
@@ -133,7 +133,7 @@ def _run_jobs(jobs: list[tuple[str, Scene]], limit: float, outdir: Path, jobs_n:
 def combine(scene: Scene, uncertain: list[Uncertain], dynamic: list[Uncertain], nodes: np.ndarray,
             results: dict[str, dict], samples: int, limit: float, seed: int, levels_extra=()) -> dict:
     """The ensemble from the jobs' curves: per-sample hours at every clearance level (module docstring)."""
-    from weftsim.scene import to_file_keys
+    from weftsim.input.scene import to_file_keys
 
     node_names = [n for n in results if n.startswith("node_")] or ["centre"]
     node_names.sort()
@@ -221,7 +221,7 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
     chaos_runs : int
         Predictions of the centre design point differing in the last bits of k (1 to 50; 1 = no scatter).
     """
-    from weftsim.output import begin_directory, prepare_directory, write_csv, write_figure, write_files, write_json
+    from weftsim.post.output import begin_directory, prepare_directory, write_csv, write_figure, write_files, write_json
     from weftsim.wear import check_request
 
     texts = [f"{k}={v}" for k, v in uncertain.items()] if isinstance(uncertain, dict) else list(uncertain)

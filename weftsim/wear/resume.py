@@ -5,7 +5,7 @@ killed while another wrote it) or edited by hand.  A resumed prediction extrapol
 update, so a wrong number there becomes a wrong answer that looks complete.  :func:`read_state`
 therefore refuses, with one line naming what is wrong, a state that
 
-- is not a readable archive of the arrays weftsim writes (:mod:`weftsim.npz_guard`: empty,
+- is not a readable archive of the arrays weftsim writes (:mod:`weftsim.post.npz_guard`: empty,
   truncated, garbage, a directory, a ZIP bomb, a header claiming more than the file holds);
 - lacks an array, or has one of the wrong shape or kind (one row per update, one column per
   profile point of each wearing joint's ``[joint_*.wear] profile_points``; per-joint arrays are
@@ -39,7 +39,7 @@ import numpy as np
 from weftsim.errors import OutputError
 
 if TYPE_CHECKING:
-    from weftsim.params import Scene
+    from weftsim.input.params import Scene
     from weftsim.wear.extrapolate import Update
 
 WHAT = "a wear state"
@@ -90,7 +90,7 @@ def read_state(path: Path, scene: Scene) -> list[Update]:
     weftsim.wear.store.StateMismatch
         One line naming the problem, the file, and what to do.
     """
-    from weftsim.npz_guard import DAMAGE, array_headers, open_archive, read_array
+    from weftsim.post.npz_guard import DAMAGE, array_headers, open_archive, read_array
     from weftsim.wear.extrapolate import joint_of, wearing_joints
     from weftsim.wear.state import LEGACY_RESPONSE, RESPONSE, StateMismatch, scene_identity
 

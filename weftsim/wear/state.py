@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 from weftsim.errors import WearError
 
 if TYPE_CHECKING:
-    from weftsim.params import Scene
+    from weftsim.input.params import Scene
 
 STATE = "wear_state.npz"
 # Response statistics of an update (extrapolate._response, _sliding): the mechanism's, then each joint's
@@ -53,7 +53,7 @@ def scene_identity(scene: Scene) -> str:
     An ideal joint F's ``[joint_f.wear]`` keys are left out: they change nothing, and a state written before F
     could wear (which did not know them) stays the same scene's.
     """
-    from weftsim.scene import to_file_keys
+    from weftsim.input.scene import to_file_keys
 
     keys = to_file_keys(scene)
     if scene.joint_f.is_ideal:

@@ -18,13 +18,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.output import write_atomic, write_csv
+from weftsim.post.output import write_atomic, write_csv
 from weftsim.wear.extrapolate import Update, effective_clearance, joint_of, limit_hours, wearing_joints
 # What a stored state is lives in weftsim.wear.state, read by weftsim.wear.resume too; re-exported here.
 from weftsim.wear.state import JOINTS, JOINT_RESPONSE, LEGACY_NAMES, LEGACY_RESPONSE, MECHANISM_RESPONSE, PARTS, RESPONSE, STATE, StateMismatch, scene_identity  # noqa: F401
 
 if TYPE_CHECKING:
-    from weftsim.params import Scene
+    from weftsim.input.params import Scene
 
 
 def response_row(update: Update) -> list[float]:
@@ -125,7 +125,7 @@ def summary(scene: Scene, updates: list[Update], hours: float, limit: float | No
     ``hours_to_limit`` is the first of the joints' ``hours_to_limit_<j>`` (the joint that needs service first,
     named by ``limit_joint``): a limit applies to every wearing joint.
     """
-    from weftsim.scene import to_file_keys
+    from weftsim.input.scene import to_file_keys
 
     joints = wearing_joints(scene)
     last = updates[-1]

@@ -3,7 +3,7 @@
 Engine-independent: everything is read from a result's per-step channels (and the engines' own
 counters where they report them), with numpy only.  Two kinds of finding:
 
-**Defects** (the run fails, :func:`weftsim.guards.plausibility_breach`): a contact history no
+**Defects** (the run fails, :func:`weftsim.run.guards.plausibility_breach`): a contact history no
 correct integration of the model produces.
 
 - *Onset with a non-positive approach rate.*  An onset is a crossing of delta from negative to
@@ -32,7 +32,7 @@ correct integration of the model produces.
 
 - restitution outside the law's ``valid_restitution`` (the range its xi(ce) was derived for);
 - largest penetration above the law's ``valid_penetration_ratio`` of the clearance
-  (:mod:`weftsim.contact`).  The Hertz-based laws (``lankarani_nikravesh``, ``flores``,
+  (:mod:`weftsim.joint.contact`).  The Hertz-based laws (``lankarani_nikravesh``, ``flores``,
   ``hunt_crossley``, ``gonthier``: :data:`PENETRATION_WARNING_RATIO`) build on Hertz's contact of two
   cylinders, which assumes a contact width small against the radii.  Two conforming cylinders at
   approach delta overlap over a half-width of about R_j sqrt(2 delta / c) (the gap x^2 / (2 R*) with
@@ -59,9 +59,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from weftsim.contact import _Law
-    from weftsim.params import ClearanceJoint, Scene
-    from weftsim.results import RunResult
+    from weftsim.joint.contact import _Law
+    from weftsim.input.params import ClearanceJoint, Scene
+    from weftsim.post.results import RunResult
 
 PENETRATION_WARNING_RATIO = 0.1  # delta_max / c of the Hertz-based laws (contact._Law.valid_penetration_ratio)
 TRESCA_LINE_CONTACT_YIELD = 1.67  # p0 / Y at first yield under a Hertz line contact (Johnson 1985, 6.2)
@@ -270,7 +270,7 @@ def joint_view(result: RunResult, joint: str) -> tuple[Scene, dict[str, np.ndarr
     channels under joint E's names (joint F's ``_f`` channels renamed), so every check reads one joint."""
     import dataclasses
 
-    from weftsim.results import JOINT_E_NAME
+    from weftsim.post.results import JOINT_E_NAME
 
     if joint == "e":
         return result.scene, result.steps
@@ -314,7 +314,7 @@ def assess(result: RunResult) -> Plausibility | None:
 
 def _assess_joint(result, scene, steps, table: str) -> Plausibility:
     """:func:`assess` of one joint: ``scene.joint`` and the E-named channels of ``steps`` are that joint's."""
-    from weftsim.contact import make_law
+    from weftsim.joint.contact import make_law
 
     law = make_law(scene.joint)
     mode = contact_mode(steps)
@@ -357,7 +357,7 @@ HINT = ("the contact history is broken, so its forces are not to be trusted: for
 
 def first_defect_row(result: RunResult, report: Plausibility) -> int:
     """Index of the first step showing one of the defects (for the failure message's time), at any joint."""
-    from weftsim.contact import make_law
+    from weftsim.joint.contact import make_law
 
     rows = []
     for joint in result.scene.loose_joints:

@@ -15,7 +15,7 @@ Planar four-bar O-E-F-G in the plane x = 0, coordinates (Y, Z) = (y, z)::
             O-----G-----> Y                G = (L_OG, 0)
 
 The spherical 4R part (rocker angle, coupler frame and angular velocity, the
-general input-output law) lives in :mod:`weftsim.spherical` and is re-exported here.
+general input-output law) lives in :mod:`weftsim.mechanism.spherical` and is re-exported here.
 """
 
 from __future__ import annotations
@@ -25,8 +25,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.params import Geometry, Inertia
-from weftsim.spherical import (
+from weftsim.input.params import Geometry, Inertia
+from weftsim.mechanism.spherical import (
     coupler_angular_velocity,
     coupler_frame,
     crank_axis,

@@ -1,6 +1,6 @@
 """Parameter objects of a weftsim scene: frozen dataclasses in SI units.
 
-Scene files (TOML) speak mm, deg, rpm and GPa; :mod:`weftsim.scene` converts them
+Scene files (TOML) speak mm, deg, rpm and GPa; :mod:`weftsim.input.scene` converts them
 and validates them once, so every object here holds checked SI values (m, rad,
 rad/s, kg, kg m^2, Pa).  Variants are made with :func:`dataclasses.replace`.
 
@@ -236,7 +236,7 @@ def lubrication_problem(lub: Lubrication) -> str | None:
     return None
 
 
-# Impact velocity rules of ClearanceJoint.impact_velocity_rule (weftsim.scene re-exports it).
+# Impact velocity rules of ClearanceJoint.impact_velocity_rule (weftsim.input.scene re-exports it).
 IMPACT_VELOCITY_RULES = ("max_approach", "onset")
 
 
@@ -260,7 +260,7 @@ class ClearanceJoint:
         L_b, axial length of the bearing, m (used by ``elastic_foundation``).
     journal_material, bearing_material : Material
     law : str
-        Name of the contact force law in :data:`weftsim.contact.LAWS`.
+        Name of the contact force law in :data:`weftsim.joint.contact.LAWS`.
     restitution : float
         Coefficient of restitution ce in (0, 1].
     friction_coefficient : float
@@ -341,7 +341,7 @@ def _positive_finite(value) -> bool:
 def joint_problem(joint: ClearanceJoint) -> str | None:
     """One line naming the first invalid field of ``joint`` and what is allowed, or None.
 
-    The law's name is checked where the laws live (:func:`weftsim.contact.make_law`).
+    The law's name is checked where the laws live (:func:`weftsim.joint.contact.make_law`).
     """
     c = joint.clearance
     if not (isinstance(c, (int, float)) and math.isfinite(c) and c >= 0.0):
@@ -352,7 +352,7 @@ def joint_problem(joint: ClearanceJoint) -> str | None:
             unit = "m/s" if name == "min_impact_velocity" else "m"
             return f"`{name}` must be > 0 ({unit}), got {value!r}"
     if not isinstance(joint.law, str) or not joint.law:
-        return f"`law` must name a contact law (weftsim.contact.LAWS), got {joint.law!r}"
+        return f"`law` must name a contact law (weftsim.joint.contact.LAWS), got {joint.law!r}"
     ce = joint.restitution
     if not (isinstance(ce, (int, float)) and 0.0 < ce <= 1.0):
         return f"`restitution` must be in (0, 1], got {ce!r}"
@@ -383,7 +383,7 @@ def joint_problem(joint: ClearanceJoint) -> str | None:
     lub = joint.lubrication
     if lub is not None:
         if not isinstance(lub, Lubrication):
-            return f"`lubrication` must be a weftsim.params.Lubrication or None, got {type(lub).__name__}"
+            return f"`lubrication` must be a weftsim.input.params.Lubrication or None, got {type(lub).__name__}"
         if c > 0.0 and lub.film_floor_ratio * lub.roughness >= c:
             return (f"`lubrication.roughness` x `film_floor_ratio` ({lub.film_floor_ratio * lub.roughness:.3g} m) "
                     f"must be smaller than the clearance {c:.3g} m (the film needs room between the surfaces)")
@@ -481,7 +481,7 @@ class CompareTolerance:
 
 @dataclass(frozen=True)
 class Limits:
-    """Run-time failure criteria and budgets, checked by both engines (:mod:`weftsim.guards`).
+    """Run-time failure criteria and budgets, checked by both engines (:mod:`weftsim.run.guards`).
 
     A run that crosses one ends with ``status = "failed"``, a message saying what, when
     (time and crank angle) and what to try, and keeps what it computed up to then.
@@ -519,7 +519,7 @@ class Limits:
         were derived for, stays within 1, and the default impact velocity rule
         ``max_approach`` keeps every step within 1: a step beyond it fails the run.  Under the
         ``onset`` rule a driven lasting contact exceeds it as a property of that model: a
-        warning (:mod:`weftsim.plausibility`).
+        warning (:mod:`weftsim.run.plausibility`).
     """
 
     max_wall_time: float = 0.0
@@ -533,7 +533,7 @@ class Limits:
 
 @dataclass(frozen=True)
 class Scene:
-    """Everything one simulation needs; produced by :func:`weftsim.scene.load_scene`."""
+    """Everything one simulation needs; produced by :func:`weftsim.input.scene.load_scene`."""
 
     name: str = "reference"
     geometry: Geometry = field(default_factory=Geometry)
@@ -549,7 +549,7 @@ class Scene:
     limits: Limits = field(default_factory=Limits)
     source: str = ""
     # Keys of [joint_f] (without the table name) that F takes from [joint_e] because the scene does not
-    # give them (weftsim.joint_keys); bookkeeping of how the scene was written, not part of the machine.
+    # give them (weftsim.input.joint_keys); bookkeeping of how the scene was written, not part of the machine.
     joint_f_inherits: tuple[str, ...] = field(default=(), compare=False)
 
     @property

@@ -23,7 +23,7 @@ Where the points come from
 Everything is read from the run's accepted solver steps (``result.steps``, the engine's own states;
 the output samples of an engine may be interpolated between steps), so the picture shows what the
 engine computed:
-the crank angle theta = omega t gives the rocker angle phi(theta) (:func:`weftsim.spherical.rocker_angle`)
+the crank angle theta = omega t gives the rocker angle phi(theta) (:func:`weftsim.mechanism.spherical.rocker_angle`)
 and so the bearing centre P_b = L_OE u(theta_OE0 + phi); the eccentricity channels give the journal
 centre P_j = P_b + e; the rapier displacement gives the sector angle
 theta_FG = theta_FG(0) + s / (d5 d7 / d6) and so F = G + L_FG u(theta_FG), the centre of the sector's
@@ -43,9 +43,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.kinematics import fourbar, rocker_angle
-from weftsim.results import RunResult
-from weftsim.spherical import crank_axis, rocker_axis
+from weftsim.mechanism.kinematics import fourbar, rocker_angle
+from weftsim.post.results import RunResult
+from weftsim.mechanism.spherical import crank_axis, rocker_axis
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator
@@ -68,7 +68,7 @@ def check_frames(frames: int) -> None:
 
     Raises ValueError with one line naming the limit.
     """
-    from weftsim.npz_guard import available_memory
+    from weftsim.post.npz_guard import available_memory
 
     if isinstance(frames, bool) or not isinstance(frames, int) or not 2 <= frames <= MAX_FRAMES:
         raise ValueError(f"--frames must be a whole number from 2 to {MAX_FRAMES} (one frame per 0.25 deg of crank; "
@@ -151,7 +151,7 @@ def _unit(angle) -> np.ndarray:
 
 def animated_window(result: RunResult) -> tuple[float, float]:
     """Times (s) of the revolution to animate: the last complete one, or the whole run if shorter."""
-    from weftsim.analysis import complete_revolutions
+    from weftsim.post.analysis import complete_revolutions
 
     n = complete_revolutions(result)
     period = result.scene.drive.period
@@ -330,8 +330,8 @@ def animation_figure(result: RunResult, frames: MechanismFrames,
         The artists ``draw`` changes (marked animated: a full draw of the figure leaves them out, so
         the static rest is drawn once and each frame redraws only these).
     """
-    from weftsim.kinematics import linkage_state
-    from weftsim.plots import figure
+    from weftsim.mechanism.kinematics import linkage_state
+    from weftsim.post.plots import figure
 
     scene = result.scene
     if magnification is None:  # one scale for both joints, set by the larger clearance
@@ -454,10 +454,10 @@ def write_animation(result: RunResult, path: str | Path, frames: int = DEFAULT_F
                     magnification: float | None = None, comment: str = "") -> MechanismFrames:
     """Write the animation of ``result`` over a revolution to ``path`` (.gif, or .mp4 with ffmpeg).
 
-    The file is written atomically (:func:`weftsim.output.write_atomic`): a failed or interrupted
+    The file is written atomically (:func:`weftsim.post.output.write_atomic`): a failed or interrupted
     write leaves no partial file.  ``comment`` goes into the file's own metadata (the GIF comment
     extension, the MP4 comment tag): the command line writes the resolved scene there
-    (:func:`weftsim.record.scene_toml`), so a single animation file says how it was made.
+    (:func:`weftsim.post.record.scene_toml`), so a single animation file says how it was made.
 
     Parameters
     ----------
@@ -479,7 +479,7 @@ def write_animation(result: RunResult, path: str | Path, frames: int = DEFAULT_F
     MechanismFrames
         The drawn points (for checks such as the rod length).
     """
-    from weftsim.output import write_atomic
+    from weftsim.post.output import write_atomic
 
     suffix = check_format(path)
     check_frames(frames)

@@ -1,4 +1,4 @@
-"""Peaks, statistics and energy balance of a :class:`weftsim.results.RunResult`.
+"""Peaks, statistics and energy balance of a :class:`weftsim.post.results.RunResult`.
 
 Everything here reads the per-step channels (``result.steps``): the solver steps
 resolve impacts that fall between output samples.  Steps are not evenly spaced
@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from weftsim.results import (
+from weftsim.post.results import (
     PEAK_CHANNELS, PEAK_CHANNELS_F, PEAK_CHANNELS_LUBRICATION, PEAK_CHANNELS_LUBRICATION_F, RunResult,
 )  # fmt: skip
 
@@ -135,8 +135,8 @@ def energy_balance(result: RunResult) -> dict[str, float]:
 
 def summary(result: RunResult) -> dict:
     """The content of ``summary.json`` (see the README's output reference)."""
-    from weftsim.provenance import commit, versions
-    from weftsim.scene import to_file_keys
+    from weftsim.post.provenance import commit, versions
+    from weftsim.input.scene import to_file_keys
 
     n = complete_revolutions(result)
     per_revolution = []
@@ -158,8 +158,8 @@ def summary(result: RunResult) -> dict:
         "statistics": statistics(result),
         "first_contact_crank_angle_deg": result.first_contact_angle_deg,
         "energy_balance": energy_balance(result) if result.steps["time_s"].size else None,
-        # Counts of a broken contact history and the law-range warnings (weftsim.plausibility; not for
-        # the ideal mechanism) and the design checks with their verdicts (weftsim.design_checks).
+        # Counts of a broken contact history and the law-range warnings (weftsim.run.plausibility; not for
+        # the ideal mechanism) and the design checks with their verdicts (weftsim.run.design_checks).
         "plausibility": dict(result.plausibility) or None,
         "solver": dict(result.solver_stats),
         "wall_time_s": result.wall_time_s,

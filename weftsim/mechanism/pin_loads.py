@@ -1,7 +1,7 @@
 """Loads on the pins E and F of the ideal mechanism, from the kinematics alone (no simulation).
 
 What a designer sizes a bushed pin with (docs/plausibility.md), over one crank revolution at the
-scene's constant speed omega, with the ideal-joint kinematics of :mod:`weftsim.kinematics`:
+scene's constant speed omega, with the ideal-joint kinematics of :mod:`weftsim.mechanism.kinematics`:
 
 **Reflected mass.**  The chain behind a joint (behind E: rod 4, sector 5, pinion and rapier gear
 6-7, rapier 8; behind F: members 5-8) is driven through the pin.  Its kinetic energy written with
@@ -39,8 +39,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from weftsim.kinematics import _cross, _normal, _unit, fourbar, linkage_state
-from weftsim.params import Scene
+from weftsim.mechanism.kinematics import _cross, _normal, _unit, fourbar, linkage_state
+from weftsim.input.params import Scene
 
 # Crank angles of one revolution the ideal loads are evaluated at: 0.25 deg apart.  Measured against 0.025 deg:
 # the peak pin force at E within 1e-6 and its mean within 5e-7, on the reference and the loom mechanisms.

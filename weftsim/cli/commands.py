@@ -26,7 +26,7 @@ import threading
 from pathlib import Path
 
 from weftsim.api import ENGINE_NAMES as ENGINE_CHOICES
-from weftsim.cli_grammar import (  # noqa: F401 (CliError, add_scene_flags, scene_from_args: for subcommands)
+from weftsim.cli.grammar import (  # noqa: F401 (CliError, add_scene_flags, scene_from_args: for subcommands)
     SCENE_HELP,
     CliError,
     Parser,
@@ -43,8 +43,8 @@ from weftsim.cli_grammar import (  # noqa: F401 (CliError, add_scene_flags, scen
     shorthand_values,
 )
 from weftsim.errors import WeftsimError
-from weftsim.record import set_command
-from weftsim.exitcodes import EXIT_DISAGREE, EXIT_FAILED, EXIT_USAGE  # noqa: F401 (re-exported)
+from weftsim.post.record import set_command
+from weftsim.cli.exitcodes import EXIT_DISAGREE, EXIT_FAILED, EXIT_USAGE  # noqa: F401 (re-exported)
 
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a command stopped by Ctrl-C
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE: the reader of stdout went away (`| head`), as for any Unix tool
@@ -176,8 +176,8 @@ def cmd_wear(args: argparse.Namespace) -> int:
 
 def _check_fits(scene, outdir: Path, runs: int = 1) -> None:
     """Refuse a run whose output grid cannot be held or written (before anything is created)."""
-    from weftsim.output import check_output_fits, output_rows
-    from weftsim.results import scene_channels
+    from weftsim.post.output import check_output_fits, output_rows
+    from weftsim.post.results import scene_channels
 
     what = (f"output.sample_deg = {math.degrees(scene.output.sample_angle):g} over "
             f"drive.revolutions = {scene.drive.revolutions:g}")
@@ -188,8 +188,8 @@ def _check_fits(scene, outdir: Path, runs: int = 1) -> None:
 def _announce_run_time(scene, engines: tuple[str, ...], command: str) -> None:
     """One line on stderr with the estimated run time of a long run (a warning above LONG_RUN_S), and for
     ``weftsim run`` one with the estimated size of the per-step record above LARGE_FILE_BYTES."""
-    from weftsim.output import _size
-    from weftsim.progress import (
+    from weftsim.post.output import _size
+    from weftsim.run.progress import (
         LARGE_FILE_BYTES, LONG_RUN_S, SHOW_ESTIMATE_S, estimate_run_time, estimate_step_bytes, format_duration,
         stiff_explicit,
     )  # fmt: skip
@@ -220,11 +220,11 @@ STOP_SIGNALS = {signal.SIGINT: "Ctrl-C, SIGINT", signal.SIGTERM: "SIGTERM"}
 @contextlib.contextmanager
 def _stop_on_interrupt(command: str):
     """While the block runs, SIGINT (Ctrl-C) or SIGTERM asks the running engine to stop at its next
-    step and keep what it computed (weftsim.guards.request_stop); a second signal abandons at once.
+    step and keep what it computed (weftsim.run.guards.request_stop); a second signal abandons at once.
 
     Yields a dict whose ``"signal"`` is the signal number once one came (else None).
     """
-    from weftsim.guards import clear_stop, request_stop
+    from weftsim.run.guards import clear_stop, request_stop
 
     state = {"signal": None}
     previous = {signum: signal.getsignal(signum) for signum in STOP_SIGNALS}
@@ -280,9 +280,9 @@ KINEMATICS_COLUMNS = ("crank_angle_deg", "rapier_displacement_m", "rapier_veloci
 def cmd_kinematics(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from weftsim.kinematics import linkage_state
-    from weftsim.output import check_output_fits, prepare_directory, write_csv, write_figure, write_files
-    from weftsim.plots import plot_kinematics
+    from weftsim.mechanism.kinematics import linkage_state
+    from weftsim.post.output import check_output_fits, prepare_directory, write_csv, write_figure, write_files
+    from weftsim.post.plots import plot_kinematics
 
     scene = scene_from_args(args)
     step = scene.output.sample_angle
@@ -329,7 +329,7 @@ def cmd_kinematics(args: argparse.Namespace) -> int:
 def _solve(scene, engine: str, label: str | None = None, announce: bool = False):
     """:func:`weftsim.api.simulate` with progress on stderr; ``announce``: first the path it takes."""
     from weftsim.api import resolve_engine, select_path, simulate
-    from weftsim.progress import Progress
+    from weftsim.run.progress import Progress
 
     engine = resolve_engine(engine)
     if announce:  # `run`: its first line is the model and method it takes, and why
@@ -347,15 +347,15 @@ def _quiet(text: str) -> None:
 
 
 def _announce_checks(scene, command: str) -> None:
-    """One ``warning:`` line on stderr per before-run plausibility check that fails (weftsim.design_checks)."""
-    from weftsim.design_checks import before_run_lines
+    """One ``warning:`` line on stderr per before-run plausibility check that fails (weftsim.run.design_checks)."""
+    from weftsim.run.design_checks import before_run_lines
 
     for line in before_run_lines(scene):
         print(f"weftsim {command}: {line}", file=sys.stderr, flush=True)
 
 
 def _report_run(result, written) -> None:
-    from weftsim.analysis import complete_revolutions, peaks
+    from weftsim.post.analysis import complete_revolutions, peaks
 
     print(f"scene {result.scene.name}, engine {result.engine}: {result.status} "
           f"in {result.wall_time_s:.2f} s wall time")
@@ -372,7 +372,7 @@ def _report_run(result, written) -> None:
 
 
 def _interrupted_line(result, outdir: Path, signum: int) -> str:
-    from weftsim.guards import where
+    from weftsim.run.guards import where
 
     t = float(result.steps["time_s"][-1]) if result.steps["time_s"].size else 0.0
     return (f"stopped by {STOP_SIGNALS[signum]} at {where(t, result.scene.drive.speed)}: the results up to "
@@ -381,8 +381,8 @@ def _interrupted_line(result, outdir: Path, signum: int) -> str:
 
 def cmd_run(args: argparse.Namespace) -> int:
     from weftsim.api import resolve_engine
-    from weftsim.output import prepare_directory, write_run
-    from weftsim.design_checks import report_lines
+    from weftsim.post.output import prepare_directory, write_run
+    from weftsim.run.design_checks import report_lines
 
     scene = scene_from_args(args)
     engine = resolve_engine(args.engine)
@@ -405,10 +405,10 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def cmd_animate(args: argparse.Namespace) -> int:
-    from weftsim.animate import animated_window, check_format, check_frames, write_animation
+    from weftsim.post.animate import animated_window, check_format, check_frames, write_animation
     from weftsim.api import resolve_engine
-    from weftsim.output import check_file_target
-    from weftsim.record import check_same_scene, scene_toml
+    from weftsim.post.output import check_file_target
+    from weftsim.post.record import check_same_scene, scene_toml
 
     scene = scene_from_args(args)
     engine = resolve_engine(args.engine)
@@ -434,7 +434,7 @@ def cmd_animate(args: argparse.Namespace) -> int:
         frames = write_animation(result, target, frames=args.frames, comment=scene_toml(scene))
     except OSError as exc:
         raise CliError(f"cannot write {target}: {exc.strerror or exc}") from None
-    from weftsim.animate import clearance_magnification, joint_caption
+    from weftsim.post.animate import clearance_magnification, joint_caption
 
     closure = float(abs(frames.rod_length - scene.geometry.l_ef).max())
     scale = clearance_magnification(max(frames.clearance, frames.clearance_f), scene.geometry.l_ef)
@@ -458,7 +458,7 @@ def _replay_in_viewer(args: argparse.Namespace, scene, engine: str) -> int:
     if problem is not None:
         raise CliError(problem)
     target = Path(args.output) if args.output else output_directory(args, scene, "exudyn") / "viewer-solution.txt"
-    from weftsim.output import check_file_target
+    from weftsim.post.output import check_file_target
 
     check_file_target(target)
     _check_fits(scene, target.parent)
@@ -476,8 +476,8 @@ def _replay_in_viewer(args: argparse.Namespace, scene, engine: str) -> int:
 
 
 def cmd_compare(args: argparse.Namespace) -> int:
-    from weftsim.compare import format_report, run_compare
-    from weftsim.output import prepare_directory, to_json
+    from weftsim.post.compare import format_report, run_compare
+    from weftsim.post.output import prepare_directory, to_json
 
     scene = scene_from_args(args)
     outdir = output_directory(args, scene, "compare")
@@ -552,7 +552,7 @@ def cmd_study(args: argparse.Namespace) -> int:
     models = models_directory(args)
     parent, tag = Path("out"), overrides_tag(command_overrides(args))
     if args.scene is not None:  # a bad scene or override refused before the first study runs
-        from weftsim.scene import load_scene
+        from weftsim.input.scene import load_scene
 
         parent = output_directory(argparse.Namespace(**{**vars(args), "output": None}),
                                   load_scene(args.scene, {**overrides, "drive.revolutions": revolutions}))
@@ -587,7 +587,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
 def cmd_scenes(args: argparse.Namespace) -> int:
     """``weftsim scenes``: each bundled scene's name and description, one a line."""
-    from weftsim.scene import bundled_directory, bundled_scene_path, bundled_scenes, scene_description
+    from weftsim.input.scene import bundled_directory, bundled_scene_path, bundled_scenes, scene_description
 
     names = bundled_scenes()
     if not names:
@@ -606,7 +606,7 @@ COMMANDS = {"scenes": cmd_scenes, "kinematics": cmd_kinematics, "run": cmd_run, 
 
 def _one_line(text: str) -> str:
     """A message as one terminal line: newlines and escape sequences from file names or values escaped."""
-    from weftsim.scene import shown
+    from weftsim.input.scene import shown
 
     return shown(str(text))
 
@@ -614,7 +614,7 @@ def _one_line(text: str) -> str:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    set_command(sys.argv[1:] if argv is None else argv)  # recorded in every output directory (weftsim.record)
+    set_command(sys.argv[1:] if argv is None else argv)  # recorded in every output directory (weftsim.post.record)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(name)s: %(message)s")
     try:

@@ -17,7 +17,7 @@ Frames (docs/physics.md section 1)::
            /
           x = axis D (rocker, normal of the four-bar plane)
 
-The public names are re-exported by :mod:`weftsim.kinematics`.
+The public names are re-exported by :mod:`weftsim.mechanism.kinematics`.
 """
 
 from __future__ import annotations

@@ -29,14 +29,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from weftsim.errors import OutputError, WriteFailed
-from weftsim.npz_guard import available_memory
-from weftsim.record import MANIFEST, SCENE_FILE, check_same_scene, provenance, scene_toml
-from weftsim.results import RunResult
+from weftsim.post.npz_guard import available_memory
+from weftsim.post.record import MANIFEST, SCENE_FILE, check_same_scene, provenance, scene_toml
+from weftsim.post.results import RunResult
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-    from weftsim.params import Scene
+    from weftsim.input.params import Scene
 
 
 # Bytes the manifest reserves on disk when a directory is opened (JSON allows trailing blanks):
@@ -58,7 +58,7 @@ def prepare_directory(path: str | Path, force: bool = False, scene: Scene | None
     A directory that already holds files but no weftsim manifest was not written by
     weftsim: it is refused (unless ``force``) so a run never mixes its files with others.
     With ``scene``, a directory holding the results of another resolved scene is refused too
-    (unless ``force``; :func:`weftsim.record.check_same_scene`), before anything is written.
+    (unless ``force``; :func:`weftsim.post.record.check_same_scene`), before anything is written.
     """
     path = Path(path)
     if path.is_dir() and not force and not (path / MANIFEST).exists() and any(path.iterdir()):
@@ -185,7 +185,7 @@ def write_figure(target: Path, figure: Figure) -> Path:
     try:
         return write_atomic(target, lambda p: figure.savefig(p, format=target.suffix.lstrip("."), dpi=130))
     finally:
-        if "matplotlib.pyplot" in sys.modules:  # a pyplot figure: free it (weftsim.plots.figure() are not held)
+        if "matplotlib.pyplot" in sys.modules:  # a pyplot figure: free it (weftsim.post.plots.figure() are not held)
             sys.modules["matplotlib.pyplot"].close(figure)
 
 
@@ -284,7 +284,7 @@ def write_files(outdir: Path, what: dict, files: dict[str, tuple[str, Callable[[
         the later ones are still attempted (a small summary may fit where a large CSV did not).
     scene : Scene, optional
         The scene of these results: the manifest records it resolved and the command line
-        (:func:`weftsim.record.provenance`), and ``scene.toml`` holds it as a scene file.
+        (:func:`weftsim.post.record.provenance`), and ``scene.toml`` holds it as a scene file.
 
     Returns
     -------
@@ -387,14 +387,14 @@ def write_run(result: RunResult, outdir: str | Path, figure: bool = True, force:
     for one run, atomically each.
 
     With ``npz`` also ``result.npz``: the whole result, per-step data included, losslessly
-    (:func:`weftsim.results.save_npz`; ``weftsim.load_result`` reads it).  ``weftsim run`` asks for
+    (:func:`weftsim.post.results.save_npz`; ``weftsim.load_result`` reads it).  ``weftsim run`` asks for
     it; a sweep's cells do not (a 10-revolution result is a few MB, times every cell).
 
     Raises :class:`WriteFailed` (after writing what it can) when a file cannot be written.
     """
-    from weftsim.analysis import summary
-    from weftsim.plots import plot_channels, plot_orbit
-    from weftsim.results import save_npz
+    from weftsim.post.analysis import summary
+    from weftsim.post.plots import plot_channels, plot_orbit
+    from weftsim.post.results import save_npz
 
     outdir = prepare_directory(outdir, force, result.scene)
     what = {"kind": "run", "engine": result.engine, "scene": result.scene.name, "status": result.status}

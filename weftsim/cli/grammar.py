@@ -19,10 +19,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, NoReturn
 
 from weftsim.errors import WeftsimError, closest
-from weftsim.exitcodes import EXIT_USAGE
+from weftsim.cli.exitcodes import EXIT_USAGE
 
 if TYPE_CHECKING:
-    from weftsim.params import Scene
+    from weftsim.input.params import Scene
 
 
 class CliError(WeftsimError):
@@ -44,7 +44,7 @@ class VersionAction(argparse.Action):
         super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, **kwargs)
 
     def __call__(self, parser, namespace, values, option_string=None):
-        from weftsim.provenance import version_line
+        from weftsim.post.provenance import version_line
 
         print(version_line())
         parser.exit()
@@ -183,9 +183,9 @@ def scene_from_args(args: argparse.Namespace) -> Scene:
     line to print; a key set both by ``--set`` and by its shorthand flag is refused.
     """
     from weftsim.api import scene_overrides
-    from weftsim.scene import load_scene
+    from weftsim.input.scene import load_scene
 
-    from weftsim.joint_keys import inheritance_note, wear_only_keys, wear_only_message
+    from weftsim.input.joint_keys import inheritance_note, wear_only_keys, wear_only_message
 
     overrides = scene_overrides(set_overrides(args), where="command line", **shorthand_values(args))
     command = getattr(args, "command", None) or "run"
@@ -209,7 +209,7 @@ def add_output_flags(parser: argparse.ArgumentParser, default: str) -> None:
 
 def models_directory(args: argparse.Namespace) -> Path:
     """``--models``, or the directory of the bundled scenes."""
-    from weftsim.scene import bundled_directory
+    from weftsim.input.scene import bundled_directory
 
     if args.models is not None:
         return Path(args.models)

@@ -15,7 +15,7 @@ import time
 from typing import TYPE_CHECKING, Callable
 
 if TYPE_CHECKING:
-    from weftsim.params import Scene
+    from weftsim.input.params import Scene
 
 SETTLE_S = 2.0  # the start-up a rate is not measured over: imports, model build, numba compilation (~1-2 s)
 MIN_SPAN_S = 1.0  # the shortest stretch of progress a rate is measured over (a shorter one is noise)

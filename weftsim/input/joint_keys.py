@@ -19,10 +19,10 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
-from weftsim.schema import _BY_PATH, SCHEMA, _set, shown
+from weftsim.input.schema import _BY_PATH, SCHEMA, _set, shown
 
 if TYPE_CHECKING:
-    from weftsim.params import Scene
+    from weftsim.input.params import Scene
 
 # Table -> (joint letter, Scene attribute).
 JOINTS = {"joint_e": ("E", "joint"), "joint_f": ("F", "joint_f")}

@@ -1,8 +1,8 @@
-"""The schema of a scene file: every key, its unit, its range and where it goes in :class:`weftsim.params.Scene`.
+"""The schema of a scene file: every key, its unit, its range and where it goes in :class:`weftsim.input.params.Scene`.
 
 :data:`SCHEMA` is the single list of keys (the README's and the site's scene reference are written from it);
-:mod:`weftsim.scene` reads files against it and :mod:`weftsim.joint_keys` (which keys joint F takes from
-joint E, which describe an ideal joint) reads it too.  Split off :mod:`weftsim.scene` so that the joint keys
+:mod:`weftsim.input.scene` reads files against it and :mod:`weftsim.input.joint_keys` (which keys joint F takes from
+joint E, which describe an ideal joint) reads it too.  Split off :mod:`weftsim.input.scene` so that the joint keys
 need no scene reader, and the reader imports the joint keys without an import circle.
 """
 
@@ -12,7 +12,7 @@ import math
 from dataclasses import dataclass, replace
 from typing import Any
 
-from weftsim import params
+from weftsim.input import params
 
 INTEGRATORS = ("auto", "DOP853", "RK45", "RK23", "Radau", "LSODA", "BDF", "numba_DOP853", "numba_RK45", "numba_RODAS4",
                "numba_DOP853_RODAS4")
@@ -134,7 +134,7 @@ SCHEMA: tuple[Key, ...] = (
     Key("joint_e.clearance_mm", "joint.clearance", "float", MM, 0, 5, False, doc="radial clearance c; 0 = ideal joint"),
     Key("joint_e.journal_radius_mm", "joint.journal_radius", "float", MM, 0, doc="R_j"),
     Key("joint_e.bearing_length_mm", "joint.bearing_length", "float", MM, 0, doc="L_b"),
-    Key("joint_e.law", "joint.law", "str", doc="contact force law (see weftsim.contact.LAWS)"),
+    Key("joint_e.law", "joint.law", "str", doc="contact force law (see weftsim.joint.contact.LAWS)"),
     Key("joint_e.restitution", "joint.restitution", "float", 1, 0, 1, True, False, doc="coefficient of restitution ce"),
     Key("joint_e.friction_coefficient", "joint.friction_coefficient", "float", 1, 0, 2, False,
         doc="mu of the modified Coulomb law; 0 = off"),
@@ -247,7 +247,7 @@ _BY_PATH = {key.path: key for key in SCHEMA}
 TOP_LEVEL = ("name", "description", "extends")
 # Sections that describe the machine: a scene must give all their keys, itself or through
 # `extends` (a missing one is an error, never a silent default).  Solver settings, output,
-# compare tolerances and limits fall back to the defaults of weftsim.params.
+# compare tolerances and limits fall back to the defaults of weftsim.input.params.
 REQUIRED_SECTIONS = ("mechanism", "inertia", "joint_e", "drive")
 # Model options inside those sections that are not part of the machine: they default.
 OPTIONAL = ("joint_e.impact_velocity_rule", "joint_e.journal_material.yield_strength_mpa",
@@ -256,7 +256,7 @@ OPTIONAL = ("joint_e.impact_velocity_rule", "joint_e.journal_material.yield_stre
     + tuple(key.path for key in WEAR_KEYS("joint_e", "joint")) \
     + tuple(key.path for key in LUBRICATION_KEYS("joint_e", "joint"))
 # [joint_f] is optional as a whole (absent: the ideal revolute joint at F).  Given a clearance > 0, F takes
-# every key of [joint_e] its table does not give (weftsim.joint_keys).
+# every key of [joint_e] its table does not give (weftsim.input.joint_keys).
 REQUIRED = tuple(key.path for key in SCHEMA
                  if key.path.partition(".")[0] in REQUIRED_SECTIONS and key.path not in OPTIONAL)
 

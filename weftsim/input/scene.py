@@ -1,4 +1,4 @@
-"""Scene files: TOML in, validated :class:`weftsim.params.Scene` out.
+"""Scene files: TOML in, validated :class:`weftsim.input.params.Scene` out.
 
 A scene file may ``extends = "other.toml"`` (path relative to the file) or
 ``extends = "reference"`` (a bundled scene, :func:`bundled_scenes`) and then holds only
@@ -9,7 +9,7 @@ is never shadowed by a bundled scene of the same name.  Units live in the key na
 must give every key of the sections that describe the machine (:data:`REQUIRED_SECTIONS`),
 itself or through ``extends``; settings (solver, output, compare, limits) default.  Every
 problem is reported as one :class:`SceneError` naming the file, the key, the bad
-value and what is allowed.  :data:`SCHEMA` (:mod:`weftsim.schema`) is the single list of
+value and what is allowed.  :data:`SCHEMA` (:mod:`weftsim.input.schema`) is the single list of
 keys; the README's scene reference is written from it.
 """
 
@@ -24,10 +24,10 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from weftsim import params
+from weftsim.input import params
 from weftsim.errors import SceneError
-# The schema (weftsim.schema), read here and re-exported (SCHEMA, Key, shown, ...) as before.
-from weftsim.schema import (  # noqa: F401
+# The schema (weftsim.input.schema), read here and re-exported (SCHEMA, Key, shown, ...) as before.
+from weftsim.input.schema import (  # noqa: F401
     _BY_PATH,
     BRANCHES,
     CALLBACK_ROUTES,
@@ -316,7 +316,7 @@ def _check_lubrication_given(keys, where: str, before: params.Scene | None = Non
 
 def _check_scene(scene: params.Scene, where: str, origin: dict[str, Path]) -> None:
     """Cross-key checks: law names, clearance below the journal radius, linkage assembly."""
-    from weftsim.contact import LAWS
+    from weftsim.joint.contact import LAWS
 
     def at(key: str) -> str:
         return str(origin.get(key, where))
@@ -334,7 +334,7 @@ def _check_scene(scene: params.Scene, where: str, origin: dict[str, Path]) -> No
             )
     if scene.output.sample_angle / scene.drive.speed > scene.drive.end_time:
         raise SceneError(f"{at('drive.revolutions')}: key 'drive.revolutions' is shorter than one output sample")
-    from weftsim.kinematics import assembly_failure_angle
+    from weftsim.mechanism.kinematics import assembly_failure_angle
 
     angle = assembly_failure_angle(scene.geometry)
     if angle is not None:
@@ -361,7 +361,7 @@ def _known(path: str, where: str) -> Key:
 
 def scene_from_keys(flat: dict[str, Any], where: str = "scene", origin: dict[str, Path] | None = None) -> params.Scene:
     """Validated :class:`Scene` from flattened dotted keys (file values, file units)."""
-    from weftsim.joint_keys import inherit_joint_f
+    from weftsim.input.joint_keys import inherit_joint_f
 
     origin = dict(origin or {})
     flat, inherited = inherit_joint_f(flat)
@@ -393,7 +393,7 @@ def load_scene(path: str | os.PathLike, overrides: dict[str, Any] | None = None,
     """Read, merge (``extends``), override and validate a scene file.
 
     Joint F given a clearance takes every key of ``[joint_e]`` its table does not give
-    (:func:`weftsim.joint_keys.inherit_joint_f`); ``scene.joint_f_inherits`` names them.
+    (:func:`weftsim.input.joint_keys.inherit_joint_f`); ``scene.joint_f_inherits`` names them.
 
     Parameters
     ----------
@@ -406,7 +406,7 @@ def load_scene(path: str | os.PathLike, overrides: dict[str, Any] | None = None,
         Where the overrides came from, as error messages name it.
     refuse_ideal_keys : bool
         Refuse an override of a joint key (other than its ``clearance_mm``) at a joint that is ideal
-        in the resulting scene: it would change nothing (:mod:`weftsim.joint_keys`).  A sweep passes
+        in the resulting scene: it would change nothing (:mod:`weftsim.input.joint_keys`).  A sweep passes
         False and checks its cells together.
 
     Raises
@@ -416,7 +416,7 @@ def load_scene(path: str | os.PathLike, overrides: dict[str, Any] | None = None,
         or the required keys (sections :data:`REQUIRED_SECTIONS`) that neither the file
         nor the files it extends give; or a joint key set on a joint that is ideal.
     """
-    from weftsim.joint_keys import describes_joint, ideal_joint_keys, ideal_key_message
+    from weftsim.input.joint_keys import describes_joint, ideal_joint_keys, ideal_key_message
 
     path = scene_source(path)
     flat, origin = _read_merged(path)
@@ -475,7 +475,7 @@ def apply_overrides(scene: params.Scene, overrides: dict[str, Any], where: str =
     The same scene :func:`load_scene` gives for a file and these overrides, without reading
     the file again: a sweep validates thousands of cells against one base scene this way.
 
-    Keys joint F takes from joint E follow E's overrides (:func:`weftsim.joint_keys.resync_joint_f`).
+    Keys joint F takes from joint E follow E's overrides (:func:`weftsim.input.joint_keys.resync_joint_f`).
 
     Raises
     ------
@@ -483,7 +483,7 @@ def apply_overrides(scene: params.Scene, overrides: dict[str, Any], where: str =
         For an unknown key, a bad value or a scene that fails the cross-key checks, naming ``where``;
         with ``refuse_ideal_keys``, for a joint key set on a joint that is ideal (it changes nothing).
     """
-    from weftsim.joint_keys import ideal_joint_keys, ideal_key_message, resync_joint_f
+    from weftsim.input.joint_keys import ideal_joint_keys, ideal_key_message, resync_joint_f
 
     before = scene
     for dotted, value in overrides.items():

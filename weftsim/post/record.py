@@ -25,9 +25,9 @@ from typing import TYPE_CHECKING, Any
 from weftsim.errors import OutputError
 
 if TYPE_CHECKING:
-    from weftsim.params import Scene
+    from weftsim.input.params import Scene
 
-MANIFEST = ".weftsim-output.json"  # the manifest of every output directory (weftsim.output writes it)
+MANIFEST = ".weftsim-output.json"  # the manifest of every output directory (weftsim.post.output writes it)
 SCENE_FILE = "scene.toml"
 SHOWN_DIFFERENCES = 3  # keys named in the refusal; the rest are counted
 
@@ -36,7 +36,7 @@ _command_text: str | None = None  # set by written_by()
 
 
 def set_command(argv: list[str]) -> None:
-    """The arguments of the ``weftsim`` command running now (``weftsim.cli.main`` sets them)."""
+    """The arguments of the ``weftsim`` command running now (``weftsim.cli.commands.main`` sets them)."""
     global _command
     _command = list(argv)
 
@@ -66,7 +66,7 @@ def command_line() -> str:
 def resolved_scene(scene: Scene) -> dict[str, Any]:
     """Every key of ``scene`` in file units, as JSON gives it back (lists, no None: a key the scene
     leaves out is left out)."""
-    from weftsim.scene import to_file_keys
+    from weftsim.input.scene import to_file_keys
 
     keys = {k: v for k, v in to_file_keys(scene).items() if v is not None}
     return json.loads(json.dumps(keys, default=str))

@@ -4,7 +4,7 @@ A result file may have been damaged by a disk or a copy, or edited by a person, 
 :func:`read_npz` checks it in this order and refuses it with one line
 (:class:`weftsim.errors.OutputError`) at the first problem:
 
-Steps 1-3 are :mod:`weftsim.npz_guard` (shared with the wear state):
+Steps 1-3 are :mod:`weftsim.post.npz_guard` (shared with the wear state):
 
 1. the path: present, a regular file, not empty, a ZIP archive (a lone ``.npy`` is named as such);
 2. the archive's directory: the members weftsim writes and no others, none twice, none encrypted,
@@ -15,9 +15,9 @@ Steps 1-3 are :mod:`weftsim.npz_guard` (shared with the wear state):
    no longer than :data:`MAX_META_BYTES`, and the bytes the header implies equal to the bytes the
    member declares.  Only then is any array read, so a header claiming 10^12 elements or a small
    file that inflates to gigabytes is refused before anything is allocated;
-4. ``meta``: JSON with every key :func:`weftsim.results.save_npz` writes, each of its type; the scene
+4. ``meta``: JSON with every key :func:`weftsim.post.results.save_npz` writes, each of its type; the scene
    rebuilt field by field (each of its type, none unknown, none of the fields the format has always
-   written missing) and validated as a scene file is (:func:`weftsim.scene.scene_from_keys`);
+   written missing) and validated as a scene file is (:func:`weftsim.input.scene.scene_from_keys`);
 5. the data against the scene: joint F's channels present exactly when the scene gives F a
    clearance, ``time_s`` finite and not decreasing, a successful run's steps reaching the scene's
    end time.
@@ -37,9 +37,9 @@ from typing import Any
 
 import numpy as np
 
-from weftsim import params
+from weftsim.input import params
 from weftsim.errors import OutputError
-from weftsim.npz_guard import DAMAGE, array_headers, fail, open_archive, read_array, size_text
+from weftsim.post.npz_guard import DAMAGE, array_headers, fail, open_archive, read_array, size_text
 
 # The JSON text of meta: scene, statistics, events (a few kB; a worn scene's profiles ~20 kB).
 MAX_META_BYTES = 16 * 2**20
@@ -100,7 +100,7 @@ def check_channel_headers(path: Path, headers: dict[str, tuple[tuple, np.dtype]]
 
 def read_meta(path: Path, archive: zipfile.ZipFile, headers: dict[str, tuple[tuple, np.dtype]]) -> dict:
     """``meta`` as a dict with every key :data:`META_TYPES` names, each of its type."""
-    from weftsim.results import ENGINES, NPZ_FORMAT, STATUSES
+    from weftsim.post.results import ENGINES, NPZ_FORMAT, STATUSES
 
     if "meta" not in headers:
         raise _fail(path, "not a complete weftsim result: it has no 'meta' (the run's scene and status)")
@@ -225,7 +225,7 @@ def rebuild(cls: type, data: Any, where: str = "scene") -> Any:
 
 def check_scene(path: Path, scene: params.Scene) -> None:
     """The rebuilt scene validated as a scene file is (ranges, laws, assembly), and its wear profiles."""
-    from weftsim.scene import scene_from_keys, to_file_keys
+    from weftsim.input.scene import scene_from_keys, to_file_keys
 
     try:
         keys = {k: v for k, v in to_file_keys(scene).items() if v is not None}  # None: an optional key not given
@@ -243,9 +243,9 @@ def check_scene(path: Path, scene: params.Scene) -> None:
 
 
 def read_npz(path: str | os.PathLike):
-    """The :class:`weftsim.results.RunResult` in ``path``, checked as the module docstring says."""
-    from weftsim.results import (CHANNELS, JOINT_F_CHANNELS, LUBRICATION_CHANNELS, LUBRICATION_CHANNELS_F, RunResult,
-                                 optional_channels)
+    """The :class:`weftsim.post.results.RunResult` in ``path``, checked as the module docstring says."""
+    from weftsim.post.results import (CHANNELS, JOINT_F_CHANNELS, LUBRICATION_CHANNELS, LUBRICATION_CHANNELS_F,
+                                      RunResult, optional_channels)
 
     path = Path(path)
     all_names = CHANNELS + JOINT_F_CHANNELS + LUBRICATION_CHANNELS + LUBRICATION_CHANNELS_F

@@ -13,8 +13,8 @@ if TYPE_CHECKING:
 
     from matplotlib.figure import Figure
 
-    from weftsim.params import Scene
-    from weftsim.results import RunResult
+    from weftsim.input.params import Scene
+    from weftsim.post.results import RunResult
 
 PANELS = (
     ("rapier_displacement_m", "rapier displacement [mm]", 1e3),
@@ -24,14 +24,14 @@ PANELS = (
     ("contact_force_N", "contact force at E [N]", 1.0),
     ("penetration_m", "penetration at E [mm]", 1e3),
 )
-# Added below PANELS when every curve has a clearance at F (weftsim.results.JOINT_F_CHANNELS).
+# Added below PANELS when every curve has a clearance at F (weftsim.post.results.JOINT_F_CHANNELS).
 PANELS_F = (
     ("contact_force_f_N", "contact force at F [N]", 1.0),
     ("penetration_f_m", "penetration at F [mm]", 1e3),
 )
 
 
-# Added when every curve has a lubricated joint E (weftsim.results.LUBRICATION_CHANNELS).
+# Added when every curve has a lubricated joint E (weftsim.post.results.LUBRICATION_CHANNELS).
 PANELS_LUBRICATION = (
     ("film_ratio", "film ratio h_min/σ at E", 1.0),
     ("film_force_N", "film force at E [N]", 1.0),
@@ -47,7 +47,7 @@ def clearance_label(scene: Scene) -> str:
 
 def figure(**options: object) -> Figure:
     """A matplotlib Figure drawn by the Agg backend, without pyplot (whose import costs ~0.2 s of a
-    ``weftsim run``); save it with :func:`weftsim.output.write_figure`."""
+    ``weftsim run``); save it with :func:`weftsim.post.output.write_figure`."""
     from matplotlib.figure import Figure
 
     return Figure(**options)
@@ -64,7 +64,7 @@ def pyplot() -> ModuleType:
 
 def last_revolution(result: RunResult) -> tuple[dict[str, np.ndarray], int]:
     """Per-step channels of the last complete revolution (all steps if the run is shorter)."""
-    from weftsim.analysis import complete_revolutions
+    from weftsim.post.analysis import complete_revolutions
 
     steps = result.steps
     n = complete_revolutions(result)
@@ -146,9 +146,9 @@ def contact_onsets(steps: dict[str, np.ndarray]) -> np.ndarray:
     """Rows of the per-step channels that start a contact at E (an impact).
 
     A contact segment is where the engine holds an impact velocity (docs/physics.md section 2):
-    :func:`weftsim.plausibility.contact_mode`; an onset is its first row after free flight.
+    :func:`weftsim.run.plausibility.contact_mode`; an onset is its first row after free flight.
     """
-    from weftsim.plausibility import contact_mode, onset_rows
+    from weftsim.run.plausibility import contact_mode, onset_rows
 
     return onset_rows(contact_mode(steps))
 
@@ -199,7 +199,7 @@ def plot_orbit(result: RunResult, title: str | None = None) -> Figure:
 
 def _orbit_panel(fig, ax, steps: dict, channels: tuple[str, str, str], clearance: float) -> None:
     """One joint's orbit: its clearance circle, the journal centre at every step, and the impacts."""
-    from weftsim.plausibility import onset_rows
+    from weftsim.run.plausibility import onset_rows
 
     ecc_y, ecc_z, impact = channels
     y_mm, z_mm = steps[ecc_y] * 1e3, steps[ecc_z] * 1e3

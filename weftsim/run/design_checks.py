@@ -6,26 +6,26 @@ gives every formula, default and source):
 =======================  ===========================================  ============================================
 check                    value                                        limit (scene key)
 =======================  ===========================================  ============================================
-``reflected_mass``       m_eff of the chain behind the pin (peak)     none: reported (:mod:`weftsim.pin_loads`)
+``reflected_mass``       m_eff of the chain behind the pin (peak)     none: reported (:mod:`weftsim.mechanism.pin_loads`)
 ``clearance_ratio``      c / d, radial clearance over pin diameter    ``joint_*.design_clearance_per_mille``
 ``pin_pressure``         peak projected pressure F / (d L_b)          ``joint_*.bearing_material.max_pressure_mpa``
 ``pv``                   cycle mean of p x v, v = R_j abs(omega_rel)  ``joint_*.bearing_material.max_pv_mpa_m_s``
 ``hertz_pressure``       Hertz line-contact pressure at peak force    1.67 x the smaller ``yield_strength_mpa``
-``penetration``          largest delta / c (after the run only)       the law's range (:mod:`weftsim.contact`)
+``penetration``          largest delta / c (after the run only)       the law's range (:mod:`weftsim.joint.contact`)
 ``rapier_acceleration``  peak of abs(rapier acceleration)             ``limits.max_rapier_acceleration_m_s2``
 =======================  ===========================================  ============================================
 
 *Before the run* (:func:`before_run`) the loads come from the ideal mechanism at the scene's speed
-(:func:`weftsim.pin_loads.ideal_pin_loads`): no simulation.  *After the run* (:func:`after_run`) they
+(:func:`weftsim.mechanism.pin_loads.ideal_pin_loads`): no simulation.  *After the run* (:func:`after_run`) they
 come from the run's contact force channels (peaks over every solver step, means over the output grid,
 which is uniform in time) and the sliding speed of the ideal kinematics at the same crank angle, from
 revolution 2 on when the run has two (:func:`running`: revolution 1 holds the start-up impact of the
 centred journal, which a running machine does not see); the law's range (penetration, Hertz) is judged
-over the whole run, as :mod:`weftsim.plausibility` judges it.
+over the whole run, as :mod:`weftsim.run.plausibility` judges it.
 Joint checks are made at each joint with a clearance (E, and F when it has one).  A check whose
 limit the scene does not give has the verdict ``"no_limit"``; the reflected mass is always
 ``"info"``.  The ``hertz_pressure`` and ``penetration`` warnings after the run are
-:func:`weftsim.plausibility.validity_warnings`' own (not repeated here).
+:func:`weftsim.run.plausibility.validity_warnings`' own (not repeated here).
 """
 
 from __future__ import annotations
@@ -36,8 +36,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.pin_loads import SAMPLES, ideal_pin_loads, sliding_speed
-from weftsim.plausibility import (
+from weftsim.mechanism.pin_loads import SAMPLES, ideal_pin_loads, sliding_speed
+from weftsim.run.plausibility import (
     TRESCA_LINE_CONTACT_YIELD,
     Plausibility,
     _yield_strength,
@@ -46,8 +46,8 @@ from weftsim.plausibility import (
 )
 
 if TYPE_CHECKING:
-    from weftsim.params import Scene
-    from weftsim.results import RunResult
+    from weftsim.input.params import Scene
+    from weftsim.post.results import RunResult
 
 VERDICTS = ("ok", "warning", "no_limit", "info")
 
@@ -195,7 +195,7 @@ def rapier_check(scene: Scene, stage: str, peak: float, numbers: dict | None = N
 
 def before_run(scene: Scene) -> list[Check]:
     """Every check that needs no simulation: each loose joint's, then the rapier's."""
-    from weftsim.kinematics import linkage_state
+    from weftsim.mechanism.kinematics import linkage_state
 
     out = []
     for name in scene.loose_joints:
@@ -240,9 +240,9 @@ def after_run(result: RunResult) -> list[Check]:
     The machine's loads (pin pressure, p x v, rapier acceleration) are judged from revolution 2 on
     when the run has two or more (:func:`running`; ``numbers["from_time_s"]`` says where); the
     contact law's range (penetration, Hertz pressure) over the whole run, as
-    :func:`weftsim.plausibility.validity_warnings` judges and words it.
+    :func:`weftsim.run.plausibility.validity_warnings` judges and words it.
     """
-    from weftsim.contact import make_law
+    from weftsim.joint.contact import make_law
 
     full = result
     result = running(full)
@@ -293,7 +293,7 @@ def warnings_of(checks: list[Check]) -> list[str]:
 
 def block(result: RunResult, report: dict) -> dict:
     """The ``plausibility`` block of a result: ``report`` (the contact-history counts and law warnings of
-    :mod:`weftsim.plausibility`, empty for the ideal mechanism) with ``checks`` (before and after the
+    :mod:`weftsim.run.plausibility`, empty for the ideal mechanism) with ``checks`` (before and after the
     run) and the after-run checks' warnings added to ``warnings``."""
     before, after = before_run(result.scene), after_run(result)
     out = dict(report)
@@ -350,7 +350,7 @@ def summary_line(checks: list[dict], stage: str) -> str:
 
 
 def format_lines(result: RunResult) -> list[str]:
-    """The counts line, the after-run design checks' numbers (:mod:`weftsim.design_checks`), and one
+    """The counts line, the after-run design checks' numbers (:mod:`weftsim.run.design_checks`), and one
     ``warning:`` line per validity warning and per after-run design-check warning (stderr)."""
     block = result.plausibility
     if not block:
@@ -366,7 +366,7 @@ def format_lines(result: RunResult) -> list[str]:
 
 
 def report_lines(result: RunResult, label: str) -> None:
-    """The plausibility counts (:mod:`weftsim.plausibility`), the after-run design checks' numbers and each
+    """The plausibility counts (:mod:`weftsim.run.plausibility`), the after-run design checks' numbers and each
     warning of a finished run, one line each on stderr (``weftsim <label>: ...``; once per run, where its
     results are written).  A failed run says
     only why it failed (its summary.json still holds the block)."""

@@ -84,7 +84,7 @@ from numba import njit
 
 from weftsim.kernel import laws as kernel
 from weftsim.kernel.python import python_form
-from weftsim.params import ClearanceJoint
+from weftsim.input.params import ClearanceJoint
 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
@@ -273,7 +273,7 @@ class _Law:
     @classmethod
     def from_joint(cls, joint: ClearanceJoint) -> "_Law":
         """The law of ``joint`` (restitution, clearance, radii, materials, bearing length; the joint
-        checked them when it was built, :func:`weftsim.params.joint_problem`)."""
+        checked them when it was built, :func:`weftsim.input.params.joint_problem`)."""
         ce = joint.restitution
         if joint.clearance <= 0.0:
             raise ValueError(f"`clearance` must be > 0 for a contact law (0 is the ideal joint), "

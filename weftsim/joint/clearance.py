@@ -12,7 +12,7 @@ one scalar definition is :mod:`weftsim.kernel.joint`, which the engines call)::
                                      Q = P_b + R_b n      contact point (on both bodies)
 
 - Penetration rate delta_dot = e_dot . n (m/s, positive while approaching).
-- Normal force F_N = law.normal_force(delta, delta_dot, v_imp) >= 0 (:mod:`weftsim.contact`).
+- Normal force F_N = law.normal_force(delta, delta_dot, v_imp) >= 0 (:mod:`weftsim.joint.contact`).
   The engine holds the impact velocity: delta_dot at the contact onset, floored at
   ``joint.min_impact_velocity``, kept until separation and, under the default rule
   ``joint.impact_velocity_rule = "max_approach"``, raised to every larger approach rate since
@@ -40,17 +40,17 @@ from typing import TYPE_CHECKING, Callable, NamedTuple
 
 import numpy as np
 
-from weftsim.contact import check_impact_velocity
+from weftsim.joint.contact import check_impact_velocity
 from weftsim.kernel import hold
 from weftsim.kernel import joint as kernel_joint
 from weftsim.kernel.joint import joint_parameters
 from weftsim.kernel.python import python_form
-from weftsim.params import ClearanceJoint
+from weftsim.input.params import ClearanceJoint
 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
-    from weftsim.contact import _Law
+    from weftsim.joint.contact import _Law
 
 # Array forms for analysis and tests, plain Python per element (the engines call the compiled kernel).
 _EFFECTIVE_IMPACT_VELOCITY = np.vectorize(python_form(hold.effective_impact_velocity), otypes=[float])
@@ -165,7 +165,7 @@ def clearance_contact(ecc: ArrayLike, ecc_rate: ArrayLike, rel_tangential_veloci
     impact_velocity : array_like (...,)
         Held, floored impact velocity, m/s (> 0 wherever delta > 0, else ``ValueError``); the
         joint's rule raises it (:func:`effective_impact_velocity`).
-    law : contact law of :mod:`weftsim.contact` (from ``make_law(joint)``).
+    law : contact law of :mod:`weftsim.joint.contact` (from ``make_law(joint)``).
     joint : ClearanceJoint
         Supplies c, R_b, mu, the friction ramp (v0, v1) and the impact-velocity rule.
     """

@@ -5,7 +5,7 @@ uniform crank-angle output grid (``samples``) and at every accepted solver step
 (``steps``).  Peaks and statistics are taken from ``steps`` because an impact
 lasts about 0.1 ms, a fraction of a degree, and falls between output samples.
 
-:func:`save_npz` / :func:`weftsim.result_file.read_npz` keep a result losslessly (both tables bit for bit,
+:func:`save_npz` / :func:`weftsim.post.result_file.read_npz` keep a result losslessly (both tables bit for bit,
 the scene in SI units, the solver statistics, events, plausibility and path), so
 the per-step data behind the peaks can be studied after the run; ``weftsim run``
 writes it as ``result.npz`` beside ``channels.csv``.
@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 
 from weftsim.errors import require
-from weftsim.params import Scene
+from weftsim.input.params import Scene
 
 if TYPE_CHECKING:
     import pandas
@@ -176,9 +176,9 @@ class RunResult:
         E.g. ``first_contact_time_s`` (true onset, located within the step) or None.
     plausibility : dict
         Counts of a broken contact history and the law-range warnings
-        (:meth:`weftsim.plausibility.Plausibility.as_dict`; not for the ideal mechanism), the design
-        checks before and after the run (``checks``, :mod:`weftsim.design_checks`) and every after-run
-        ``warnings``, filled by :func:`weftsim.guards.vet_result`; empty for a result no engine vetted.
+        (:meth:`weftsim.run.plausibility.Plausibility.as_dict`; not for the ideal mechanism), the design
+        checks before and after the run (``checks``, :mod:`weftsim.run.design_checks`) and every after-run
+        ``warnings``, filled by :func:`weftsim.run.guards.vet_result`; empty for a result no engine vetted.
     path : dict
         The model and method that ran and why (``{"model": ..., "method": ..., "reason": ...}``):
         what the engine's automatic selection chose for this scene, or what the scene forced.
@@ -303,7 +303,7 @@ def angle_grid(end_time: float, omega: float, step_angle: float) -> np.ndarray:
     return t
 
 
-# Format tag of a saved result; weftsim.result_file.read_npz refuses others (a later layout gets a new number).
+# Format tag of a saved result; weftsim.post.result_file.read_npz refuses others (a later layout gets a new number).
 NPZ_FORMAT = "weftsim-result/1"
 
 
@@ -325,12 +325,12 @@ def _plain(value: Any) -> Any:
 
 
 def save_npz(result: RunResult, path: str | os.PathLike) -> Path:
-    """Write ``result`` to one NPZ file from which :func:`weftsim.result_file.read_npz` rebuilds it
+    """Write ``result`` to one NPZ file from which :func:`weftsim.post.result_file.read_npz` rebuilds it
     exactly (reading it as untrusted input).
 
     The file holds ``samples/<channel>`` and ``steps/<channel>`` (float64 arrays, bit for bit)
     and ``meta``: one JSON text with the format tag, the scene (SI values of
-    :class:`weftsim.params.Scene`), engine, status, message, solver statistics, events,
+    :class:`weftsim.input.params.Scene`), engine, status, message, solver statistics, events,
     plausibility and path.  No pickled objects, so reading a file runs no code.
 
     Returns
