@@ -8,7 +8,7 @@ _shown: dict[str, list] = {}
 
 
 def weftsim_figures(block, block_vars, gallery_conf):
-    """sphinx-gallery image scraper for the figures of :mod:`weftsim.plots`.
+    """sphinx-gallery image scraper for the figures of :mod:`weftsim.post.plots`.
 
     weftsim draws on plain ``matplotlib.figure.Figure`` objects, never through pyplot (so that a run
     does not pay pyplot's import), which the gallery's own matplotlib scraper cannot see. This one

@@ -1,4 +1,4 @@
-"""The scene-key reference page (``docs/scene-keys.md``), written from :data:`weftsim.scene.SCHEMA`.
+"""The scene-key reference page (``docs/scene-keys.md``), written from :data:`weftsim.input.schema.SCHEMA`.
 
 ``docs/conf.py`` calls :func:`write_page` at every build, so the page always lists the keys the code
 accepts, with their units, defaults, allowed values and the part of the physics each belongs to
@@ -10,8 +10,8 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from weftsim import scene as scene_module
-from weftsim.params import Scene
+from weftsim.input import scene as scene_module
+from weftsim.input.params import Scene
 
 # Unit suffixes of the key names, longest first: (suffix, unit as shown, factor to SI). The factor is
 # checked against each key's conversion (Key.scale), so a unit shown here is the unit the loader reads.
@@ -139,7 +139,7 @@ def page(docs: Path) -> str:
         "# Scene-key reference",
         "",
         "Every key a scene file (or `--set KEY=VALUE`, or `weftsim.load_scene(..., overrides=...)`) accepts, "
-        "generated from the schema the loader checks against (`weftsim.scene.SCHEMA`) when the site is built. "
+        "generated from the schema the loader checks against (`weftsim.input.schema.SCHEMA`) when the site is built. "
         "Units are part of the key names; the loader converts to SI. **Required** keys are part of the "
         "machine: a scene gives them itself or through `extends`; for them the column *default* gives the "
         "values of the two bundled mechanisms, reference / loom, a starting point for your own "

@@ -26,7 +26,7 @@ os.environ.setdefault("EXUDYN_SUPPRESS_UI_WINDOW_OPEN", "1")
 import weftsim  # noqa: E402
 from _scene_keys import write_page  # noqa: E402
 
-# The scene-key reference, from weftsim.scene.SCHEMA (rewritten only when the schema changed).
+# The scene-key reference, from weftsim.input.schema.SCHEMA (rewritten only when the schema changed).
 write_page(Path(__file__).resolve().parent)
 
 project = "weftsim"

@@ -5,7 +5,7 @@ Not a gallery page itself (``docs/conf.py`` ignores it): ``plot_flores_slider_cr
 
 Crank OA (length r, turning about O at constant speed omega) - rod AB (length l) - slider B on the X
 axis, all in Exudyn's XY plane, gravity along -Y.  At B the slider carries the bearing (radius
-R_b = R_j + c) and the rod the journal (radius R_j) of a :class:`~weftsim.params.ClearanceJoint`
+R_b = R_j + c) and the rod the journal (radius R_j) of a :class:`~weftsim.input.params.ClearanceJoint`
 (:func:`weftsim.exudyn_engine.add_clearance_joint`).  The crank and rod centres of mass are assumed
 at their midpoints.  The crank angle theta starts at 0 (B at its outer dead centre), the journal
 centred, every velocity that of the ideal mechanism.
@@ -30,7 +30,7 @@ from exudyn.itemInterface import (
 from exudyn.rigidBodyUtilities import RigidBodyInertia
 
 from weftsim.exudyn_engine import add_clearance_joint
-from weftsim.params import ClearanceJoint, Material
+from weftsim.input.params import ClearanceJoint, Material
 
 CRANK_LENGTH, ROD_LENGTH = 0.05, 0.12  # r, l, m
 CRANK_MASS, ROD_MASS, SLIDER_MASS = 0.30, 0.21, 0.14  # kg
@@ -235,14 +235,14 @@ LUBRICATED_JOURNAL_RADIUS, LUBRICATED_BEARING_LENGTH, OIL_VISCOSITY = 9.5e-3, 40
 def lubricated_joint(model: str | None = "short_half") -> ClearanceJoint:
     """The pin B of the lubricated slider-crank (Flores et al. 2006); ``model=None``: the same pin dry.
 
-    ``model`` is the film model of :class:`~weftsim.params.Lubrication` (``"short_half"``: the short
+    ``model`` is the film model of :class:`~weftsim.input.params.Lubrication` (``"short_half"``: the short
     bearing as the paper writes it; ``"finite"``: weftsim's finite-length film).  Roughness and asperity
     parameters are weftsim's defaults (the paper has no asperity contact); the dry contact law beyond
     e = c is the dry example's.
     """
     from dataclasses import replace
 
-    from weftsim.params import Lubrication
+    from weftsim.input.params import Lubrication
 
     lubrication = None if model is None else Lubrication(viscosity=OIL_VISCOSITY, model=model)
     return replace(flores_joint(), journal_radius=LUBRICATED_JOURNAL_RADIUS,

@@ -2,7 +2,7 @@
 Pictures that move: the mechanism over a revolution
 ===================================================
 
-:func:`weftsim.animate.write_animation` draws a run as a GIF: the linkage projected on the four-bar
+:func:`weftsim.post.animate.write_animation` draws a run as a GIF: the linkage projected on the four-bar
 plane (seen along the rocker axis D; the spherical 4R as its projected crank axis B and rocker axis
 C), the journal inside its clearance at E, drawn magnified and labelled with the factor, red while
 it touches the bearing, and the rapier along its stroke. The shell command is
@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 import weftsim
-from weftsim.animate import write_animation
+from weftsim.post.animate import write_animation
 
 scene = weftsim.load_scene("reference", clearance_mm=0.5, revolutions=2)
 result = weftsim.simulate(scene, engine="reference")

@@ -14,7 +14,7 @@ trend figures).
 # One run per clearance
 # ---------------------
 import weftsim
-from weftsim.analysis import peaks
+from weftsim.post.analysis import peaks
 
 clearances_mm = (0.0, 0.01, 0.25, 0.5)
 results = [weftsim.simulate(weftsim.load_scene("reference", clearance_mm=c, revolutions=1), engine="reference")
@@ -36,7 +36,7 @@ for c, result in zip(clearances_mm, results):
 # %%
 # The channels side by side
 # -------------------------
-from weftsim.plots import plot_channels
+from weftsim.post.plots import plot_channels
 
 labels = ["ideal joint" if c == 0 else f"c = {c:g} mm" for c in clearances_mm]
 figure = plot_channels(results, labels=labels, title="Clearance at E, 400 rpm, first revolution")

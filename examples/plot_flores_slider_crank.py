@@ -27,7 +27,7 @@ discusses the results against the paper.
 # Crank OA (length r, turning about O at constant speed omega) - rod AB (length l) - slider B on
 # the X axis, all in Exudyn's XY plane, gravity along -Y.  At B the slider carries the bearing
 # (radius R_b = R_j + c) and the rod the journal (radius R_j); the
-# :class:`~weftsim.params.ClearanceJoint` is given every value explicitly.  Parameters of Flores
+# :class:`~weftsim.input.params.ClearanceJoint` is given every value explicitly.  Parameters of Flores
 # and Ambrosio (2004); assumed here: the crank and rod centres of mass at their midpoints.  The
 # crank angle theta starts at 0 (B at its outer dead centre), the journal centred,
 # every velocity that of the ideal mechanism.
@@ -63,7 +63,7 @@ from flores_mechanism import (  # noqa: F401  (re-exported: the tests read them 
     settings,
     simulate,
 )
-from weftsim.params import ClearanceJoint
+from weftsim.input.params import ClearanceJoint
 
 def _cumulative(rate, time):
     """Trapezoid integral of ``rate`` over ``time`` from the first sample."""
@@ -120,7 +120,7 @@ def start_up_impact(joint: ClearanceJoint) -> dict:
     from scipy.integrate import solve_ivp
     from scipy.optimize import brentq
 
-    from weftsim.contact import make_law
+    from weftsim.joint.contact import make_law
 
     r, l, omega, c = CRANK_LENGTH, ROD_LENGTH, CRANK_SPEED, joint.clearance
     force = make_law(joint).scalar()

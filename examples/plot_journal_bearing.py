@@ -29,7 +29,7 @@ from matplotlib.figure import Figure
 from scipy.integrate import solve_ivp
 
 from weftsim.kernel.film import MODEL_FINITE, MODEL_LONG, MODEL_SHORT, film_force
-from weftsim.reynolds import RAIMONDI_BOYD, equilibrium, steady_load
+from weftsim.joint.reynolds import RAIMONDI_BOYD, equilibrium, steady_load
 
 RADIUS, LENGTH, CLEARANCE, VISCOSITY = 10e-3, 20e-3, 20e-6, 0.02  # m, m, m, Pa s
 OMEGA = 2.0 * math.pi * 1500.0 / 60.0  # journal speed, rad/s; the bearing stands still
@@ -124,7 +124,7 @@ chart.tight_layout()
 # %%
 # The same equilibria by root finding
 # -----------------------------------
-# :func:`weftsim.reynolds.equilibrium` solves F(eps) = W directly; the dynamic runs above end there.
+# :func:`weftsim.joint.reynolds.equilibrium` solves F(eps) = W directly; the dynamic runs above end there.
 for width, rows in RAIMONDI_BOYD.items():
     for eps_table, sommerfeld, attitude_table in rows:
         eps, attitude = equilibrium(sommerfeld, width, MODEL_FINITE)

@@ -29,7 +29,7 @@ print(f"{result.solver_stats['steps']} accepted steps, {result.solver_stats['con
 # Peaks are taken at every accepted solver step (``result.steps``), not on the output grid
 # (``result.samples``): an impact lasts about 0.1 ms and falls between output samples. Revolution 1
 # starts from the centred journal, whose first impact (the start-up impact) is not the running loom's.
-from weftsim.analysis import peaks
+from weftsim.post.analysis import peaks
 
 for name, value in peaks(result, 1).items():
     print(f"{name:28s} {value['min']:+12.5g} .. {value['max']:+12.5g}")
@@ -42,7 +42,7 @@ for name, value in peaks(result, 1).items():
 # the revolution: the curves are the ideal mechanism's (stroke 1.241 m, +-43 m/s, +-2133 m/s^2 at
 # 600 rpm) but near 90 and 270 deg, where the force at E reverses and the journal crosses its
 # clearance with a few small impacts.
-from weftsim.plots import plot_channels, plot_orbit
+from weftsim.post.plots import plot_channels, plot_orbit
 
 channels = plot_channels([result])
 

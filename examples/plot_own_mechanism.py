@@ -19,7 +19,7 @@ variant from the shell is ``weftsim run loom --set mechanism.rapier_gear_pitch_r
 import numpy as np
 
 import weftsim
-from weftsim.kinematics import rapier_motion
+from weftsim.mechanism.kinematics import rapier_motion
 
 ratio = 150.0 / 190.0  # reed width of the variant over the loom's
 overrides = {
@@ -89,7 +89,7 @@ for line in messages + results["variant, c = 0.1 mm"].plausibility["warnings"]:
 # ---------------------------
 # The channels of the last revolution: the narrower loom's smaller stroke and acceleration, and the
 # worn pin's impacts near 90 and 270 deg, where the force at E reverses.
-from weftsim.plots import plot_channels
+from weftsim.post.plots import plot_channels
 
 channels = plot_channels(list(results.values()), labels=list(results),
                          title="the loom, its 150 cm variant and the variant with a worn pin (last revolution)")

@@ -3,7 +3,7 @@ The reusable clearance joint on a pendulum
 ==========================================
 
 :func:`weftsim.exudyn_engine.add_clearance_joint` puts a planar revolute clearance joint between any
-two bodies of an Exudyn model, with any contact law of :mod:`weftsim.contact`. Here it replaces the
+two bodies of an Exudyn model, with any contact law of :mod:`weftsim.joint.contact`. Here it replaces the
 pin of a pendulum: a 1 kg bar, 0.2 m long, hangs by a journal of radius 10 mm in a bearing with a
 radial clearance c = 0.1 mm. The bar is released at 60 degrees with the journal centred; the journal
 falls onto the bearing wall, bounces, and then slides along the wall as the bar swings, pressed by
@@ -29,7 +29,7 @@ from exudyn.itemInterface import MarkerBodyPosition, SensorBody, SensorObject
 from exudyn.rigidBodyUtilities import RigidBodyInertia
 
 from weftsim.exudyn_engine import add_clearance_joint
-from weftsim.params import ClearanceJoint
+from weftsim.input.params import ClearanceJoint
 
 MASS, LENGTH, GRAVITY = 1.0, 0.2, 9.81  # kg, m, m/s^2: a uniform bar hanging from one end
 RELEASE = math.radians(60.0)  # initial angle of the bar from the downward vertical
@@ -94,7 +94,7 @@ print(f"{len(t)} steps, {model.tracker.contact_events} contact onsets, "
 # (the damping term is small in a slow, lasting contact).
 from scipy.optimize import brentq
 
-from weftsim.contact import make_law
+from weftsim.joint.contact import make_law
 
 law = make_law(joint)
 alpha = -(GRAVITY / half) * (3.0 / 4.0) * np.sin(psi)  # angular acceleration of the bar: I_pin = m L^2 / 3

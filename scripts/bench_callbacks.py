@@ -24,13 +24,13 @@ import time
 import exudyn as exu
 import numpy as np
 
-from weftsim.contact import make_law
+from weftsim.joint.contact import make_law
 from weftsim.exudyn_engine import callbacks
 from weftsim.exudyn_engine.clearance_joint import DEFAULT_ROUTE, ROUTES
 from weftsim.exudyn_engine.mechanism import build_mechanism
 from weftsim.exudyn_engine.sensors import add_sensors, step_channels
 from weftsim.exudyn_engine.solver import simulation_settings, step_plan
-from weftsim.params import Drive, Scene
+from weftsim.input.params import Drive, Scene
 
 
 def run(scene: Scene, route: str | None, count: bool = False, profile: bool = False):

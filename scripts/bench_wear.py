@@ -18,7 +18,7 @@ import statistics
 import time
 from pathlib import Path
 
-from weftsim.scene import load_scene
+from weftsim.input.scene import load_scene
 from weftsim.wear.extrapolate import effective_clearance, predict
 
 ROOT = Path(__file__).resolve().parents[1]

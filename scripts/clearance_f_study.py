@@ -25,9 +25,9 @@ from pathlib import Path
 
 import numpy as np
 
-from weftsim.analysis import peaks, statistics
+from weftsim.post.analysis import peaks, statistics
 from weftsim.reference import solve
-from weftsim.scene import load_scene
+from weftsim.input.scene import load_scene
 from weftsim.studies.common import revolution_steps
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -85,9 +85,9 @@ def ensemble(case: str, revolutions: float, members: int) -> dict:
 
 
 def figure(results: dict, target: Path) -> None:
-    """Revolution 2 of each case in four panels (weftsim.plots.channel_panels)."""
-    from weftsim.output import write_figure
-    from weftsim.plots import channel_panels
+    """Revolution 2 of each case in four panels (weftsim.post.plots.channel_panels)."""
+    from weftsim.post.output import write_figure
+    from weftsim.post.plots import channel_panels
 
     styles = {"ideal": {"color": "k", "lw": 1.2, "ls": "--"}, "E only": {"color": "tab:blue"},
               "F only": {"color": "tab:orange"}, "E and F": {"color": "tab:green"}}  # fmt: skip

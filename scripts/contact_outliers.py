@@ -24,7 +24,7 @@ import shlex
 import sys
 from pathlib import Path
 
-from weftsim.scene import SceneError
+from weftsim.input.scene import SceneError
 from weftsim.studies.common import StudyError
 from weftsim.studies import outliers, outliers_report
 from weftsim.sweep.grid import SweepError, parse_set

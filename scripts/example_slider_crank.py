@@ -40,7 +40,7 @@ from exudyn.rigidBodyUtilities import RigidBodyInertia
 from scipy.optimize import brentq
 
 from weftsim.exudyn_engine import add_clearance_joint
-from weftsim.params import ClearanceJoint
+from weftsim.input.params import ClearanceJoint
 
 CRANK, ROD = 0.05, 0.20  # lengths, m
 ROD_MASS, SLIDER_MASS = 0.3, 0.5  # kg

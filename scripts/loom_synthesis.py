@@ -2,8 +2,8 @@
 
 Reproducible: ``PYTHONPATH=. python scripts/loom_synthesis.py`` prints every figure the docs quote and
 checks that models/loom.toml holds the values this synthesis chooses.  Ideal joints throughout
-(weftsim.kinematics); the joint force at E is the Newton-Euler force of the rod and the sector chain
-(weftsim.pin_loads), which a run at the design clearance reproduces in the mean (tests/test_loom.py).
+(weftsim.mechanism.kinematics); the joint force at E is the Newton-Euler force of the rod and the sector chain
+(weftsim.mechanism.pin_loads), which a run at the design clearance reproduces in the mean (tests/test_loom.py).
 
 Steps:
 1. Timing and stroke.  The rapier is out of the shed for a third of the cycle, the giver's head passes
@@ -29,11 +29,11 @@ from pathlib import Path
 
 import numpy as np
 
-from weftsim import kinematics as kin
-from weftsim.params import Geometry, Inertia
-from weftsim.pin_loads import ideal_pin_loads
+from weftsim.mechanism import kinematics as kin
+from weftsim.input.params import Geometry, Inertia
+from weftsim.mechanism.pin_loads import ideal_pin_loads
 from weftsim.reference.ideal import ideal_torque, sector_chain_inertia
-from weftsim.scene import load_scene
+from weftsim.input.scene import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -115,7 +115,7 @@ def member_inertias(geometry: Geometry) -> dict:
 
 
 def loads(geometry: Geometry, inertia: Inertia, rpm: float) -> dict:
-    """Ideal-joint figures at ``rpm``: force at E (weftsim.pin_loads, Newton-Euler of the chain behind E),
+    """Ideal-joint figures at ``rpm``: force at E (weftsim.mechanism.pin_loads, Newton-Euler of the chain behind E),
     pin pressure, p x v, rapier acceleration, driving torque."""
     omega = rpm * math.pi / 30.0
     base = load_scene("reference")

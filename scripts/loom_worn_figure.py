@@ -2,7 +2,7 @@
 
 ``PYTHONPATH=. python scripts/loom_worn_figure.py``: the new joint (c = 0.02 mm) against worn ones
 (0.1 and 0.25 mm), two revolutions on the default engine each, the six channels of revolution 2
-(weftsim.plots.plot_channels).  Revolution 2 is one draw of the impact sequence (docs/physics.md
+(weftsim.post.plots.plot_channels).  Revolution 2 is one draw of the impact sequence (docs/physics.md
 section 6): its single peaks are an illustration; the loads table (scripts/loom_loads_table.py) gives
 the means.
 """
@@ -10,7 +10,7 @@ the means.
 from pathlib import Path
 
 import weftsim
-from weftsim.plots import plot_channels
+from weftsim.post.plots import plot_channels
 
 ROOT = Path(__file__).resolve().parents[1]
 CLEARANCES_MM = (0.02, 0.1, 0.25)

@@ -48,7 +48,7 @@ def _row(label: str, ens: dict, horizon: float) -> str:
 
 
 def main() -> None:
-    from weftsim.scene import apply_overrides, load_scene
+    from weftsim.input.scene import apply_overrides, load_scene
     from weftsim.wear.ensemble import combine, plan, wear_ensemble
     from weftsim.wear.jobs import CURVE
     from weftsim.wear.uncertain import parse_uncertain

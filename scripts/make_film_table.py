@@ -4,7 +4,7 @@ Usage::
 
     python scripts/make_film_table.py [--check]
 
-Solves Reynolds' equation with cavitation (:func:`weftsim.reynolds.film`) on every node of the
+Solves Reynolds' equation with cavitation (:func:`weftsim.joint.reynolds.film`) on every node of the
 grid of :mod:`weftsim.kernel.film` (eccentricity ratio x squeeze-velocity angle x B/D) and stores
 the scaled dimensionless force.  Deterministic: the same code gives the same table.  About
 5000 solves, a few minutes on one core.  ``--check`` instead compares the kernel's interpolated
@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from weftsim import reynolds
+from weftsim.joint import reynolds
 from weftsim.kernel import film
 
 TABLE = Path(film.__file__).with_name("film_table.npz")

@@ -17,7 +17,7 @@ import sys
 import time
 from pathlib import Path
 
-from weftsim.output import write_text
+from weftsim.post.output import write_text
 from weftsim.studies import STUDIES, format_study, run_study
 from weftsim.studies.regression import environment
 from weftsim.studies.report import render

@@ -20,7 +20,7 @@ import shutil
 import sys
 from pathlib import Path
 
-from weftsim.scene import SceneError
+from weftsim.input.scene import SceneError
 from weftsim.sweep import SweepError, format_report, plan_sweep, run_sweep
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -20,7 +20,7 @@ import sys
 import time
 from pathlib import Path
 
-from weftsim.output import to_json, write_text
+from weftsim.post.output import to_json, write_text
 from weftsim.studies import regression
 
 ROOT = Path(__file__).resolve().parents[1]

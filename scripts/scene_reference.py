@@ -1,9 +1,9 @@
-"""Print the scene-file key reference (Markdown) from weftsim.scene.SCHEMA, for the README."""
+"""Print the scene-file key reference (Markdown) from weftsim.input.schema.SCHEMA, for the README."""
 
 import dataclasses
 
-from weftsim.params import Lubrication, Scene
-from weftsim.scene import SCHEMA, to_file_keys
+from weftsim.input.params import Lubrication, Scene
+from weftsim.input.scene import SCHEMA, to_file_keys
 
 
 def main() -> None:

@@ -22,9 +22,9 @@ from pathlib import Path
 
 import numpy as np
 
-from weftsim.analysis import complete_revolutions, statistics
+from weftsim.post.analysis import complete_revolutions, statistics
 from weftsim.reference import solve
-from weftsim.scene import load_scene
+from weftsim.input.scene import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ("clearance_0p25mm_400rpm", "clearance_0p50mm_400rpm")

@@ -19,7 +19,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from weftsim.scene import load_scene
+from weftsim.input.scene import load_scene
 from weftsim.wear.engines import ENGINES, simulator
 from weftsim.wear.ensemble import _last_bits
 from weftsim.wear.extrapolate import MAX_HOURS, advance, effective_clearance, predict

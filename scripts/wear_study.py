@@ -20,8 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from weftsim.output import write_figure
-from weftsim.scene import load_scene
+from weftsim.post.output import write_figure
+from weftsim.input.scene import load_scene
 from weftsim.wear.extrapolate import advance, effective_clearance, limit_hours, predict
 from weftsim.wear.figures import growth_figure, profile_figure, statistic_label
 from weftsim.wear.store import table
@@ -98,7 +98,7 @@ def main() -> None:
         ax.plot(columns[800.0]["hours"], columns[800.0][name], "x-", ms=3, label="800 rpm " + statistic_label(name))
         ax.legend(fontsize=7)
     write_figure(img / "wear_growth.png", fig)
-    from weftsim.plots import figure
+    from weftsim.post.plots import figure
 
     fig = figure(figsize=(6, 4))
     ax = fig.add_subplot(1, 1, 1)

@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from weftsim import analysis
-from weftsim.params import Scene
-from weftsim.results import CHANNELS, RunResult
+from weftsim.post import analysis
+from weftsim.input.params import Scene
+from weftsim.post.results import CHANNELS, RunResult
 
 
 def synthetic(time, **channels):

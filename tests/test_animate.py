@@ -1,4 +1,4 @@
-"""``weftsim animate`` and weftsim.animate: a valid GIF with the frames asked for, and drawn points that
+"""``weftsim animate`` and weftsim.post.animate: a valid GIF with the frames asked for, and drawn points that
 obey the mechanism's closure (docs/physics.md section 1): the rod EF keeps its length, F stays on the
 sector arm's circle, E on the rocker arm's, and for the ideal joint F is the closed-form kinematics' F."""
 
@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from weftsim.animate import clearance_magnification, mechanism_frames, write_animation
-from weftsim.cli import EXIT_USAGE
-from weftsim.kinematics import linkage_state
+from weftsim.post.animate import clearance_magnification, mechanism_frames, write_animation
+from weftsim.cli.commands import EXIT_USAGE
+from weftsim.mechanism.kinematics import linkage_state
 from weftsim.reference import solve
-from weftsim.scene import load_scene
+from weftsim.input.scene import load_scene
 
 REFERENCE = Path(__file__).resolve().parents[1] / "models" / "reference.toml"
 # Round-off on a point of the linkage: a few ulps of its link lengths (0.27 m), ~1e-16 m. The rod-length
@@ -60,7 +60,7 @@ def test_frames_spread_evenly_over_the_last_revolution(clearance_run):
 
 def test_ideal_joint_draws_the_closed_form_kinematics():
     """With c = 0 the engine's rapier displacement, turned back into the sector angle, must put F where
-    the closed-form kinematics (weftsim.kinematics, checked against docs/physics.md section 1) puts it."""
+    the closed-form kinematics (weftsim.mechanism.kinematics, checked against docs/physics.md section 1) puts it."""
     scene = load_scene(REFERENCE, {"drive.revolutions": 1, "joint_e.clearance_mm": 0.0})
     result = solve(scene)
     frames = mechanism_frames(result, 24)

@@ -11,7 +11,7 @@ import pytest
 
 import weftsim
 from weftsim import errors
-from weftsim.results import CHANNELS
+from weftsim.post.results import CHANNELS
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = ROOT / "models"
@@ -236,9 +236,9 @@ def test_every_error_is_a_weftsim_error_and_the_builtin_a_caller_expects():
                 errors.StudyError: ValueError, errors.SimulationFailed: ValueError, errors.MissingExtra: ImportError}
     for cls, builtin in expected.items():
         assert issubclass(cls, weftsim.WeftsimError) and issubclass(cls, builtin), cls
-    from weftsim.cli import CliError
-    from weftsim.output import OutputError
-    from weftsim.scene import SceneError
+    from weftsim.cli.commands import CliError
+    from weftsim.post.output import OutputError
+    from weftsim.input.scene import SceneError
     from weftsim.studies import StudyError
     from weftsim.sweep import SweepError
 

@@ -20,9 +20,9 @@ from pathlib import Path
 
 import pytest
 
-from weftsim.output import MANIFEST
+from weftsim.post.output import MANIFEST
 
-from weftsim.cli import EXIT_USAGE
+from weftsim.cli.commands import EXIT_USAGE
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 REFERENCE = MODELS / "reference.toml"
@@ -238,7 +238,7 @@ def test_bad_flag_or_output(outcomes, name, args, words):
 
 def test_every_scene_key_section_is_covered_by_the_table():
     """The table reaches every section of the schema with at least one bad value."""
-    from weftsim.scene import SCHEMA
+    from weftsim.input.scene import SCHEMA
 
     sections = {key.path.split(".")[0] for key in SCHEMA}
     text = "".join(text for _, text, _ in SCENES)
@@ -284,7 +284,7 @@ _SLOW_WRITER = r"""
 import sys, time
 from pathlib import Path
 import numpy as np
-import weftsim.output as output
+import weftsim.post.output as output
 
 real = np.savetxt
 def half_then_hang(path, table, **kw):
@@ -292,7 +292,7 @@ def half_then_hang(path, table, **kw):
     Path(sys.argv[1]).write_text(str(path))
     time.sleep(600)
 output.np.savetxt = half_then_hang
-from weftsim.cli import main
+from weftsim.cli.commands import main
 sys.exit(main(sys.argv[2:]))
 """
 

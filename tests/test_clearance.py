@@ -1,19 +1,19 @@
-"""Physics checks of the planar clearance-joint force (weftsim.clearance, docs/physics.md section 2)."""
+"""Physics checks of the planar clearance-joint force (weftsim.joint.clearance, docs/physics.md section 2)."""
 
 import dataclasses
 
 import numpy as np
 import pytest
 
-from weftsim.clearance import (
+from weftsim.joint.clearance import (
     clearance_contact,
     clearance_force,
     contact_geometry,
     make_clearance_kernel,
     tangential_velocity,
 )
-from weftsim.contact import make_law
-from weftsim.params import LOOM_JOINT_E
+from weftsim.joint.contact import make_law
+from weftsim.input.params import LOOM_JOINT_E
 
 RNG = np.random.default_rng(7)
 JOINT = dataclasses.replace(LOOM_JOINT_E, friction_coefficient=0.1)  # reference joint, c = 0.25 mm, with friction

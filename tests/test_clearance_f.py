@@ -15,13 +15,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from weftsim.analysis import time_weights
-from weftsim import kinematics as kin
-from weftsim.params import ReferenceSolver, Scene
+from weftsim.post.analysis import time_weights
+from weftsim.mechanism import kinematics as kin
+from weftsim.input.params import ReferenceSolver, Scene
 from weftsim.reference import solve
 from weftsim.reference.ideal import ideal_torque
-from weftsim.results import CHANNELS, JOINT_F_CHANNELS
-from weftsim.scene import SceneError, load_scene
+from weftsim.post.results import CHANNELS, JOINT_F_CHANNELS
+from weftsim.input.scene import SceneError, load_scene
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 BASE = dataclasses.replace(Scene(), reference_solver=ReferenceSolver(method="numba_DOP853", rtol=1e-9, atol=1e-12))
@@ -224,7 +224,7 @@ def test_e_only_kernel_path_is_unchanged_by_the_joint_f_block():
 
 def _agreement(c_e, c_f, revolutions):
     from weftsim import exudyn_engine
-    from weftsim.compare import agreement_checks
+    from weftsim.post.compare import agreement_checks
 
     scene = load_scene(MODELS / "clearance_ef.toml", {"joint_e.clearance_mm": c_e * 1e3,
                                                        "drive.revolutions": revolutions})

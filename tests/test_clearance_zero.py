@@ -18,9 +18,9 @@ from pathlib import Path
 import pytest
 
 from weftsim import exudyn_engine, reference
-from weftsim.compare import agreement_checks
+from weftsim.post.compare import agreement_checks
 from weftsim.exudyn_engine.solver import IDEAL_JOINT_STEP_ANGLE, step_plan
-from weftsim.scene import load_scene
+from weftsim.input.scene import load_scene
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 

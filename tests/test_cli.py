@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from weftsim.cli import EXIT_USAGE, main
+from weftsim.cli.commands import EXIT_USAGE, main
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 
@@ -101,7 +101,7 @@ def test_runs_of_the_two_engines_go_to_their_own_directories(tmp_path):
                            capture_output=True, text=True)
     assert first.returncode == 0, first.stderr
     # Overrides on the command line: the scene's directory is named after them (issue 25).
-    from weftsim.cli_grammar import overrides_tag
+    from weftsim.cli.grammar import overrides_tag
 
     name = "clearance_0p50mm_400rpm-" + overrides_tag({"drive.revolutions": 0.25, "joint_e.restitution": 0.8})
     assert name.startswith("clearance_0p50mm_400rpm-0.25rev-set")
@@ -161,7 +161,7 @@ def test_mistyped_flags_commands_and_keys_get_the_closest_spelling(args, words):
 
 def test_every_scene_command_takes_the_same_flags():
     """--set and the shorthands on every command that loads one scene; kinematics only what it uses."""
-    from weftsim.cli import build_parser
+    from weftsim.cli.commands import build_parser
 
     parser = build_parser()
     commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices
@@ -173,8 +173,8 @@ def test_every_scene_command_takes_the_same_flags():
 
 
 def test_study_and_bench_find_the_bundled_scenes_without_models():
-    from weftsim.cli import build_parser, models_directory
-    from weftsim.scene import bundled_directory
+    from weftsim.cli.commands import build_parser, models_directory
+    from weftsim.input.scene import bundled_directory
 
     for argv in (["study", "clearance"], ["bench", "--quick"]):
         args = build_parser().parse_args(argv)

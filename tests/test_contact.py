@@ -1,4 +1,4 @@
-"""Physics checks of the contact force laws (weftsim.contact, docs/physics.md section 3).
+"""Physics checks of the contact force laws (weftsim.joint.contact, docs/physics.md section 3).
 
 Restored coefficient of restitution, single mass m = 1 kg hitting the law at v0 = 0.5 m/s,
 c = 0.25 mm, steel, R_j = 10 mm (DOP853, rtol 1e-11, event at separation), ce_out = -v_sep/v0:
@@ -11,7 +11,7 @@ c = 0.25 mm, steel, R_j = 10 mm (DOP853, rtol 1e-11, event at separation), ce_ou
     hunt_crossley        0.5813   0.6630   0.9090    [0.75, 1]
     gonthier             0.3042   0.4877   0.8764    (0, 1]
 
-Valid means |ce_out - ce| <= 0.05; the values equal weftsim.contact.restored_restitution(xi)
+Valid means |ce_out - ce| <= 0.05; the values equal weftsim.joint.contact.restored_restitution(xi)
 (restitution depends on xi only), which the tests check to integration accuracy.
 """
 
@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad, solve_ivp
 
-from weftsim.contact import (
+from weftsim.joint.contact import (
     LAWS,
     bai_zhao_stiffness,
     friction_factor,
@@ -30,7 +30,7 @@ from weftsim.contact import (
     make_law,
     restored_restitution,
 )
-from weftsim.params import ClearanceJoint
+from weftsim.input.params import ClearanceJoint
 
 NAMES = sorted(LAWS)
 RNG = np.random.default_rng(20200101)
@@ -202,7 +202,7 @@ def test_single_mass_impact_restores_the_declared_restitution(name, ce):
     assert ce_out == pytest.approx(restored_restitution(law.hysteresis), abs=1e-8)
     lo, hi = law.valid_restitution
     if lo <= ce <= hi:
-        assert abs(ce_out - ce) <= 0.05  # the validity criterion declared in weftsim.contact
+        assert abs(ce_out - ce) <= 0.05  # the validity criterion declared in weftsim.joint.contact
     else:
         assert abs(ce_out - ce) > 0.09  # outside, clearly wrong (not a borderline declaration)
 

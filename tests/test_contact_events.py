@@ -17,12 +17,12 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from weftsim.clearance import make_clearance_kernel
-from weftsim.contact import LAWS, make_law, restored_restitution
-from weftsim.params import ClearanceJoint
+from weftsim.joint.clearance import make_clearance_kernel
+from weftsim.joint.contact import LAWS, make_law, restored_restitution
+from weftsim.input.params import ClearanceJoint
 from weftsim.reference import events, solve
 from weftsim.reference.dynamics import ChainConstants, penetration
-from weftsim.scene import load_scene
+from weftsim.input.scene import load_scene
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 
@@ -127,7 +127,7 @@ def test_isolated_impact_restitution_is_unchanged_by_the_rule(name, ce):
     new = _single_impact(name, ce, "max_approach")[0]
     old = _single_impact(name, ce, "onset")[0]
     assert new == old  # delta_dot never exceeds its onset value: the very same force at every evaluation
-    # Closed form of weftsim.contact (DOP853 at rtol 1e-11: ~1e-9).
+    # Closed form of weftsim.joint.contact (DOP853 at rtol 1e-11: ~1e-9).
     assert new == pytest.approx(restored_restitution(make_law(ClearanceJoint(clearance=0.25e-3, law=name, restitution=ce)).hysteresis),
                                 abs=1e-8)  # fmt: skip
 
@@ -219,7 +219,7 @@ def test_very_slow_crank_engines_agree():
     the journal settles on the bearing under gravity-scale loads, touching it again and again."""
     pytest.importorskip("exudyn")
     from weftsim import exudyn_engine
-    from weftsim.compare import agreement_checks
+    from weftsim.post.compare import agreement_checks
 
     scene = load_scene(MODELS / "reference.toml", {"drive.speed_rpm": 5.0, "drive.revolutions": 0.01})
     ref, exu = solve(scene), exudyn_engine.solve(scene)

@@ -33,8 +33,8 @@ from pathlib import Path
 
 import pytest
 
-from weftsim.compare import agreement_checks, compare_results
-from weftsim.scene import load_scene
+from weftsim.post.compare import agreement_checks, compare_results
+from weftsim.input.scene import load_scene
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 REVOLUTIONS = 40

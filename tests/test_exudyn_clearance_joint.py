@@ -12,7 +12,7 @@ from scipy.optimize import brentq
 
 from exudyn.itemInterface import MarkerBodyPosition
 
-from weftsim.contact import LAWS, make_law, restored_restitution
+from weftsim.joint.contact import LAWS, make_law, restored_restitution
 from weftsim.exudyn_engine import callbacks
 from weftsim.exudyn_engine.clearance_joint import add_clearance_joint, register_post_step
 from weftsim.exudyn_engine.onset import (
@@ -23,7 +23,7 @@ from weftsim.exudyn_engine.onset import (
     onset_velocity,
     penetration_state,
 )
-from weftsim.params import ClearanceJoint
+from weftsim.input.params import ClearanceJoint
 
 C = 0.25e-3
 JOINT = ClearanceJoint(clearance=C, law="variable_kd")
@@ -272,7 +272,7 @@ def test_free_impact_restores_the_laws_restitution_under_both_rules(name):
         ce[rule] = -rate[-1] / V0  # free flight after the separation: constant rate
     # Rules are equal in an isolated impact: delta_dot only falls after the onset.
     assert ce["max_approach"] == ce["onset"]
-    # Closed-form restitution of the law's ODE (weftsim.contact.restored_restitution).  Generalized-
+    # Closed-form restitution of the law's ODE (weftsim.joint.contact.restored_restitution).  Generalized-
     # alpha at rho = 1, h = 1e-7 s (~1300 steps in contact): measured errors 0.9-1.7e-7 for the six
     # laws, converging at second order (4.8-7.3e-7 at 2e-7 s, 2.3-4.3e-8 at 5e-8 s).
     assert ce["max_approach"] == pytest.approx(restored_restitution(law.hysteresis), abs=5e-7)
@@ -499,7 +499,7 @@ def test_clearance_joint_refuses_bad_values_in_one_line(field, value, words):
 def test_clearance_joint_has_no_hidden_loom_default():
     # A researcher who omits the law (or the clearance) is told, instead of silently getting the loom's
     # empirical variable_kd at 0.25 mm; the loom's joint is named where it is meant.
-    from weftsim.params import LOOM_JOINT_E, Scene
+    from weftsim.input.params import LOOM_JOINT_E, Scene
 
     with pytest.raises(TypeError, match="law"):
         ClearanceJoint(clearance=1e-4)

@@ -13,8 +13,8 @@ import pytest
 from weftsim import reference
 from weftsim.exudyn_engine import build_mechanism, solve
 from weftsim.exudyn_engine import callbacks as cb
-from weftsim.kinematics import rapier_motion
-from weftsim.params import ClearanceJoint, Drive, ExudynSolver, Scene
+from weftsim.mechanism.kinematics import rapier_motion
+from weftsim.input.params import ClearanceJoint, Drive, ExudynSolver, Scene
 
 RPM = math.pi / 30.0
 

@@ -13,9 +13,9 @@ pytest.importorskip("exudyn")
 from weftsim import exudyn_engine  # noqa: E402
 from weftsim.exudyn_engine.selection import select_path  # noqa: E402
 from weftsim.exudyn_engine.solver import IDEAL_JOINT_STEP_ANGLE  # noqa: E402
-from weftsim.params import Scene  # noqa: E402
+from weftsim.input.params import Scene  # noqa: E402
 import weftsim  # noqa: E402
-from weftsim.scene import SceneError, load_scene  # noqa: E402
+from weftsim.input.scene import SceneError, load_scene  # noqa: E402
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 SHORT = {"drive.revolutions": 0.02}  # 7.2 deg: through the first contact at 6.6 deg
@@ -150,7 +150,7 @@ def test_the_run_time_estimate_follows_the_exudyn_trees_solver_with_friction():
     """The estimate prices friction by the path that integrates it: the implicit tree (the default with
     friction) at ~5x a dry run as measured in issue 23, the explicit tree at its stability-limited 1400x,
     and only the explicit one is announced as an explicit solver on a stiff joint."""
-    from weftsim.progress import (
+    from weftsim.run.progress import (
         EXUDYN_IMPLICIT_STIFF_FACTOR, EXUDYN_STIFF_FACTOR, estimate_run_time, stiff_explicit,
     )  # fmt: skip
 

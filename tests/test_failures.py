@@ -22,11 +22,11 @@ import numpy as np
 import pytest
 
 from weftsim import exudyn_engine, reference
-from weftsim.analysis import energy_balance
-from weftsim.guards import RunGuard, failure_message, vet_result, where
-from weftsim.params import Drive, ExudynSolver, Limits, Material, ReferenceSolver, Scene
-from weftsim.results import CHANNELS
-from weftsim.scene import SCHEMA
+from weftsim.post.analysis import energy_balance
+from weftsim.run.guards import RunGuard, failure_message, vet_result, where
+from weftsim.input.params import Drive, ExudynSolver, Limits, Material, ReferenceSolver, Scene
+from weftsim.post.results import CHANNELS
+from weftsim.input.scene import SCHEMA
 
 RPM = math.pi / 30.0
 MODELS = Path(__file__).resolve().parents[1] / "models"
@@ -381,10 +381,10 @@ def run_cli(*args, cwd=None):
 
 
 def _error_lines(stderr: str) -> list[str]:
-    """stderr without the progress lines, which any run longer than 2 s prints (weftsim.progress): a
+    """stderr without the progress lines, which any run longer than 2 s prints (weftsim.run.progress): a
     loaded machine, or numba's start-up when the process first loads a compiled kernel, gets there; and
     without the design checks' numbers and the plausibility warnings (the reference scene's 0.25 mm
-    clearance on a 20 mm pin is outside a new bushed pin's design range, weftsim.design_checks)."""
+    clearance on a 20 mm pin is outside a new bushed pin's design range, weftsim.run.design_checks)."""
     return [line for line in stderr.strip().splitlines()
             if not re.search(r"\d%\s+elapsed", line) and not line.startswith(("weftsim run: warning: ",
                                                                                 "weftsim run: design checks "))]
@@ -469,10 +469,10 @@ def test_cli_compare_with_a_failed_engine_exits_3(tmp_path):
 
 @pytest.mark.parametrize("engine", SOLVERS)
 def test_a_stop_request_ends_the_run_as_interrupted_and_keeps_what_was_computed(engine):
-    """weftsim.guards.request_stop (the CLI's SIGINT handler) is seen at the next guard check: the
+    """weftsim.run.guards.request_stop (the CLI's SIGINT handler) is seen at the next guard check: the
     run ends as failed with kind "interrupted", the steps up to there kept.  The request is made
     from the progress callback once 30 % of the run is done."""
-    from weftsim.guards import clear_stop, request_stop
+    from weftsim.run.guards import clear_stop, request_stop
 
     def progress(fraction):
         if fraction >= 0.3:
@@ -506,9 +506,9 @@ def test_a_stop_request_ends_the_run_as_interrupted_and_keeps_what_was_computed(
 def test_penetration_bound_at_joint_f_names_joint_f():
     """Joint F against its own journal radius: a soft bushing at F (E ideal) sinks past a tenth of the
     radius in the start-up impact, and both engines stop naming [joint_f] (the guard judges each joint
-    with its own bound, weftsim.guards.RunGuard)."""
+    with its own bound, weftsim.run.guards.RunGuard)."""
     from weftsim import exudyn_engine, reference
-    from weftsim.scene import load_scene
+    from weftsim.input.scene import load_scene
 
     soft = load_scene("clearance_f", {"drive.revolutions": 0.1, "joint_f.bearing_material.youngs_modulus_gpa": 0.05})
     for r in (reference.solve(soft), exudyn_engine.solve(soft)):

@@ -11,9 +11,9 @@ import pytest
 
 pytest.importorskip("numba")
 
-from weftsim.analysis import peaks  # noqa: E402
-from weftsim.contact import LAWS, make_law  # noqa: E402
-from weftsim.params import ReferenceSolver, Scene  # noqa: E402
+from weftsim.post.analysis import peaks  # noqa: E402
+from weftsim.joint.contact import LAWS, make_law  # noqa: E402
+from weftsim.input.params import ReferenceSolver, Scene  # noqa: E402
 from weftsim.reference import solve  # noqa: E402
 from weftsim.kernel import laws  # noqa: E402
 from weftsim.reference.compiled_channels import crank_side_eval, crank_side_table  # noqa: E402

@@ -28,10 +28,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from weftsim import cli, output
-from weftsim.exitcodes import EXIT_DISAGREE, EXIT_FAILED
-from weftsim.output import MANIFEST
-from weftsim.results import CHANNELS
+from weftsim.cli import commands as cli
+from weftsim.post import output
+from weftsim.cli.exitcodes import EXIT_DISAGREE, EXIT_FAILED
+from weftsim.post.output import MANIFEST
+from weftsim.post.results import CHANNELS
 
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE = ROOT / "models" / "reference.toml"
@@ -270,7 +271,7 @@ def test_output_piped_into_head_ends_quietly(tmp_path):
 def test_closed_stdout_gives_the_sigpipe_status(tmp_path):
     """stdout already closed by the reader: the first print fails; exit 141, nothing on stderr."""
     script = ("import os, sys\nr, w = os.pipe()\nos.close(r)\nos.dup2(w, 1)\n"
-              "from weftsim.cli import main\nsys.exit(main(sys.argv[1:]))\n")
+              "from weftsim.cli.commands import main\nsys.exit(main(sys.argv[1:]))\n")
     done = subprocess.run([sys.executable, "-c", script, "kinematics", str(REFERENCE), "-o", str(tmp_path / "k")],
                           capture_output=True, text=True, env=ENV, timeout=120)  # fmt: skip
     assert done.returncode == cli.EXIT_BROKEN_PIPE, done.stderr
@@ -324,7 +325,7 @@ def test_compare_with_a_failed_engine_says_which_and_why(tmp_path):
 
 def test_progress_on_a_closed_stream_does_not_end_the_run():
     """stderr piped into a reader that exited (``2>&1 | head -1``): progress stops, the run goes on."""
-    from weftsim.progress import Progress
+    from weftsim.run.progress import Progress
 
     read, write = os.pipe()
     os.close(read)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from weftsim.scene import load_scene
+from weftsim.input.scene import load_scene
 from weftsim.sweep.plots import plot_sweep_2d
 from weftsim.wear.extrapolate import Update
 from weftsim.wear.figures import label_angle, profile_figure

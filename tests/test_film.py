@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from weftsim import reynolds
+from weftsim.joint import reynolds
 from weftsim.kernel.film import (MODEL_FINITE, MODEL_LONG, MODEL_SHORT, MODEL_SHORT_HALF, _long_pressure, film_force,
                                  finite_force, long_force, short_force, sommerfeld_angle)
-from weftsim.reynolds import RAIMONDI_BOYD, equilibrium, steady_load
+from weftsim.joint.reynolds import RAIMONDI_BOYD, equilibrium, steady_load
 
 VISCOSITY, RADIUS, LENGTH, CLEARANCE = 0.1, 0.01, 0.02, 2e-5  # Pa s, m, m, m: a pin of B/D = 1
 
@@ -237,7 +237,7 @@ def test_the_film_only_dissipates(model):
 
 @pytest.mark.parametrize(("k", "i", "j"), [(4, 10, 0), (4, 20, 24), (2, 27, 48), (7, 5, 30)])
 def test_stored_table_is_the_solver_of_this_code_at_its_nodes(k, i, j):
-    """The shipped film_table.npz is what weftsim.reynolds gives today (rebuild it after changing the solver)."""
+    """The shipped film_table.npz is what weftsim.joint.reynolds gives today (rebuild it after changing the solver)."""
     from weftsim.kernel import film
 
     eps, xi, width = film.table_eccentricities()[i], film.table_angles()[j], film.table_widths()[k]

@@ -175,7 +175,7 @@ def test_the_docs_example_runs_and_meets_its_closed_forms(tmp_path, monkeypatch,
     assert model.tracker.first_contact_time == pytest.approx(onset, rel=1e-5)
     # Hertz impact of m / 4 at v = g t: the peak of the run.  LN damping at ce = 0.9 lowers it by
     # 2.9 % (measured 339.0 against 349.0 N); the bound only admits the damping's direction.
-    from weftsim.contact import make_law
+    from weftsim.joint.contact import make_law
 
     v, m_eff, k = g * onset, scope["mass"] / 4.0, make_law(joint).coefficient
     hertz = k * (5.0 * m_eff * v**2 / (4.0 * k)) ** 0.6

@@ -45,8 +45,8 @@ import pytest
 
 pytest.importorskip("exudyn")
 
-from weftsim.compare import agreement_checks  # noqa: E402
-from weftsim.scene import load_scene  # noqa: E402
+from weftsim.post.compare import agreement_checks  # noqa: E402
+from weftsim.input.scene import load_scene  # noqa: E402
 
 MODELS = Path(__file__).resolve().parents[1] / "models" / "paper"
 
@@ -67,7 +67,7 @@ PEAK_CHANNELS = ("contact_force_N", "rapier_acceleration_m_s2", "driving_torque_
 
 def _span_disagreements(exu, ref) -> list[str]:
     """First contact within the scene's 0.1 deg and the maxima of |x| over the span within its 1 %
-    (the tolerances of the first-revolution checks, weftsim.compare.agreement_checks)."""
+    (the tolerances of the first-revolution checks, weftsim.post.compare.agreement_checks)."""
     tol = ref.scene.compare
     out = []
     gap = abs(exu.first_contact_angle_deg - ref.first_contact_angle_deg)
@@ -249,7 +249,7 @@ def test_the_rigid_body_model_with_friction_agrees_with_the_reference_engine():
     The start-up peaks converge to the reference's as the tolerance shrinks (F_N 1.8e-3, 7e-5, 2.6e-5 at
     3e-10, 3e-11, 3e-12 m): the test runs at 3e-11 m for a margin below the 1 %."""
     from weftsim import exudyn_engine, reference
-    from weftsim.scene import apply_overrides
+    from weftsim.input.scene import apply_overrides
 
     scene = _scene(0.15, "0p25", revolutions=SPAN_REVOLUTIONS / 2)
     rigid = apply_overrides(scene, {"solver.exudyn.model": "rigid_body", "solver.exudyn.local_error_m": 3e-11})

@@ -5,7 +5,7 @@ the impact velocity are in tests/test_hard_cases_long.py.  docs/hard-cases.md ha
 Every case asserts physics, not stored numbers:
 
 - no NaN or inf in any channel, and the run ends as a success;
-- penetration below the run-time bound of weftsim.guards, a tenth of the journal radius (the
+- penetration below the run-time bound of weftsim.run.guards, a tenth of the journal radius (the
   rigid-body model with a local contact compliance needs the deformed zone small against the
   bodies).  It is *not* small against the clearance: the start-up impact penetrates 0.69 c at
   c = 0.25 mm and 18.5 c at c = 0.01 mm (docs/hard-cases.md, "Penetration");
@@ -29,10 +29,10 @@ import numpy as np
 import pytest
 
 from weftsim import exudyn_engine, reference
-from weftsim.analysis import energy_balance, time_weights
-from weftsim.contact import LAWS
-from weftsim.params import ClearanceJoint, Drive, ExudynSolver, Material, ReferenceSolver, Scene
-from weftsim.results import CHANNELS
+from weftsim.post.analysis import energy_balance, time_weights
+from weftsim.joint.contact import LAWS
+from weftsim.input.params import ClearanceJoint, Drive, ExudynSolver, Material, ReferenceSolver, Scene
+from weftsim.post.results import CHANNELS
 
 RPM = math.pi / 30.0
 STEEL = Scene()

@@ -17,10 +17,10 @@ import numpy as np
 import pytest
 
 from weftsim import exudyn_engine, reference
-from weftsim.analysis import channel_statistics, energy_balance, peaks
-from weftsim.contact import make_law
-from weftsim.params import Drive, ExudynSolver, Material, Scene
-from weftsim.results import CHANNELS
+from weftsim.post.analysis import channel_statistics, energy_balance, peaks
+from weftsim.joint.contact import make_law
+from weftsim.input.params import Drive, ExudynSolver, Material, Scene
+from weftsim.post.results import CHANNELS
 
 RPM = math.pi / 30.0
 STEEL = Scene()
@@ -52,7 +52,7 @@ def per_revolution(result, first: int = 1) -> dict[str, np.ndarray]:
 def assert_finite_and_bounded(result) -> None:
     assert result.ok, result.message
     assert all(np.all(np.isfinite(result.steps[name])) for name in CHANNELS)
-    bound = result.scene.limits.max_penetration * result.scene.joint.journal_radius  # weftsim.guards
+    bound = result.scene.limits.max_penetration * result.scene.joint.journal_radius  # weftsim.run.guards
     assert result.steps["penetration_m"].max() < bound
 
 

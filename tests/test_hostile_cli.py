@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from weftsim.cli import EXIT_USAGE, main
-from weftsim.display import unreachable_display
+from weftsim.cli.commands import EXIT_USAGE, main
+from weftsim.post.display import unreachable_display
 
 UNUSED_DISPLAY = 987  # an X display number nothing on a test machine serves
 
@@ -33,7 +33,7 @@ def no_solve(monkeypatch):
     def solve(*args, **kwargs):
         raise AssertionError("the scene was solved before the refusal")
 
-    monkeypatch.setattr("weftsim.cli._solve", solve)
+    monkeypatch.setattr("weftsim.cli.commands._solve", solve)
     return solve
 
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import weftsim
-from weftsim.results import JOINT_F_CHANNELS
+from weftsim.post.results import JOINT_F_CHANNELS
 
 FORMAT = "weftsim-result/1"
 
@@ -251,7 +251,7 @@ def test_a_first_contact_after_the_end_of_the_run(tmp_path, saved):
 
 
 def test_a_manifest_that_is_a_directory_is_one_line(tmp_path, capsys):
-    from weftsim.cli import main
+    from weftsim.cli.commands import main
 
     (tmp_path / "out" / ".weftsim-output.json").mkdir(parents=True)
     assert main(["run", "reference", "--engine", "reference", "--revolutions", "0.05", "--no-plot",
@@ -263,7 +263,7 @@ def test_a_manifest_that_is_a_directory_is_one_line(tmp_path, capsys):
 def test_a_manifest_listing_odd_names_removes_nothing_of_the_user(tmp_path):
     """A run manifest edited to list a directory, a parent path and non-text entries: the rerun neither fails
     nor removes anything but its own stale files."""
-    from weftsim.output import MANIFEST, write_files, write_text
+    from weftsim.post.output import MANIFEST, write_files, write_text
 
     out = tmp_path / "out"
     (out / "sub").mkdir(parents=True)

@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from weftsim.cli import main
+from weftsim.cli.commands import main
 from weftsim.errors import SceneError, SweepError, WearError
-from weftsim.scene import load_scene
+from weftsim.input.scene import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = ROOT / "models"
@@ -194,7 +194,7 @@ def test_compare_of_less_than_a_revolution_is_partial_not_an_agreement(capsys, t
 
 def test_animation_of_a_clearance_at_f_draws_and_captions_f():
     from weftsim import reference
-    from weftsim.animate import animation_figure, joint_caption, mechanism_frames
+    from weftsim.post.animate import animation_figure, joint_caption, mechanism_frames
 
     result = reference.solve(load_scene(CLEARANCE_F, {"drive.revolutions": 0.3}))
     frames = mechanism_frames(result, 12)
@@ -213,8 +213,8 @@ def test_animation_of_a_clearance_at_f_draws_and_captions_f():
 def test_orbit_figure_has_a_panel_per_clearance_joint(tmp_path):
     """Further round: orbit.png showed joint E alone (and nothing for a clearance at F alone)."""
     from weftsim import reference
-    from weftsim.output import write_run
-    from weftsim.plots import plot_orbit
+    from weftsim.post.output import write_run
+    from weftsim.post.plots import plot_orbit
 
     only_f = reference.solve(load_scene(CLEARANCE_F, {"drive.revolutions": 0.3}))
     figure = plot_orbit(only_f)
@@ -316,7 +316,7 @@ def test_a_wear_update_failing_mid_way_keeps_every_update_before_it(tmp_path, mo
 
 
 def test_a_stop_during_a_wear_update_is_an_interruption_not_a_failure(capsys, tmp_path, monkeypatch):
-    from weftsim.guards import clear_stop, request_stop
+    from weftsim.run.guards import clear_stop, request_stop
     from weftsim.wear import extrapolate
 
     scene = load_scene(REFERENCE)

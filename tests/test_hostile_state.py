@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import weftsim
-from weftsim.cli import main
+from weftsim.cli.commands import main
 from weftsim.errors import OutputError
 from weftsim.wear import predict_to_directory
 from weftsim.wear.store import STATE, StateMismatch
@@ -146,7 +146,7 @@ def test_an_edited_response_statistic_fails_the_checksum(finished, tmp_path):
 @pytest.mark.parametrize("overrides", [{"joint_e.clearance_mm": 0.3}, {"joint_e.wear.profile_points": 180}])
 def test_a_state_of_another_scene_is_refused(finished, tmp_path, overrides):
     """Named as another scene's, also where its arrays no longer fit (fewer profile points): the directory's
-    record of its scene refuses it first, naming the key that differs (weftsim.record)."""
+    record of its scene refuses it first, naming the key that differs (weftsim.post.record)."""
     other = weftsim.load_scene("reference", overrides)
     with pytest.raises(OutputError) as caught:
         predict_to_directory(other, HOURS, _copy(finished, tmp_path, finished[2]), figures=False)

@@ -19,9 +19,9 @@ from exudyn.itemInterface import (  # noqa: E402
 )  # fmt: skip
 from scipy.optimize import brentq  # noqa: E402
 
-from weftsim.contact import make_law  # noqa: E402
+from weftsim.joint.contact import make_law  # noqa: E402
 from weftsim.exudyn_engine.clearance_joint import add_clearance_joint  # noqa: E402
-from weftsim.params import ClearanceJoint  # noqa: E402
+from weftsim.input.params import ClearanceJoint  # noqa: E402
 
 JOINT = ClearanceJoint(clearance=0.25e-3, law="lankarani_nikravesh", friction_coefficient=0.15)
 LOAD = 100.0  # N, pressing the journal onto the bottom of the bearing

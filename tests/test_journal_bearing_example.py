@@ -12,7 +12,7 @@ import matplotlib
 import pytest
 
 from weftsim.kernel.film import MODEL_FINITE
-from weftsim.reynolds import equilibrium
+from weftsim.joint.reynolds import equilibrium
 
 matplotlib.use("Agg")
 

@@ -1,4 +1,4 @@
-"""Tests of weftsim.kinematics: docs/physics.md section 1 check values, closure identities,
+"""Tests of weftsim.mechanism.kinematics: docs/physics.md section 1 check values, closure identities,
 analytic derivatives against finite differences, assembly failure detection."""
 
 from __future__ import annotations
@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize_scalar
 
-from weftsim import kinematics as kin
-from weftsim.params import Drive, Geometry
+from weftsim.mechanism import kinematics as kin
+from weftsim.input.params import Drive, Geometry
 
 GEOM = Geometry()
 OMEGA_400 = Drive().speed  # 400 rpm

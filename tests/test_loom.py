@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 import weftsim
-from weftsim import kinematics as kin
-from weftsim.design_checks import after_run, before_run, running
-from weftsim.pin_loads import ideal_pin_loads
+from weftsim.mechanism import kinematics as kin
+from weftsim.run.design_checks import after_run, before_run, running
+from weftsim.mechanism.pin_loads import ideal_pin_loads
 
 # Targets of the synthesis (docs/physics.md, "The loom mechanism").
 REED_WIDTH = 1.90  # m
@@ -30,7 +30,7 @@ def loom():
 
 
 def test_the_loom_is_a_bundled_scene():
-    from weftsim.scene import bundled_scenes
+    from weftsim.input.scene import bundled_scenes
 
     assert "loom" in bundled_scenes() and "reference" in bundled_scenes()
 
@@ -129,7 +129,7 @@ def test_both_engines_agree_on_the_start_up_impact(speed_rpm, clearance_mm):
     at 0.1 mm: 38.6 and 35.0 deg, 9.9e-2 apart in value; 600 rpm at 0.05 mm: 50.3 and 45.7 deg) they drew
     different impacts of the chaotic sequence, and compare judges the start-up impact's torque maximum
     instead, listing the first-revolution one as not compared, with both angles."""
-    from weftsim.compare import _max_angle_deg, compare_results
+    from weftsim.post.compare import _max_angle_deg, compare_results
 
     scene = weftsim.load_scene("loom", speed_rpm=speed_rpm, clearance_mm=clearance_mm, revolutions=1)
     with warnings.catch_warnings():
@@ -158,7 +158,7 @@ def test_both_engines_agree_on_the_start_up_impact(speed_rpm, clearance_mm):
 def test_compare_at_the_defaults_agrees_on_every_check():
     """`weftsim compare loom` as it runs (2 revolutions, 600 rpm, c = 0.02 mm): every check, the torque's
     too (measured 4.9e-3 against 0.01)."""
-    from weftsim.compare import agreement_checks
+    from weftsim.post.compare import agreement_checks
 
     scene = weftsim.load_scene("loom")
     ref, exu = weftsim.simulate(scene, engine="reference"), weftsim.simulate(scene, engine="exudyn")

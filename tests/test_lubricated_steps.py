@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import weftsim
-from weftsim.analysis import peaks
+from weftsim.post.analysis import peaks
 from weftsim.reference.compiled_ros import rate_tolerance_factor
 from weftsim.reference.dynamics import pack_parameters
 

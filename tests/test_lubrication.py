@@ -21,11 +21,11 @@ import weftsim
 from weftsim.kernel.asperity import H_CUTOFF, asperity_load, f52, greenwood_tripp_coefficient
 from weftsim.kernel.joint import clearance_force_at, joint_parameters
 from weftsim.kernel.lubricated import L_ASPERITY, L_FILM, lubricated_force
-from weftsim.contact import make_law
-from weftsim.params import ClearanceJoint, Lubrication
+from weftsim.joint.contact import make_law
+from weftsim.input.params import ClearanceJoint, Lubrication
 from weftsim.reference import solve
-from weftsim.results import LUBRICATION_CHANNELS
-from weftsim.scene import SceneError, load_scene
+from weftsim.post.results import LUBRICATION_CHANNELS
+from weftsim.input.scene import SceneError, load_scene
 
 OIL = {"joint_e.lubrication.viscosity_mpa_s": 80.0}  # ISO VG 220 near 60 C
 SHORT_RUN = {"drive.revolutions": 0.1}  # the first impact at E and its rebound (~20 deg of crank)

@@ -1,4 +1,4 @@
-"""The journal-centre orbit (weftsim.plots.plot_orbit, orbit.png of ``weftsim run``) draws the run's
+"""The journal-centre orbit (weftsim.post.plots.plot_orbit, orbit.png of ``weftsim run``) draws the run's
 eccentricity inside the clearance circle, with the impacts on that circle (docs/physics.md section 2)."""
 
 from pathlib import Path
@@ -6,10 +6,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from weftsim.output import write_run
-from weftsim.plots import contact_onsets, plot_orbit
+from weftsim.post.output import write_run
+from weftsim.post.plots import contact_onsets, plot_orbit
 from weftsim.reference import solve
-from weftsim.scene import load_scene
+from weftsim.input.scene import load_scene
 
 REFERENCE = Path(__file__).resolve().parents[1] / "models" / "reference.toml"
 PNG = b"\x89PNG\r\n\x1a\n"

@@ -14,7 +14,7 @@ import pytest
 
 from weftsim.reference import solve
 from weftsim.reference.dynamics import ChainConstants, penetration
-from weftsim.scene import load_scene
+from weftsim.input.scene import load_scene
 from weftsim.studies.common import StudyError
 from weftsim.studies.outliers import (
     Cell,

@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from weftsim.output import MANIFEST, OutputError, finish_directory, prepare_directory, write_atomic, write_csv
+from weftsim.post.output import MANIFEST, OutputError, finish_directory, prepare_directory, write_atomic, write_csv
 
 
 def test_failed_write_keeps_the_previous_complete_file(tmp_path):

@@ -11,7 +11,7 @@ import re
 
 import pytest
 
-from weftsim.progress import Progress, RateEstimate
+from weftsim.run.progress import Progress, RateEstimate
 from weftsim.sweep.pool import SweepProgress
 
 

@@ -8,9 +8,9 @@ import sys
 from importlib import metadata
 from pathlib import Path
 
-from weftsim.analysis import summary
+from weftsim.post.analysis import summary
 from weftsim.reference import solve
-from weftsim.scene import load_scene
+from weftsim.input.scene import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 

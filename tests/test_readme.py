@@ -4,7 +4,7 @@ from pathlib import Path
 
 import pytest
 
-from weftsim.scene import SCHEMA
+from weftsim.input.scene import SCHEMA
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -16,11 +16,11 @@ from pathlib import Path
 import pytest
 
 import weftsim
-from weftsim import cli
+from weftsim.cli import commands as cli
 from weftsim.errors import EngineError, OutputError
-from weftsim.output import MANIFEST, prepare_directory
-from weftsim.record import check_same_scene, differences, resolved_scene, scene_toml
-from weftsim.scene import load_scene, to_file_keys
+from weftsim.post.output import MANIFEST, prepare_directory
+from weftsim.post.record import check_same_scene, differences, resolved_scene, scene_toml
+from weftsim.input.scene import load_scene, to_file_keys
 from weftsim.studies import common
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
@@ -143,7 +143,7 @@ def test_every_command_refuses_a_directory_of_another_scene(tmp_path, capsys, co
 def test_prepare_directory_refuses_another_scene_and_force_passes(tmp_path):
     scene = load_scene("reference")
     result = weftsim.simulate(load_scene("reference", {"drive.revolutions": 0.05}), "reference")
-    from weftsim.output import write_run
+    from weftsim.post.output import write_run
 
     write_run(result, tmp_path, figure=False)
     other = load_scene("reference", {"drive.revolutions": 0.05, "joint_e.law": "flores"})

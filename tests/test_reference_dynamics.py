@@ -10,9 +10,9 @@ import math
 import numpy as np
 import pytest
 
-from weftsim import kinematics as kin
+from weftsim.mechanism import kinematics as kin
 from weftsim.kernel.chain import chain
-from weftsim.params import Scene
+from weftsim.input.params import Scene
 from weftsim.reference.dynamics import ChainConstants, eccentricity, initial_state, pack_parameters, penetration
 from weftsim.reference.ideal import crank_side_inertia, crank_side_potential, ideal_torque
 
@@ -119,7 +119,7 @@ def test_ideal_reaction_through_the_contact_gives_the_ideal_torque(theta):
 
 
 def test_eccentricity_uses_the_kinematics_of_the_rocker():
-    """The inlined rocker law (fast float path) equals weftsim.kinematics: P_b = E, dP_b/dtheta = E'."""
+    """The inlined rocker law (fast float path) equals weftsim.mechanism.kinematics: P_b = E, dP_b/dtheta = E'."""
     p = ChainConstants.from_scene(SCENE)
     theta = np.linspace(0.0, 2 * np.pi, 37)
     st = kin.linkage_state(theta, SCENE.geometry, SCENE.inertia.rocker_com)

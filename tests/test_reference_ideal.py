@@ -8,11 +8,11 @@ import math
 
 import numpy as np
 
-from weftsim import kinematics as kin
-from weftsim.params import Scene
+from weftsim.mechanism import kinematics as kin
+from weftsim.input.params import Scene
 from weftsim.reference import solve
 from weftsim.reference.ideal import equivalent_inertia, ideal_torque, potential_energy
-from weftsim.results import CHANNELS, CONTACT_CHANNELS
+from weftsim.post.results import CHANNELS, CONTACT_CHANNELS
 
 SCENE = dataclasses.replace(Scene(), joint=dataclasses.replace(Scene().joint, clearance=0.0))
 THETA = np.linspace(0.0, 2.0 * np.pi, 73)[:-1] + 0.013  # off the symmetric points 0, 90, 180 deg

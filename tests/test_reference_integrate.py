@@ -9,12 +9,12 @@ import math
 import numpy as np
 import pytest
 
-from weftsim import kinematics as kin
-from weftsim.analysis import peaks, time_weights
-from weftsim.params import ReferenceSolver, Scene
+from weftsim.mechanism import kinematics as kin
+from weftsim.post.analysis import peaks, time_weights
+from weftsim.input.params import ReferenceSolver, Scene
 from weftsim.reference import solve
 from weftsim.reference.ideal import ideal_torque
-from weftsim.results import CHANNELS
+from weftsim.post.results import CHANNELS
 
 # This file tests the scipy path (weftsim.reference.integrate), at the tolerances it was written for
 # (the reference engine's default until issue 12; the automatic path is the compiled one).

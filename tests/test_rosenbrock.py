@@ -11,12 +11,12 @@ import pytest
 
 pytest.importorskip("numba")
 
-from weftsim.analysis import energy_balance, peaks  # noqa: E402
+from weftsim.post.analysis import energy_balance, peaks  # noqa: E402
 from weftsim.kernel.chain_f import rhs_any  # noqa: E402
 from weftsim.reference import compiled_ros as ros  # noqa: E402
 from weftsim.reference import select_path, solve  # noqa: E402
 from weftsim.reference.dynamics import initial_state, pack_parameters  # noqa: E402
-from weftsim.scene import load_scene  # noqa: E402
+from weftsim.input.scene import load_scene  # noqa: E402
 
 REFERENCE = Path(__file__).resolve().parents[1] / "models" / "reference.toml"
 PEAK_CHANNELS = ("contact_force_N", "rapier_acceleration_m_s2", "driving_torque_Nm")
@@ -186,7 +186,7 @@ def test_automatic_choice_names_the_stiff_joint_and_keeps_explicit_paths_selecta
 
 
 def test_run_time_and_record_estimates_know_friction():
-    from weftsim.progress import EXPLICIT_STIFF_FACTOR, estimate_run_time, estimate_step_bytes
+    from weftsim.run.progress import EXPLICIT_STIFF_FACTOR, estimate_run_time, estimate_step_bytes
 
     dry, rough = _scene(degrees=360.0), _scene(mu=0.15, degrees=360.0)
     explicit = _scene(mu=0.15, degrees=360.0, method="numba_DOP853")
@@ -199,7 +199,7 @@ def test_run_time_and_record_estimates_know_friction():
 
 
 def test_weftsim_run_announces_an_explicit_friction_run_before_it_starts(capsys):
-    from weftsim.cli import _announce_run_time
+    from weftsim.cli.commands import _announce_run_time
 
     _announce_run_time(_scene(mu=0.15, degrees=720.0, method="numba_DOP853"), ("reference",), "run")
     err = capsys.readouterr().err

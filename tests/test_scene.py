@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from weftsim.params import Scene
-from weftsim.scene import SCHEMA, SceneError, load_scene, to_file_keys
+from weftsim.input.params import Scene
+from weftsim.input.scene import SCHEMA, SceneError, load_scene, to_file_keys
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 PAPER_CASES = {

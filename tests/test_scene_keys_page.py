@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from weftsim.scene import SCHEMA
+from weftsim.input.scene import SCHEMA
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
 sys.path.insert(0, str(DOCS))

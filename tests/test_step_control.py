@@ -16,8 +16,8 @@ import pytest
 from weftsim import reference
 from weftsim.exudyn_engine import solve
 from weftsim.exudyn_engine.step_control import newmark_beta, to_sample_grid
-from weftsim.params import ClearanceJoint, Drive, ExudynSolver, ReferenceSolver, Scene
-from weftsim.scene import SceneError, load_scene
+from weftsim.input.params import ClearanceJoint, Drive, ExudynSolver, ReferenceSolver, Scene
+from weftsim.input.scene import SceneError, load_scene
 
 RPM = math.pi / 30.0
 MODELS = Path(__file__).resolve().parents[1] / "models"

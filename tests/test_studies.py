@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 from scipy.integrate import trapezoid
 
-from weftsim.params import Drive, Scene
-from weftsim.results import CHANNELS, RunResult
+from weftsim.input.params import Drive, Scene
+from weftsim.post.results import CHANNELS, RunResult
 from weftsim.studies import STUDIES, StudyError, run_study
 from weftsim.studies.spectrum import acceleration_spectrum, amplitude_spectrum, bin_means
 
@@ -117,9 +117,9 @@ def test_acceleration_spectrum_needs_a_revolution_after_the_first():
 
 
 def test_spectrum_of_the_ideal_run_holds_harmonics_only_and_satisfies_parseval():
-    from weftsim.analysis import time_weights
+    from weftsim.post.analysis import time_weights
     from weftsim.reference import solve
-    from weftsim.scene import load_scene
+    from weftsim.input.scene import load_scene
 
     result = solve(load_scene(MODELS / "ideal.toml", {"drive.revolutions": 3}))
     spectrum = acceleration_spectrum(result)
@@ -140,8 +140,8 @@ def test_spectrum_of_the_ideal_run_holds_harmonics_only_and_satisfies_parseval()
 
 
 def test_stiffness_curve_is_the_law_and_its_log_slope_the_analytic_one():
-    from weftsim.contact import make_law
-    from weftsim.params import ClearanceJoint
+    from weftsim.joint.contact import make_law
+    from weftsim.input.params import ClearanceJoint
     from weftsim.studies.contact_law import log_slope, stiffness_curve
 
     joint = ClearanceJoint(clearance=0.01e-3, law="variable_kd")
@@ -181,7 +181,7 @@ def test_contact_law_study_writes_its_files_and_the_damping_is_the_law(reduced):
 
 def test_acceleration_deviation_of_the_ideal_run_is_round_off():
     from weftsim.reference import solve
-    from weftsim.scene import load_scene
+    from weftsim.input.scene import load_scene
     from weftsim.studies.clearance import acceleration_deviation, ideal_features
 
     result = solve(load_scene(MODELS / "ideal.toml", {"drive.revolutions": 2}))
@@ -236,7 +236,7 @@ def test_unknown_study_and_missing_scenes_are_errors(tmp_path):
 
 
 def test_cli_study_command(tmp_path, capsys):
-    from weftsim.cli import main
+    from weftsim.cli.commands import main
 
     assert main(["study", "nope", "-o", str(tmp_path)]) == 2
     assert "unknown study" in capsys.readouterr().err
@@ -276,7 +276,7 @@ def test_report_has_a_row_per_paper_statement_and_links_existing_figures(reduced
     (["speed", "--set", "joint_e.wear.wear_coefficient=1e-6"], "read by `weftsim wear` only"),
 ])
 def test_study_refuses_overrides_of_what_it_sets(args, words, tmp_path, capsys):
-    from weftsim.cli import main
+    from weftsim.cli.commands import main
 
     out = tmp_path / "out"
     assert main(["study", *args, "-o", str(out), "--models", str(MODELS)]) == 2
@@ -291,7 +291,7 @@ def test_study_overrides_reach_every_run(tmp_path, capsys):
     section 2), here e = 0.8 -> 0.27 against the scene's 0.9 -> 0.1425."""
     import json
 
-    from weftsim.cli import main
+    from weftsim.cli.commands import main
 
     out = tmp_path / "cl"
     assert main(["study", "contact-law", "-o", str(out), "--models", str(MODELS), "--revolutions", "0.05",

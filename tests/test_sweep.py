@@ -17,8 +17,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from weftsim.cli import EXIT_FAILED, EXIT_USAGE, main
-from weftsim.results import CHANNELS, RunResult
+from weftsim.cli.commands import EXIT_FAILED, EXIT_USAGE, main
+from weftsim.post.results import CHANNELS, RunResult
 from weftsim.sweep import plan_sweep, run_sweep
 from weftsim.sweep.cell import CELL_FILE, ERROR_FILE
 from weftsim.sweep.grid import SweepError, cell_name, grid_cells, parse_set, parse_vary
@@ -42,7 +42,7 @@ def fake_solve(scene, progress=None):
     call sleep that long; ``WEFTSIM_FAKE_GATE_DIR`` lets only ``WEFTSIM_FAKE_FAST_CELLS`` calls
     finish (for the kill-and-resume test).
     """
-    from weftsim.kinematics import rapier_motion
+    from weftsim.mechanism.kinematics import rapier_motion
 
     time.sleep(float(os.environ.get("WEFTSIM_FAKE_DELAY_S", "0")))
     gate = os.environ.get("WEFTSIM_FAKE_GATE_DIR")
@@ -82,8 +82,8 @@ def fake_solve(scene, progress=None):
 
 def fake_peaks(clearance_mm, speed_rpm, revolutions=0.5):
     """The peaks fake_solve's per-step channels reach (same 0.25 deg grid)."""
-    from weftsim.kinematics import rapier_motion
-    from weftsim.scene import load_scene
+    from weftsim.mechanism.kinematics import rapier_motion
+    from weftsim.input.scene import load_scene
 
     scene = load_scene(REFERENCE)
     omega = speed_rpm * math.pi / 30
@@ -313,8 +313,8 @@ def test_interrupted_sweep_resumes_without_losing_or_redoing_finished_cells(tmp_
 
 def test_reference_engine_sweep_of_twelve_cells(tmp_path):
     """Twelve short reference-engine cells: ideal cells give the closed-form kinematics, clearance adds contact."""
-    from weftsim.kinematics import rapier_motion
-    from weftsim.scene import load_scene
+    from weftsim.mechanism.kinematics import rapier_motion
+    from weftsim.input.scene import load_scene
 
     report = sweep(tmp_path, ["clearance_mm=0,0.1,0.25,0.5", "speed_rpm=300,400,800"], ["revolutions=0.25"],
                    engine="reference", jobs=2)

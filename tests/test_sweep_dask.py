@@ -23,8 +23,8 @@ from pathlib import Path
 
 import pytest
 
-from weftsim.cli import EXIT_FAILED, main
-from weftsim.record import MANIFEST
+from weftsim.cli.commands import EXIT_FAILED, main
+from weftsim.post.record import MANIFEST
 from weftsim.sweep import plan_sweep, run_sweep
 from weftsim.sweep.cell import CELL_FILE, is_finished, read_record
 from weftsim.sweep.store import TABLE_FILE, read_table

@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 from test_sweep import FAKE, REFERENCE, ROOT, SHORT, _terminal_sigint, sweep
 
-from weftsim.cli import EXIT_USAGE, main
+from weftsim.cli.commands import EXIT_USAGE, main
 from weftsim.sweep import LARGE_GRID_CELLS, SweepError, plan_sweep
 from weftsim.sweep.cell import CELL_FILE, SUMMARY_FILE, is_finished, read_record
 from weftsim.sweep.grid import parse_vary
@@ -389,7 +389,7 @@ def test_an_edited_cell_record_is_run_again(finished_sweep, tmp_path, capsys, ed
 
 
 def _many_axes(count):
-    from weftsim.scene import SCHEMA
+    from weftsim.input.scene import SCHEMA
 
     keys = [k.path for k in SCHEMA if k.kind == "float"][:count]
     assert len(keys) == count

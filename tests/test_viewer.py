@@ -8,7 +8,7 @@ import pytest
 from exudyn import ConfigurationType
 from exudyn.utilities import LoadSolutionFile
 
-from weftsim.cli import EXIT_USAGE, main
+from weftsim.cli.commands import EXIT_USAGE, main
 from weftsim.exudyn_engine.mechanism import CRANK_COORDINATE, ROTATION_2D
 from weftsim.exudyn_engine.viewer import (
     SUPPRESS_VARIABLE,
@@ -18,8 +18,8 @@ from weftsim.exudyn_engine.viewer import (
     record_solution,
     show_solution,
 )
-from weftsim.kinematics import linkage_state
-from weftsim.scene import load_scene
+from weftsim.mechanism.kinematics import linkage_state
+from weftsim.input.scene import load_scene
 
 # The solution file stores 10 significant digits (Exudyn's solution.precision default): ~1e-10 rad on the
 # crank angle (< 2 pi).  Measured: crank angle vs omega t within 6.4e-10 rad over a quarter revolution (the

@@ -16,9 +16,9 @@ import pytest
 
 from weftsim import reference
 from weftsim.kernel.wear import deposit
-from weftsim.params import LOOM_JOINT_E, WearModel
+from weftsim.input.params import LOOM_JOINT_E, WearModel
 from weftsim.reference.dynamics import pack_parameters
-from weftsim.scene import load_scene
+from weftsim.input.scene import load_scene
 from weftsim.wear.archard import contact_rows, run_wear, wear_from_rows
 from weftsim.wear.extrapolate import effective_clearance, predict
 

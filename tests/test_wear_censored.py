@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from weftsim.errors import WearError
-from weftsim.scene import apply_overrides, load_scene
+from weftsim.input.scene import apply_overrides, load_scene
 from weftsim.wear import ensemble
 from weftsim.wear.censored import censored_quantile, fraction_interval
 from weftsim.wear.ensemble_design import _hat, interpolate

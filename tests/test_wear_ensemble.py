@@ -16,7 +16,7 @@ import pytest
 from scipy import stats
 
 from weftsim.errors import WearError
-from weftsim.scene import load_scene
+from weftsim.input.scene import load_scene
 from weftsim.wear.ensemble import _lagrange, combine, plan
 from weftsim.wear.jobs import hours_at, run_job
 from weftsim.wear.uncertain import latin_hypercube, parse_uncertain, quantile_interval, rank_shares
@@ -211,7 +211,7 @@ def test_a_hard_cycle_backs_off_and_goes_on(monkeypatch, tmp_path):
 def test_design_interpolation_matches_a_direct_prediction(tmp_path):
     """A dynamic key (speed) from three design predictions: the interpolated hours at an off-design speed
     equal a prediction simulated there (loom, 0.02 -> 0.025 mm)."""
-    from weftsim.scene import apply_overrides
+    from weftsim.input.scene import apply_overrides
 
     loom = load_scene(Path(__file__).resolve().parents[1] / "models" / "loom.toml")
     limit = 0.025e-3

@@ -18,7 +18,7 @@ from weftsim import exudyn_engine, reference
 from weftsim.kernel import chain as kc
 from weftsim.kernel.wear import worn_clearance
 from weftsim.reference.dynamics import pack_parameters
-from weftsim.scene import load_scene
+from weftsim.input.scene import load_scene
 from weftsim.wear import WearError, check_request
 from weftsim.wear.engines import engine_update, exudyn_update
 from weftsim.wear.extrapolate import worn_scene
@@ -203,7 +203,7 @@ def test_a_worn_lubricated_joint_agrees_between_the_engines():
     half a revolution: the film sees the local clearance on both engines (the worn spots raise the smallest
     film ratio from 3.86 to 3.91 on the reference engine), and the engines agree on the smallest film ratio and
     the largest film force."""
-    from weftsim.scene import apply_overrides
+    from weftsim.input.scene import apply_overrides
 
     scene = apply_overrides(load_scene("loom"), {"joint_e.lubrication.viscosity_mpa_s": 20.0})
     worn = _worn(scene, 0.5)[0]
@@ -290,8 +290,8 @@ def test_the_reusable_connector_sees_a_worn_spot_as_the_clearance_there():
     """``add_clearance_joint`` on a joint worn at one spot of the bearing (0.5 c0 deep at 0 deg of the ground's
     frame): a journal moving straight into the spot meets the wall at c0 + h and rebounds as from a round joint
     of clearance c0 + h with the same law, to round-off (a mass point and the ground: both frames at angle 0)."""
-    from weftsim.contact import make_law
-    from weftsim.params import ClearanceJoint
+    from weftsim.joint.contact import make_law
+    from weftsim.input.params import ClearanceJoint
 
     c0, speed, gap = 0.25e-3, 0.5, 1e-6
     joint = ClearanceJoint(clearance=c0, law="variable_kd")

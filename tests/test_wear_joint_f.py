@@ -18,7 +18,7 @@ import pytest
 from weftsim import reference
 from weftsim.kernel import chain_f as kf
 from weftsim.reference.dynamics import pack_parameters
-from weftsim.scene import SceneError, load_scene
+from weftsim.input.scene import SceneError, load_scene
 from weftsim.wear import predict_to_directory
 from weftsim.wear.archard import contact_rows_f, run_wear
 from weftsim.wear.extrapolate import effective_clearance, predict

@@ -59,8 +59,8 @@ from weftsim.errors import (  # noqa: E402
     WeftsimError,
     WriteFailed,
 )
-from weftsim.params import Scene  # noqa: E402
-from weftsim.results import CHANNELS, RunResult  # noqa: E402
+from weftsim.input.params import Scene  # noqa: E402
+from weftsim.post.results import CHANNELS, RunResult  # noqa: E402
 
 __all__ = [
     "ArgumentError",

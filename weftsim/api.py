@@ -25,8 +25,8 @@ from types import ModuleType
 from typing import TYPE_CHECKING, Any, Callable
 
 from weftsim.errors import ArgumentError, EngineError, OutputError, PlausibilityWarning, RunFailed, SceneError, closest
-from weftsim.params import Scene
-from weftsim.results import RunResult
+from weftsim.input.params import Scene
+from weftsim.post.results import RunResult
 
 if TYPE_CHECKING:
     import xarray
@@ -85,12 +85,12 @@ def load_scene(scene: str | os.PathLike, overrides: Mapping[str, Any] | None = N
     **flags
         The command line's shorthands: ``clearance_mm`` (radial clearance at E, mm; 0 is the ideal
         joint), ``speed_rpm`` (crank speed, rpm), ``revolutions`` (crank revolutions), ``law``
-        (contact force law, a name of :data:`weftsim.contact.LAWS`).
+        (contact force law, a name of :data:`weftsim.joint.contact.LAWS`).
 
     Returns
     -------
     Scene
-        The validated scene in SI units (:class:`weftsim.params.Scene`, frozen).
+        The validated scene in SI units (:class:`weftsim.input.params.Scene`, frozen).
 
     Raises
     ------
@@ -98,7 +98,7 @@ def load_scene(scene: str | os.PathLike, overrides: Mapping[str, Any] | None = N
         The file or name, a key or a value is not acceptable; the message names the file, the
         key, the bad value and what is allowed (and the closest key or scene name for a typo).
     """
-    from weftsim.scene import load_scene as load_file
+    from weftsim.input.scene import load_scene as load_file
 
     return load_file(scene, scene_overrides(overrides, **flags), overrides_from="overrides")
 
@@ -110,7 +110,7 @@ def bundled_scenes() -> list[str]:
     400 rpm), ``"ideal"`` the same with an ideal joint, ``"paper/..."`` the paper's clearance and
     speed cases.  ``weftsim scenes`` lists them with their descriptions.
     """
-    from weftsim.scene import bundled_scenes as names
+    from weftsim.input.scene import bundled_scenes as names
 
     return names()
 
@@ -191,7 +191,7 @@ def simulate(scene: Scene | str | os.PathLike, engine: str = "auto", *,
     weftsim.errors.ArgumentError
         ``progress`` is neither None nor callable.
     """
-    from weftsim.design_checks import before_run, warnings_of
+    from weftsim.run.design_checks import before_run, warnings_of
 
     module = _engine_module(engine)
     if progress is not None and not callable(progress):
@@ -217,7 +217,7 @@ def plausibility_checks(scene: Scene | str | os.PathLike) -> list[dict]:
     "info"), further ``numbers`` and the warning ``message``.  A run adds the after-run checks in
     ``result.plausibility["checks"]``.
     """
-    from weftsim.design_checks import before_run
+    from weftsim.run.design_checks import before_run
 
     return [check.as_dict() for check in before_run(_as_scene(scene))]
 
@@ -237,14 +237,14 @@ def save_result(result: RunResult, path: str | os.PathLike) -> Path:
     weftsim.errors.OutputError
         The file cannot be written.
     """
-    from weftsim.results import save_npz
+    from weftsim.post.results import save_npz
 
     if not isinstance(result, RunResult):
         raise ArgumentError(f"save_result: result must be a RunResult (from weftsim.simulate or load_result), "
                             f"got {type(result).__name__}")
     if not isinstance(path, (str, os.PathLike)):
         raise ArgumentError(f"save_result: path must be a file path, got {type(path).__name__}")
-    from weftsim.output import write_atomic
+    from weftsim.post.output import write_atomic
 
     try:  # atomic: a run killed while saving leaves the previous file (or none), never a truncated one
         write_atomic(Path(path), lambda tmp: save_npz(result, tmp))
@@ -262,15 +262,15 @@ def load_result(path: str | os.PathLike) -> RunResult:
     ------
     weftsim.errors.OutputError
         The file is missing, unreadable, not a weftsim result, or damaged or edited so that it no longer
-        is one (each checked before anything is allocated: :mod:`weftsim.result_file`).
+        is one (each checked before anything is allocated: :mod:`weftsim.post.result_file`).
     weftsim.errors.ArgumentError
         ``path`` is not a path.
     """
-    from weftsim.results import load_npz
+    from weftsim.post.result_file import read_npz
 
     if not isinstance(path, (str, os.PathLike)):
         raise ArgumentError(f"load_result: path must be a file path, got {type(path).__name__}")
-    return load_npz(path)
+    return read_npz(path)
 
 
 def load_sweep(directory: str | os.PathLike) -> xarray.Dataset:

@@ -7,7 +7,7 @@ command line prints after ``weftsim COMMAND: error:``.  A script catches them al
 expect (``ValueError`` for bad input, ``OSError`` for files, ``ImportError`` for a missing
 package), so code written against those keeps working.
 
-``exit_status`` is the status the ``weftsim`` command ends with (:mod:`weftsim.exitcodes`).
+``exit_status`` is the status the ``weftsim`` command ends with (:mod:`weftsim.cli.exitcodes`).
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from __future__ import annotations
 import difflib
 from typing import Any, Iterable
 
-from weftsim.exitcodes import EXIT_FAILED, EXIT_USAGE
+from weftsim.cli.exitcodes import EXIT_FAILED, EXIT_USAGE
 
 
 class WeftsimError(Exception):
@@ -49,10 +49,10 @@ class WriteFailed(OutputError):
 
 class RunFailed(WeftsimError, RuntimeError):
     """A simulation ended with ``status = "failed"``; :attr:`result` keeps what it computed (a
-    :class:`weftsim.results.RunResult`, or None).
+    :class:`weftsim.post.results.RunResult`, or None).
 
     The attribute is typed loosely on purpose: this module is the bottom of weftsim's imports (every
-    module raises these errors, :mod:`weftsim.results` among them), so it names no module above it.
+    module raises these errors, :mod:`weftsim.post.results` among them), so it names no module above it.
     """
 
     exit_status = EXIT_FAILED
@@ -116,4 +116,4 @@ def require(module: str, extra: str, purpose: str) -> Any:
 
 
 class PlausibilityWarning(UserWarning):
-    """A scene value outside what a real loom is built for (weftsim.design_checks); the run goes on."""
+    """A scene value outside what a real loom is built for (weftsim.run.design_checks); the run goes on."""

@@ -25,13 +25,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from weftsim.analysis import complete_revolutions, peaks, statistics
+from weftsim.post.analysis import complete_revolutions, peaks, statistics
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
 
-    from weftsim.params import Scene
-    from weftsim.results import RunResult
+    from weftsim.input.params import Scene
+    from weftsim.post.results import RunResult
 
 QUANTITY_CHANNELS = ("driving_torque_Nm", "rapier_acceleration_m_s2", "contact_force_N")
 CASES = {
@@ -123,7 +123,7 @@ def settings(case: str, quick: bool = False) -> list[Setting]:
 
 
 def load_case(case: str, models: str | Path, revolutions: float, overrides: dict | None = None) -> Scene:
-    from weftsim.scene import load_scene
+    from weftsim.input.scene import load_scene
 
     keys = {**CASES[case], "drive.revolutions": revolutions, **(overrides or {})}
     scene = load_scene(Path(models) / "reference.toml", keys)

@@ -21,7 +21,7 @@ FAILED_Y = 1.0  # where failed runs are drawn (relative error 100 %)
 
 
 def machine_info() -> dict:
-    """CPU, cores, load average, OS, Python and package versions, git commit (:mod:`weftsim.provenance`,
+    """CPU, cores, load average, OS, Python and package versions, git commit (:mod:`weftsim.post.provenance`,
     as ``summary.json`` records them)."""
     cpu = platform.processor() or "?"
     try:
@@ -31,7 +31,7 @@ def machine_info() -> dict:
                 break
     except OSError:
         pass
-    from weftsim import provenance
+    from weftsim.post import provenance
 
     return {
         "cpu": cpu,
@@ -161,7 +161,8 @@ def figure(report: dict, case: str) -> Figure:
 
 def write_report(report: dict, outdir: str | Path, force: bool = False) -> list[Path]:
     """bench.json, bench.md and one figure per case into ``outdir``; returns the files."""
-    from weftsim.output import begin_directory, finish_directory, prepare_directory, write_figure, write_json, write_text
+    from weftsim.post.output import (begin_directory, finish_directory, prepare_directory, write_figure, write_json,
+                                     write_text)
 
     outdir = prepare_directory(outdir, force)
     begin_directory(outdir, {"kind": "bench", "mode": report["mode"]})

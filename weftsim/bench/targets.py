@@ -221,7 +221,7 @@ def markdown(report: dict) -> str:
 def write_targets(report: dict, outdir: str | Path, force: bool = False) -> list[Path]:
     """targets.json and targets.md into ``outdir``; returns the files."""
     from weftsim.bench.report import machine_info
-    from weftsim.output import begin_directory, finish_directory, prepare_directory, write_json, write_text
+    from weftsim.post.output import begin_directory, finish_directory, prepare_directory, write_json, write_text
 
     outdir = prepare_directory(outdir, force)
     begin_directory(outdir, {"kind": "bench", "mode": "targets"})

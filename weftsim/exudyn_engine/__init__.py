@@ -2,7 +2,7 @@
 
 Public API::
 
-    solve(scene, progress=None) -> weftsim.results.RunResult
+    solve(scene, progress=None) -> weftsim.post.results.RunResult
     select_path(scene) -> dict                                 the model and method solve will use, and why
     build_mechanism(mbs, scene, ...) -> MechanismModel          members 1-8 in an Exudyn system
     add_clearance_joint(mbs, marker_bearing, marker_journal, joint, law=None, callback="auto")

@@ -51,7 +51,7 @@ if TYPE_CHECKING:
 
     from numba.core.registry import CPUDispatcher
 
-    from weftsim.contact import _Law
+    from weftsim.joint.contact import _Law
 
 ROUTES = ("python", "numba")
 # Fastest route on the loom model, rigid body and kinematic tree (scripts/bench_callbacks.py,

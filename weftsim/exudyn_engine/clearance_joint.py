@@ -3,7 +3,7 @@
 :func:`add_clearance_joint` puts the joint between a bearing marker and a journal marker
 (``MarkerBodyPosition`` at the two joint centres, bodies moving in Exudyn's XY plane,
 joint axis = Exudyn Z) as an ``ObjectConnectorCartesianSpringDamper`` whose force callback
-applies a contact law of :mod:`weftsim.contact`.  The impact velocity is located at the
+applies a contact law of :mod:`weftsim.joint.contact`.  The impact velocity is located at the
 true onset within the step and held until separation, raised to any larger approach rate
 under the default ``joint.impact_velocity_rule = "max_approach"`` (:mod:`.onset`); the
 bookkeeping runs in a post-step user function, i.e. on accepted steps only.  Usage::
@@ -31,7 +31,7 @@ reports it as a ``ModelError`` carrying this message):
 - bodies that leave Exudyn's XY plane: an eccentricity with an out-of-plane part larger than the
   clearance (the contact only sees the in-plane part).
 
-Lubrication (``joint.lubrication``, :class:`weftsim.params.Lubrication`): the oil film, the asperity
+Lubrication (``joint.lubrication``, :class:`weftsim.input.params.Lubrication`): the oil film, the asperity
 contact and the boundary friction of :mod:`weftsim.kernel.lubricated` act at every state, in contact or
 not, through the same connector and torque loads as friction (:mod:`.joint_friction`, with the kernel's
 :func:`~weftsim.kernel.lubricated.connector_lubricated_force`); ``model.friction.lubrication_history``
@@ -57,18 +57,18 @@ import exudyn as exu
 import numpy as np
 from exudyn.itemInterface import ObjectConnectorCartesianSpringDamper
 
-from weftsim.contact import make_law
+from weftsim.joint.contact import make_law
 from weftsim.exudyn_engine import callbacks
 from weftsim.exudyn_engine.joint_friction import JointFriction
 from weftsim.exudyn_engine.onset import OnsetTracker, penetration_state
 from weftsim.kernel.joint import joint_parameters
 from weftsim.kernel.wear import wear_block
-from weftsim.params import ClearanceJoint
+from weftsim.input.params import ClearanceJoint
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from weftsim.contact import _Law
+    from weftsim.joint.contact import _Law
 
 ROUTES = callbacks.ROUTES
 DEFAULT_ROUTE = callbacks.DEFAULT_ROUTE
@@ -134,7 +134,7 @@ class ClearanceJointModel:
         The ``ObjectConnectorCartesianSpringDamper``; its ``Force`` output is F_N n (the
         force on the bearing; the journal gets the opposite), ``Displacement`` is e.
     joint : ClearanceJoint
-    law : contact law of :mod:`weftsim.contact`
+    law : contact law of :mod:`weftsim.joint.contact`
     route : str
         Callback route in use (one of :data:`ROUTES`).
     tracker : OnsetTracker
@@ -187,7 +187,7 @@ def add_clearance_joint(mbs: exu.MainSystem, marker_bearing: exu.MarkerIndex, ma
     joint : ClearanceJoint
         Clearance c > 0, radii, materials, law name, restitution, v_min.
     law : contact law, optional
-        Defaults to ``weftsim.contact.make_law(joint)``; any law of that library.
+        Defaults to ``weftsim.joint.contact.make_law(joint)``; any law of that library.
     callback : {"auto", "python", "numba"}
         Force callback route; "auto" = :data:`DEFAULT_ROUTE` (the fastest measured).
     call_counter : list, optional

@@ -49,8 +49,8 @@ from exudyn.itemInterface import (
 from exudyn.rigidBodyUtilities import RigidBodyInertia
 
 from weftsim.exudyn_engine.clearance_joint import ClearanceJointModel, add_clearance_joint
-from weftsim.kinematics import coupler_angular_velocity, coupler_frame, crank_axis, linkage_state, rocker_axis
-from weftsim.params import Scene
+from weftsim.mechanism.kinematics import coupler_angular_velocity, coupler_frame, crank_axis, linkage_state, rocker_axis
+from weftsim.input.params import Scene
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -134,7 +134,7 @@ def build_mechanism(mbs: exu.MainSystem, scene: Scene, callback: str | None = No
     """Add members 1-8, their joints, gravity and the crank drive to ``mbs`` (not assembled).
 
     Initial state: the ideal mechanism at theta = 0 (positions and velocities from
-    :func:`weftsim.kinematics.linkage_state`), journal centred.
+    :func:`weftsim.mechanism.kinematics.linkage_state`), journal centred.
 
     Parameters
     ----------
@@ -191,7 +191,7 @@ def build_mechanism(mbs: exu.MainSystem, scene: Scene, callback: str | None = No
     else:  # F with a clearance: the sector's eye is the bearing, the rod's pin the journal
         bearing_f = mbs.AddMarker(MarkerBodyPosition(bodyNumber=sector["bodyNumber"], localPosition=[g.l_fg, 0.0, 0.0]))
         journal_f = mbs.AddMarker(MarkerBodyPosition(bodyNumber=rod["bodyNumber"], localPosition=[half, 0.0, 0.0]))
-        with warnings.catch_warnings():  # the scene's own check names joint_f.restitution (weftsim.plausibility);
+        with warnings.catch_warnings():  # the scene's own check names joint_f.restitution (weftsim.run.plausibility);
             warnings.simplefilter("ignore", UserWarning)  # the joint's warning names the Python field
             clearance_f = add_clearance_joint(mbs, bearing_f, journal_f, scene.joint_f, callback=route)
     _pin(mbs, ground, [g.l_og, 0.0, 0.0], sector["bodyNumber"], [0.0, 0.0, 0.0])  # G

@@ -1,6 +1,6 @@
 """Impact-velocity capture at the true contact onset (pure Python, no Exudyn).
 
-The contact laws (:mod:`weftsim.contact`) scale their damping by the impact velocity
+The contact laws (:mod:`weftsim.joint.contact`) scale their damping by the impact velocity
 v_imp = delta_dot at the instant delta crosses zero.  A fixed-step integrator sees the
 crossing only between two accepted states: the last free one (delta0 <= 0, rate0) and
 the first penetrated one (delta1 > 0, rate1).  Taking rate1 as v_imp makes an O(h)
@@ -48,7 +48,7 @@ from weftsim.kernel.hold import (  # noqa: F401 - the rules' one definition, re-
     onset_fraction,
     onset_velocity,
 )
-from weftsim.scene import IMPACT_VELOCITY_RULES
+from weftsim.input.scene import IMPACT_VELOCITY_RULES
 
 
 def positive_onset_velocity(t0: float, delta0: float, rate0: float, t1: float, delta1: float,

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import math
 
-from weftsim.params import Scene
+from weftsim.input.params import Scene
 
 AUTO = "auto"
 # Step of the ideal joint, as crank angle.  The ideal mechanism has no free coordinate: its motion

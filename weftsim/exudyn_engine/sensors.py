@@ -31,7 +31,7 @@ import numpy as np
 from exudyn.itemInterface import SensorBody, SensorNode, SensorObject
 
 from weftsim.exudyn_engine.mechanism import CRANK_COORDINATE, ROTATION_2D, MechanismModel
-from weftsim.results import (
+from weftsim.post.results import (
     CHANNELS, CONTACT_CHANNELS, JOINT_E_NAME, JOINT_F_CHANNELS, LUBRICATION_CHANNELS, LUBRICATION_CHANNELS_F,
     optional_channels,
 )  # fmt: skip
@@ -79,7 +79,7 @@ def _cumtrapz(y, x):
 
 
 def step_channels(mbs: exu.MainSystem, model: MechanismModel, sensors: dict) -> dict[str, np.ndarray]:
-    """All :data:`~weftsim.results.CHANNELS` at every stored step (rows cut to a common length)."""
+    """All :data:`~weftsim.post.results.CHANNELS` at every stored step (rows cut to a common length)."""
     scene = model.scene
     get = mbs.GetSensorStoredData
     crank = get(sensors["crank"])

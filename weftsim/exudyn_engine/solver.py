@@ -34,10 +34,10 @@ from weftsim.exudyn_engine.selection import (  # noqa: F401 (IDEAL_JOINT_STEP_AN
 )
 from weftsim.exudyn_engine.step_control import StepController, failure_reason
 from weftsim.exudyn_engine.sensors import add_sensors, first_nonfinite_row, sample_channels, silence, step_channels
-from weftsim.guards import RunGuard, failure_message, non_finite_breach, vet_result
-from weftsim.params import Scene
-from weftsim.scene import IMPACT_VELOCITY_RULES, STEP_CONTROLS
-from weftsim.results import RunResult, angle_grid, empty_channels
+from weftsim.run.guards import RunGuard, failure_message, non_finite_breach, vet_result
+from weftsim.input.params import Scene
+from weftsim.input.scene import IMPACT_VELOCITY_RULES, STEP_CONTROLS
+from weftsim.post.results import RunResult, angle_grid, empty_channels
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -295,7 +295,7 @@ def _solve_model(scene: Scene, model: str, progress, callback: str | None, wall0
         events.update({f"first_contact_time_{name}_s": first.get(name) for name in ("e", "f")})
     if progress is not None:
         progress(1.0)
-    # Post-run criteria (energy balance, ...) that no single step shows; see weftsim.guards.
+    # Post-run criteria (energy balance, ...) that no single step shows; see weftsim.run.guards.
     return vet_result(RunResult(scene, "exudyn", status, message, samples, steps, stats, events))
 
 

@@ -44,7 +44,7 @@ if TYPE_CHECKING:
     import numpy as np
 
     from weftsim.exudyn_engine.mechanism import MechanismModel
-    from weftsim.params import Scene
+    from weftsim.input.params import Scene
 
 # Controller constants (Hairer, Norsett and Wanner, section II.4): aim at 0.9 of the tolerance,
 # never shrink below 0.2 or grow beyond 2x in one step (a step that grows faster meets an impact

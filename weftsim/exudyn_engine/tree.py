@@ -53,7 +53,7 @@ from exudyn.itemInterface import NodeGenericODE2, ObjectKinematicTree
 
 from weftsim.exudyn_engine import callbacks
 from weftsim.exudyn_engine.onset import OnsetTracker
-from weftsim.params import Scene
+from weftsim.input.params import Scene
 from weftsim.reference.dynamics import initial_state, pack_parameters
 from weftsim.reference.ideal import sector_chain_inertia
 

@@ -38,7 +38,7 @@ from weftsim.exudyn_engine.step_control import StepController, newmark_beta, to_
 
 if TYPE_CHECKING:
     from weftsim.exudyn_engine.tree import TreeModel
-    from weftsim.params import Scene
+    from weftsim.input.params import Scene
 
 OVT = exu.OutputVariableType
 # Newton: full (a fresh Jacobian each iteration: with friction the ramp's slope changes the Jacobian by

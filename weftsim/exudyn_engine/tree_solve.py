@@ -22,8 +22,8 @@ Channels, at every accepted step (docs/physics.md section 4 signs):
                      integral (F_N - F_el) delta_dot - F_T v_T dt (damping and friction work,
                      :func:`contact_work` over accepted steps)
 
-Failures as in :mod:`.solver`: the run guards of :mod:`weftsim.guards` after every step,
-Exudyn exceptions, non-finite values, a premature stop; :func:`weftsim.guards.vet_result`.
+Failures as in :mod:`.solver`: the run guards of :mod:`weftsim.run.guards` after every step,
+Exudyn exceptions, non-finite values, a premature stop; :func:`weftsim.run.guards.vet_result`.
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ import exudyn as exu
 import numpy as np
 from exudyn.itemInterface import SensorNode
 
-from weftsim.contact import make_law
+from weftsim.joint.contact import make_law
 from weftsim.exudyn_engine.sensors import first_nonfinite_row, sample_channels, silence
 from weftsim.exudyn_engine import callbacks
 from weftsim.exudyn_engine.clearance_joint import register_post_step
@@ -53,11 +53,11 @@ from weftsim.exudyn_engine.selection import (  # noqa: F401 (re-exported: the tr
 )
 from weftsim.exudyn_engine.tree_implicit import ImplicitTree
 from weftsim.exudyn_engine.step_control import failure_reason as implicit_failure
-from weftsim.guards import RunGuard, failure_message, non_finite_breach, vet_result
-from weftsim.params import Scene
+from weftsim.run.guards import RunGuard, failure_message, non_finite_breach, vet_result
+from weftsim.input.params import Scene
 from weftsim.reference.dynamics import NUMPY, ChainConstants, chain_energy, eccentricity, initial_state
 from weftsim.reference.ideal import crank_side_inertia, crank_side_potential
-from weftsim.results import RunResult, angle_grid, empty_channels
+from weftsim.post.results import RunResult, angle_grid, empty_channels
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -232,8 +232,8 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
     ratio = scene.geometry.rapier_ratio
     kin13 = 0.5 * j13 * omega**2
     lubricated = {}
-    if scene.joint.is_lubricated:  # the film channels from the kernel at the tree's states (weftsim.lubrication)
-        from weftsim.lubrication import lubrication_table
+    if scene.joint.is_lubricated:  # the film channels from the kernel at the tree's states (weftsim.joint.lubrication)
+        from weftsim.joint.lubrication import lubrication_table
         from weftsim.reference.dynamics import pack_parameters
 
         states = np.zeros((n, 6))

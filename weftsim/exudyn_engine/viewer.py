@@ -30,11 +30,11 @@ import exudyn as exu
 import exudyn.graphics as graphics
 
 from weftsim.errors import RunFailed, WeftsimError
-from weftsim.exitcodes import EXIT_USAGE
+from weftsim.cli.exitcodes import EXIT_USAGE
 from weftsim.exudyn_engine.mechanism import MechanismModel, build_mechanism
 from weftsim.exudyn_engine.solver import adaptive, check_settings, simulation_settings, step_plan
 from weftsim.exudyn_engine.step_control import StepController
-from weftsim.params import Scene
+from weftsim.input.params import Scene
 
 # Exudyn reads this variable at import; any value but these blocks its windows (exudyn/__init__.py).
 SUPPRESS_VARIABLE = "EXUDYN_SUPPRESS_UI_WINDOW_OPEN"
@@ -62,7 +62,7 @@ def display_problem(environ: Mapping[str, str] | None = None, platform: str | No
     macOS and Windows always have a desktop.  ``EXUDYN_SUPPRESS_UI_WINDOW_OPEN`` (set by test and
     documentation builds) makes Exudyn skip every window, which would leave the viewer with nothing to do.
     ``probe`` (default: when ``environ`` is the process's own) also connects to the display's socket
-    (:func:`weftsim.display.unreachable_display`): a ``DISPLAY`` with no server behind it makes the
+    (:func:`weftsim.post.display.unreachable_display`): a ``DISPLAY`` with no server behind it makes the
     renderer abort the process natively.
     """
     probe = environ is None if probe is None else probe
@@ -75,7 +75,7 @@ def display_problem(environ: Mapping[str, str] | None = None, platform: str | No
             environ.get("DISPLAY") or environ.get("WAYLAND_DISPLAY")):
         return f"the Exudyn viewer needs a display (neither DISPLAY nor WAYLAND_DISPLAY is set); {instead}"
     if probe and platform.startswith(("linux", "freebsd", "openbsd", "netbsd")):
-        from weftsim.display import unreachable_display
+        from weftsim.post.display import unreachable_display
 
         problem = unreachable_display(environ)
         if problem is not None:

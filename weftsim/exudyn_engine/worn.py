@@ -19,8 +19,8 @@ from weftsim.exudyn_engine.selection import tree_relative_tolerance
 from weftsim.exudyn_engine.solver import solve
 
 if TYPE_CHECKING:
-    from weftsim.params import Scene
-    from weftsim.results import RunResult
+    from weftsim.input.params import Scene
+    from weftsim.post.results import RunResult
 
 # Relative tolerance of the explicit tree on a worn geometry, and of its retry.  The default 1e-6 is the
 # tree's own (the engines' compare meets its tolerances there); a failed update is run again at 1e-8.

@@ -38,7 +38,7 @@ any mix of rotation and squeeze, exact in both directions of the squeeze.  ``mod
     negative part discarded (Gumbel).
 ``MODEL_FINITE``
     the finite bearing: Reynolds' equation with Reynolds' cavitation condition solved on a grid
-    (:mod:`weftsim.reynolds`) and tabulated over eps, xi and B/D (``film_table.npz``,
+    (:mod:`weftsim.joint.reynolds`) and tabulated over eps, xi and B/D (``film_table.npz``,
     interpolated by :func:`finite_force`).
 ``MODEL_SHORT_HALF``
     the short bearing as the multibody papers write it: wedge and squeeze pressure over the fixed

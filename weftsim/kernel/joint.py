@@ -31,8 +31,8 @@ from weftsim.kernel.hold import effective_impact_velocity
 from weftsim.kernel.laws import friction_factor, normal_force
 
 if TYPE_CHECKING:
-    from weftsim.contact import _Law
-    from weftsim.params import ClearanceJoint
+    from weftsim.joint.contact import _Law
+    from weftsim.input.params import ClearanceJoint
 
 # Indices into the joint parameter block: the dry joint's, then the lubrication's (zeros when dry;
 # weftsim.kernel.lubricated reads them).
@@ -47,7 +47,7 @@ def joint_parameters(joint: ClearanceJoint, law: _Law) -> np.ndarray:
     then the lubrication (flag, viscosity, film model, roughness, Greenwood-Tripp K E*, boundary mu, film
     floor, R_j, L_b; zeros for a dry joint).
 
-    ``joint``: a :class:`weftsim.params.ClearanceJoint`; ``law``: a law of :mod:`weftsim.contact`
+    ``joint``: a :class:`weftsim.input.params.ClearanceJoint`; ``law``: a law of :mod:`weftsim.joint.contact`
     (its ``parameters``).  ``TRACK_MAX`` is 1.0 under the "max_approach" rule, 0.0 under "onset";
     ``DEAD_RATE`` = RESTING_RATE_FRACTION v_min, the damping dead zone of :func:`connector_force`.
     """

@@ -1,6 +1,6 @@
 """Contact force laws of the clearance joint as scalar functions (the one definition).
 
-Every law of :mod:`weftsim.contact` gives the normal force of a journal pressed into its bearing,
+Every law of :mod:`weftsim.joint.contact` gives the normal force of a journal pressed into its bearing,
 
     F_N = max(0, K(delta) delta^1.5 (1 + xi delta_dot / v_imp))   for delta > 0, else 0,
 
@@ -15,7 +15,7 @@ impact velocity v_imp (m/s, > 0) and hysteresis factor xi.  A law is four number
 ``LAW_ELASTIC_FOUND.`` b = L_b (pi/2) E*, N/m     b / sqrt(2 (c + delta))
 =====================  =========================  =========================================
 
-plus the clearance c (m, used by the delta-dependent laws) and xi.  :mod:`weftsim.contact` builds
+plus the clearance c (m, used by the delta-dependent laws) and xi.  :mod:`weftsim.joint.contact` builds
 them from a joint (``law.parameters``) and documents each law and its sources (Lankarani &
 Nikravesh 1990, Bai & Zhao 2013, Liu, Zhang & Yang 2007, ...).  The functions take floats and
 return floats, never check their arguments (speed), and are compiled with numba; ``fn.py_func``

@@ -42,7 +42,7 @@ from weftsim.kernel.joint import (
 )  # fmt: skip
 from weftsim.kernel.laws import friction_factor
 
-# Outputs of lubricated_force, in order (the channels of weftsim.lubrication read them by these indices).
+# Outputs of lubricated_force, in order (the channels of weftsim.joint.lubrication read them by these indices).
 (L_FX, L_FY, L_MJ, L_MB, L_FILM, L_ASPERITY, L_FILM_TORQUE, L_ASPERITY_ENERGY, L_DISSIPATED, L_FILM_POWER) = range(10)
 
 

@@ -5,7 +5,7 @@ still numba dispatchers: each call from Python pays numba's dispatch (~1 us) and
 code, and a dispatcher cannot take a Python callable as an argument.  :func:`python_form` rebuilds
 the function with the same code object and globals in which every compiled callee is replaced by
 its own plain-Python form, recursively.  Callers off the compiled paths use it: the array methods
-of :mod:`weftsim.clearance`, the ``"python"`` callback route, and the event search of the scipy
+of :mod:`weftsim.joint.clearance`, the ``"python"`` callback route, and the event search of the scipy
 path.  :func:`specialize` does the same with some globals bound to other functions and compiles the
 result: the compiled path binds the event search of :mod:`.roots` to its dense output that way
 (numba cannot cache a function that passes a compiled function on as an argument through branches

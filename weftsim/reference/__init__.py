@@ -2,7 +2,7 @@
 
 The cross-check engine that plays ADAMS's role for the Exudyn model.  Public entry:
 
-    solve(scene, progress=None) -> weftsim.results.RunResult
+    solve(scene, progress=None) -> weftsim.post.results.RunResult
 
 - Ideal joint (``scene.joint.is_ideal``): one coordinate theta, the driving torque
   T = 1/2 J_eq'(theta) omega^2 + U'(theta) in closed form (:mod:`.ideal`); nothing is
@@ -25,10 +25,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.guards import vet_result
-from weftsim.params import Scene
+from weftsim.run.guards import vet_result
+from weftsim.input.params import Scene
 from weftsim.reference.integrate import AUTO, METHODS
-from weftsim.results import RunResult, empty_channels
+from weftsim.post.results import RunResult, empty_channels
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -69,7 +69,7 @@ def _check(scene: Scene) -> str | None:
 
 def _solve_ideal(scene: Scene, progress) -> RunResult:
     from weftsim.reference.ideal import ideal_channels
-    from weftsim.results import angle_grid
+    from weftsim.post.results import angle_grid
 
     wall0 = _time.perf_counter()
     omega, t_end = scene.drive.speed, scene.drive.end_time
@@ -225,5 +225,5 @@ def solve(scene: Scene, progress: Callable[[float], None] | None = None,
     else:
         result = _solve_clearance(scene, progress, step_states)
     object.__setattr__(result, "path", select_path(scene))
-    # Post-run criteria (energy balance, ...) that no single step shows; see weftsim.guards.
+    # Post-run criteria (energy balance, ...) that no single step shows; see weftsim.run.guards.
     return vet_result(result)

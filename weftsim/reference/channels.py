@@ -22,12 +22,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from weftsim.params import Scene
+from weftsim.input.params import Scene
 
 
 def clearance_channels(scene: Scene, time: np.ndarray, states: np.ndarray, contact: np.ndarray,
                        impact: np.ndarray) -> dict[str, np.ndarray]:
-    """All :data:`weftsim.results.CHANNELS` at the given times.
+    """All :data:`weftsim.post.results.CHANNELS` at the given times.
 
     Parameters
     ----------

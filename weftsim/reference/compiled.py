@@ -58,7 +58,7 @@ _SUBSTEPS = np.arange(1, _CONTACT_SUBSTEPS + 1) / (_CONTACT_SUBSTEPS + 1.0)
 _GRID = np.linspace(0.0, 1.0, SAMPLES + 1)  # the event search grid of a step (integrate._GRID)
 
 # Float state: t, h_abs, held impact velocity at E, max penetration rate, first contact time (-1: none),
-# penetration at E of the last accepted step and its length (for the guards of weftsim.guards); then the
+# penetration at E of the last accepted step and its length (for the guards of weftsim.run.guards); then the
 # held impact velocity, penetration and first contact time at F.  IMPACT + joint, LAST_PENETRATION + joint
 # and FIRST_CONTACT + joint are read through JOINT_SLOTS.
 T, H_ABS, IMPACT, MAX_RATE, FIRST_CONTACT, LAST_PENETRATION, LAST_STEP, IMPACT_F, LAST_PENETRATION_F, \
@@ -347,7 +347,7 @@ def advance(prm: np.ndarray, method: int, rtol: float, atol: float, max_step: fl
                 ist[PEAKS] += 1
             else:
                 if not value > 0.0:
-                    ist[NONPOSITIVE] += 1  # no rising root found: counted, judged by weftsim.guards
+                    ist[NONPOSITIVE] += 1  # no rising root found: counted, judged by weftsim.run.guards
                 fst[MAX_RATE] = max(fst[MAX_RATE], value)
                 ist[CONTACT] = contact | (1 << event_joint)
                 fst[held] = max(value, prm[BLOCKS[event_joint] + V_MIN])

@@ -21,14 +21,14 @@ import math
 import numpy as np
 from numba import njit
 
-from weftsim.params import Geometry, Inertia, Scene
+from weftsim.input.params import Geometry, Inertia, Scene
 from weftsim.kernel.chain import (
     COEF, COUPLING, GRAVITY, KIND, L_EF, L_FG, M11, M22, OMEGA, ROD_MASS, chain, local_clearance, penetration,
 )  # fmt: skip
 from weftsim.kernel import chain_f as kf
 from weftsim.kernel.laws import elastic_energy
 from weftsim.reference.dynamics import initial_state, pack_parameters
-from weftsim.results import CHANNELS, JOINT_F_CHANNELS
+from weftsim.post.results import CHANNELS, JOINT_F_CHANNELS
 
 TABLE_POINTS = 4096  # spline knots per revolution: interpolation error ~ 5/384 h^4 |f''''| ~ 1e-12 relative
 
@@ -184,9 +184,9 @@ def _fill_f(prm, table, a0, ratio, time, states, contact, impact, out):
 
 def compiled_channels(scene: Scene, time: np.ndarray, states: np.ndarray, contact: np.ndarray,
                       impact: np.ndarray) -> dict[str, np.ndarray]:
-    """All :data:`~weftsim.results.CHANNELS` at the given rows (arguments as ``clearance_channels``).
+    """All :data:`~weftsim.post.results.CHANNELS` at the given rows (arguments as ``clearance_channels``).
 
-    With clearance at F (``scene.joint_f``) also :data:`~weftsim.results.JOINT_F_CHANNELS`; then
+    With clearance at F (``scene.joint_f``) also :data:`~weftsim.post.results.JOINT_F_CHANNELS`; then
     ``contact`` is the mask of the joints in contact (bit 0 E, bit 1 F) and ``impact`` (n, 2) their
     held impact velocities (:func:`weftsim.reference.compiled_run.integrate_compiled`).
     """
@@ -210,7 +210,7 @@ def compiled_channels(scene: Scene, time: np.ndarray, states: np.ndarray, contac
     if scene.joint.is_lubricated or scene.joint_f.is_lubricated:
         # The film and asperity channels; the asperities' potential joins the contact energy (the chain
         # books only the film's and the boundary friction's work as dissipated, weftsim.kernel.lubricated).
-        from weftsim.lubrication import lubrication_table
+        from weftsim.joint.lubrication import lubrication_table
 
         lubricated, asperity_energy = lubrication_table(scene, prm, time, states)
         channels["contact_energy_J"] = channels["contact_energy_J"] + asperity_energy

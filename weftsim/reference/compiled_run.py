@@ -1,6 +1,6 @@
 """Driver of the compiled reference path: runs :func:`weftsim.reference.compiled.advance` in
-chunks (progress, wall-time budget, buffers), applies the run guards of :mod:`weftsim.guards`
-and builds the :class:`~weftsim.results.RunResult` with the compiled channels.
+chunks (progress, wall-time budget, buffers), applies the run guards of :mod:`weftsim.run.guards`
+and builds the :class:`~weftsim.post.results.RunResult` with the compiled channels.
 
 Entry: :func:`solve_compiled` (``reference_solver.method`` = ``"numba_DOP853"``, ``"numba_RK45"``,
 ``"numba_RODAS4"`` or ``"numba_DOP853_RODAS4"``).
@@ -14,8 +14,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.guards import RunGuard, failure_message, non_finite_breach
-from weftsim.params import Scene
+from weftsim.run.guards import RunGuard, failure_message, non_finite_breach
+from weftsim.input.params import Scene
 from weftsim.reference.compiled import (
     DECOMPOSITIONS, DENSE, DONE, EVENTS, IMPLICIT_STEPS, JACOBIANS, FIRST_CONTACT, FIRST_CONTACT_F, GUARD, IMPACTS, LAST_PENETRATION, LAST_PENETRATION_F,
     LAST_STEP, MAX_RATE, METHODS, N_FLOAT_STATE, N_INT_STATE, NEXT_SAMPLE, NFEV, NON_FINITE, NONPOSITIVE, PAUSED,
@@ -25,7 +25,7 @@ from weftsim.reference.compiled import (
 from weftsim.kernel.chain_f import N_JOINTS
 from weftsim.reference.dynamics import initial_state, pack_parameters
 from weftsim.reference.integrate import _PROGRESS_EVERY
-from weftsim.results import RunResult
+from weftsim.post.results import RunResult
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -170,7 +170,7 @@ def solve_compiled(scene: Scene, progress: Callable[[float], None] | None = None
     in :func:`weftsim.reference.solve`.
     """
     from weftsim.reference.compiled_channels import compiled_channels
-    from weftsim.results import empty_channels
+    from weftsim.post.results import empty_channels
 
     steps, samples, stats, events, status, message = integrate_compiled(
         scene, progress, method or scene.reference_solver.method, rtol)

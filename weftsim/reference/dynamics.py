@@ -20,13 +20,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numba import njit
 
-from weftsim import kinematics as kin
-from weftsim.contact import make_law
+from weftsim.mechanism import kinematics as kin
+from weftsim.joint.contact import make_law
 from weftsim.kernel import chain as kc
 from weftsim.kernel import chain_f as kf
 from weftsim.kernel.joint import N_JOINT, joint_parameters
 from weftsim.kernel.wear import wear_block
-from weftsim.params import Scene
+from weftsim.input.params import Scene
 from weftsim.reference.ideal import sector_chain_inertia
 
 if TYPE_CHECKING:

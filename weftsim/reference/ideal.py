@@ -37,8 +37,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 
-from weftsim import kinematics as kin
-from weftsim.params import Scene
+from weftsim.mechanism import kinematics as kin
+from weftsim.input.params import Scene
 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
@@ -154,7 +154,7 @@ def ideal_torque(theta: ArrayLike, scene: Scene) -> np.ndarray:
 
 
 def ideal_channels(time: np.ndarray, scene: Scene) -> dict[str, np.ndarray]:
-    """All :data:`weftsim.results.CHANNELS` of the ideal-joint run at the given times.
+    """All :data:`weftsim.post.results.CHANNELS` of the ideal-joint run at the given times.
 
     theta = omega t.  Kinetic energy 1/2 J_eq omega^2, potential U; driving work
     W(t) = integral_0^t T omega dt = [KE + U](t) - [KE + U](0) exactly (closed form,

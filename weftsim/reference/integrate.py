@@ -14,7 +14,7 @@ only where delta rises (onset) or falls (separation), and the first one inside t
 taken, not only a change of sign between the step's ends.  At onset the penetration rate of
 the located state is the held impact velocity delta_dot^-, floored at
 ``joint.min_impact_velocity``; under ``"max_approach"`` the contact force uses
-max(held, delta_dot) (:func:`weftsim.clearance.effective_impact_velocity`) and every maximum
+max(held, delta_dot) (:func:`weftsim.joint.clearance.effective_impact_velocity`) and every maximum
 of delta_dot above the held value ends the segment with that maximum as the new held value,
 so delta_dot^- is exactly the largest approach rate since the onset.  Restarting the solver at
 each event also keeps the method's order: the force law is only C^0 at delta = 0 and at
@@ -36,10 +36,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.guards import RunGuard, failure_message, non_finite_breach
+from weftsim.run.guards import RunGuard, failure_message, non_finite_breach
 from weftsim.kernel import chain as kernel_chain
 from weftsim.kernel.chain import rhs as chain_rhs
-from weftsim.params import Scene
+from weftsim.input.params import Scene
 from weftsim.reference import events
 from weftsim.reference.dynamics import initial_state, pack_parameters
 
@@ -353,7 +353,7 @@ def _integrate(scene: Scene, progress) -> Trajectory:
         else:
             rate = value
             if not rate > 0.0:
-                n_nonpositive += 1  # no rising root found: counted, and judged by weftsim.guards
+                n_nonpositive += 1  # no rising root found: counted, and judged by weftsim.run.guards
             max_penetration_rate = max(max_penetration_rate, rate)
             contact, impact = True, max(rate, joint.min_impact_velocity)
             n_impacts += 1

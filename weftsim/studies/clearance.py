@@ -22,8 +22,8 @@ import numpy as np
 from weftsim.studies import common
 
 if TYPE_CHECKING:
-    from weftsim.params import Geometry
-    from weftsim.results import RunResult
+    from weftsim.input.params import Geometry
+    from weftsim.post.results import RunResult
 
 IDEAL_SCENE = "ideal.toml"
 SCENES = {0.01: "paper/clearance_0p01mm_400rpm.toml", 0.25: "paper/clearance_0p25mm_400rpm.toml",
@@ -36,7 +36,7 @@ COLOURS = {0.01: "tab:blue", 0.25: "tab:orange", 0.50: "tab:red"}
 
 def ideal_features(geometry: Geometry, omega: float, points: int = 36001) -> dict[str, list[float]]:
     """Crank angles (deg) of the ideal rapier acceleration extremes, velocity extremes and velocity zeros."""
-    from weftsim.kinematics import rapier_motion
+    from weftsim.mechanism.kinematics import rapier_motion
 
     theta = np.linspace(0.0, 2.0 * math.pi, points)
     _, v, a = rapier_motion(theta, omega, geometry)
@@ -64,8 +64,8 @@ def acceleration_deviation(result: RunResult, bin_deg: float = BIN_DEG,
     rms : ndarray
         m/s^2 (nan for empty bins).
     """
-    from weftsim.analysis import complete_revolutions, time_weights
-    from weftsim.kinematics import rapier_motion
+    from weftsim.post.analysis import complete_revolutions, time_weights
+    from weftsim.mechanism.kinematics import rapier_motion
 
     n = complete_revolutions(result)
     edges = np.arange(0.0, 360.0 + 0.5 * bin_deg, bin_deg)
@@ -133,7 +133,7 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
     ``overrides``: scene keys (file units) applied to every run, except the clearance (:data:`SETS`).
     ``scene``: the scene file or bundled name its cases run on (default: the paper's reference, ``models/``).
     """
-    from weftsim.output import write_figure, write_json
+    from weftsim.post.output import write_figure, write_json
     from weftsim.studies.figures import channel_panels, deviation_panel, trend_panels
 
     overrides = common.study_overrides("clearance", SETS, revolutions, REVOLUTIONS, overrides)

@@ -23,8 +23,8 @@ import numpy as np
 from weftsim.errors import SimulationFailed, StudyError  # noqa: F401 (re-exported: weftsim.studies)
 
 if TYPE_CHECKING:
-    from weftsim.params import Scene
-    from weftsim.results import RunResult
+    from weftsim.input.params import Scene
+    from weftsim.post.results import RunResult
 
 log = logging.getLogger(__name__)
 
@@ -48,7 +48,7 @@ NAMED_KEYS = {"joint_e.clearance_mm": "c{:g}mm", "drive.speed_rpm": "{:g}rpm"}
 def own_keys(path: Path) -> dict:
     """The keys a scene file gives itself (not those of the scene it extends), ``extends``, ``name`` and
     ``description`` left out: what a study's case changes on the scene it is run on."""
-    from weftsim.scene import TOP_LEVEL, _flatten, _read_toml
+    from weftsim.input.scene import TOP_LEVEL, _flatten, _read_toml
 
     return {k: v for k, v in _flatten(_read_toml(path), str(path)).items() if k not in TOP_LEVEL}
 
@@ -60,7 +60,7 @@ def load(models: str | Path, name: str, overrides: dict | None = None, base: str
     instead: ``base`` with the keys ``models/<name>`` sets itself (:func:`own_keys`: the clearance of a
     clearance case, the speed of a speed case), then ``overrides``; it is named after ``base`` and those keys.
     """
-    from weftsim.scene import load_scene
+    from weftsim.input.scene import load_scene
 
     path = scene_path(models, name)
     if base is None:
@@ -73,16 +73,16 @@ def load(models: str | Path, name: str, overrides: dict | None = None, base: str
 
 def base_scene(models: str | Path, base: str | Path | None, overrides: dict) -> Scene:
     """The scene a study runs its cases on, resolved with ``overrides`` (``models/reference.toml`` by default):
-    what its output directory records (:mod:`weftsim.record`) and refuses to mix with another."""
-    from weftsim.scene import load_scene
+    what its output directory records (:mod:`weftsim.post.record`) and refuses to mix with another."""
+    from weftsim.input.scene import load_scene
 
     return load_scene(scene_path(models, REFERENCE) if base is None else base, overrides)
 
 
 def open_directory(outdir: Path, force: bool, scene: Scene) -> Path:
-    """:func:`weftsim.output.prepare_directory` for a study of ``scene`` (a directory holding a study of
+    """:func:`weftsim.post.output.prepare_directory` for a study of ``scene`` (a directory holding a study of
     another scene or other overrides is refused unless ``force``)."""
-    from weftsim.output import prepare_directory
+    from weftsim.post.output import prepare_directory
 
     return prepare_directory(outdir, force, scene)
 
@@ -90,7 +90,7 @@ def open_directory(outdir: Path, force: bool, scene: Scene) -> Path:
 def record(scene: Scene, overrides: dict) -> dict:
     """What a study's JSON records of how it was made: the scene its cases run on, the overrides given
     (``--set`` and the shorthands, file units, the revolutions included) and the command line."""
-    from weftsim.record import command_line
+    from weftsim.post.record import command_line
 
     return {"base_scene": scene.name, "overrides": dict(overrides), "command": command_line()}
 
@@ -106,8 +106,8 @@ def title_note(scene: Scene, overrides: dict) -> str:
 
 def finish(outdir: Path, written: dict, study: str, scene: Scene) -> None:
     """Write ``scene.toml`` (the resolved scene the cases run on) and the manifest, last."""
-    from weftsim.output import finish_directory, write_text
-    from weftsim.record import SCENE_FILE, provenance, scene_toml
+    from weftsim.post.output import finish_directory, write_text
+    from weftsim.post.record import SCENE_FILE, provenance, scene_toml
 
     written["scene"] = write_text(outdir / SCENE_FILE, scene_toml(scene))
     finish_directory(outdir, written, {"kind": "study", "study": study, **provenance(scene)})
@@ -115,14 +115,14 @@ def finish(outdir: Path, written: dict, study: str, scene: Scene) -> None:
 
 def wrote_lines(outdir: Path, report: dict) -> list[str]:
     """``  wrote <path>`` per file of a study, as ``weftsim run`` reports its files."""
-    from weftsim.record import SCENE_FILE
+    from weftsim.post.record import SCENE_FILE
 
     return [f"  wrote {Path(outdir) / name}" for name in sorted(set(report.get("files", [])) | {SCENE_FILE})]
 
 
 def solve(scene: Scene, engine: str = "reference", label: str | None = None, progress: bool = True) -> RunResult:
     """Run one engine on a scene (progress on stderr for long runs); a failed run raises SimulationFailed."""
-    from weftsim.progress import Progress
+    from weftsim.run.progress import Progress
 
     if engine == "reference":
         from weftsim.reference import solve as engine_solve
@@ -153,7 +153,7 @@ def clearance_mm(scene: Scene) -> float:
 
 def percentile(result: RunResult, channel: str, q: float, skip_revolutions: int = 1) -> float | None:
     """Time-weighted percentile q of a channel over the whole revolutions after ``skip_revolutions``."""
-    from weftsim.analysis import complete_revolutions, time_weights, weighted_percentile
+    from weftsim.post.analysis import complete_revolutions, time_weights, weighted_percentile
 
     n = complete_revolutions(result)
     if n <= skip_revolutions:
@@ -168,11 +168,11 @@ def run_metrics(result: RunResult) -> dict:
     """The numbers of one run that the studies and the report use (JSON-ready).
 
     ``statistics`` (revolutions 2..N) adds ``p1`` (1st percentile) to the fields of
-    :func:`weftsim.analysis.channel_statistics`; it is None for runs of fewer than 2 revolutions.
+    :func:`weftsim.post.analysis.channel_statistics`; it is None for runs of fewer than 2 revolutions.
     ``first_revolution`` and ``last_revolution`` are those of the part run when the run is
     shorter than one revolution.
     """
-    from weftsim.analysis import complete_revolutions, peaks, statistics
+    from weftsim.post.analysis import complete_revolutions, peaks, statistics
 
     n = complete_revolutions(result)
     stats = statistics(result)
@@ -224,7 +224,7 @@ CURVE_CHANNELS = ("time_s", "crank_angle_deg", "rapier_displacement_m", "rapier_
 
 def write_curves(outdir: Path, name: str, data: dict[str, np.ndarray]) -> Path:
     """The per-step curves a figure shows, as ``<name>.csv`` (crank angle folded to 0..360 deg)."""
-    from weftsim.output import write_csv
+    from weftsim.post.output import write_csv
 
     return write_csv(Path(outdir) / f"{name}.csv", {channel: data[channel] for channel in CURVE_CHANNELS})
 

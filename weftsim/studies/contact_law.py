@@ -8,7 +8,7 @@
     same steps, against penetration (paper Fig. 9), with D(delta) of the law at fixed
     impact velocities.
 
-K and D come from the contact-law library (:mod:`weftsim.contact`) evaluated on the
+K and D come from the contact-law library (:mod:`weftsim.joint.contact`) evaluated on the
 per-step penetration and held impact velocity of a reference-engine run.
 """
 
@@ -25,8 +25,8 @@ from weftsim.studies import common
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from weftsim.params import ClearanceJoint
-    from weftsim.results import RunResult
+    from weftsim.input.params import ClearanceJoint
+    from weftsim.post.results import RunResult
 
 SCENE = "paper/clearance_0p01mm_400rpm.toml"
 SPEED_RPM = 500.0  # paper Fig. 7-9
@@ -50,7 +50,7 @@ def stiffness_curve(joint: ClearanceJoint, points: int = CURVE_POINTS, extent: f
     """K(delta) of ``joint``'s law on 0..extent x c, and the numbers quoted against the paper."""
     from dataclasses import replace
 
-    from weftsim.contact import lankarani_nikravesh_stiffness, make_law
+    from weftsim.joint.contact import lankarani_nikravesh_stiffness, make_law
 
     law = make_law(joint)
     c = joint.clearance
@@ -82,7 +82,7 @@ def stiffness_curve(joint: ClearanceJoint, points: int = CURVE_POINTS, extent: f
 
 def contact_steps(result: RunResult, revolution: int) -> dict[str, np.ndarray]:
     """Steps in contact of one revolution with K(delta) and D(delta, v_imp) from the scene's law."""
-    from weftsim.contact import make_law
+    from weftsim.joint.contact import make_law
 
     law = make_law(result.scene.joint)
     data = common.revolution_steps(result, revolution)
@@ -108,8 +108,8 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
     ``overrides``: scene keys (file units) applied to its run, except its speed and clearance (:data:`SETS`).
     ``scene``: the scene file or bundled name its cases run on (default: the paper's reference, ``models/``).
     """
-    from weftsim.contact import make_law
-    from weftsim.output import write_csv, write_figure, write_json
+    from weftsim.joint.contact import make_law
+    from weftsim.post.output import write_csv, write_figure, write_json
     from weftsim.studies.figures import contact_law_panels
 
     overrides = common.study_overrides("contact-law", SETS, revolutions, REVOLUTIONS, overrides)
@@ -119,7 +119,7 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
                                         **overrides}, source)
     curve = stiffness_curve(scene.joint)
     result = common.solve(scene, "reference", progress=progress)
-    from weftsim.analysis import complete_revolutions
+    from weftsim.post.analysis import complete_revolutions
 
     n = complete_revolutions(result)
     revolution = max(n - 1, 0)
@@ -151,7 +151,7 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
     in_contact = {}
     if steps["stiffness"].size:
         data = common.revolution_steps(result, revolution)
-        from weftsim.analysis import time_weights
+        from weftsim.post.analysis import time_weights
 
         w = time_weights(data["time_s"])
         in_contact = {

@@ -6,7 +6,7 @@ reports model / prototype peak ratios of 1.035 (rapier acceleration) and 1.099
 paper's model and the Exudyn multibody model (``exudyn``) the virtual prototype, so the
 paper's ratios correspond to reference / exudyn; both directions are reported.
 
-The agreement checks are those of ``weftsim compare`` (:func:`weftsim.compare.compare_results`):
+The agreement checks are those of ``weftsim compare`` (:func:`weftsim.post.compare.compare_results`):
 first contact angle and first-revolution maxima, and with 10 or more revolutions the RMS
 and 99th percentiles over revolutions 2..N.  Two figures: the first revolution (where
 the engines must agree) and the last one (an illustration, as the paper's Fig. 16).
@@ -52,8 +52,8 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
     ``overrides``: scene keys (file units) applied to the scene both engines run.
     ``scene``: the scene file or bundled name its cases run on (default: the paper's reference, ``models/``).
     """
-    from weftsim.compare import compare_results
-    from weftsim.output import write_figure, write_json
+    from weftsim.post.compare import compare_results
+    from weftsim.post.output import write_figure, write_json
     from weftsim.studies.figures import channel_panels
 
     overrides = common.study_overrides("engines", SETS, revolutions, REVOLUTIONS, overrides)
@@ -99,7 +99,7 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
 
 def format_report(report: dict) -> str:
     """The lines ``weftsim study engines`` prints."""
-    from weftsim.compare import format_report as compare_table
+    from weftsim.post.compare import format_report as compare_table
 
     def f(value):
         return f"{value:.4f}" if value is not None else "-"

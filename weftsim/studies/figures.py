@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.plots import pyplot, channel_panels  # noqa: F401 - channel_panels re-exported for the studies
+from weftsim.post.plots import pyplot, channel_panels  # noqa: F401 - channel_panels re-exported for the studies
 
 if TYPE_CHECKING:
     from collections.abc import Sequence

@@ -38,8 +38,8 @@ if TYPE_CHECKING:
     from collections.abc import Sequence
     from typing import TextIO
 
-    from weftsim.params import Scene
-    from weftsim.results import RunResult
+    from weftsim.input.params import Scene
+    from weftsim.post.results import RunResult
 
 # The frequency study of the outliers: every paper scene at these tolerances (72 runs).
 STUDY_RTOLS = {
@@ -99,7 +99,7 @@ class Cell:
         return (self.scene_name, self.method, f"{self.rtol:.0e}", self.overrides_text)
 
     def scene(self) -> Scene:
-        from weftsim.scene import load_scene
+        from weftsim.input.scene import load_scene
 
         if self.method == EXUDYN:
             return load_scene(self.scene_file, {"drive.revolutions": self.revolutions, **dict(self.overrides)})
@@ -231,7 +231,7 @@ def negative_penetration_in_contact(contact: np.ndarray, penetration: np.ndarray
 
 def revolution_peaks(result: RunResult, channel: str = "contact_force_N") -> list[float]:
     """Peak (max) of a channel in every complete revolution of the run."""
-    from weftsim.analysis import complete_revolutions, peaks
+    from weftsim.post.analysis import complete_revolutions, peaks
 
     return [peaks(result, k)[channel]["max"] for k in range(complete_revolutions(result))]
 
@@ -278,7 +278,7 @@ def measure(cell: Cell) -> dict:
 
 def _peak_columns(cell: Cell, scene, result) -> dict:
     """The columns of a row that need only the channels: identity, status, peaks, cost."""
-    from weftsim.analysis import complete_revolutions
+    from weftsim.post.analysis import complete_revolutions
 
     peaks = revolution_peaks(result)
     median, worst, worst_rev = peak_ratios(peaks)

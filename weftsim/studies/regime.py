@@ -44,7 +44,7 @@ def regime(ratio: float) -> str:
 
 
 def _last_revolution(result) -> dict[str, np.ndarray]:
-    from weftsim.analysis import complete_revolutions
+    from weftsim.post.analysis import complete_revolutions
 
     return common.revolution_steps(result, max(complete_revolutions(result) - 1, 0))
 
@@ -54,7 +54,7 @@ def _cell(scene_name: str, models, overrides: dict, progress: bool, base: str | 
     if base is None:
         scene = common.load(models, scene_name, overrides)
     else:  # weftsim study regime SCENE: the cells are that scene with the cell's keys
-        from weftsim.scene import load_scene
+        from weftsim.input.scene import load_scene
 
         scene = load_scene(base, overrides)
     result = common.solve(scene, progress=progress)
@@ -83,7 +83,7 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
     ``overrides``: scene keys (file units) applied to every run, except speed, clearance and viscosity
     (:data:`SETS`); e.g. ``joint_e.lubrication.roughness_um`` or ``joint_e.lubrication.model``.
     """
-    from weftsim.output import write_csv, write_figure, write_json
+    from weftsim.post.output import write_csv, write_figure, write_json
 
     overrides = common.study_overrides("regime", SETS, revolutions, REVOLUTIONS, overrides)
     lubrication = {k: v for k, v in overrides.items() if k.startswith("joint_e.lubrication.")}
@@ -123,7 +123,7 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
 def regime_figure(rows: list[dict], scene_name: str):
     """One column per viscosity: the minimum film ratio (colour: regime) and the peak joint force against
     the dry contact force, over clearance, one line per speed."""
-    from weftsim.plots import pyplot
+    from weftsim.post.plots import pyplot
 
     plt = pyplot()
     etas = sorted({row["viscosity_mpa_s"] for row in rows})

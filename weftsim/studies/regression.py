@@ -35,7 +35,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable
     from pathlib import Path
 
-    from weftsim.results import RunResult
+    from weftsim.post.results import RunResult
 
 # kind -> floor on the relative tolerance, and the factor on the largest measured shift.
 FLOOR = {
@@ -111,7 +111,7 @@ def perturbation_key(case: Case) -> str:
     from pathlib import Path
 
     from weftsim.exudyn_engine.selection import select_model
-    from weftsim.scene import load_scene
+    from weftsim.input.scene import load_scene
 
     scene = load_scene(Path(__file__).resolve().parents[2] / case.scene, case.overrides)
     return "exudyn kinematic_tree" if select_model(scene)[0] == "kinematic_tree" else "exudyn"
@@ -130,7 +130,7 @@ def case_from_entry(entry: dict) -> Case:
 
 def _resolve(overrides: dict, base_scene) -> dict:
     """Turn ``"scale:f"`` override values into the base scene's value times f (file units)."""
-    from weftsim.scene import to_file_keys
+    from weftsim.input.scene import to_file_keys
 
     keys = to_file_keys(base_scene)
     out = {}
@@ -143,7 +143,7 @@ def _resolve(overrides: dict, base_scene) -> dict:
 
 def run_case(case: Case, root: Path, extra: dict | None = None) -> RunResult:
     """Load and solve a case (``root`` = repository root); a failed run raises RuntimeError."""
-    from weftsim.scene import load_scene
+    from weftsim.input.scene import load_scene
     from weftsim.studies.common import solve
 
     path = root / case.scene
@@ -154,7 +154,7 @@ def run_case(case: Case, root: Path, extra: dict | None = None) -> RunResult:
 
 def quantities(case: Case, result: RunResult) -> dict[str, float]:
     """The stored quantities of a case, named ``<channel>.<statistic>`` (plus the first contact angle)."""
-    from weftsim.analysis import peaks, statistics
+    from weftsim.post.analysis import peaks, statistics
 
     first = peaks(result, 0)
     out: dict[str, float] = {}

@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from weftsim.results import RunResult
+    from weftsim.post.results import RunResult
 
 DEFAULT_BINS_PER_REVOLUTION = 720  # 0.5 deg, the output grid of the scenes
 
@@ -144,7 +144,7 @@ def acceleration_spectrum(result: RunResult, skip_revolutions: int = 1,
 
     Parameters
     ----------
-    result : weftsim.results.RunResult
+    result : weftsim.post.results.RunResult
         Uses the per-step channels (every accepted solver step).
     skip_revolutions : int
         Start-up revolutions left out (1: the start-up impact from the centred journal).
@@ -158,7 +158,7 @@ def acceleration_spectrum(result: RunResult, skip_revolutions: int = 1,
     ValueError
         When the run has no whole revolution after the skipped ones.
     """
-    from weftsim.analysis import complete_revolutions
+    from weftsim.post.analysis import complete_revolutions
 
     n = complete_revolutions(result)
     count = n - skip_revolutions

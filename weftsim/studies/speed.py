@@ -78,7 +78,7 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
     ``overrides``: scene keys (file units) applied to every run, except the speed (:data:`SETS`).
     ``scene``: the scene file or bundled name its cases run on (default: the paper's reference, ``models/``).
     """
-    from weftsim.output import write_csv, write_figure, write_json
+    from weftsim.post.output import write_csv, write_figure, write_json
     from weftsim.studies.figures import channel_panels, spectrum_panels, trend_panels
 
     overrides = common.study_overrides("speed", SETS, revolutions, REVOLUTIONS, overrides)

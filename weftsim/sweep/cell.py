@@ -26,11 +26,11 @@ from pathlib import Path
 from typing import Any
 from typing import TYPE_CHECKING
 
-from weftsim.record import written_by
+from weftsim.post.record import written_by
 from weftsim.version import __version__
 
 if TYPE_CHECKING:
-    from weftsim.results import RunResult
+    from weftsim.post.results import RunResult
 
 CELL_FILE = "cell.json"
 ERROR_FILE = "error.txt"
@@ -47,7 +47,7 @@ JOINT_OF_CHANNEL = {"contact_force_N": "joint", "contact_force_f_N": "joint_f"}
 
 def normalise(data: Any) -> Any:
     """The value as it reads back from JSON (tuples -> lists, NaN -> None), for comparing manifests."""
-    from weftsim.output import to_json
+    from weftsim.post.output import to_json
 
     return json.loads(to_json({"v": data}))["v"]
 
@@ -65,11 +65,11 @@ def cell_metrics(result: RunResult) -> dict[str, Any]:
     (``last_revolution``, 1-based; the first one when the run is shorter than one),
     ``*_p99`` the time-weighted 99th percentile of the magnitude over revolutions
     2..N (None with fewer than two complete revolutions).  Peaks come from the
-    solver steps, which resolve the impacts (see :mod:`weftsim.analysis`).  The
+    solver steps, which resolve the impacts (see :mod:`weftsim.post.analysis`).  The
     contact force of a joint that is ideal in the run (E's ``contact_force_N``,
     F's ``contact_force_f_N``) is None: there is no contact there.
     """
-    from weftsim.analysis import complete_revolutions, peaks, statistics
+    from weftsim.post.analysis import complete_revolutions, peaks, statistics
 
     n = complete_revolutions(result)
     out: dict[str, Any] = {
@@ -118,7 +118,7 @@ def cell_record(name: str, params: dict, overrides: dict, scene_keys: dict | Non
 
 def write_cell_record(cell_dir: Path, record: dict, detail: str = "") -> None:
     """Write ``error.txt`` (failed cells) and then, last, ``cell.json``; both atomic."""
-    from weftsim.output import write_json, write_text
+    from weftsim.post.output import write_json, write_text
 
     if record["status"] != "success":
         write_text(cell_dir / ERROR_FILE, record["error"] + ("\n\n" + detail if detail else "") + "\n")
@@ -143,13 +143,13 @@ def _scratch_places() -> list[str | None]:
 
 
 def render_run(result: RunResult, figure: bool) -> dict[str, bytes]:
-    """The files :func:`weftsim.output.write_run` writes for ``result``, as bytes (name -> content).
+    """The files :func:`weftsim.post.output.write_run` writes for ``result``, as bytes (name -> content).
 
     They are written to a private temporary directory of this process and read back; a memory
     file system halves the cost of that detour (1 revolution: 13 ms against 24-32 ms on this
     machine's disk, next to a 29 ms solve), and a full one falls back to the disk.
     """
-    from weftsim.output import write_run
+    from weftsim.post.output import write_run
 
     error: OSError | None = None
     for place in _scratch_places():
@@ -172,7 +172,7 @@ def solve_cell(name: str, scene_keys: dict, engine: str, figure: bool = False, c
         The cell's name (for messages).
     scene_keys : dict
         The cell's resolved scene as dotted file keys in file units (absent optional keys left out);
-        :func:`weftsim.scene.scene_from_keys` rebuilds it without any file.
+        :func:`weftsim.input.scene.scene_from_keys` rebuilds it without any file.
     engine : str
         ``reference``, ``exudyn`` or ``module:function`` (checked by the sweep before it starts).
     figure : bool
@@ -190,7 +190,7 @@ def solve_cell(name: str, scene_keys: dict, engine: str, figure: bool = False, c
         only interrupts pass.  Nothing is read from or written to the sweep directory.
     """
     global _CELLS_IN_THIS_PROCESS
-    from weftsim.scene import scene_from_keys
+    from weftsim.input.scene import scene_from_keys
     from weftsim.sweep.engines import engine_solve
 
     _CELLS_IN_THIS_PROCESS += 1
@@ -216,7 +216,7 @@ def solve_cell(name: str, scene_keys: dict, engine: str, figure: bool = False, c
 
 def _listed_files(cell_dir: Path) -> set[str]:
     """Plain file names the cell's previous run manifest lists (anything else in it is ignored)."""
-    from weftsim.output import MANIFEST
+    from weftsim.post.output import MANIFEST
 
     if not (cell_dir / MANIFEST).is_file():
         return set()
@@ -235,7 +235,7 @@ def store_cell(cell_dir: Path, record: dict, files: dict[str, bytes], detail: st
     plain files; a listed name that is a directory (or a link) is left alone: a cell's own
     files are never directories, so that one is not ours to remove.
     """
-    from weftsim.output import MANIFEST, prepare_directory, write_atomic
+    from weftsim.post.output import MANIFEST, prepare_directory, write_atomic
 
     # force: a cell directory belongs to its sweep (checked by the driver) and may hold a killed run's files.
     cell_dir = prepare_directory(cell_dir, force=True)

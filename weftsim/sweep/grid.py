@@ -4,7 +4,7 @@ A sweep varies some scene keys over lists of values; every combination (the
 Cartesian product) is one *cell*, i.e. one scene run.  Values are given in the
 scene file's units (``clearance_mm=0.25``), as a list ``a,b,c`` or as an
 inclusive range ``start:stop:count`` (``speed_rpm=300:800:6`` is 300, 400, ...,
-800).  Keys are the dotted scene keys of :data:`weftsim.scene.SCHEMA` or their
+800).  Keys are the dotted scene keys of :data:`weftsim.input.scene.SCHEMA` or their
 short names (the last dotted part where it is unique: ``clearance_mm``,
 ``speed_rpm``, ``law``, ``revolutions``, ``restitution``, ...).
 
@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from weftsim.errors import SweepError
-from weftsim.scene import SCHEMA, Key
+from weftsim.input.scene import SCHEMA, Key
 
 SWEEPABLE_KINDS = ("float", "int", "str", "bool")
 LIST_SIZES = {"floats2": 2, "floats3": 3}  # list-valued keys: --set only (a comma separates --vary values)

@@ -1,7 +1,7 @@
 """Planning a sweep: the grid, the engine check and the validated scene of every cell, nothing run.
 
 Planning is linear in the number of cells and reads the scene file once: each cell's scene
-is the base scene with the cell's keys applied (:func:`weftsim.scene.apply_overrides`, about
+is the base scene with the cell's keys applied (:func:`weftsim.input.scene.apply_overrides`, about
 1 ms a cell), not a fresh read of the file.  A grid of more than :data:`LARGE_GRID_CELLS`
 cells is refused unless asked for (``--yes``), so a typo such as ``speed_rpm=100:1000:1000000``
 costs one line, not hours.
@@ -19,7 +19,7 @@ from weftsim.sweep.engines import check_engine
 from weftsim.sweep.grid import Axis, Cell, SweepError, grid_cells, grid_size, parse_set, parse_vary, value_count
 
 if TYPE_CHECKING:
-    from weftsim.params import Scene
+    from weftsim.input.params import Scene
 
 # Beyond this many cells a sweep must be asked for with --yes.  The README's clearance x speed map
 # has 121 cells; 2000 cells of the reference engine at 2 revolutions are about an hour on 2 cores.
@@ -53,7 +53,7 @@ class SweepPlan:
     base_keys: dict
     cells: tuple[PlannedCell, ...]
     base: Scene  # the base scene (after --set), from which each cell's scene is rebuilt
-    notes: tuple[str, ...] = ()  # lines for the user: what joint F takes from E (weftsim.joint_keys)
+    notes: tuple[str, ...] = ()  # lines for the user: what joint F takes from E (weftsim.input.joint_keys)
 
     @property
     def axis_names(self) -> list[str]:
@@ -61,13 +61,13 @@ class SweepPlan:
 
     def scene(self, planned: PlannedCell) -> Scene:
         """The cell's validated scene."""
-        from weftsim.scene import apply_overrides
+        from weftsim.input.scene import apply_overrides
 
         return apply_overrides(self.base, planned.overrides, CELL_NAME_CHECK, refuse_ideal_keys=False)
 
     def scene_keys(self, planned: PlannedCell) -> dict:
         """The cell's resolved scene as stored in ``cell.json`` and compared on resume."""
-        from weftsim.scene import to_file_keys
+        from weftsim.input.scene import to_file_keys
 
         return normalise(to_file_keys(self.scene(planned)))
 
@@ -91,12 +91,12 @@ def plan_sweep(scene_path: str | Path, vary: list[str], fixed: list[str] | tuple
     SweepError
         Bad grid text or engine, a grid too large without ``allow_large``, or any cell whose scene
         is invalid (all such cells are named).
-    weftsim.scene.SceneError
+    weftsim.input.scene.SceneError
         The base scene itself is invalid.
     """
-    from weftsim.joint_keys import (ideal_joint_keys, ideal_key_message, inheritance_note, wear_only_keys,
+    from weftsim.input.joint_keys import (ideal_joint_keys, ideal_key_message, inheritance_note, wear_only_keys,
                                     wear_only_message)
-    from weftsim.scene import SceneError, apply_overrides, load_scene, to_file_keys
+    from weftsim.input.scene import SceneError, apply_overrides, load_scene, to_file_keys
 
     # Counted from the text first: a range of 10^8 values is refused before any of them is built.
     size = math.prod(value_count(text) for text in vary)

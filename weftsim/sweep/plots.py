@@ -115,7 +115,7 @@ def _grid_panel(fig, ax, grid, xc, yc, channel, annotate, numeric=(False, False)
 def plot_sweep_1d(rows: list[dict], name: str, title: str = "") -> Figure:
     """Panels of peak torque, acceleration and the contact force of each clearance joint (E, F) against
     the varied parameter."""
-    from weftsim.plots import pyplot
+    from weftsim.post.plots import pyplot
 
     plt = pyplot()
     values, numeric = _axis_values(rows, name)
@@ -145,7 +145,7 @@ def plot_sweep_2d(rows: list[dict], x_name: str, y_name: str, title: str = "") -
     One row for the first revolution and, when the runs are longer, one for the last
     complete revolution; values are written into the cells of small grids.
     """
-    from weftsim.plots import pyplot
+    from weftsim.post.plots import pyplot
 
     plt = pyplot()
     xs, x_numeric = _axis_values(rows, x_name)

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from weftsim.record import command_line
+from weftsim.post.record import command_line
 from weftsim.sweep.cell import CELL_FILE, cell_record, is_finished, solve_cell, store_cell, write_cell_record
 from weftsim.sweep.grid import SweepError
 from weftsim.sweep.lock import SweepLock
@@ -74,7 +74,7 @@ def _record_lost(outdir: Path, plan: SweepPlan, planned: PlannedCell, scene_keys
 def write_table(plan: SweepPlan, outdir: Path, pending: dict[str, PlannedCell] | None = None
                 ) -> tuple[Path, list[dict]]:
     """Rebuild ``sweep.csv`` from the cell directories (``pending``: cells not yet run, by name)."""
-    from weftsim.output import write_text
+    from weftsim.post.output import write_text
 
     rows = collect_rows(outdir, plan.axis_names, {n: p.cell.params for n, p in (pending or {}).items()})
     return write_text(outdir / TABLE_FILE, table_text(rows, plan.axis_names)), rows
@@ -82,7 +82,7 @@ def write_table(plan: SweepPlan, outdir: Path, pending: dict[str, PlannedCell] |
 
 def write_figure(plan: SweepPlan, outdir: Path, rows: list[dict]) -> Path | None:
     """``sweep.png`` for 1-D and 2-D sweeps (None for more axes or no successful cell)."""
-    from weftsim.output import write_figure as save
+    from weftsim.post.output import write_figure as save
     from weftsim.sweep.plots import plot_sweep
 
     base = plan.base_keys
@@ -97,7 +97,7 @@ def write_figure(plan: SweepPlan, outdir: Path, rows: list[dict]) -> Path | None
 
 def _open_directory(outdir: Path, plan: SweepPlan, lock: SweepLock) -> None:
     """Check ``outdir`` can take this sweep, create it, lock it and write ``sweep.json`` (union of the grids)."""
-    from weftsim.output import OutputError, prepare_directory, write_json
+    from weftsim.post.output import OutputError, prepare_directory, write_json
 
     if outdir.exists() and not outdir.is_dir():
         raise SweepError(f"sweep directory {outdir} exists and is not a directory; choose another -o")
@@ -109,7 +109,7 @@ def _open_directory(outdir: Path, plan: SweepPlan, lock: SweepLock) -> None:
         raise SweepError(str(exc)) from None
     lock.acquire()
     write_json(outdir / SWEEP_FILE, merge_manifest(outdir, new))  # again under the lock: another sweep may have been first
-    from weftsim.output import check_file_target
+    from weftsim.post.output import check_file_target
 
     for name in (TABLE_FILE, FIGURE_FILE):  # before any cell runs: the table and figure come last
         if (outdir / name).is_dir():

@@ -25,7 +25,7 @@ import re
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from weftsim.record import command_line
+from weftsim.post.record import command_line
 from weftsim.version import __version__
 from weftsim.sweep.cell import METRIC_CHANNELS, finite_or_none, read_record
 from weftsim.sweep.grid import Axis, SweepError, format_value

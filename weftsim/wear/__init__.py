@@ -31,7 +31,7 @@ from weftsim.errors import WearError
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from weftsim.params import Scene
+    from weftsim.input.params import Scene
 
 __all__ = ["ENGINES", "WearError", "check_engine", "predict", "predict_to_directory"]
 
@@ -91,7 +91,7 @@ def check_engine(outdir: str | Path, engine: str, force: bool = False) -> None:
     a record without one is the reference engine's); with ``force`` that state is deleted (starting over)."""
     import json
 
-    from weftsim.record import MANIFEST
+    from weftsim.post.record import MANIFEST
     from weftsim.wear.store import STATE, StateMismatch
 
     outdir = Path(outdir)
@@ -100,7 +100,7 @@ def check_engine(outdir: str | Path, engine: str, force: bool = False) -> None:
     try:
         record = json.loads((outdir / MANIFEST).read_text())
     except (OSError, ValueError):
-        return  # a damaged record is refused where it is read (weftsim.output, weftsim.record)
+        return  # a damaged record is refused where it is read (weftsim.post.output, weftsim.post.record)
     stored = record.get("engine", "reference") if isinstance(record, dict) and record.get("kind") == "wear" else engine
     if stored == engine:
         return
@@ -125,7 +125,7 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
     hours : float
         Operating hours to predict.
     outdir : str or path-like
-        Created if needed and checked by :func:`weftsim.output.prepare_directory` (``force``: also a
+        Created if needed and checked by :func:`weftsim.post.output.prepare_directory` (``force``: also a
         directory weftsim did not write); ``wear_state.npz`` in it is resumed when it belongs to the
         same scene and passes :func:`weftsim.wear.resume.read_state` (:class:`~.store.StateMismatch`
         otherwise, as for a request of fewer hours than it holds).
@@ -155,8 +155,8 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
         extrapolate): every update before it is written first (``wear.csv``, ``wear.json``, the
         profiles) and the message says so.
     """
-    from weftsim.output import begin_directory, prepare_directory
-    from weftsim.record import provenance
+    from weftsim.post.output import begin_directory, prepare_directory
+    from weftsim.post.record import provenance
     from weftsim.wear import store
     from weftsim.wear.engines import simulator
     from weftsim.wear.extrapolate import predict
@@ -257,7 +257,7 @@ def _write_results(scene: Scene, updates: list, hours: float, limit: float | Non
     """
     from dataclasses import replace
 
-    from weftsim.output import write_figure, write_files, write_json
+    from weftsim.post.output import write_figure, write_files, write_json
     from weftsim.wear import store
     from weftsim.wear.extrapolate import advance_update, effective_clearance, ended_by_limit, joint_of, wearing_joints
 

@@ -4,7 +4,7 @@ At every step row the kernel gives the normal force F_N, the sliding velocity v_
 points (:func:`weftsim.kernel.joint.tangential_velocity`: the journal's rotation relative to the
 bearing plus the tangential eccentricity rate), the contact direction in the bearing's and in the
 journal's frame and the contact half-angle.  The sliding work integral W = int F_N |v_T| dt is
-taken with the trapezoidal weights of the rows (:func:`weftsim.analysis.time_weights`), so each row
+taken with the trapezoidal weights of the rows (:func:`weftsim.post.analysis.time_weights`), so each row
 i carries dW_i = F_N,i |v_T,i| w_i; each surface of hardness H loses dV = (k / H) dW_i, spread over
 the contact arc (:func:`weftsim.kernel.wear.deposit`).  The worn depth of a profile cell is its
 volume over the cell's area L_b R dpsi (R = R_b for the bearing, R_j for the journal).
@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numba import njit
 
-from weftsim.analysis import time_weights
+from weftsim.post.analysis import time_weights
 from weftsim.kernel import chain_f as kf
 from weftsim.kernel.chain import BEARING_RADIUS, OMEGA, chain, eccentricity, local_clearance, rocker_angle
 from weftsim.kernel.asperity import asperity_half_angle, asperity_load
@@ -30,7 +30,7 @@ from weftsim.kernel.lubricated import is_lubricated
 from weftsim.kernel.wear import contact_half_angle, deposit
 
 if TYPE_CHECKING:
-    from weftsim.params import ClearanceJoint, Scene
+    from weftsim.input.params import ClearanceJoint, Scene
 
 
 @njit(cache=True, error_model="numpy")
@@ -162,7 +162,7 @@ class RunWear:
 def wear_from_rows(joint: ClearanceJoint, time: np.ndarray, rows: np.ndarray) -> RunWear:
     """Archard wear of contact rows (``rows`` (n, 5) as :func:`contact_rows` fills them) at times ``time`` (s).
 
-    ``joint``: the :class:`~weftsim.params.ClearanceJoint` (radii, length, ``wear``).
+    ``joint``: the :class:`~weftsim.input.params.ClearanceJoint` (radii, length, ``wear``).
     """
     wear = joint.wear
     weights = time_weights(time) if time.size > 1 else np.zeros(time.size)

@@ -5,8 +5,8 @@ from __future__ import annotations
 import sys
 from typing import TYPE_CHECKING
 
-from weftsim.exitcodes import EXIT_FAILED
-from weftsim.progress import format_duration
+from weftsim.cli.exitcodes import EXIT_FAILED
+from weftsim.run.progress import format_duration
 
 if TYPE_CHECKING:
     import argparse
@@ -14,7 +14,7 @@ if TYPE_CHECKING:
     from contextlib import AbstractContextManager
     from pathlib import Path
 
-    from weftsim.params import Scene
+    from weftsim.input.params import Scene
 
 
 def add_flags(p: argparse.ArgumentParser, positive: Callable[[Callable[[str], float]], Callable[[str], float]]) -> None:
@@ -52,9 +52,9 @@ def _duration(seconds: float) -> str:
 def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
         stop_on_interrupt: Callable[[str], AbstractContextManager]) -> int:
     """Predict, report progress on stderr and the result on stdout; Ctrl-C keeps the state for a resume."""
-    from weftsim.cli_grammar import CliError
-    from weftsim.output import prepare_directory
-    from weftsim.progress import Progress
+    from weftsim.cli.grammar import CliError
+    from weftsim.post.output import prepare_directory
+    from weftsim.run.progress import Progress
     from weftsim.wear import WearError, check_engine, check_request, predict_to_directory
     from weftsim.wear.extrapolate import MAX_HOURS, update_time
     from weftsim.wear.store import StateMismatch
@@ -137,7 +137,7 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
 def _stored_updates(outdir: Path, scene: Scene, force: bool) -> list:
     """The updates a previous run stored in ``outdir`` (resumed); with ``force`` a state of another
     scene is deleted (the prediction starts over), without it that is refused (one line)."""
-    from weftsim.cli_grammar import CliError
+    from weftsim.cli.grammar import CliError
     from weftsim.wear import store
 
     try:
@@ -152,7 +152,7 @@ def _stored_updates(outdir: Path, scene: Scene, force: bool) -> list:
 def run_ensemble(args: argparse.Namespace, scene: Scene, outdir: str | Path,
                  stop_on_interrupt: Callable[[str], AbstractContextManager]) -> int:
     """``weftsim wear SCENE --uncertain KEY=DIST ... --limit-clearance-mm X``: the hours to X as a distribution."""
-    from weftsim.cli_grammar import CliError
+    from weftsim.cli.grammar import CliError
     from weftsim.wear import WearError
     from weftsim.wear.ensemble import wear_ensemble
 

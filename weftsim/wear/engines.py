@@ -26,7 +26,7 @@ from weftsim.errors import WearError
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from weftsim.params import Scene
+    from weftsim.input.params import Scene
     from weftsim.wear.archard import RunWear
 
 ENGINES = ("reference", "exudyn")
@@ -54,7 +54,7 @@ def exudyn_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray) -> tup
     """:func:`engine_update` on the Exudyn engine (module docstring); raises
     :class:`~weftsim.wear.extrapolate.UpdateFailed` when every attempt of the run fails."""
     from weftsim.exudyn_engine.worn import ATTEMPTS, solve_worn
-    from weftsim.guards import stop_requested
+    from weftsim.run.guards import stop_requested
     from weftsim.reference.dynamics import pack_parameters
     from weftsim.wear.archard import rows_from_contact, wear_from_rows
     from weftsim.wear.extrapolate import UpdateFailed, WearInterrupted, wear_response, worn_scene

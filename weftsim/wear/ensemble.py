@@ -41,7 +41,7 @@ from weftsim.wear.uncertain import Uncertain, latin_hypercube, parse_uncertain, 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from weftsim.params import Scene
+    from weftsim.input.params import Scene
 
 CHAOS_RUNS = 6  # the centre run and five whose k differs in the last bits (docs/wear.md section 6 used six)
 LEVELS = 40  # clearance levels of the band between the largest starting clearance and the limit
@@ -90,7 +90,7 @@ def combine(scene: Scene, uncertain: list[Uncertain], dynamic: list[Uncertain], 
 
     Hours are ``inf`` where a sample does not reach a level within ``horizon`` (censored).
     """
-    from weftsim.scene import to_file_keys
+    from weftsim.input.scene import to_file_keys
     from weftsim.wear.extrapolate import MAX_HOURS
 
     node_names = [n for n in results if n.startswith("node_")] or ["centre"]
@@ -199,7 +199,7 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
     design_points : dict, optional
         ``{key: n}``: n design points (2 to 9) for a simulated key instead of 3 (docs/wear.md section 9).
     """
-    from weftsim.output import begin_directory, prepare_directory, write_csv, write_figure, write_files, write_json
+    from weftsim.post.output import begin_directory, prepare_directory, write_csv, write_figure, write_files, write_json
     from weftsim.wear import check_request
 
     texts = [f"{k}={v}" for k, v in uncertain.items()] if isinstance(uncertain, dict) else list(uncertain)

@@ -30,7 +30,7 @@ import numpy as np
 from weftsim.errors import WearError
 
 if TYPE_CHECKING:
-    from weftsim.params import Scene
+    from weftsim.input.params import Scene
     from weftsim.wear.uncertain import Uncertain
 
 RESCALED = ("joint_e.wear.wear_coefficient", "joint_e.wear.bearing_hardness_mpa", "joint_e.wear.journal_hardness_mpa")
@@ -94,7 +94,7 @@ def plan(scene: Scene, uncertain: list[Uncertain], chaos_runs: int = 6, design_p
     """(jobs as (name, scene), the dynamic inputs, their design values (nodes, dims)); checks every design scene.
 
     The chaos runs are made at the centre point (index ``points // 2`` of every key)."""
-    from weftsim.scene import SceneError, apply_overrides, to_file_keys
+    from weftsim.input.scene import SceneError, apply_overrides, to_file_keys
 
     keys = to_file_keys(scene)
     seen = set()

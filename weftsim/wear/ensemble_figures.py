@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.plots import figure
+from weftsim.post.plots import figure
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure

@@ -33,7 +33,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.analysis import channel_statistics, time_weights
+from weftsim.post.analysis import channel_statistics, time_weights
 from weftsim.errors import WearError
 from weftsim.wear.archard import run_wear
 from weftsim.wear.updates import (  # noqa: F401 - the data model of a prediction, used here and re-exported
@@ -44,7 +44,7 @@ from weftsim.wear.updates import (  # noqa: F401 - the data model of a predictio
 if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
 
-    from weftsim.params import Scene
+    from weftsim.input.params import Scene
     from weftsim.wear.archard import RunWear
 
 # Film ratio h_min / sigma below which a lubricated joint runs mixed (asperities carry part of the load;
@@ -184,7 +184,7 @@ def _response(steps: dict, t0: float, joints: Sequence[str] = ("e",)) -> dict:
     out = {"rapier_acceleration_rms_m_s2": acc["rms"], "rapier_acceleration_p99_m_s2": acc["p99_abs"],
            "driving_torque_rms_Nm": torque["rms"], "driving_torque_p99_Nm": torque["p99_abs"]}
     for joint in joints:
-        tail = "" if joint == "e" else "_f"  # the channels' names (weftsim.results)
+        tail = "" if joint == "e" else "_f"  # the channels' names (weftsim.post.results)
         force = channel_statistics(t, steps[f"contact_force{tail}_N"][keep])
         film = {"film_ratio_min": math.nan, "film_ratio_mean": math.nan, "mixed_fraction": math.nan}
         if f"film_ratio{tail}" in steps:  # a lubricated joint: the film ratio over the steady cycle
@@ -217,7 +217,7 @@ def simulate_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray,
     from weftsim import reference
     from weftsim.reference.dynamics import pack_parameters
 
-    from weftsim.guards import stop_requested
+    from weftsim.run.guards import stop_requested
 
     joints = wearing_joints(scene)
     w = joint_of(scene, joints[0]).wear  # the run's revolutions: the first wearing joint's table
@@ -317,7 +317,7 @@ def predict(scene: Scene, hours: float, updates: Sequence[Update] = (),
     ``on_update(updates)``: called after each update (storing, progress); ``stop()``: True asks to
     end after the current update.  The last update simulates the final geometry, with N = 0; or,
     when the prediction ends at a geometric limit (:func:`ended_by_limit`), extrapolates up to it.
-    A stop asked for while an update is simulated (:func:`weftsim.guards.request_stop`) drops it.
+    A stop asked for while an update is simulated (:func:`weftsim.run.guards.request_stop`) drops it.
     Every loose joint wears (:func:`wearing_joints`).
     """
     if not (0.0 < hours <= MAX_HOURS):
@@ -374,9 +374,9 @@ def predict(scene: Scene, hours: float, updates: Sequence[Update] = (),
 
 def update_time(scene: Scene, engine: str = "reference") -> float:
     """Estimated wall-clock seconds of one wear update: the engine's estimate
-    (:func:`weftsim.progress.estimate_run_time`) for its settle + steady revolutions at the solver
+    (:func:`weftsim.run.progress.estimate_run_time`) for its settle + steady revolutions at the solver
     tolerance of a worn geometry (:data:`WORN_RTOL` on the reference engine)."""
-    from weftsim.progress import estimate_run_time
+    from weftsim.run.progress import estimate_run_time
 
     w = joint_of(scene, (wearing_joints(scene) or ("e",))[0]).wear
     solver = replace(scene.reference_solver, rtol=min(scene.reference_solver.rtol, WORN_RTOL))

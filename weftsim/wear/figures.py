@@ -7,14 +7,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.plots import figure
+from weftsim.post.plots import figure
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
     from matplotlib.figure import Figure
 
-    from weftsim.params import Scene
+    from weftsim.input.params import Scene
     from weftsim.wear.extrapolate import Update
 
 

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from weftsim.params import Scene
+    from weftsim.input.params import Scene
 
 CURVE = "curve.json"
 CURVE_VERSION = 2  # 2: two-ended hours, one update simulated at the limit (older curves are run again)

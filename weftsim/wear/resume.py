@@ -5,7 +5,7 @@ killed while another wrote it) or edited by hand.  A resumed prediction extrapol
 update, so a wrong number there becomes a wrong answer that looks complete.  :func:`read_state`
 therefore refuses, with one line naming what is wrong, a state that
 
-- is not a readable archive of the arrays weftsim writes (:mod:`weftsim.npz_guard`: empty,
+- is not a readable archive of the arrays weftsim writes (:mod:`weftsim.post.npz_guard`: empty,
   truncated, garbage, a directory, a ZIP bomb, a header claiming more than the file holds);
 - lacks an array, or has one of the wrong shape or kind (one row per update, one column per
   profile point of each wearing joint's ``[joint_*.wear] profile_points``; per-joint arrays are
@@ -39,7 +39,7 @@ import numpy as np
 from weftsim.errors import OutputError
 
 if TYPE_CHECKING:
-    from weftsim.params import Scene
+    from weftsim.input.params import Scene
     from weftsim.wear.extrapolate import Update
 
 WHAT = "a wear state"
@@ -90,9 +90,9 @@ def read_state(path: Path, scene: Scene) -> list[Update]:
     weftsim.wear.store.StateMismatch
         One line naming the problem, the file, and what to do.
     """
-    from weftsim.npz_guard import DAMAGE, array_headers, open_archive, read_array
+    from weftsim.post.npz_guard import DAMAGE, array_headers, open_archive, read_array
     from weftsim.wear.extrapolate import joint_of, wearing_joints
-    from weftsim.wear.store import LEGACY_RESPONSE, RESPONSE, StateMismatch, scene_identity
+    from weftsim.wear.state import LEGACY_RESPONSE, RESPONSE, StateMismatch, scene_identity
 
     joints = wearing_joints(scene)
     allowed = {"scene", "response", "digest", *SERIES, *LEGACY,
@@ -148,7 +148,7 @@ def read_state(path: Path, scene: Scene) -> list[Update]:
 
 def _legacy_response(response: np.ndarray) -> np.ndarray:
     """A legacy state's response columns (:data:`~weftsim.wear.store.LEGACY_RESPONSE`) in today's layout."""
-    from weftsim.wear.store import LEGACY_NAMES, LEGACY_RESPONSE, RESPONSE
+    from weftsim.wear.state import LEGACY_NAMES, LEGACY_RESPONSE, RESPONSE
 
     out = np.full((response.shape[0], len(RESPONSE)), math.nan)
     for k, name in enumerate(LEGACY_RESPONSE):
@@ -193,7 +193,7 @@ def _value_problem(data: dict, response: np.ndarray) -> str:
             return f"'{name}' holds a value that is not finite"
         if np.any(values < 0.0):
             return f"'{name}' holds a negative value (times, revolutions, depths and rates are >= 0)"
-    from weftsim.wear.store import RESPONSE
+    from weftsim.wear.state import RESPONSE
 
     # NaN is allowed: the film statistics of a dry joint (store.RESPONSE)
     if np.any(np.isinf(response)) or not np.all(response[:, RESPONSE.index("solver_rtol")] > 0.0):
@@ -255,7 +255,7 @@ def _model_problem(data: dict, scene: Scene, joints: tuple[str, ...]) -> str:
 
 def _updates(data: dict, response: np.ndarray, joints: tuple[str, ...]) -> list[Update]:
     from weftsim.wear.extrapolate import JointWear, Update
-    from weftsim.wear.store import RESPONSE
+    from weftsim.wear.state import RESPONSE
 
     out = []
     for i in range(data["hours"].size):
@@ -273,7 +273,7 @@ def _updates(data: dict, response: np.ndarray, joints: tuple[str, ...]) -> list[
 def check_resume(updates: list[Update], scene: Scene, hours: float, outdir: Path) -> None:
     """Refuse a resume asking for fewer hours than the stored state already reaches."""
     from weftsim.wear.extrapolate import SECONDS_PER_HOUR
-    from weftsim.wear.store import STATE, StateMismatch
+    from weftsim.wear.state import STATE, StateMismatch
 
     if not updates:
         return

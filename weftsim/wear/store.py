@@ -12,64 +12,19 @@ resumes at its last update (docs/wear.md section 4).
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.errors import WearError
-from weftsim.output import write_atomic, write_csv
+from weftsim.post.output import write_atomic, write_csv
 from weftsim.wear.extrapolate import Update, effective_clearance, joint_of, limit_hours, wearing_joints
+# What a stored state is lives in weftsim.wear.state, read by weftsim.wear.resume too; re-exported here.
+from weftsim.wear.state import JOINTS, JOINT_RESPONSE, LEGACY_NAMES, LEGACY_RESPONSE, MECHANISM_RESPONSE, PARTS, RESPONSE, STATE, StateMismatch, scene_identity  # noqa: F401
 
 if TYPE_CHECKING:
-    from weftsim.params import Scene
-
-STATE = "wear_state.npz"
-# Response statistics of an update (extrapolate._response, _sliding): the mechanism's, then each joint's
-# (NaN for a joint that does not wear).
-MECHANISM_RESPONSE = ("rapier_acceleration_rms_m_s2", "rapier_acceleration_p99_m_s2", "driving_torque_rms_Nm",
-                      "driving_torque_p99_Nm", "solver_rtol", "backoffs_after")
-JOINT_RESPONSE = ("contact_force_{j}_mean_N", "contact_force_{j}_p99_N", "contact_force_{j}_max_N",
-                  "film_ratio_min_{j}", "film_ratio_mean_{j}", "mixed_fraction_{j}", "sliding_distance_per_rev_{j}_m",
-                  "sliding_work_per_rev_{j}_J", "contact_force_sliding_mean_{j}_N")
-JOINTS = ("e", "f")
-RESPONSE = MECHANISM_RESPONSE + tuple(name.format(j=j) for j in JOINTS for name in JOINT_RESPONSE)
-# The columns of a state written before the joints were named (joint E alone), in their stored order, and
-# their names now: such a state still loads (weftsim.wear.resume).
-LEGACY_RESPONSE = ("rapier_acceleration_rms_m_s2", "rapier_acceleration_p99_m_s2", "driving_torque_rms_Nm",
-                   "driving_torque_p99_Nm", "contact_force_mean_N", "contact_force_p99_N", "contact_force_max_N",
-                   "solver_rtol", "film_ratio_min", "film_ratio_mean", "mixed_fraction", "sliding_distance_per_rev_m",
-                   "sliding_work_per_rev_J", "contact_force_sliding_mean_N", "backoffs_after")
-LEGACY_NAMES = {"contact_force_mean_N": "contact_force_e_mean_N", "contact_force_p99_N": "contact_force_e_p99_N",
-                "contact_force_max_N": "contact_force_e_max_N", "film_ratio_min": "film_ratio_min_e",
-                "film_ratio_mean": "film_ratio_mean_e", "mixed_fraction": "mixed_fraction_e",
-                "sliding_distance_per_rev_m": "sliding_distance_per_rev_e_m",
-                "sliding_work_per_rev_J": "sliding_work_per_rev_e_J",
-                "contact_force_sliding_mean_N": "contact_force_sliding_mean_e_N",
-                **{name: name for name in MECHANISM_RESPONSE}}
-# Per-joint arrays of the state, stored as NAME_<joint>.
-PARTS = ("bearing", "journal", "rate_bearing", "rate_journal", "volume_rate")
-
-
-class StateMismatch(WearError):
-    """The directory's stored state cannot be resumed: another scene or other wear settings, a damaged
-    or edited file (:mod:`weftsim.wear.resume`), or more hours than asked for."""
-
-
-def scene_identity(scene: Scene) -> str:
-    """The scene's file keys as canonical JSON: what a stored state must match to be resumed.
-
-    An ideal joint F's ``[joint_f.wear]`` keys are left out: they change nothing, and a state written before F
-    could wear (which did not know them) stays the same scene's.
-    """
-    from weftsim.scene import to_file_keys
-
-    keys = to_file_keys(scene)
-    if scene.joint_f.is_ideal:
-        keys = {k: v for k, v in keys.items() if not k.startswith("joint_f.wear.")}
-    return json.dumps(keys, sort_keys=True, default=str)
+    from weftsim.input.params import Scene
 
 
 def response_row(update: Update) -> list[float]:
@@ -170,7 +125,7 @@ def summary(scene: Scene, updates: list[Update], hours: float, limit: float | No
     ``hours_to_limit`` is the first of the joints' ``hours_to_limit_<j>`` (the joint that needs service first,
     named by ``limit_joint``): a limit applies to every wearing joint.
     """
-    from weftsim.scene import to_file_keys
+    from weftsim.input.scene import to_file_keys
 
     joints = wearing_joints(scene)
     last = updates[-1]

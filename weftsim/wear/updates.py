@@ -16,7 +16,7 @@ import numpy as np
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
-    from weftsim.params import Scene
+    from weftsim.input.params import Scene
 
 SECONDS_PER_HOUR = 3600.0
 
@@ -83,7 +83,7 @@ def wearing_joints(scene: Scene) -> tuple[str, ...]:
 
 
 def joint_of(scene: Scene, joint: str):
-    """The :class:`~weftsim.params.ClearanceJoint` of ``joint`` ("e" or "f")."""
+    """The :class:`~weftsim.input.params.ClearanceJoint` of ``joint`` ("e" or "f")."""
     return scene.joint if joint == "e" else scene.joint_f
 
 

@@ -1,0 +1,7 @@
+"""``python -m weftsim``: the ``weftsim`` command."""
+
+import sys
+
+from weftsim.cli.commands import main
+
+sys.exit(main())

@@ -1,0 +1,7 @@
+"""``python -m weftsim.cli``: the ``weftsim`` command."""
+
+import sys
+
+from weftsim.cli.commands import main
+
+sys.exit(main())

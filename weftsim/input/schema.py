@@ -1,0 +1,281 @@
+"""The schema of a scene file: every key, its unit, its range and where it goes in :class:`weftsim.input.params.Scene`.
+
+:data:`SCHEMA` is the single list of keys (the README's and the site's scene reference are written from it);
+:mod:`weftsim.input.scene` reads files against it and :mod:`weftsim.input.joint_keys` (which keys joint F takes from
+joint E, which describe an ideal joint) reads it too.  Split off :mod:`weftsim.input.scene` so that the joint keys
+need no scene reader, and the reader imports the joint keys without an import circle.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import Any
+
+from weftsim.input import params
+
+INTEGRATORS = ("auto", "DOP853", "RK45", "RK23", "Radau", "LSODA", "BDF", "numba_DOP853", "numba_RK45", "numba_RODAS4",
+               "numba_DOP853_RODAS4")
+EXUDYN_MODELS = ("auto", "rigid_body", "kinematic_tree")
+EXPLICIT_METHODS = ("DOPRI5", "ODE23")
+TREE_SOLVERS = ("auto", "explicit", "implicit")
+STEP_CONTROLS = ("adaptive", "fixed")
+CALLBACK_ROUTES = ("auto", "python", "symbolic", "numba")
+BRANCHES = {"+": 1, "-": -1}
+IMPACT_VELOCITY_RULES = params.IMPACT_VELOCITY_RULES
+
+
+@dataclass(frozen=True)
+class Key:
+    """One scene-file key: where it goes, its unit conversion and its allowed range."""
+
+    path: str  # dotted TOML key, e.g. "joint_e.clearance_mm"
+    target: str  # "<scene attribute>.<field>" or deeper, e.g. "joint.clearance"
+    kind: str  # "float", "int", "bool", "str", "floats2", "floats3"
+    scale: float = 1.0  # SI value = file value * scale
+    low: float | None = None
+    high: float | None = None
+    low_open: bool = True  # low excluded
+    high_open: bool = False  # high excluded
+    choices: tuple = ()
+    doc: str = ""
+
+    def allowed(self) -> str:
+        if self.choices:
+            return "one of " + ", ".join(repr(c) for c in self.choices)
+        parts = []
+        if self.low is not None:
+            parts.append(f"{'>' if self.low_open else '>='} {self.low:g}")
+        if self.high is not None:
+            parts.append(f"{'<' if self.high_open else '<='} {self.high:g}")
+        return " and ".join(parts) or "any finite value"
+
+
+MM, DEG, GPA, MPA, RPM = 1e-3, math.pi / 180.0, 1e9, 1e6, 2.0 * math.pi / 60.0
+
+
+def WEAR_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 - a constant-like key factory
+    """The ``[<table>.wear]`` keys of a clearance joint (weftsim wear; docs/wear.md), all optional."""
+    return (
+        # k spans 1e-2 (severe, dry) to below 1e-6 (Archard 1953; Rabinowicz 1995); hardness from soft
+        # polymer bushings (~10 MPa) to ceramics and diamond (~1e5 MPa).  Beyond these the wear per update
+        # dwarfs the clearance and the cycle extrapolation cannot follow it (issue 24).
+        Key(f"{table}.wear.wear_coefficient", f"{joint}.wear.wear_coefficient", "float", 1, 0, 1e-2, True, False,
+            doc="Archard's dimensionless wear coefficient k (default 1e-7, mild lubricated steel; 1e-2 severe dry wear)"),
+        Key(f"{table}.wear.bearing_hardness_mpa", f"{joint}.wear.bearing_hardness", "float", MPA, 1, 1e5, False,
+            doc="hardness H of the bearing surface (default 2000 MPa, hardened steel)"),
+        Key(f"{table}.wear.journal_hardness_mpa", f"{joint}.wear.journal_hardness", "float", MPA, 1, 1e5, False,
+            doc="hardness H of the journal surface (default 2000 MPa)"),
+        Key(f"{table}.wear.max_clearance_change", f"{joint}.wear.max_clearance_change", "float", 1, 0, 0.5, True,
+            False, doc="update criterion: largest growth of the effective clearance per update, as a fraction"),
+        Key(f"{table}.wear.revolutions_per_update", f"{joint}.wear.revolutions_per_update", "int", 1, 0, 1000,
+            doc="steady crank revolutions simulated per geometry update"),
+        Key(f"{table}.wear.settle_revolutions", f"{joint}.wear.settle_revolutions", "int", 1, 0, 100, False,
+            doc="revolutions simulated first and not counted (start from the centred journal)"),
+        # At least 180 (2 deg cells): on the reference loom, profiles of 8, 16, 36, 72 and 120 points failed
+        # the contact-history check within 5 h (damping above the bound, the contact's rate of clearance
+        # change dc/dt jumping between coarse knots); 180 and 240 ran 25 h, as the default 360 does (issue 24).
+        Key(f"{table}.wear.profile_points", f"{joint}.wear.profile_points", "int", 1, 180, 100000, False,
+            doc="points of the tabulated wear profiles over 360 deg (>= 180: coarser ones break the worn contact)"),
+    )
+
+
+def LUBRICATION_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 - a constant-like key factory
+    """The ``[<table>.lubrication]`` keys of a clearance joint (docs/lubricated-joint.md).  The table is optional
+    (absent: the dry joint); given, it must name ``viscosity_mpa_s``, the other keys default."""
+    at = f"{table}.lubrication."
+    to = f"{joint}.lubrication."
+    return (
+        Key(at + "viscosity_mpa_s", to + "viscosity", "float", 1e-3, 0, None, False,
+            doc="dynamic viscosity of the oil at operating temperature (ISO VG 220 at 60 C: ~80 mPa s); 0 = no film"),
+        Key(at + "model", to + "model", "str", choices=params.FILM_MODELS,
+            doc="film model: finite (finite-length bearing, default), short (Ocvirk), long (Sommerfeld) or "
+                "short_half (Flores et al.'s short bearing)"),
+        Key(at + "roughness_um", to + "roughness", "float", 1e-6, 0,
+            doc="combined RMS roughness of journal and bearing (default 0.4 um, two ground surfaces)"),
+        Key(at + "asperity_density_radius_roughness", to + "asperity_density_radius_roughness", "float", 1, 0, 1,
+            False, doc="Greenwood-Tripp eta beta sigma (default 0.04); 0 = no asperity contact"),
+        Key(at + "roughness_radius_ratio", to + "roughness_radius_ratio", "float", 1, 0, 1,
+            doc="Greenwood-Tripp sigma / beta, RMS roughness over asperity summit radius (default 1e-3)"),
+        Key(at + "boundary_friction_coefficient", to + "boundary_friction_coefficient", "float", 1, 0, 2, False,
+            doc="friction coefficient on the asperity load (default 0.1)"),
+        Key(at + "film_floor_ratio", to + "film_floor_ratio", "float", 1, 0, 4,
+            doc="the film force is evaluated no closer than this many RMS roughnesses (default 1)"),
+    )
+
+
+SCHEMA: tuple[Key, ...] = (
+    Key("mechanism.crank_inclination_deg", "geometry.crank_inclination", "float", DEG, 0, 90, True, True,
+        doc="beta, arc A-B of the spherical 4R"),
+    Key("mechanism.rocker_arm_angle_deg", "geometry.rocker_arm_angle", "float", DEG, -360, 360, False, False,
+        doc="theta_OE0, angle of OE from +y towards +z at phi = 0"),
+    Key("mechanism.l_oe_mm", "geometry.l_oe", "float", MM, 0, doc="rocker arm OE"),
+    Key("mechanism.l_ef_mm", "geometry.l_ef", "float", MM, 0, doc="connecting rod EF"),
+    Key("mechanism.l_fg_mm", "geometry.l_fg", "float", MM, 0, doc="sector arm FG"),
+    Key("mechanism.l_og_mm", "geometry.l_og", "float", MM, 0, doc="frame O-G"),
+    Key("mechanism.fourbar_branch", "geometry.fourbar_branch", "str", choices=tuple(BRANCHES),
+        doc="assembly branch of the four-bar (docs/physics.md section 1: \"+\")"),
+    Key("mechanism.sector_pitch_radius_mm", "geometry.sector_pitch_radius", "float", MM, 0, doc="d5"),
+    Key("mechanism.pinion_pitch_radius_mm", "geometry.pinion_pitch_radius", "float", MM, 0, doc="d6"),
+    Key("mechanism.rapier_gear_pitch_radius_mm", "geometry.rapier_gear_pitch_radius", "float", MM, 0, doc="d7"),
+    Key("inertia.crank_inertia_kg_m2", "inertia.crank_inertia", "float", 1, 0, doc="J1 about A"),
+    Key("inertia.coupler_mass_kg", "inertia.coupler_mass", "float", 1, 0, doc="m2 (centre of mass at O)"),
+    Key("inertia.coupler_inertia_kg_m2", "inertia.coupler_inertia", "floats3", 1, 0,
+        doc="principal inertia of the coupler about O in [b, c, b x c]"),
+    Key("inertia.rocker_mass_kg", "inertia.rocker_mass", "float", 1, 0, doc="m3"),
+    Key("inertia.rocker_com_mm", "inertia.rocker_com", "float", MM, None, doc="rocker centre of mass on OE from O"),
+    Key("inertia.rocker_inertia_kg_m2", "inertia.rocker_inertia", "float", 1, 0, doc="J3 about D"),
+    Key("inertia.rod_mass_kg", "inertia.rod_mass", "float", 1, 0, doc="m4 (centre of mass mid EF)"),
+    Key("inertia.rod_inertia_kg_m2", "inertia.rod_inertia", "float", 1, 0, doc="J4 about its centre of mass"),
+    Key("inertia.sector_inertia_kg_m2", "inertia.sector_inertia", "float", 1, 0, doc="J5 about G"),
+    Key("inertia.pinion_gear_inertia_kg_m2", "inertia.pinion_gear_inertia", "float", 1, 0, doc="J67"),
+    Key("inertia.rapier_mass_kg", "inertia.rapier_mass", "float", 1, 0, doc="m8"),
+    Key("inertia.gravity_m_s2", "inertia.gravity", "float", 1, 0, doc="g along -z"),
+    Key("joint_e.clearance_mm", "joint.clearance", "float", MM, 0, 5, False, doc="radial clearance c; 0 = ideal joint"),
+    Key("joint_e.journal_radius_mm", "joint.journal_radius", "float", MM, 0, doc="R_j"),
+    Key("joint_e.bearing_length_mm", "joint.bearing_length", "float", MM, 0, doc="L_b"),
+    Key("joint_e.law", "joint.law", "str", doc="contact force law (see weftsim.joint.contact.LAWS)"),
+    Key("joint_e.restitution", "joint.restitution", "float", 1, 0, 1, True, False, doc="coefficient of restitution ce"),
+    Key("joint_e.friction_coefficient", "joint.friction_coefficient", "float", 1, 0, 2, False,
+        doc="mu of the modified Coulomb law; 0 = off"),
+    Key("joint_e.friction_velocities_m_s", "joint.friction_velocities", "floats2", 1, 0,
+        doc="[v0, v1] of the friction ramp, v0 < v1"),
+    Key("joint_e.min_impact_velocity_m_s", "joint.min_impact_velocity", "float", 1, 0,
+        doc="floor on the held impact velocity"),
+    Key("joint_e.impact_velocity_rule", "joint.impact_velocity_rule", "str", choices=IMPACT_VELOCITY_RULES,
+        doc="held impact velocity: largest approach rate since onset, or the onset value alone"),
+    Key("joint_e.journal_material.youngs_modulus_gpa", "joint.journal_material.youngs_modulus", "float", GPA, 0),
+    Key("joint_e.journal_material.poisson_ratio", "joint.journal_material.poisson_ratio", "float", 1, 0, 0.5,
+        False, True),
+    Key("joint_e.bearing_material.youngs_modulus_gpa", "joint.bearing_material.youngs_modulus", "float", GPA, 0),
+    Key("joint_e.bearing_material.poisson_ratio", "joint.bearing_material.poisson_ratio", "float", 1, 0, 0.5,
+        False, True),
+    Key("joint_e.journal_material.yield_strength_mpa", "joint.journal_material.yield_strength", "float", MPA, 0,
+        doc="optional; peak contact pressure above 1.67 x this (first yield) is warned about"),
+    Key("joint_e.bearing_material.yield_strength_mpa", "joint.bearing_material.yield_strength", "float", MPA, 0,
+        doc="optional; as for the journal (the smaller of the two counts)"),
+    Key("joint_e.bearing_material.max_pressure_mpa", "joint.bearing_material.max_pressure", "float", MPA, 0,
+        doc="optional; the bushing's permitted projected pin pressure F / (d B): a peak above it is warned about"),
+    Key("joint_e.bearing_material.max_pv_mpa_m_s", "joint.bearing_material.max_pv", "float", MPA, 0,
+        doc="optional; the bushing's permitted p x v (MPa x m/s): a cycle mean above it is warned about"),
+    Key("joint_e.design_clearance_per_mille", "joint.design_clearance", "floats2", 1e-3, 0, None, False,
+        doc="optional; [low, high] design range of the radial clearance over the pin diameter, per mille "
+            "(default [0.5, 1.0], a bushed pin in oscillating motion); outside it is warned about"),
+    *WEAR_KEYS("joint_e", "joint"),
+    *LUBRICATION_KEYS("joint_e", "joint"),
+    Key("drive.speed_rpm", "drive.speed", "float", RPM, 0, 5000, doc="constant crank speed"),
+    Key("drive.revolutions", "drive.revolutions", "float", 1, 0, 1000, doc="crank revolutions to simulate"),
+    Key("solver.reference.method", "reference_solver.method", "str", choices=INTEGRATORS,
+        doc="method of the reference engine: scipy's, or numba_* (compiled, docs/performance.md; numba_RODAS4 "
+            "linearly implicit, numba_DOP853_RODAS4 implicit in contact); auto = numba_DOP853, or with friction "
+            "numba_DOP853_RODAS4 at rtol <= 1e-6, or with a lubricated joint numba_RODAS4 (the fastest paths "
+            "meeting the accuracy targets)"),
+    Key("solver.reference.rtol", "reference_solver.rtol", "float", 1, 0, 1e-2, doc="relative tolerance"),
+    Key("solver.reference.atol", "reference_solver.atol", "float", 1, 0, 1e-2, doc="absolute tolerance"),
+    Key("solver.reference.max_step_deg", "reference_solver.max_step", "float", DEG, 0, 90,
+        doc="largest step, as crank angle"),
+    Key("solver.exudyn.model", "exudyn_solver.model", "str", choices=EXUDYN_MODELS,
+        doc="Exudyn model: auto = kinematic_tree unless the scene needs rigid_body (ideal joint); "
+            "rigid_body = members 1-8, general; kinematic_tree = members 1-3 prescribed"),
+    Key("solver.exudyn.step_control", "exudyn_solver.step_control", "str", choices=STEP_CONTROLS,
+        doc="rigid_body model: adaptive (step from a local error estimate: large in free flight, small "
+            "through impacts) or fixed (step_size_s)"),
+    Key("solver.exudyn.local_error_m", "exudyn_solver.local_error", "float", 1, 0, 1e-3,
+        doc="rigid_body model, adaptive, and kinematic_tree, implicit: tolerance of the local error estimate "
+            "of the journal centre at E per step"),
+    Key("solver.exudyn.step_size_s", "exudyn_solver.step_size", "float", 1, 0, 1e-2,
+        doc="generalized-alpha step when fixed (adaptive: unused; an ideal joint then steps 0.25 deg of "
+            "crank, nothing to resolve)"),
+    Key("solver.exudyn.spectral_radius", "exudyn_solver.spectral_radius", "float", 1, 0, 1, False, False,
+        doc="rigid_body model: generalized-alpha spectral radius (<= 0.9 for smooth constraint torques; the "
+            "kinematic tree's implicit solver takes 1, it has no constraints)"),
+    Key("solver.exudyn.modified_newton", "exudyn_solver.modified_newton", "bool", doc="modified Newton"),
+    Key("solver.exudyn.newton_relative_tolerance", "exudyn_solver.newton_relative_tolerance", "float", 1, 0, 1e-2),
+    Key("solver.exudyn.newton_max_iterations", "exudyn_solver.newton_max_iterations", "int", 1, 0, 1000),
+    Key("solver.exudyn.callback", "exudyn_solver.callback", "str", choices=CALLBACK_ROUTES,
+        doc="contact callback route; auto = fastest measured"),
+    Key("solver.exudyn.tree_solver", "exudyn_solver.tree_solver", "str", choices=TREE_SOLVERS,
+        doc="kinematic_tree model: explicit (explicit_method, automatic step size) or implicit "
+            "(generalized-alpha, step error-controlled to local_error_m); auto = implicit with friction "
+            "in the joint, explicit without (the faster of the two for each, docs/performance.md)"),
+    Key("solver.exudyn.explicit_method", "exudyn_solver.explicit_method", "str", choices=EXPLICIT_METHODS,
+        doc="kinematic_tree model: explicit solver with automatic step size"),
+    Key("solver.exudyn.relative_tolerance", "exudyn_solver.relative_tolerance", "float", 1, 0, 1e-2,
+        doc="kinematic_tree model: relative tolerance of the step-size control"),
+    Key("solver.exudyn.absolute_tolerance", "exudyn_solver.absolute_tolerance", "float", 1, 0, 1e-2,
+        doc="kinematic_tree model: absolute tolerance (joint angles in rad, rates in rad/s)"),
+    Key("output.sample_deg", "output.sample_angle", "float", DEG, 0, 0.5, True, False,
+        doc="output grid spacing in crank angle (0.5 deg or finer)"),
+    Key("compare.first_contact_angle_deg", "compare.first_contact_angle", "float", DEG, 0),
+    Key("compare.first_revolution_peaks", "compare.first_revolution_peaks", "float", 1, 0,
+        doc="relative tolerance on first-revolution maxima"),
+    Key("compare.rms", "compare.rms", "float", 1, 0, doc="relative tolerance on RMS over revolutions 2..N"),
+    Key("compare.percentile_99", "compare.percentile_99", "float", 1, 0, doc="relative tolerance on 99th percentiles"),
+    Key("compare.ideal_curves", "compare.ideal_curves", "float", 1, 0,
+        doc="ideal joint: largest difference at any sample, relative to the peak"),
+    Key("limits.max_wall_time_s", "limits.max_wall_time", "float", 1, 0, None, False,
+        doc="wall-clock budget of one run; 0 = no limit (the run fails when it is spent)"),
+    Key("limits.max_steps", "limits.max_steps", "int", 1, 0, None, False,
+        doc="budget of accepted solver steps; 0 = no limit"),
+    Key("limits.max_penetration_ratio", "limits.max_penetration", "float", 1, 0, 1, True, False,
+        doc="the run fails when the penetration exceeds this fraction of the journal radius"),
+    Key("limits.min_step_s", "limits.min_step", "float", 1, 0, 1e-4,
+        doc="step-size collapse: the smallest step either engine may take"),
+    Key("limits.max_energy_error", "limits.max_energy_error", "float", 1, 0, 1, True, False,
+        doc="the run fails when the energy balance misses by more than this fraction of the largest kinetic energy"),
+    Key("limits.max_rapier_acceleration_m_s2", "limits.max_rapier_acceleration", "float", 1, 0,
+        doc="largest rapier acceleration a rapier head is built for (default 3000 m/s2); above it is warned about"),
+    Key("limits.max_damping_ratio", "limits.max_damping_ratio", "float", 1, 0, None, True,
+        doc="damping force bound, multiple of xi x the elastic force (delta_dot / v_imp): <= 1 in an isolated "
+            "impact and under max_approach (beyond it the run fails); the onset rule exceeds it (a warning)"),
+)
+
+def _joint_f_keys() -> tuple[Key, ...]:
+    """The keys of [joint_f] (joint F, rod 4 - sector 5): those of [joint_e], for the scene's ``joint_f``,
+    its wear table ``[joint_f.wear]`` included (``weftsim wear`` wears every loose joint; docs/wear.md)."""
+    out = []
+    for key in SCHEMA:
+        if key.path.startswith("joint_e."):
+            doc = "joint F: " + (key.doc or key.path.partition(".")[2])
+            out.append(replace(key, path="joint_f." + key.path.partition(".")[2],
+                               target="joint_f." + key.target.partition(".")[2], doc=doc))
+    return tuple(out)
+
+
+SCHEMA = SCHEMA + _joint_f_keys()
+_BY_PATH = {key.path: key for key in SCHEMA}
+TOP_LEVEL = ("name", "description", "extends")
+# Sections that describe the machine: a scene must give all their keys, itself or through
+# `extends` (a missing one is an error, never a silent default).  Solver settings, output,
+# compare tolerances and limits fall back to the defaults of weftsim.input.params.
+REQUIRED_SECTIONS = ("mechanism", "inertia", "joint_e", "drive")
+# Model options inside those sections that are not part of the machine: they default.
+OPTIONAL = ("joint_e.impact_velocity_rule", "joint_e.journal_material.yield_strength_mpa",
+            "joint_e.bearing_material.yield_strength_mpa", "joint_e.bearing_material.max_pressure_mpa",
+            "joint_e.bearing_material.max_pv_mpa_m_s", "joint_e.design_clearance_per_mille") \
+    + tuple(key.path for key in WEAR_KEYS("joint_e", "joint")) \
+    + tuple(key.path for key in LUBRICATION_KEYS("joint_e", "joint"))
+# [joint_f] is optional as a whole (absent: the ideal revolute joint at F).  Given a clearance > 0, F takes
+# every key of [joint_e] its table does not give (weftsim.input.joint_keys).
+REQUIRED = tuple(key.path for key in SCHEMA
+                 if key.path.partition(".")[0] in REQUIRED_SECTIONS and key.path not in OPTIONAL)
+
+
+
+def shown(text: str) -> str:
+    """``text`` with every non-printable character escaped (``\\n``, ``\\x1b``, ...).
+
+    Keys and names come from the user's file: a newline or a terminal escape sequence in one
+    must not split a one-line message or reach the terminal raw.
+    """
+    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii") for c in text)
+
+
+def _set(scene: params.Scene, target: str, value: Any) -> params.Scene:
+    head, _, rest = target.partition(".")
+    if not rest:
+        return replace(scene, **{head: value})
+    inner = getattr(scene, head)
+    if inner is None and head == "lubrication":  # the table's first key: the film starts from the defaults
+        inner = params.Lubrication(viscosity=0.0)
+    return replace(scene, **{head: _set(inner, rest, value)})
