@@ -25,8 +25,8 @@ from weftsim.wear.store import table
 scene = weftsim.load_scene("reference", {"joint_e.wear.max_clearance_change": 0.05})
 updates = predict(scene, hours=20.0)
 columns = table(scene, updates)
-for hours, clearance, p99 in zip(columns["hours"], columns["effective_clearance_mm"],
-                                 columns["contact_force_p99_N"]):
+for hours, clearance, p99 in zip(columns["hours"], columns["effective_clearance_e_mm"],
+                                 columns["contact_force_e_p99_N"]):
     print(f"{hours:7.2f} h   clearance {clearance:.4f} mm   99th percentile contact force {p99:8.0f} N")
 
 # %%
