@@ -21,7 +21,7 @@ import numpy as np
 
 from weftsim.input.scene import load_scene
 from weftsim.wear.engines import ENGINES, simulator
-from weftsim.wear.ensemble import _last_bits
+from weftsim.wear.ensemble_design import last_bits
 from weftsim.wear.extrapolate import MAX_HOURS, advance, effective_clearance, predict
 
 
@@ -63,7 +63,7 @@ def main() -> None:
     print("engine, run, " + ", ".join(f"hours to {1e3 * x:g} mm" for x in levels) + ", updates, CPU s", flush=True)
     for engine in args.engines:
         for j in range(args.runs):
-            hours, updates, cpu = hours_to(_last_bits(scene, j), args.limit_mm * 1e-3, levels, engine)
+            hours, updates, cpu = hours_to(last_bits(scene, j), args.limit_mm * 1e-3, levels, engine)
             print(f"{engine}, {j}, " + ", ".join(f"{h:.6g}" for h in hours) + f", {updates}, {cpu:.1f}", flush=True)
 
 

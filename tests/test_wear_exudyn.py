@@ -166,11 +166,11 @@ def test_both_engines_agree_on_the_hours_to_a_limit_within_the_chaotic_scatter()
     """The reference mechanism (c0 = 0.25 mm, 400 rpm) to 0.3 mm, ten updates: its cycle is chaotic, and
     predictions differing only in the last bits of k (the ensemble's chaos runs) scatter by percents; the
     Exudyn engine's predictions fall within that scatter of the reference engine's."""
-    from weftsim.wear.ensemble import _last_bits
+    from weftsim.wear.ensemble_design import last_bits
 
     scene, limit = load_scene("reference"), 0.3e-3
-    ref = np.array([_hours_to(_last_bits(scene, j), limit, "reference") for j in range(4)])
-    exu = np.array([_hours_to(_last_bits(scene, j), limit, "exudyn") for j in range(2)])
+    ref = np.array([_hours_to(last_bits(scene, j), limit, "reference") for j in range(4)])
+    exu = np.array([_hours_to(last_bits(scene, j), limit, "exudyn") for j in range(2)])
     spread = ref.max() - ref.min()
     assert spread > 0.005 * ref.mean()  # the scatter is there (measured: 1.1-3.4 %)
     # every Exudyn prediction within the reference engine's chaos band widened by its own width

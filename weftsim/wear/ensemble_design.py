@@ -45,7 +45,7 @@ def design_quantiles(points: int) -> tuple[float, ...]:
     return tuple(float(q) for q in np.linspace(0.05, 0.95, points))
 
 
-def _last_bits(scene: Scene, j: int) -> Scene:
+def last_bits(scene: Scene, j: int) -> Scene:
     """``scene`` with its wear coefficient j units in the last place larger (the same physics to 1e-15)."""
     k = scene.joint.wear.wear_coefficient
     for _ in range(j):
@@ -121,7 +121,7 @@ def plan(scene: Scene, uncertain: list[Uncertain], chaos_runs: int = 6, design_p
         name = "node_" + "_".join(str(i) for i in index) if dynamic else "centre"
         jobs.append((name, node_scene))
         if index == centre:
-            jobs.extend((f"chaos_{j}", _last_bits(node_scene, j)) for j in range(1, chaos_runs))
+            jobs.extend((f"chaos_{j}", last_bits(node_scene, j)) for j in range(1, chaos_runs))
     return jobs, dynamic, nodes
 
 
