@@ -120,6 +120,16 @@ class Trajectory:
             self.sample_impact.append(impact)
 
 
+def _add_samples(traj: Trajectory, sample_times: np.ndarray, first: int, t_until: float, dense: Callable,
+                 contact: bool, impact: float) -> int:
+    """Record the output samples from index ``first`` up to ``t_until`` (inclusive) from the step's dense
+    output; the index of the next sample."""
+    stop = int(np.searchsorted(sample_times, t_until, side="right"))
+    ts = sample_times[first:stop]
+    traj.add_samples(ts, dense(ts).T, contact, impact)
+    return stop
+
+
 def penetration(prm: np.ndarray, t: float, y: np.ndarray) -> tuple[float, float]:
     """(delta, delta_dot) of a state y at time t: :func:`weftsim.kernel.chain.penetration`."""
     return kernel_chain.penetration(prm, float(t), np.ascontiguousarray(y, dtype=float))
@@ -266,17 +276,15 @@ def _integrate(scene: Scene, progress) -> Trajectory:
                     f"the right-hand side turned non-finite (NaN or inf) in the trials of this step, which "
                     f"shrank to {h:.3g} s (below limits.min_step_s = {scene.limits.min_step:.3g} s)"
                 )  # fmt: skip
+            possible = (sign * g_new > 0.0 or sign * r_old > 0.0 > sign * r_new) and not joint.is_ideal
             if breach is not None and breach.kind == "interrupted":
                 # A stop asked for from outside: the accepted step is kept with its output samples, so that
                 # the record ends within one sample of where the run says it stopped; a step in which a contact
                 # event may lie is dropped instead (the run then ends where it began).
-                event_inside = (sign * g_new > 0.0 or sign * r_old > 0.0 > sign * r_new) and not joint.is_ideal
-                if finite and not event_inside:
-                    stop = int(np.searchsorted(sample_times, t_new, side="right"))
-                    if stop > next_sample:
-                        ts = sample_times[next_sample:stop]
-                        traj.add_samples(ts, solver.dense_output()(ts).T, contact, impact)
-                        next_sample = stop
+                if finite and not possible:
+                    if next_sample < len(sample_times) and sample_times[next_sample] <= t_new:
+                        next_sample = _add_samples(traj, sample_times, next_sample, t_new, solver.dense_output(),
+                                                   contact, impact)  # fmt: skip
                     t = t_new
                     traj.add_step(t, y_new, contact, impact)
                 fail(breach.what, breach.hint, breach.kind)
@@ -290,7 +298,6 @@ def _integrate(scene: Scene, progress) -> Trajectory:
             t_stop = t_new
             dense = None
             grid = None
-            possible = (sign * g_new > 0.0 or sign * r_old > 0.0 > sign * r_new) and not joint.is_ideal
             if contact or possible:
                 dense = solver.dense_output()
                 n_dense += 1
@@ -320,10 +327,7 @@ def _integrate(scene: Scene, progress) -> Trajectory:
                 if dense is None:
                     dense = solver.dense_output()
                     n_dense += 1
-                stop = int(np.searchsorted(sample_times, t_stop, side="right"))
-                ts = sample_times[next_sample:stop]
-                traj.add_samples(ts, dense(ts).T, contact, impact)
-                next_sample = stop
+                next_sample = _add_samples(traj, sample_times, next_sample, t_stop, dense, contact, impact)
             if contact and _CONTACT_SUBSTEPS:
                 # Impacts last tens of steps: read the pulse between steps too, for its peaks.
                 ts = t_old + (t_stop - t_old) * _SUBSTEP_FRACTIONS
