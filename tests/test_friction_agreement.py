@@ -208,13 +208,18 @@ def test_the_trees_contact_with_friction_is_the_reference_chains():
     out = np.zeros(6)
     q3, f_n, delta, ey, ez, sa, ca, sp, cp, f_y, f_z, m_j, m_b = kc.chain(prm, t, y, True, held, out)
     q0, q1 = a, psi + math.pi - a
-    g0, g1, d2, r2, fbx, fby, fn2, mb2, power, v_t, _, _ = kc.tree_joint_force(prm, t, q0, q1, da, dpsi - da, held, 1e-6, rate)
+    g0, g1, d2, r2, fbx, fby, fn2, mb2, power, v_t, _, _, drawn, dissipated = kc.tree_joint_force(
+        prm, t, q0, q1, da, dpsi - da, held, 1e-6, rate)
     assert abs(m_b) > 0.1 * 0.15 * f_n * scene.joint.bearing_radius  # friction is on (full Coulomb here)
     # Same kernel in two coordinate sets (~1e-16 m of a 0.4 m chain); the tree's damping dead zone of
     # 1e-10 m/s changes F_N by xi 1e-10 / v_imp ~ 1e-9 relative.
     assert d2 == pytest.approx(delta, abs=1e-13) and fn2 == pytest.approx(f_n, rel=1e-8)
     np.testing.assert_allclose([fbx, fby], [-f_y, -f_z], rtol=1e-8)
     assert mb2 == pytest.approx(m_b, rel=1e-8)
+    # The powers the explicit tree integrates are the reference chain's W3' and D' (out[4], out[5]), computed
+    # there from the forces' work on both bodies and here from F_N, delta_dot and F_T v_T (same 1e-8).
+    assert drawn == pytest.approx(out[4], rel=1e-8) and dissipated == pytest.approx(out[5], rel=1e-8)
+    assert dissipated > 0.0
     # Power on the pair = -F_N delta_dot + F_T v_T (kernel docstring): the friction part is <= 0.
     assert power < 0.0
     # v_T, the sliding speed the implicit tree's friction pieces read, is the one of that power:

@@ -142,19 +142,21 @@ def make_numba_force(law: _Law, clearance: float, min_impact_velocity: float,
 
 
 def make_tree_force(prm: np.ndarray, memory: list, stash: list, route: str = "numba",
-                    counter: list | None = None) -> Callable[..., list[float]]:
-    """``forceUserFunction(mbs, t, itemNumber, q, q_t)`` of the kinematic tree: its two joint torques.
+                    counter: list | None = None, powers: bool = False) -> Callable[..., list[float]]:
+    """``forceUserFunction(mbs, t, itemNumber, q, q_t)`` of the kinematic tree: its joint forces.
 
     The contact of the moving bearing, projected on the joints by virtual work, is
     :func:`weftsim.kernel.chain.tree_joint_force`.  ``prm``: the scene's kernel parameter array
     (:func:`weftsim.reference.dynamics.pack_parameters`, friction included); ``memory`` =
     [v_held, delta0, rate0] of the last accepted step (written by the post-step bookkeeping); every
-    call leaves [t, delta, delta_dot, F_b,x, F_b,y, F_N, M_b, F_T v_T, v_T, D'_lub, U_a] in ``stash`` (F_b =
-    F_N n - F_T t, the force on the bearing, plus the film's and asperities' of a lubricated joint; M_b its
-    moment; F_T v_T the dry friction power; v_T the sliding speed; D'_lub and U_a the lubricated part's
-    dissipated power and the asperity potential, 0 when dry): the last call of an accepted explicit step is
-    at its end state (the last DOPRI5 / ODE23 stage), so the bookkeeping needs no extra evaluation.  The
-    parameters the callback reads are its attribute ``prm`` (a copy; :mod:`.friction_segments` sets the
+    call leaves [t, delta, delta_dot, F_b,x, F_b,y, F_N, M_b, F_T v_T, v_T, D'_lub, U_a, W3', D'] in ``stash``
+    (F_b = F_N n - F_T t, the force on the bearing, plus the film's and asperities' of a lubricated joint; M_b
+    its moment; F_T v_T the dry friction power; v_T the sliding speed; D'_lub and U_a the lubricated part's
+    dissipated power and the asperity potential, 0 when dry; W3' and D' the drawn and dissipated powers): the
+    last call of an accepted explicit step is at its end state (the last DOPRI5 / ODE23 stage), so the
+    bookkeeping needs no extra evaluation.  ``powers``: the tree has two more joints whose accelerations
+    are W3' and D' (:func:`weftsim.exudyn_engine.tree.build_tree`), so the callback returns four forces.
+    The parameters the callback reads are its attribute ``prm`` (a copy; :mod:`.friction_segments` sets the
     friction entries of it).
     """
     force = kernel_form(kernel_chain.tree_joint_force, route)
@@ -168,10 +170,10 @@ def make_tree_force(prm: np.ndarray, memory: list, stash: list, route: str = "nu
     def tree_force(mbs, t, itemNumber, q, q_t):
         counter[0] += 1
         (g0, g1, stash[1], stash[2], stash[3], stash[4], stash[5], stash[6], stash[7], stash[8], stash[9],
-         stash[10]) = force(
+         stash[10], stash[11], stash[12]) = force(
             prm, t, q[0], q[1], q_t[0], q_t[1], memory[0], memory[1], memory[2])
         stash[0] = t
-        return [g0, g1]
+        return [g0, g1, stash[11], stash[12]] if powers else [g0, g1]
 
     tree_force.prm = prm
     return tree_force

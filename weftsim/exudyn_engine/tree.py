@@ -58,6 +58,7 @@ from weftsim.reference.dynamics import initial_state, pack_parameters
 from weftsim.reference.ideal import sector_chain_inertia
 
 UNSPECIFIED_MASS = 1.0  # sector mass (balanced, on its fixed axis: no effect), kg
+POWER_JOINTS = 2  # build_tree(powers=True): the integrators of W3 and D
 
 
 @dataclass
@@ -71,7 +72,7 @@ class TreeModel:
     tracker: OnsetTracker
     route: str
     memory: list  # [v_held, delta0, rate0] read by the force callback
-    stash: list  # [t, delta, delta_dot, F_b,x, F_b,y, F_N, M_b, F_T v_T, v_T, D'_lub, U_a] of the last callback
+    stash: list  # [t, delta, delta_dot, F_b,x, F_b,y, F_N, M_b, F_T v_T, v_T, D'_lub, U_a, W3', D'] of the last callback
     callback_calls: list = field(default_factory=lambda: [0])  # [count]
     # [t, F_b,x, F_b,y, F_N, M_b, F_T v_T, D'_lub, U_a, v_T] per accepted state (tree_joint_force's joint force
     # on the bearing, the lubricated part's dissipated power, the asperity potential, the sliding velocity)
@@ -83,20 +84,27 @@ class TreeModel:
             q = mbs.GetNodeOutput(self.node, exu.OutputVariableType.Coordinates)
             q_t = mbs.GetNodeOutput(self.node, exu.OutputVariableType.Coordinates_t)
             self.force(mbs, t, self.tree, q, q_t)
-        _, delta, rate, fx, fy, f_n, m_b, power, v_t, lub_power, asperity_energy = self.stash
+        _, delta, rate, fx, fy, f_n, m_b, power, v_t, lub_power, asperity_energy = self.stash[:11]
         tracker = self.tracker
         tracker.accept(t, delta, rate)
         self.memory[0], self.memory[1], self.memory[2] = tracker.held, delta, rate
         self.bearing_force.append((t, fx, fy, f_n, m_b, power, lub_power, asperity_energy, v_t))
 
 
-def build_tree(mbs: exu.MainSystem, scene: Scene, callback: str = "auto") -> TreeModel:
+def build_tree(mbs: exu.MainSystem, scene: Scene, callback: str = "auto", powers: bool = False) -> TreeModel:
     """Add the kinematic tree of members 4-8, gravity and the clearance contact to ``mbs``.
 
     Initial state: the ideal mechanism at theta = 0, journal centred
     (:func:`weftsim.reference.dynamics.initial_state`).  ``callback``: "auto" (:func:`weftsim.exudyn_engine.callbacks.resolve_route`),
     "python" or "numba"; both evaluate :func:`weftsim.kernel.chain.tree_joint_force`.  Needs ``scene.joint.clearance > 0``;
     friction (``joint.friction_coefficient`` > 0) acts at the contact point with its moments on rod and rocker.
+
+    ``powers``: two more joints (:data:`POWER_JOINTS`), prismatic along Exudyn Z on the base with a unit mass,
+    so gravity (along -Y) and the rotating links do not couple to them and their accelerations are the
+    callback's forces: the drawn power W3' = -Q3 omega and the dissipated power D'.  Their rates, q_t[2] = W3
+    and q_t[3] = D, are then integrated by the solver with the motion, at its order and under its error control,
+    as the reference engine integrates them (a quadrature over the steps afterwards left 1 J a revolution of the
+    ~1000 J the contact moves in and out of the chain on the worn loom, c = 0.1 mm, 600 rpm).
     """
     g, m, joint = scene.geometry, scene.inertia, scene.joint
     a0, psi0, da0, dpsi0 = initial_state(scene)[:4]
@@ -107,19 +115,22 @@ def build_tree(mbs: exu.MainSystem, scene: Scene, callback: str = "auto") -> Tre
     calls = [0]
     tracker = OnsetTracker(joint.clearance, joint.min_impact_velocity, rule=joint.impact_velocity_rule)
     memory = list(tracker.callback_state)
-    stash = [math.nan] + [0.0] * 10
-    force = callbacks.make_tree_force(pack_parameters(scene), memory, stash, route, calls)
+    stash = [math.nan] + [0.0] * 12
+    force = callbacks.make_tree_force(pack_parameters(scene), memory, stash, route, calls, powers)
+    extra = POWER_JOINTS if powers else 0
     node = mbs.AddNode(NodeGenericODE2(
-        referenceCoordinates=[0.0, 0.0], initialCoordinates=[a0, psi0 + math.pi - a0],
-        initialCoordinates_t=[da0, dpsi0 - da0], numberOfODE2Coordinates=2,
+        referenceCoordinates=[0.0] * (2 + extra), initialCoordinates=[a0, psi0 + math.pi - a0] + [0.0] * extra,
+        initialCoordinates_t=[da0, dpsi0 - da0] + [0.0] * extra, numberOfODE2Coordinates=2 + extra,
     ))  # fmt: skip
     tree = mbs.AddObject(ObjectKinematicTree(
-        nodeNumber=node, jointTypes=[exu.JointType.RevoluteZ] * 2, linkParents=[-1, 0],
-        jointTransformations=exu.Matrix3DList([np.eye(3)] * 2),
-        jointOffsets=exu.Vector3DList([[0.0, 0.0, 0.0], [g.l_fg, 0.0, 0.0]]),
-        linkInertiasCOM=exu.Matrix3DList([np.eye(3) * sector_chain_inertia(scene), np.eye(3) * m.rod_inertia]),
-        linkCOMs=exu.Vector3DList([[0.0, 0.0, 0.0], [0.5 * g.l_ef, 0.0, 0.0]]),
-        linkMasses=[UNSPECIFIED_MASS, m.rod_mass], baseOffset=[g.l_og, 0.0, 0.0], gravity=[0.0, -m.gravity, 0.0],
-        forceUserFunction=force,
+        nodeNumber=node, jointTypes=[exu.JointType.RevoluteZ] * 2 + [exu.JointType.PrismaticZ] * extra,
+        linkParents=[-1, 0] + [-1] * extra,
+        jointTransformations=exu.Matrix3DList([np.eye(3)] * (2 + extra)),
+        jointOffsets=exu.Vector3DList([[0.0, 0.0, 0.0], [g.l_fg, 0.0, 0.0]] + [[0.0, 0.0, 0.0]] * extra),
+        linkInertiasCOM=exu.Matrix3DList([np.eye(3) * sector_chain_inertia(scene), np.eye(3) * m.rod_inertia]
+                                         + [np.eye(3)] * extra),
+        linkCOMs=exu.Vector3DList([[0.0, 0.0, 0.0], [0.5 * g.l_ef, 0.0, 0.0]] + [[0.0, 0.0, 0.0]] * extra),
+        linkMasses=[UNSPECIFIED_MASS, m.rod_mass] + [1.0] * extra, baseOffset=[g.l_og, 0.0, 0.0],
+        gravity=[0.0, -m.gravity, 0.0], forceUserFunction=force,
     ))  # fmt: skip
     return TreeModel(scene, node, tree, force, tracker, route, memory, stash, calls)

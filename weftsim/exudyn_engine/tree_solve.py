@@ -227,6 +227,11 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
         loaded = np.ones(n)
         lubricated_work = contact_work(force[:, 6], t, np.ones(n))
         energy = energy + force[:, 7]
+    if q_t.shape[1] > 3:  # the power joints (build_tree(powers=True)): W3 and D integrated with the motion
+        drawn, dissipated = q_t[:, 3] - q_t[0, 3], q_t[:, 4] - q_t[0, 4]
+    else:  # quadrature over the steps (the implicit tree)
+        drawn = contact_work(-q3 * omega, t, loaded)
+        dissipated = contact_work((f_n - f_el) * rate - friction_power, t, delta) + lubricated_work
     hist = model.tracker.history()
     row = np.clip(np.searchsorted(hist["time"], t * (1.0 + 1e-12), side="right") - 1, 0, len(hist["time"]) - 1)
     ratio = scene.geometry.rapier_ratio
@@ -255,8 +260,8 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
         "kinetic_energy_J": kin13 + kin48,
         "potential_energy_J": u13 + pot48,
         "contact_energy_J": energy,
-        "driving_work_J": kin13 + u13 - (0.5 * float(j13_0) * omega**2 + float(u13_0)) + contact_work(-q3 * omega, t, loaded),
-        "dissipated_energy_J": contact_work((f_n - f_el) * rate - friction_power, t, delta) + lubricated_work,
+        "driving_work_J": kin13 + u13 - (0.5 * float(j13_0) * omega**2 + float(u13_0)) + drawn,
+        "dissipated_energy_J": dissipated,
         "penetration_rate_m_s": rate,
     }
 
@@ -274,7 +279,8 @@ def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, ca
     omega, t_end = scene.drive.speed, scene.drive.end_time
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
-    model = build_tree(mbs, scene, scene.exudyn_solver.callback if callback is None else callback)
+    implicit = tree_solver(scene) == "implicit"
+    model = build_tree(mbs, scene, scene.exudyn_solver.callback if callback is None else callback, powers=not implicit)
     store = {"storeInternal": True, "writeToFile": False}
     sensors = {
         "q": mbs.AddSensor(SensorNode(nodeNumber=model.node, outputVariableType=OVT.Coordinates, **store)),
@@ -302,7 +308,6 @@ def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, ca
             return False
         return True
 
-    implicit = tree_solver(scene) == "implicit"
     if implicit:
         register_post_step(mbs, post_step)  # first: the step controller's hook plans the next step after it
         solver = exu.MainSolverImplicitSecondOrder()

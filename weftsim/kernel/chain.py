@@ -216,10 +216,16 @@ def tree_joint_force(prm: np.ndarray, t: float, a: float, q1: float, da: float, 
     (:func:`rod_clearance`, the rod's angle psi = b - pi), as :func:`chain` does: delta and delta_dot are then
     |e| - c and e_dot . n - dc/dt.
 
-    Returns (Q0, Q1, delta, delta_dot, F_bx, F_by, F_N, M_b, F_T v_T, v_T, D'_lub, U_a): N m, N m, m, m/s,
-    N, N, N, N m, W (the dry friction power on the pair, <= 0; 0 without friction), m/s (the sliding speed
+    The two powers of the energy balance, at this state (the explicit tree integrates them with the motion,
+    as the reference engine integrates W3 and D in :func:`chain`):
+
+        W3' = -Q3 omega,  Q3 = F_b . dP_b/dtheta + M_b phi'       (drawn through the rocker)
+        D'  = (F_N - F_el(delta)) delta_dot - F_T v_T + D'_lub     (damping, friction, film)
+
+    Returns (Q0, Q1, delta, delta_dot, F_bx, F_by, F_N, M_b, F_T v_T, v_T, D'_lub, U_a, W3', D'): N m, N m, m,
+    m/s, N, N, N, N m, W (the dry friction power on the pair, <= 0; 0 without friction), m/s (the sliding speed
     of the contact points, 0 out of contact; the implicit tree's friction segments read it), the
-    lubricated part's dissipated power (W) and the asperity potential (J) (both 0 for a dry joint).
+    lubricated part's dissipated power (W) and the asperity potential (J) (both 0 for a dry joint), W, W.
     """
     l_fg, l_ef = prm[L_FG], prm[L_EF]
     b = a + q1
@@ -244,5 +250,7 @@ def tree_joint_force(prm: np.ndarray, t: float, a: float, q1: float, da: float, 
         fx, fy, delta, rate, f_n, f_t, m_j, m_b, v_t = connector_friction_force_at(
             prm, c, c_rate, ex, ey, evx, evy, held, delta0, rate0, db, omega * dphi)
     g1 = l_ef * (fx * sb - fy * cb) + m_j
+    drawn = -(fx * db_y + fy * db_z + m_b * dphi) * omega
+    dissipated = (f_n - elastic_force(prm[KIND], prm[COEF], c, delta)) * rate - f_t * v_t + lub_power
     return (l_fg * (fx * sa - fy * ca) + g1, g1, delta, rate, fx, fy, f_n, m_b, f_t * v_t, v_t, lub_power,
-            asperity_energy)  # fmt: skip
+            asperity_energy, drawn, dissipated)  # fmt: skip
