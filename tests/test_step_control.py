@@ -135,3 +135,28 @@ def test_progress_follows_the_simulated_time():
     assert seen[0] == 0.0 and seen[-1] == 1.0
     assert all(b >= a for a, b in zip(seen, seen[1:]))
     assert len(seen) > 20 and max(b - a for a, b in zip(seen, seen[1:])) < 0.25
+
+
+def test_a_fixed_step_in_the_round_off_is_refused_and_one_above_it_gives_the_physics():
+    """Issue 35: a fixed step of 1e-9 s reported round-off (1.4e5 m/s2) as the peak rapier acceleration
+    (6571.3 m/s2, the reference engine at rtol 1e-12).  Below the floor (selection.roundoff_floor_step,
+    3.4e-8 s at 600 rpm) the run is refused before a step, naming the key and the floor; at twice the floor
+    the peak is the physics: measured 1.2e-4 off at 5e-8 s and 6e-5 at 1e-7 s, so 1e-3 is 8x above it."""
+    from weftsim.exudyn_engine.selection import roundoff_floor_step
+
+    fixed = {"solver.exudyn.model": "rigid_body", "solver.exudyn.step_control": "fixed"}
+    loom = load_scene("loom", {**fixed, "solver.exudyn.step_size_s": 1e-9, "drive.revolutions": 0.01})
+    floor = roundoff_floor_step(loom)
+    assert 2e-8 < floor < 5e-8  # between the measured steps with 2.2e-3 and 1.2e-4 of round-off
+    r = solve(loom)
+    assert not r.ok and len(r.steps["time_s"]) == 0
+    assert "step_size_s" in r.message and "round-off" in r.message and f"{floor:.2g} s" in r.message, r.message
+    # Slower crank: the floor grows as 1/omega (round-off is absolute, the peaks grow as omega^2).
+    slow = load_scene("loom", {**fixed, "drive.speed_rpm": 300.0})
+    assert roundoff_floor_step(slow) == pytest.approx(2.0 * floor)
+    above = solve(load_scene("loom", {**fixed, "solver.exudyn.step_size_s": 2.0 * floor, "drive.revolutions": 0.01}))
+    assert above.ok, above.message
+    peak = np.abs(above.steps["rapier_acceleration_m_s2"]).max()
+    ref = reference.solve(load_scene("loom", {"drive.revolutions": 0.01, "solver.reference.rtol": 1e-12,
+                                              "solver.reference.atol": 1e-14}))  # fmt: skip
+    assert peak == pytest.approx(np.abs(ref.steps["rapier_acceleration_m_s2"]).max(), rel=1e-3)

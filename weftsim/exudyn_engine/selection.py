@@ -138,6 +138,39 @@ def requested_step(scene: Scene) -> float:
     return step
 
 
+# Round-off floor of the rigid-body model's fixed step.  Generalized-alpha solves the position-level constraints
+# scaled by 1/(beta h^2), so the round-off of the coordinates (eps |q|) enters the accelerations and the
+# constraint reactions as ~eps |q| / (beta h^2): an absolute error independent of the speed, against peaks
+# growing as omega^2, so the share of round-off is ROUNDOFF_GAIN eps / (omega h)^2.  Measured on the loom at
+# 600 rpm, 0.01 revolution, peak rapier acceleration against 6571.3 m/s2 (the reference engine at rtol 1e-12):
+# h = 1e-7 s: 6571.7; 5e-8: 6572.5 (1.2e-4); 2e-8: 6585.9 (2.2e-3); 1e-8: 6634 (9.6e-3); 5e-9: 6830 (3.9e-2);
+# 2e-9: 3.7e4; 1e-9: 1.4e5.  From 2e-8 to 5e-9 the share is 17 eps / (omega h)^2 within 10 %; below, Newton's
+# iteration stops resolving the step and it grows faster.  ROUNDOFF_GAIN = 20 bounds it; a fixed step whose
+# share exceeds ROUNDOFF_SHARE_LIMIT is refused (600 rpm: below 3.4e-8 s).
+ROUNDOFF_GAIN = 20.0
+ROUNDOFF_SHARE_LIMIT = 1e-3
+
+
+def roundoff_floor_step(scene: Scene) -> float:
+    """Smallest fixed step of the rigid-body model whose round-off stays within :data:`ROUNDOFF_SHARE_LIMIT` of
+    the peak accelerations and reactions, s: sqrt(ROUNDOFF_GAIN eps / ROUNDOFF_SHARE_LIMIT) / omega."""
+    return math.sqrt(ROUNDOFF_GAIN * 2.220446049250313e-16 / ROUNDOFF_SHARE_LIMIT) / scene.drive.speed
+
+
+def roundoff_problem(scene: Scene) -> str | None:
+    """One line refusing a fixed step of the rigid-body model below :func:`roundoff_floor_step`, or None."""
+    if select_model(scene)[0] != "rigid_body" or adaptive(scene) or scene.drive.speed <= 0.0:
+        return None
+    h, floor = step_plan(scene)[0], roundoff_floor_step(scene)
+    if h >= floor:
+        return None
+    share = ROUNDOFF_GAIN * 2.220446049250313e-16 / (scene.drive.speed * h) ** 2
+    return (f"`solver.exudyn.step_size_s` = {h:.3g} s is below the round-off floor of the rigid-body model at "
+            f"{scene.drive.speed * 30.0 / math.pi:g} rpm ({floor:.2g} s): generalized-alpha's accelerations and "
+            f"reactions would carry round-off of at least ~{share:.1%} of their peaks, not physics; use a step of at least "
+            f"{floor:.2g} s (1e-6 s resolves the impacts to 0.5 %) or step_control = 'adaptive'")
+
+
 def step_plan(scene: Scene) -> tuple[float, int]:
     """(step size, number of steps): :func:`requested_step` shortened to divide the sample period."""
     omega, t_end = scene.drive.speed, scene.drive.end_time

@@ -28,6 +28,7 @@ from weftsim.exudyn_engine.selection import (  # noqa: F401 (IDEAL_JOINT_STEP_AN
     IDEAL_JOINT_STEP_ANGLE,
     adaptive,
     requested_step,
+    roundoff_problem,
     select_model,
     select_path,
     step_plan,
@@ -71,6 +72,10 @@ def check_settings(scene: Scene) -> str | None:
         return f"`solver.exudyn.newton_max_iterations` must be >= 1, got {s.newton_max_iterations}"
     if s.step_control not in STEP_CONTROLS:
         return f"`solver.exudyn.step_control` must be one of {STEP_CONTROLS}, got {s.step_control!r}"
+    if not scene.output.sample_angle > 0.0:
+        return f"`output.sample_deg` must be > 0, got {math.degrees(scene.output.sample_angle):g}"
+    if roundoff_problem(scene):
+        return roundoff_problem(scene)
     if not (s.local_error > 0.0 and math.isfinite(s.local_error)):
         return f"`solver.exudyn.local_error_m` must be > 0 (m), got {s.local_error}"
     if route_error(s.callback):
