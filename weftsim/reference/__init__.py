@@ -93,6 +93,12 @@ def _solve_ideal(scene: Scene, progress) -> RunResult:
 # at most: the first-revolution peaks of the friction case (c = 0.5 mm, 400 rpm, mu = 0.15) are then within
 # 3e-4 of the converged solution, at 1e-5 the torque peak is 1.1 % high (docs/reference-solver.md section 4).
 STIFF_RTOL = 1e-6
+# Dry friction at E alone (no film, F ideal): "auto" takes RODAS4 only near the friction ramp (compiled.RAMP_SWITCH)
+# and DOP853 in full sliding, whose steps are longer; at 1e-6 the loom's torque peak (c = 0.1 mm, 600 rpm) fell
+# between two rows 11.5 us apart, 1.1e-3 low; at this rtol first-revolution peaks are within 9.3e-5 (c = 0.1 mm),
+# 4.3e-4 (0.02 mm) and 1.9e-5 (reference scene, 0.5 mm, 400 rpm) of RODAS4 at rtol 1e-10, at 3 664, 3 615 and
+# 2 672 steps a revolution (dry: 938, 1 335, 1 267; all on RODAS4 at 1e-6: 16 340 on the loom at 0.1 mm).
+SLIDING_RTOL = 1e-7
 
 
 def stiff_joints(scene: Scene) -> list[str]:
@@ -138,8 +144,15 @@ def effective_rtol(scene: Scene) -> float:
     s = scene.reference_solver
     friction = any(j.friction_coefficient > 0.0 for j in (scene.joint, scene.joint_f) if not j.is_ideal)
     if s.method == AUTO and stiff_joints(scene) and friction:
-        return min(s.rtol, STIFF_RTOL)
+        return min(s.rtol, SLIDING_RTOL if switches_by_sliding(scene) else STIFF_RTOL)
     return s.rtol
+
+
+def switches_by_sliding(scene: Scene) -> bool:
+    """True when "auto" integrates contact with RODAS4 only near the friction ramp (:mod:`.compiled`,
+    ``RAMP_SWITCH``): dry friction at E, no oil film, an ideal joint at F."""
+    return (not scene.joint.is_ideal and scene.joint.friction_coefficient > 0.0 and not scene.joint.is_lubricated
+            and scene.joint_f.is_ideal)
 
 
 def select_path(scene: Scene) -> dict:
@@ -153,7 +166,8 @@ def select_path(scene: Scene) -> dict:
     why = ("solver.reference.method = 'auto': the fastest path meeting the accuracy targets" if s.method == AUTO
            else f"set by solver.reference.method = {s.method!r}")
     if s.method == AUTO and stiff:
-        where = "every step" if method == "numba_RODAS4" else "contact segments"
+        where = ("every step" if method == "numba_RODAS4" else "contact within 10 v1 of the friction ramp"
+                 if switches_by_sliding(scene) else "contact segments")
         why += f"; {', '.join(stiff)}: {where} linearly implicit, rtol {effective_rtol(scene):g}"
     model = {("e",): "clearance chain (2 DOF)", ("f",): "clearance at F: chain about E (2 DOF)",
              ("e", "f"): "clearance at E and F: free rod (4 DOF)"}[scene.loose_joints]

@@ -19,7 +19,8 @@ The loop (:func:`advance`) returns to Python every 0.1 % of the run (progress) o
 buffer is full; :mod:`.compiled_run` drives it and builds the result.
 
 Methods (``reference_solver.method``): ``"numba_DOP853"``, ``"numba_RK45"``, ``"numba_RODAS4"`` (linearly implicit,
-:mod:`.compiled_ros`) and ``"numba_DOP853_RODAS4"`` (DOP853 in free flight, RODAS4 in contact segments).
+:mod:`.compiled_ros`) and ``"numba_DOP853_RODAS4"`` (DOP853 in free flight, RODAS4 in contact segments; with dry friction at E alone
+RODAS4 only while the sliding speed is near the friction ramp, :data:`RAMP_SWITCH`).
 """
 
 from __future__ import annotations
@@ -29,7 +30,9 @@ import math
 import numpy as np
 from numba import njit
 
-from weftsim.kernel.chain import TRACK_MAX, V_MIN
+from weftsim.kernel.chain import OMEGA, TRACK_MAX, V_MIN, eccentricity
+from weftsim.kernel.joint import BEARING_RADIUS, MU, V1, tangential_velocity
+from weftsim.kernel.lubricated import is_lubricated
 from weftsim.kernel.chain_f import BLOCKS, N_JOINTS, joint_is_loose, penetration_at
 from weftsim.reference.compiled_rk import (
     _MAX_FACTOR, _MIN_FACTOR, _SAFETY, DOP853, RK45, _dense, _dense_coefficients, _error_norm, _f,
@@ -47,6 +50,12 @@ from weftsim.reference.integrate import _CONTACT_SUBSTEPS, _ROOT_XTOL
 # free flight (HYBRID: the stiffness is the contact's and the friction ramp's; free flight is not stiff).
 RODAS4 = ros.RODAS4
 HYBRID = 3
+# HYBRID with dry friction at E: RODAS4 only while the sliding speed is within RAMP_SWITCH v1 of the ramp (the
+# modified Coulomb law's slope mu F_N / (v1 - v0) gives the one stiff eigenvalue, ~-3e7 1/s on the loom, while
+# the rocker reverses); in full sliding the contact's eigenvalues are the dry joint's (within 10 %, +-1e4 i 1/s),
+# where RODAS4 (order 4) needs ~15x the steps of DOP853 (order 8) for the same tolerance: the worn loom is in
+# contact 95-99 % of the time, so contact segments all on RODAS4 cost 16 340 steps a revolution against 938 dry.
+RAMP_SWITCH = 10.0
 METHODS = {"numba_DOP853": DOP853, "numba_RK45": RK45, "numba_RODAS4": RODAS4, "numba_DOP853_RODAS4": HYBRID}
 
 
@@ -156,6 +165,17 @@ def _events_of_joint(prm, method, F, t, h, y, tmp, joint, in_contact, held, g_ol
 
 
 @njit(cache=True, error_model="numpy")
+def _near_ramp(prm: np.ndarray, t: float, y: np.ndarray) -> bool:
+    """True when joint E's sliding speed |v_T| is below RAMP_SWITCH v1 (or the journal is centred)."""
+    ecc_y, ecc_z, v_y, v_z, _, _, dphi = eccentricity(prm, t, y)[:7]
+    length = math.sqrt(ecc_y * ecc_y + ecc_z * ecc_z)
+    if length <= 0.0:
+        return True
+    v_t = tangential_velocity(ecc_y, ecc_z, v_y, v_z, length, y[3], prm[OMEGA] * dphi, prm[BEARING_RADIUS])
+    return abs(v_t) < RAMP_SWITCH * prm[V1]
+
+
+@njit(cache=True, error_model="numpy")
 def advance(prm: np.ndarray, method: int, rtol: float, atol: float, max_step: float, t_end: float, t_pause: float,
             limits: np.ndarray, y: np.ndarray, f: np.ndarray, fst: np.ndarray, ist: np.ndarray,
             sample_times: np.ndarray, smp_t: np.ndarray, smp_y: np.ndarray, smp_c: np.ndarray, smp_i: np.ndarray,
@@ -200,6 +220,8 @@ def advance(prm: np.ndarray, method: int, rtol: float, atol: float, max_step: fl
     peak_t = np.empty(SAMPLES + 2)
     peak_r = np.empty(SAMPLES + 2)
     stiff_dense = ros.central_differences(prm)  # a lubricated joint: RODAS4's dense output from its stages
+    # HYBRID: dry friction at E alone (no film, no clearance at F) switches on the sliding speed (RAMP_SWITCH)
+    by_sliding = prm[MU] > 0.0 and not is_lubricated(prm) and not loose[N_JOINTS - 1]
     t = fst[T]
     while t < t_end:
         contact = ist[CONTACT]
@@ -208,7 +230,11 @@ def advance(prm: np.ndarray, method: int, rtol: float, atol: float, max_step: fl
         m = method
         if method == HYBRID:
             m = RODAS4 if contact != 0 else DOP853
-        md = ros.RODAS4_STIFF_DENSE if (m == RODAS4 and stiff_dense) else m  # the dense output's code
+            if m == RODAS4 and by_sliding and not _near_ramp(prm, t, y):
+                m = DOP853
+        # the dense output's code: RODAS's continuous extension with a film, and with friction switched by the
+        # sliding speed (its RODAS4 steps are in the ramp, where the Hermite cubic bends with f: 13 % of torque)
+        md = ros.RODAS4_STIFF_DENSE if (m == RODAS4 and (stiff_dense or by_sliding)) else m
         order = 7 if m == DOP853 else 4
         f_row = 12 if m == DOP853 else 6
         if m == RODAS4:  # the error estimate k_6 is O(h^4): exponent -1/4 as in the code RODAS
