@@ -45,7 +45,13 @@ CASES = {
 # Cases whose converged ensemble cannot be explicit (DOP853 steps at ~1e-9 s where the journal sticks: hours at
 # rtol 1e-12): the linearly implicit RODAS4 at tight tolerances instead (its first-revolution peaks agree with
 # explicit DOP853 at rtol 1e-8 to 4e-5, tests/test_rosenbrock.py).
-STIFF_CASES = ("c0.50mm-400rpm-mu0.15",)
+# Issue 36: the loom (models/loom.toml, 600 rpm) with friction at E, new and worn; timed by `bench --targets`
+# against the same scene dry, not part of the full benchmark's cases.
+LOOM_CASES = {
+    "loom-c0.02mm-mu0.15": {"scene": "loom", "joint_e.clearance_mm": 0.02, "joint_e.friction_coefficient": 0.15},
+    "loom-c0.10mm-mu0.15": {"scene": "loom", "joint_e.clearance_mm": 0.10, "joint_e.friction_coefficient": 0.15},
+}
+STIFF_CASES = ("c0.50mm-400rpm-mu0.15",) + tuple(LOOM_CASES)
 CONVERGED_STIFF = (("numba_RODAS4", 1e-10), ("numba_RODAS4", 1e-9), ("numba_DOP853_RODAS4", 1e-9))
 # The converged solution: compiled DOP853 at the tightest tolerances; the spread of the ensemble is
 # the floor below which errors are not meaningful (docs/physics.md section 6: statistics reproduce to 1-2 %).
@@ -125,9 +131,10 @@ def settings(case: str, quick: bool = False) -> list[Setting]:
 def load_case(case: str, models: str | Path, revolutions: float, overrides: dict | None = None) -> Scene:
     from weftsim.input.scene import load_scene
 
-    keys = {**CASES[case], "drive.revolutions": revolutions, **(overrides or {})}
-    scene = load_scene(Path(models) / "reference.toml", keys)
-    return scene
+    keys = {**(CASES[case] if case in CASES else LOOM_CASES[case]), "drive.revolutions": revolutions,
+            **(overrides or {})}
+    name = keys.pop("scene", "reference")
+    return load_scene(Path(models) / f"{name}.toml", keys)
 
 
 def _solver(engine: str):

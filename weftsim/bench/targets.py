@@ -27,7 +27,7 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from weftsim.bench.measure import Setting, _ref, _rigid, converged_solution, measure
+from weftsim.bench.measure import LOOM_CASES, Setting, _ref, _rigid, converged_solution, measure
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -130,6 +130,38 @@ def stiff_items(models: str | Path, repeats: int, log: Callable[[str], None] = p
     return items
 
 
+LOOM_FRICTION_REVOLUTIONS = 1.0  # one revolution of the loom, start-up impact included (converged: RODAS4 rtol 1e-10)
+LOOM_PEAK_TARGET = 1e-3  # issue 36: peaks within 0.1 % of a converged run
+
+
+def loom_friction_items(models: str | Path, repeats: int, log: Callable[[str], None] = print) -> dict:
+    """Issue 36: the loom with mu = 0.15 against the same scene dry, per revolution, at c = 0.02 and 0.1 mm, on
+    both engines' default paths; the peaks of each against the reference engine's converged run of its scene."""
+    items = {}
+    for case in LOOM_CASES:
+        refs = {"dry": converged_solution(case, models, LOOM_FRICTION_REVOLUTIONS, log, DRY),
+                "friction": converged_solution(case, models, LOOM_FRICTION_REVOLUTIONS, log)}
+        for engine in ("reference", "exudyn"):
+            rows = {}
+            for key, overrides in (("dry", DRY), ("friction", {})):
+                rows[key] = measure(case, Setting(engine, engine, "default", overrides), refs[key], models,
+                                    LOOM_FRICTION_REVOLUTIONS, repeats, 8.0, 1.0)  # fmt: skip
+                items[f"{engine} default, {case}, {key}"] = rows[key]
+            dry, rough = rows["dry"], rows["friction"]
+            ratio = dry["realtime_ratio"] / rough["realtime_ratio"]
+            cpu = dry["realtime_ratio_cpu"] / rough["realtime_ratio_cpu"]
+            peak = (rough.get("errors") or {}).get("peak_max")
+            ok = rough["status"] == dry["status"] == "success"
+            items[f"friction / dry, {engine} default, {case}"] = {
+                "status": "success" if ok else "failed", "ratio": ratio, "cpu_ratio": cpu, "peak_error": peak,
+                "steps": [dry["steps"], rough["steps"]],
+                "met": ok and ratio <= FRICTION_RATIO_AT_MOST and peak is not None and peak <= LOOM_PEAK_TARGET,
+                "target_text": f"<= {FRICTION_RATIO_AT_MOST:g}x, peaks within {LOOM_PEAK_TARGET:.1%}"}
+            log(f"  friction / dry, {engine}, {case}: {ratio:.2f}x wall, {cpu:.2f}x CPU, steps {dry['steps']} / "
+                f"{rough['steps']}, peak error {peak}")
+    return items
+
+
 def _ratio_item(case: str, overrides: dict, refs: dict, dry: dict, models, repeats: int) -> dict:
     """The lubricated run's time against the dry one's; its errors are against the dry solution (a film changes
     the peaks), so only the ratio is judged here; its accuracy needs a converged lubricated ensemble."""
@@ -166,6 +198,7 @@ def run_targets(models: str | Path = "models", repeats: int = 5, jobs: int = 2, 
         log(f"  {name}: x{row['realtime_ratio']:.2f} real time, peak err "
             f"{(row['errors'] or {}).get('peak_max')}, stats err {(row['errors'] or {}).get('stats_max')}")
     report["items"].update(stiff_items(models, repeats, log))
+    report["items"].update(loom_friction_items(models, repeats, log))
     with tempfile.TemporaryDirectory(prefix="weftsim-targets-") as tmp:
         for engine in ("reference", "exudyn"):
             name = f"weftsim run {engine}, new process, 2 rev"
