@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.mechanism.pin_loads import SAMPLES, ideal_pin_loads, sliding_speed
+from weftsim.mechanism.pin_loads import SAMPLES, ideal_pin_loads, sliding_speed_at
 from weftsim.run.plausibility import (
     TRESCA_LINE_CONTACT_YIELD,
     Plausibility,
@@ -263,8 +263,8 @@ def after_run(result: RunResult) -> list[Check]:
         force_samples = np.asarray(samples["contact_force_N"]) if samples["time_s"].size else force_steps
         theta_steps = np.radians(np.asarray(steps["crank_angle_deg"]))
         theta_samples = np.radians(np.asarray(samples["crank_angle_deg"])) if samples["time_s"].size else theta_steps
-        v_steps = sliding_speed(theta_steps, scene, name, joint.journal_radius)
-        v_samples = sliding_speed(theta_samples, scene, name, joint.journal_radius)
+        v_steps = sliding_speed_at(theta_steps, scene, name, joint.journal_radius)
+        v_samples = sliding_speed_at(theta_samples, scene, name, joint.journal_radius)
         out += pressure_checks("after", table, joint, float(force_steps.max()), float(force_samples.mean()),
                                float(np.mean(force_samples * v_samples)) / area,
                                float(np.max(force_steps * v_steps)) / area, float(v_steps.max()),
