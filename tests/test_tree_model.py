@@ -101,12 +101,13 @@ def test_accelerations_are_those_of_the_accepted_states():
     assert np.quantile(err, 0.99) < 5e-3 * np.abs(acc).max()
 
 
-@pytest.mark.parametrize("scene_name, clearance_mm, revolutions", [
-    ("reference", 0.5, 6.0),  # the reference scene's worst drift under quadrature
-    ("loom", 0.1, 3.0),  # the worn loom, in lasting contact (95 % of the steps)
-    ("loom", 0.25, 3.0),
+@pytest.mark.parametrize("scene_name, clearance_mm, revolutions, mu", [
+    ("reference", 0.5, 6.0, 0.0),  # the reference scene's worst drift under quadrature
+    ("loom", 0.1, 3.0, 0.0),  # the worn loom, in lasting contact (95 % of the steps)
+    ("loom", 0.25, 3.0, 0.0),
+    ("loom", 0.1, 3.0, 0.15),  # friction: the implicit tree, with the power joints too
 ])
-def test_energy_balance_closes_over_revolutions_on_the_default_path(scene_name, clearance_mm, revolutions):
+def test_energy_balance_closes_over_revolutions_on_the_default_path(scene_name, clearance_mm, revolutions, mu):
     """The default path: driving work = kinetic + potential + contact + dissipated energy, with the drawn
     and dissipated powers integrated by DOPRI5 with the motion (the tree's power joints).
 
@@ -115,8 +116,10 @@ def test_energy_balance_closes_over_revolutions_on_the_default_path(scene_name, 
     quadrature over the steps (tree_solve.contact_work) they were 8e-4 and 3.9e-3: the worn loom draws
     ~1000 J in and out of the chain through the contact in each revolution, and the quadrature at its
     ~50 us steps missed 1.2 J a revolution, so a 10-revolution run failed the energy guard (1 %) at
-    revolution 8 (c = 0.1 mm) and 6.4 (0.25 mm).  2e-5 keeps 500 revolutions below the guard."""
-    scene = load_scene(scene_name, {"drive.revolutions": revolutions, "joint_e.clearance_mm": clearance_mm})
+    revolution 8 (c = 0.1 mm) and 6.4 (0.25 mm).  With friction (generalized-alpha): 1.2e-6, and 1.3e-4 under
+    the quadrature (the guard after ~230 revolutions).  2e-5 keeps 500 revolutions below the guard."""
+    scene = load_scene(scene_name, {"drive.revolutions": revolutions, "joint_e.clearance_mm": clearance_mm,
+                                    "joint_e.friction_coefficient": mu})
     r = solve(scene)
     assert r.ok and r.path["model"] == "kinematic_tree", r.message
     st = r.steps
