@@ -31,13 +31,18 @@ The floors, from the bottom (a module may import its own floor and the floors be
 2. ``input``: the scene as validated, frozen SI data (``Scene``);
 3. ``joint``, ``mechanism``, ``model``: the clearance joint, the linkage's kinematics, the shared model
    both engines build on (parameter packing, initial state, crank-side inertia and potential);
-4. ``post``: results (``RunResult``), analysis, output files, figures;
-5. ``run``: before-run checks, guards, post-run vetting, estimates;
+4. ``run``: before-run checks, guards, post-run vetting, estimates;
+5. ``post``: results (``RunResult``), analysis, output files, the figures and comparison reports that show
+   the checks of ``run`` (so ``post`` sits above ``run``; the checks reading a result's channel table,
+   ``run.plausibility`` -> ``post.results``, is the one arrow back up between them);
 6. ``reference``, ``exudyn_engine``: the two engines (neither imports the other);
-7. ``engines``: the registry that names the engines;
-8. ``api``: ``simulate``, the one door, and the rest of the Python interface;
-9. ``sweep``, ``studies``, ``wear``, ``bench``: what runs many simulations through the API;
+7. ``engines``: the registry that names the engines, and ``simulate``, the one door into them;
+8. ``sweep``, ``studies``, ``wear``, ``bench``: what runs many simulations through the door;
+9. ``api``: the Python interface (``simulate`` re-exported, ``sweep``, ``wear``, ``compare``, ...);
 10. ``cli``, ``__main__``, the package ``__init__``: the command line and the package's exports.
+
+(Before issue 32 there was no ``engines`` module and no ``model`` subpackage; the same floors apply to the
+tree before it.)
 
 The same script measured the house before and after issue 32 (its figures are in CHANGELOG.md).
 """
@@ -57,12 +62,12 @@ FLOORS: dict[str, int] = {
     "kernel": 1,
     "input": 2,
     "joint": 3, "mechanism": 3, "model": 3,
-    "post": 4,
-    "run": 5,
+    "run": 4,
+    "post": 5,
     "reference": 6, "exudyn_engine": 6,
     "engines": 7,
-    "api": 8,
-    "sweep": 9, "studies": 9, "wear": 9, "bench": 9,
+    "sweep": 8, "studies": 8, "wear": 8, "bench": 8,
+    "api": 9,
     "cli": 10, "__main__": 10, "": 10,  # "" is the package's __init__
 }
 

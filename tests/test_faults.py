@@ -30,7 +30,7 @@ import pytest
 
 from weftsim.cli import commands as cli
 from weftsim.post import output
-from weftsim.cli.exitcodes import EXIT_DISAGREE, EXIT_FAILED
+from weftsim.errors import EXIT_DISAGREE, EXIT_FAILED
 from weftsim.post.output import MANIFEST
 from weftsim.post.results import CHANNELS
 

@@ -17,7 +17,7 @@ import pytest
 import weftsim
 from weftsim.post.analysis import peaks
 from weftsim.reference.compiled_ros import rate_tolerance_factor
-from weftsim.reference.dynamics import pack_parameters
+from weftsim.model.dynamics import pack_parameters
 
 FILM = {"joint_e.lubrication.viscosity_mpa_s": 80.0}  # the loom at c = 0.02 mm, 600 rpm: no contact
 TIGHT = {"solver.reference.rtol": 1e-8, "solver.reference.atol": 1e-11}
@@ -95,11 +95,12 @@ def test_jacobian_of_the_mixed_film_is_accurate():
     from weftsim.kernel.chain import penetration
     from weftsim.kernel.chain_f import rhs_any
     from weftsim.reference import compiled_ros as ros
-    from weftsim.reference import solve
+    from conftest import door
+    solve = door("reference")
 
     scene = weftsim.load_scene("loom", MIXED, revolutions=0.25)
     rows = {}
-    solve(scene, step_states=lambda t, y, contact, impact: rows.update(t=t, y=y))
+    solve(scene, observe=lambda t, y, contact, impact: rows.update(t=t, y=y))
     prm = pack_parameters(scene)
     gaps = [penetration(prm, t, y)[0] for t, y in zip(rows["t"], rows["y"])]
     k = int(np.argmax(gaps))
@@ -169,7 +170,7 @@ def test_stiff_dense_output_is_order_3_and_follows_the_clearance_rate():
 
     from weftsim.kernel.chain_f import rhs_any
     from weftsim.reference import compiled_ros as ros
-    from weftsim.reference.dynamics import initial_state
+    from weftsim.model.dynamics import initial_state
 
     def interpolants(prm, t, y, h, s):
         y_new, F = _rodas_step(prm, t, y, h)
@@ -196,7 +197,7 @@ def test_stiff_dense_output_is_order_3_and_follows_the_clearance_rate():
 
     mixed = weftsim.load_scene("loom", MIXED, revolutions=0.3)
     rows = {}
-    weftsim.reference.solve(mixed, step_states=lambda t, y, contact, impact: rows.update(t=t, y=y))
+    door("reference")(mixed, observe=lambda t, y, contact, impact: rows.update(t=t, y=y))
     prm = pack_parameters(mixed)
     for degrees in (60.0, 80.0):  # film ratio ~2.1 and ~1.6: on the asperities
         k = int(np.searchsorted(rows["t"], degrees / 360.0 * mixed.drive.period))

@@ -147,7 +147,7 @@ def make_tree_force(prm: np.ndarray, memory: list, stash: list, route: str = "nu
 
     The contact of the moving bearing, projected on the joints by virtual work, is
     :func:`weftsim.kernel.chain.tree_joint_force`.  ``prm``: the scene's kernel parameter array
-    (:func:`weftsim.reference.dynamics.pack_parameters`, friction included); ``memory`` =
+    (:func:`weftsim.model.dynamics.pack_parameters`, friction included); ``memory`` =
     [v_held, delta0, rate0] of the last accepted step (written by the post-step bookkeeping); every
     call leaves [t, delta, delta_dot, F_b,x, F_b,y, F_N, M_b, F_T v_T, v_T, D'_lub, U_a] in ``stash`` (F_b =
     F_N n - F_T t, the force on the bearing, plus the film's and asperities' of a lubricated joint; M_b its

@@ -3,7 +3,7 @@
 The film and the asperities are evaluated by the kernel the engines integrated
 (:func:`weftsim.kernel.lubricated.lubricated_force`) at each row's eccentricity, its rate and the
 bodies' rotation rates, so the channels are the forces the solver saw.  Rows are reference-engine
-states (:func:`weftsim.reference.dynamics.initial_state` layout: [a, psi, a', psi', W3, D] with E alone,
+states (:func:`weftsim.model.dynamics.initial_state` layout: [a, psi, a', psi', W3, D] with E alone,
 the 4-DOF or F-only layouts of :mod:`weftsim.kernel.chain_f` otherwise); the Exudyn kinematic tree
 converts its joint coordinates to that layout first.
 

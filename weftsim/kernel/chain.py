@@ -22,7 +22,7 @@ the state y = [a, psi, a', psi', W3, D] so the energy balance closes to the solv
 Derivation: docs/reference-solver.md.
 
 Every number comes in one float array: the joint block of :mod:`weftsim.kernel.joint` followed by
-the chain's constants (indices below; :func:`weftsim.reference.dynamics.pack_parameters` builds it
+the chain's constants (indices below; :func:`weftsim.model.dynamics.pack_parameters` builds it
 from a scene), so numba compiles these functions once per machine and loads them from its cache.
 """
 

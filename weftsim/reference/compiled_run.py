@@ -23,7 +23,7 @@ from weftsim.reference.compiled import (
     advance,
 )  # fmt: skip
 from weftsim.kernel.chain_f import N_JOINTS
-from weftsim.reference.dynamics import initial_state, pack_parameters
+from weftsim.model.dynamics import initial_state, pack_parameters
 from weftsim.reference.integrate import _PROGRESS_EVERY
 from weftsim.post.results import RunResult
 
@@ -162,11 +162,11 @@ def integrate_compiled(scene: Scene, progress: Callable[[float], None] | None = 
 
 
 def solve_compiled(scene: Scene, progress: Callable[[float], None] | None = None, method: str | None = None,
-                   step_states: Callable[..., None] | None = None, rtol: float | None = None) -> RunResult:
+                   observe: Callable[..., None] | None = None, rtol: float | None = None) -> RunResult:
     """The reference engine's clearance mode through the compiled integrator.
 
     ``method``: one of :data:`METHODS`; default ``scene.reference_solver.method``.
-    ``step_states``: optional callable given the raw step rows (t, y, contact, impact), as
+    ``observe``: optional callable given the raw step rows (t, y, contact, impact), as
     in :func:`weftsim.reference.solve`.
     """
     from weftsim.reference.compiled_channels import compiled_channels
@@ -174,8 +174,8 @@ def solve_compiled(scene: Scene, progress: Callable[[float], None] | None = None
 
     steps, samples, stats, events, status, message = integrate_compiled(
         scene, progress, method or scene.reference_solver.method, rtol)
-    if step_states is not None:
-        step_states(*steps)
+    if observe is not None:
+        observe(*steps)
     wall0 = _time.perf_counter()
 
     def channels(arrays):

@@ -41,7 +41,7 @@ from weftsim.kernel import chain as kernel_chain
 from weftsim.kernel.chain import rhs as chain_rhs
 from weftsim.input.params import Scene
 from weftsim.reference import events
-from weftsim.reference.dynamics import initial_state, pack_parameters
+from weftsim.model.dynamics import initial_state, pack_parameters
 
 if TYPE_CHECKING:
     from collections.abc import Callable

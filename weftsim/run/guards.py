@@ -252,7 +252,9 @@ def result_breach(result: RunResult) -> tuple[int, Breach] | None:
         guard = RunGuard(joint_scene)
         i = _first(joint_steps["penetration_m"] > guard.max_penetration)
         if i is not None:
-            return i, guard.check(penetration=float(joint_steps["penetration_m"][i]), steps=0)
+            breach = guard.check(penetration=float(joint_steps["penetration_m"][i]), steps=0)
+            if breach is not None:
+                return i, breach
     residual = energy_residual(st)
     scale = float(np.max(np.abs(st["kinetic_energy_J"]))) or 1.0
     limit = scene.limits.max_energy_error

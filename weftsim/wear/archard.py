@@ -183,9 +183,9 @@ def wear_from_rows(joint: ClearanceJoint, time: np.ndarray, rows: np.ndarray) ->
 def run_wear(scene: Scene, prm: np.ndarray, time: np.ndarray, states: np.ndarray, contact: np.ndarray,
              impact: np.ndarray, joint: str = "e") -> RunWear:
     """Archard wear of ``joint`` ("e" or "f") over the given step rows (times (n,) s, states, contact
-    modes, held impact velocities: as :func:`weftsim.reference.solve` gives them to ``step_states``).
+    modes, held impact velocities: as :func:`weftsim.reference.solve` gives them to ``observe``).
 
-    ``prm``: the kernel parameter array of ``scene`` (:func:`weftsim.reference.dynamics.pack_parameters`).
+    ``prm``: the kernel parameter array of ``scene`` (:func:`weftsim.model.dynamics.pack_parameters`).
     With E alone loose, the rows of :func:`contact_rows` (states (n, 6)); with a clearance at F, those of
     :func:`contact_rows_f` for the joint asked for.
     """

@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 from typing import TYPE_CHECKING
 
-from weftsim.cli.exitcodes import EXIT_FAILED
+from weftsim.errors import EXIT_FAILED
 from weftsim.run.progress import format_duration
 
 if TYPE_CHECKING:

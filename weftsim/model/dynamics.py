@@ -27,7 +27,7 @@ from weftsim.kernel import chain_f as kf
 from weftsim.kernel.joint import N_JOINT, joint_parameters
 from weftsim.kernel.wear import wear_block
 from weftsim.input.params import Scene
-from weftsim.reference.ideal import sector_chain_inertia
+from weftsim.model.ideal import sector_chain_inertia
 
 if TYPE_CHECKING:
     from types import ModuleType
