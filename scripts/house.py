@@ -34,7 +34,7 @@ The floors, from the bottom (a module may import its own floor and the floors be
 4. ``run``: before-run checks, guards, post-run vetting, estimates;
 5. ``post``: results (``RunResult``), analysis, output files, the figures and comparison reports that show
    the checks of ``run`` (so ``post`` sits above ``run``; the checks reading a result's channel table,
-   ``run.plausibility`` -> ``post.results``, is the one arrow back up between them);
+   ``weftsim.run.plausibility`` -> ``weftsim.post.results``, is the one arrow back up between them);
 6. ``reference``, ``exudyn_engine``: the two engines (neither imports the other);
 7. ``engines``: the registry that names the engines, and ``simulate``, the one door into them;
 8. ``sweep``, ``studies``, ``wear``, ``bench``: what runs many simulations through the door;

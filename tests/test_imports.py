@@ -18,79 +18,24 @@ import pytest
 PACKAGE = Path(__file__).resolve().parent.parent / "weftsim"
 
 
-def _modules() -> dict[str, Path]:
-    out = {}
-    for path in PACKAGE.rglob("*.py"):
-        parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
-        name = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
-        out[name] = path
-    return out
+def _house():
+    """scripts/house.py, the one reader of the import graph (floors, circles, arrows back up, the walk)."""
+    import importlib.util
 
-
-def _resolve(name: str, modules: dict[str, Path]) -> str | None:
-    while name and name not in modules:
-        name = name.rpartition(".")[0]
-    return name or None
+    spec = importlib.util.spec_from_file_location("house", PACKAGE.parent / "scripts" / "house.py")
+    house = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(house)
+    return house
 
 
 def import_graph() -> dict[str, set[str]]:
     """module -> the weftsim modules it imports anywhere in its source (itself and its own packages left out)."""
-    modules = _modules()
-    graph = {}
-    for name, path in modules.items():
-        package = name if path.name == "__init__.py" else name.rpartition(".")[0]
-        targets = set()
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
-            if isinstance(node, ast.Import):
-                targets.update(alias.name for alias in node.names)
-            elif isinstance(node, ast.ImportFrom):
-                base = node.module or ""
-                if node.level:
-                    parts = package.split(".")[: len(package.split(".")) - node.level + 1]
-                    base = ".".join(parts + ([base] if base else []))
-                # `from weftsim.x import y`: the submodule weftsim.x.y where there is one, else weftsim.x
-                targets.update(f"{base}.{alias.name}" if f"{base}.{alias.name}" in modules else base
-                               for alias in node.names)
-        edges = {_resolve(t, modules) for t in targets if t == "weftsim" or t.startswith("weftsim.")}
-        # A package importing its own submodules (to export them) is not a dependency of theirs on it.
-        graph[name] = {e for e in edges if e and e != name and not (path.name == "__init__.py" and
-                                                                    e.startswith(name + "."))}
-    return graph
+    return _house().graph()
 
 
 def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
     """The strongly connected components of more than one module (Tarjan), each sorted."""
-    index: dict[str, int] = {}
-    low: dict[str, int] = {}
-    stack: list[str] = []
-    on_stack: set[str] = set()
-    found = []
-
-    def visit(v: str) -> None:
-        index[v] = low[v] = len(index)
-        stack.append(v)
-        on_stack.add(v)
-        for w in graph.get(v, ()):
-            if w not in index:
-                visit(w)
-                low[v] = min(low[v], low[w])
-            elif w in on_stack:
-                low[v] = min(low[v], index[w])
-        if low[v] == index[v]:
-            component = []
-            while True:
-                w = stack.pop()
-                on_stack.discard(w)
-                component.append(w)
-                if w == v:
-                    break
-            if len(component) > 1:
-                found.append(sorted(component))
-
-    for v in sorted(graph):
-        if v not in index:
-            visit(v)
-    return found
+    return _house().circles(graph)
 
 
 def test_the_cycle_finder_finds_a_circle_and_a_chain_has_none():
@@ -163,15 +108,6 @@ def test_python_m_weftsim_and_weftsim_cli_run_the_command():
 ENGINE_PACKAGES = ("weftsim.reference", "weftsim.exudyn_engine")
 
 
-def _house():
-    import importlib.util
-
-    spec = importlib.util.spec_from_file_location("house", PACKAGE.parent / "scripts" / "house.py")
-    house = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(house)
-    return house
-
-
 def test_no_module_of_one_engine_imports_the_other():
     """Issue 32: the shared model (weftsim.model) sits below both engines; neither engine imports the other."""
     graph = import_graph()
@@ -187,8 +123,7 @@ def test_engines_are_chosen_by_name_in_one_module():
     """Only weftsim.engines names the engines' modules (its registry); every other caller gets an engine from it
     (weftsim.engines.get) or runs one through the door (simulate): no module outside the engines imports an
     engine's solve."""
-    modules = {name: path for name, path in ((n, PACKAGE.parent / (n.replace(".", "/"))) for n in import_graph())}
-    for name in modules:
+    for name in import_graph():
         if name.startswith(ENGINE_PACKAGES):
             continue
         path = PACKAGE.parent / (name.replace(".", "/") + ".py")

@@ -41,7 +41,7 @@ from typing import TYPE_CHECKING, Any, Callable, Protocol, runtime_checkable
 
 from weftsim.errors import ArgumentError, EngineError, PlausibilityWarning, RunFailed, SceneError, closest
 from weftsim.input.params import Scene
-from weftsim.run.progress import Estimate
+from weftsim.run.contract import Estimate
 
 if TYPE_CHECKING:
     from weftsim.post.results import RunResult

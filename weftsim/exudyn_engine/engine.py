@@ -7,16 +7,16 @@ not included): within ~3x on other scenes, enough to tell seconds from hours.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Callable
+from typing import TYPE_CHECKING
 
 from weftsim.exudyn_engine.selection import adaptive, select_model, select_path, step_plan, tree_solver
 from weftsim.exudyn_engine.solver import solve
 from weftsim.model.stiffness import stiff_joints
-from weftsim.run.progress import NPZ_BYTES_PER_ROW, STEP_ROWS_PER_REVOLUTION, Estimate
+from weftsim.run.contract import BoundEngine, Estimate
+from weftsim.run.progress import NPZ_BYTES_PER_ROW, STEP_ROWS_PER_REVOLUTION
 
 if TYPE_CHECKING:
     from weftsim.input.params import Scene
-    from weftsim.post.results import RunResult
 
 SECONDS_PER_REVOLUTION = {
     "exudyn kinematic_tree": 0.10,  # the default path (DOPRI5 rtol 1e-6, numba route): 0.97-1.02 s for 10
@@ -61,20 +61,4 @@ def estimate(scene: Scene) -> Estimate:
     return Estimate(seconds, rows * NPZ_BYTES_PER_ROW, bool(stiff_joints(scene)) and tree_explicit(scene))
 
 
-class ExudynEngine:
-    """The Exudyn multibody model (:mod:`weftsim.exudyn_engine`) under the engine contract."""
-
-    name = "exudyn"
-
-    def select_path(self, scene: Scene) -> dict:
-        return select_path(scene)
-
-    def estimate(self, scene: Scene) -> Estimate:
-        return estimate(scene)
-
-    def solve(self, scene: Scene, progress: Callable[[float], None] | None = None,
-              observe: Callable[..., None] | None = None) -> RunResult:
-        return solve(scene, progress=progress, observe=observe)
-
-
-ENGINE = ExudynEngine()
+ENGINE = BoundEngine("exudyn", select_path, estimate, solve)

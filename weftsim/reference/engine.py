@@ -8,15 +8,15 @@ the step a contact needs: the estimate is meant to tell seconds from hours, with
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Callable
+from typing import TYPE_CHECKING
 
 from weftsim.model.stiffness import stiff_joints
 from weftsim.reference import compiled_method, effective_rtol, select_path, solve
-from weftsim.run.progress import NPZ_BYTES_PER_ROW, STEP_ROWS_PER_REVOLUTION, Estimate
+from weftsim.run.contract import BoundEngine, Estimate
+from weftsim.run.progress import NPZ_BYTES_PER_ROW, STEP_ROWS_PER_REVOLUTION
 
 if TYPE_CHECKING:
     from weftsim.input.params import Scene
-    from weftsim.post.results import RunResult
 
 # Wall-clock seconds per crank revolution (module docstring).
 SECONDS_PER_REVOLUTION = {
@@ -63,20 +63,4 @@ def estimate(scene: Scene) -> Estimate:
     return Estimate(seconds, rows * factor * revolutions * NPZ_BYTES_PER_ROW, explicit_stiff)
 
 
-class ReferenceEngine:
-    """The closed-form Lagrange cross-check (:mod:`weftsim.reference`) under the engine contract."""
-
-    name = "reference"
-
-    def select_path(self, scene: Scene) -> dict:
-        return select_path(scene)
-
-    def estimate(self, scene: Scene) -> Estimate:
-        return estimate(scene)
-
-    def solve(self, scene: Scene, progress: Callable[[float], None] | None = None,
-              observe: Callable[..., None] | None = None) -> RunResult:
-        return solve(scene, progress=progress, observe=observe)
-
-
-ENGINE = ReferenceEngine()
+ENGINE = BoundEngine("reference", select_path, estimate, solve)

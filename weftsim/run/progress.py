@@ -12,7 +12,6 @@ import bisect
 import math
 import sys
 import time
-from dataclasses import dataclass
 from typing import Callable
 
 SETTLE_S = 2.0  # the start-up a rate is not measured over: imports, model build, numba compilation (~1-2 s)
@@ -116,26 +115,6 @@ class Progress:
     def close(self) -> None:
         if self.shown and self.tty:
             self._write("\n")
-
-
-@dataclass(frozen=True)
-class Estimate:
-    """What a run of one scene on one engine will cost, before it starts (measured rates, within ~3x).
-
-    Attributes
-    ----------
-    run_time_s : float
-        Wall-clock seconds of the run (NaN: unknown, e.g. a plug-in without an estimate).
-    step_bytes : float
-        Bytes of the per-step table (``result.npz``, and about as much memory while held).
-    stiff_explicit : bool
-        The run integrates a stiff joint law (friction's ramp, an oil film) with an explicit method.
-    """
-
-    run_time_s: float
-    step_bytes: float
-    stiff_explicit: bool = False
-
 
 
 # The engines' run-time and memory estimates are theirs (the engine contract's ``estimate``:
