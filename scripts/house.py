@@ -27,14 +27,14 @@ The figures (issue 32), all read from the source with :mod:`ast` except the walk
 The floors, from the bottom (a module may import its own floor and the floors below it):
 
 0. ``errors``, ``version``: what every module raises and reports;
-1. ``kernel``: the physics, compiled (contact laws, the chain's equations, the film, wear);
+1. ``physics``: the physics, compiled (contact laws, the chain's equations, the film, wear);
 2. ``input``: the scene as validated, frozen SI data (``Scene``);
 3. ``joint``, ``mechanism``, ``model``: the clearance joint, the linkage's kinematics, the shared model
    both engines build on (parameter packing, initial state, crank-side inertia and potential);
-4. ``run``: before-run checks, guards, post-run vetting, estimates;
+4. ``checks``: before-run checks, guards, post-run vetting, estimates;
 5. ``post``: results (``RunResult``), analysis, output files, the figures and comparison reports that show
-   the checks of ``run`` (so ``post`` sits above ``run``; the checks reading a result's channel table,
-   ``weftsim.run.plausibility`` -> ``weftsim.post.results``, is the one arrow back up between them);
+   the checks of ``checks`` (so ``post`` sits above ``checks``; the checks reading a result's channel table,
+   ``weftsim.checks.plausibility`` -> ``weftsim.post.results``, is the one arrow back up between them);
 6. ``reference``, ``exudyn_engine``: the two engines (neither imports the other);
 7. ``engines``: the registry that names the engines, and ``simulate``, the one door into them;
 8. ``sweep``, ``studies``, ``wear``, ``bench``: what runs many simulations through the door;
@@ -59,10 +59,10 @@ PACKAGE = ROOT / "weftsim"
 
 FLOORS: dict[str, int] = {
     "errors": 0, "version": 0,
-    "kernel": 1,
+    "physics": 1,
     "input": 2,
     "joint": 3, "mechanism": 3, "model": 3,
-    "run": 4,
+    "checks": 4,
     "post": 5,
     "reference": 6, "exudyn_engine": 6,
     "engines": 7,

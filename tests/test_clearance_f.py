@@ -205,9 +205,9 @@ def test_small_clearance_tends_to_the_ideal_mechanism(case):
 
 def test_e_only_kernel_path_is_unchanged_by_the_joint_f_block():
     """A scene with clearance at E alone runs through the same chain as before joint F existed: the
-    kernel's topology E_ONLY calls weftsim.kernel.chain.chain unchanged (bit for bit)."""
-    from weftsim.kernel import chain as kc
-    from weftsim.kernel import chain_f as kf
+    kernel's topology E_ONLY calls weftsim.physics.chain.chain unchanged (bit for bit)."""
+    from weftsim.physics import chain as kc
+    from weftsim.physics import chain_f as kf
     from weftsim.model.dynamics import initial_state, pack_parameters
 
     scene = _scene(C, 0.0)

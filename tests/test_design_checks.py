@@ -1,4 +1,4 @@
-"""Plausibility checks of a scene before and after a run (issue 21; weftsim.mechanism.pin_loads, weftsim.run.design_checks).
+"""Plausibility checks of a scene before and after a run (issue 21; weftsim.mechanism.pin_loads, weftsim.checks.design_checks).
 
 The ideal pin loads are checked against closed forms: the reflected mass against finite differences of the
 kinematics (the rapier alone: m8 (ds/dv_E)^2), the pin forces against the power balance of the chain
@@ -19,7 +19,7 @@ import pytest
 
 import weftsim
 from weftsim import reference
-from weftsim.run.design_checks import after_run, before_run, before_run_lines
+from weftsim.checks.design_checks import after_run, before_run, before_run_lines
 from weftsim.errors import PlausibilityWarning
 from weftsim.mechanism.kinematics import linkage_state, rapier_motion
 from weftsim.mechanism.pin_loads import ideal_pin_loads, pin_forces, reflected_mass_e, reflected_mass_f, sliding_speed

@@ -23,7 +23,7 @@ import pytest
 
 from weftsim import exudyn_engine, reference
 from weftsim.post.analysis import energy_balance
-from weftsim.run.guards import RunGuard, failure_message, vet_result, where
+from weftsim.checks.guards import RunGuard, failure_message, vet_result, where
 from weftsim.input.params import Drive, ExudynSolver, Limits, Material, ReferenceSolver, Scene
 from weftsim.post.results import CHANNELS
 from weftsim.input.scene import SCHEMA
@@ -382,10 +382,10 @@ def run_cli(*args, cwd=None):
 
 
 def _error_lines(stderr: str) -> list[str]:
-    """stderr without the progress lines, which any run longer than 2 s prints (weftsim.run.progress): a
+    """stderr without the progress lines, which any run longer than 2 s prints (weftsim.checks.progress): a
     loaded machine, or numba's start-up when the process first loads a compiled kernel, gets there; and
     without the design checks' numbers and the plausibility warnings (the reference scene's 0.25 mm
-    clearance on a 20 mm pin is outside a new bushed pin's design range, weftsim.run.design_checks)."""
+    clearance on a 20 mm pin is outside a new bushed pin's design range, weftsim.checks.design_checks)."""
     return [line for line in stderr.strip().splitlines()
             if not re.search(r"\d%\s+elapsed", line) and not line.startswith(("weftsim run: warning: ",
                                                                                 "weftsim run: design checks "))]
@@ -470,10 +470,10 @@ def test_cli_compare_with_a_failed_engine_exits_3(tmp_path):
 
 @pytest.mark.parametrize("engine", SOLVERS)
 def test_a_stop_request_ends_the_run_as_interrupted_and_keeps_what_was_computed(engine):
-    """weftsim.run.guards.request_stop (the CLI's SIGINT handler) is seen at the next guard check: the
+    """weftsim.checks.guards.request_stop (the CLI's SIGINT handler) is seen at the next guard check: the
     run ends as failed with kind "interrupted", the steps up to there kept.  The request is made
     from the progress callback once 30 % of the run is done."""
-    from weftsim.run.guards import clear_stop, request_stop
+    from weftsim.checks.guards import clear_stop, request_stop
 
     def progress(fraction):
         if fraction >= 0.3:
@@ -507,7 +507,7 @@ def test_a_stop_request_ends_the_run_as_interrupted_and_keeps_what_was_computed(
 def test_penetration_bound_at_joint_f_names_joint_f():
     """Joint F against its own journal radius: a soft bushing at F (E ideal) sinks past a tenth of the
     radius in the start-up impact, and both engines stop naming [joint_f] (the guard judges each joint
-    with its own bound, weftsim.run.guards.RunGuard)."""
+    with its own bound, weftsim.checks.guards.RunGuard)."""
     from weftsim import exudyn_engine, reference
     from weftsim.input.scene import load_scene
 

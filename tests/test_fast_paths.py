@@ -16,7 +16,7 @@ from weftsim.joint.contact import LAWS, make_law  # noqa: E402
 from weftsim.input.params import ReferenceSolver, Scene  # noqa: E402
 from conftest import door
 solve = door("reference")
-from weftsim.kernel import laws  # noqa: E402
+from weftsim.physics import laws  # noqa: E402
 from weftsim.reference.compiled_channels import crank_side_eval, crank_side_table  # noqa: E402
 from weftsim.model.ideal import crank_side_inertia, crank_side_potential  # noqa: E402
 

@@ -1,9 +1,9 @@
 """Friction in the Exudyn engine's kinematic tree against the reference engine (issue 13 section 1).
 
 The modified Coulomb friction of docs/physics.md section 2 at the journal-bearing contact: both engines
-evaluate one kernel (:func:`weftsim.kernel.joint.friction_force` at the tangential velocity of
-:func:`weftsim.kernel.joint.tangential_velocity`), the reference in its closed-form chain, the tree in its
-generalized force (:func:`weftsim.kernel.chain.tree_joint_force`), so what is compared is the two
+evaluate one kernel (:func:`weftsim.physics.joint.friction_force` at the tangential velocity of
+:func:`weftsim.physics.joint.tangential_velocity`), the reference in its closed-form chain, the tree in its
+generalized force (:func:`weftsim.physics.chain.tree_joint_force`), so what is compared is the two
 integrations of the same model.  Compared as without friction (tests/test_engine_agreement.py, the
 scene's ``[compare]`` table): first contact within 0.1 deg, first-revolution maxima of contact force,
 rapier acceleration and driving torque within 1 %, here over the first 0.1 revolution (the start-up
@@ -187,7 +187,7 @@ def test_the_trees_contact_with_friction_is_the_reference_chains():
     torques are the virtual work of the journal's force and moment."""
     import math
 
-    from weftsim.kernel import chain as kc
+    from weftsim.physics import chain as kc
     from weftsim.model.dynamics import initial_state, pack_parameters
 
     scene = _scene(0.15, "0p25")
@@ -267,7 +267,7 @@ def test_each_frozen_friction_piece_is_the_law_on_its_own_speed_range():
     must equal the law (to round-off) at every sliding speed of that piece, and the piece of a speed must be
     the law's (its inequalities at v0 and v1)."""
     from weftsim.exudyn_engine.friction_segments import DEAD, RAMP, SLIDE, FrictionSegments
-    from weftsim.kernel.joint import friction_force
+    from weftsim.physics.joint import friction_force
     from weftsim.model.dynamics import pack_parameters
 
     scene = _scene(0.15, "0p50")

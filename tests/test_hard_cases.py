@@ -5,7 +5,7 @@ the impact velocity are in tests/test_hard_cases_long.py.  docs/hard-cases.md ha
 Every case asserts physics, not stored numbers:
 
 - no NaN or inf in any channel, and the run ends as a success;
-- penetration below the run-time bound of weftsim.run.guards, a tenth of the journal radius (the
+- penetration below the run-time bound of weftsim.checks.guards, a tenth of the journal radius (the
   rigid-body model with a local contact compliance needs the deformed zone small against the
   bodies).  It is *not* small against the clearance: the start-up impact penetrates 0.69 c at
   c = 0.25 mm and 18.5 c at c = 0.01 mm (docs/hard-cases.md, "Penetration");

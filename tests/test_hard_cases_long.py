@@ -53,7 +53,7 @@ def per_revolution(result, first: int = 1) -> dict[str, np.ndarray]:
 def assert_finite_and_bounded(result) -> None:
     assert result.ok, result.message
     assert all(np.all(np.isfinite(result.steps[name])) for name in CHANNELS)
-    bound = result.scene.limits.max_penetration * result.scene.joint.journal_radius  # weftsim.run.guards
+    bound = result.scene.limits.max_penetration * result.scene.joint.journal_radius  # weftsim.checks.guards
     assert result.steps["penetration_m"].max() < bound
 
 

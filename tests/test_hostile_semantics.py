@@ -317,7 +317,7 @@ def test_a_wear_update_failing_mid_way_keeps_every_update_before_it(tmp_path, mo
 
 
 def test_a_stop_during_a_wear_update_is_an_interruption_not_a_failure(capsys, tmp_path, monkeypatch):
-    from weftsim.run.guards import clear_stop, request_stop
+    from weftsim.checks.guards import clear_stop, request_stop
     from weftsim.wear import extrapolate
 
     scene = load_scene(REFERENCE)

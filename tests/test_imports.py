@@ -48,7 +48,7 @@ def test_the_graph_sees_deferred_and_type_checking_imports():
     kinds (checked on edges that exist today), so a circle of either kind would be found."""
     graph = import_graph()
     assert "weftsim.exudyn_engine.callbacks" in graph["weftsim.exudyn_engine.selection"]  # inside a function
-    assert "weftsim.post.results" in graph["weftsim.run.design_checks"]  # under TYPE_CHECKING
+    assert "weftsim.post.results" in graph["weftsim.checks.design_checks"]  # under TYPE_CHECKING
     assert "weftsim.errors" in graph["weftsim.post.results"]
 
 
@@ -69,12 +69,12 @@ def test_errors_is_the_bottom_of_the_hierarchy_and_selection_needs_no_solver():
     graph = import_graph()
     assert graph["weftsim.errors"] == set()
     assert "weftsim.exudyn_engine.solver" not in graph["weftsim.exudyn_engine.selection"]
-    assert "weftsim.run.design_checks" not in graph["weftsim.run.plausibility"]
+    assert "weftsim.checks.design_checks" not in graph["weftsim.checks.plausibility"]
 
 
 FORMER_CIRCLES = [
     "weftsim.post.results", "weftsim.errors", "weftsim.exudyn_engine.selection",
-    "weftsim.run.design_checks", "weftsim.sweep.store", "weftsim.input.joint_keys",
+    "weftsim.checks.design_checks", "weftsim.sweep.store", "weftsim.input.joint_keys",
     "weftsim.input.scene", "weftsim.post.result_file", "weftsim.post.npz_guard",
     "weftsim.post.output", "weftsim.post.plots", "weftsim.wear.resume", "weftsim.wear.store",
 ]
@@ -92,7 +92,7 @@ def test_the_top_level_keeps_the_interface_and_each_concept_is_a_subpackage():
     subpackage (a top-level one would also stop apply_regroup.py, the script that made this layout)."""
     assert sorted(p.stem for p in PACKAGE.glob("*.py")) == ["__init__", "__main__", "api", "engines", "errors",
                                                             "version"]
-    for concept in ("input", "mechanism", "joint", "run", "post", "cli"):
+    for concept in ("input", "mechanism", "joint", "checks", "post", "cli"):
         init = PACKAGE / concept / "__init__.py"
         assert init.is_file() and ast.get_docstring(ast.parse(init.read_text(encoding="utf-8")))
 
@@ -147,7 +147,7 @@ def test_at_most_four_imports_run_back_up_a_floor():
         ("weftsim.input.scene", "weftsim.joint.contact"),  # the scene reader validates the law's parameters
         ("weftsim.input.scene", "weftsim.mechanism.kinematics"),  # ... and that the linkage assembles
         ("weftsim.joint.lubrication", "weftsim.post.results"),  # the film's channel names
-        ("weftsim.run.plausibility", "weftsim.post.results"),  # the checks read a result's channel table
+        ("weftsim.checks.plausibility", "weftsim.post.results"),  # the checks read a result's channel table
     }, up
 
 

@@ -92,8 +92,8 @@ def test_jacobian_of_the_mixed_film_is_accurate():
     """With a lubricated joint RODAS4's Jacobian is a central difference: against a Richardson-extrapolated
     difference (steps 10x and 20x larger), at the thinnest film of the first quarter revolution (on the
     asperities)."""
-    from weftsim.kernel.chain import penetration
-    from weftsim.kernel.chain_f import rhs_any
+    from weftsim.physics.chain import penetration
+    from weftsim.physics.chain_f import rhs_any
     from weftsim.reference import compiled_ros as ros
     from conftest import door
     solve = door("reference")
@@ -146,7 +146,7 @@ def test_mixed_regime_converges_at_few_steps(mixed_runs):
 
 def _rodas_step(prm, t, y, h):
     """One RODAS4 step of the kernel from (t, y): (y_new, dense rows F) with F complete for both dense outputs."""
-    from weftsim.kernel.chain_f import rhs_any
+    from weftsim.physics.chain_f import rhs_any
     from weftsim.reference import compiled_ros as ros
 
     n, impact, ist = y.size, np.zeros(2), np.zeros(32, dtype=np.int64)
@@ -168,7 +168,7 @@ def test_stiff_dense_output_is_order_3_and_follows_the_clearance_rate():
     Hermite interpolant does not."""
     from scipy.integrate import solve_ivp
 
-    from weftsim.kernel.chain_f import rhs_any
+    from weftsim.physics.chain_f import rhs_any
     from weftsim.reference import compiled_ros as ros
     from weftsim.model.dynamics import initial_state
 

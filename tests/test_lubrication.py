@@ -18,9 +18,9 @@ import numpy as np
 import pytest
 
 import weftsim
-from weftsim.kernel.asperity import H_CUTOFF, asperity_load, f52, greenwood_tripp_coefficient
-from weftsim.kernel.joint import clearance_force_at, joint_parameters
-from weftsim.kernel.lubricated import L_ASPERITY, L_FILM, lubricated_force
+from weftsim.physics.asperity import H_CUTOFF, asperity_load, f52, greenwood_tripp_coefficient
+from weftsim.physics.joint import clearance_force_at, joint_parameters
+from weftsim.physics.lubricated import L_ASPERITY, L_FILM, lubricated_force
 from weftsim.joint.contact import make_law
 from weftsim.input.params import ClearanceJoint, Lubrication
 from conftest import door
@@ -143,7 +143,7 @@ def test_asperity_load_is_continuous_and_its_potential_is_its_integral():
 
 
 def test_asperity_quadrature_is_converged():
-    from weftsim.kernel import asperity
+    from weftsim.physics import asperity
 
     e = C - 0.5 * SIGMA
     force = asperity_load(COEF, SIGMA, C, e, R, L)[0]
@@ -157,7 +157,7 @@ def test_asperity_quadrature_is_converged():
 def test_asperity_gauss_jacobi_rule_matches_a_fine_legendre_rule():
     """The 8-point Gauss-Jacobi rule of asperity_load (weight (theta_max - theta)^5.804) against 400 Gauss-Legendre
     points, load, potential and stiffness, over film ratios 0-4 at clearances 2 um-0.25 mm."""
-    from weftsim.kernel import asperity
+    from weftsim.physics import asperity
 
     x, w = np.polynomial.legendre.leggauss(400)
     x, w = 0.5 * (x + 1.0), 0.5 * w

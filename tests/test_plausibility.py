@@ -1,7 +1,7 @@
-"""The plausibility guard and the validity warnings (issue 11 section 4; weftsim.run.plausibility).
+"""The plausibility guard and the validity warnings (issue 11 section 4; weftsim.checks.plausibility).
 
 Sound runs pass with every defect count at zero; each defect, put into a sound run's per-step data
-by hand, fails the run through weftsim.run.guards.vet_result (the path every engine's result takes);
+by hand, fails the run through weftsim.checks.guards.vet_result (the path every engine's result takes);
 an "onset"-rule run whose damping outgrows the isolated-impact bound gets a warning (a property of
 that rule, not a defect); the warnings fire where the law is used outside its range, once each on stderr.
 """
@@ -21,9 +21,9 @@ import pytest
 from weftsim import reference
 from weftsim.post.analysis import summary
 from weftsim.joint.contact import make_law
-from weftsim.run.guards import vet_result, where
+from weftsim.checks.guards import vet_result, where
 from weftsim.input.params import Limits
-from weftsim.run.plausibility import (
+from weftsim.checks.plausibility import (
     PENETRATION_WARNING_RATIO, TRESCA_LINE_CONTACT_YIELD, contact_mode, damping_ratio, line_contact_pressure,
     onset_rows, roundoff_penetration, validity_warnings,
 )  # fmt: skip

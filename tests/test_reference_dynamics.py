@@ -1,6 +1,6 @@
 """Clearance-mode equations of the reference solver: the 2-DOF chain against a Lagrangian
 built numerically from positions, the contact's generalized forces by virtual work, the
-link with the ideal-joint torque (the one kernel, weftsim.kernel.chain)."""
+link with the ideal-joint torque (the one kernel, weftsim.physics.chain)."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from weftsim.mechanism import kinematics as kin
-from weftsim.kernel.chain import chain
+from weftsim.physics.chain import chain
 from weftsim.input.params import Scene
 from weftsim.model.dynamics import ChainConstants, eccentricity, initial_state, pack_parameters, penetration
 from weftsim.model.ideal import crank_side_inertia, crank_side_potential, ideal_torque

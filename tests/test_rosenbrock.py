@@ -12,7 +12,7 @@ import pytest
 pytest.importorskip("numba")
 
 from weftsim.post.analysis import energy_balance, peaks  # noqa: E402
-from weftsim.kernel.chain_f import rhs_any  # noqa: E402
+from weftsim.physics.chain_f import rhs_any  # noqa: E402
 from weftsim.reference import compiled_ros as ros  # noqa: E402
 from weftsim.reference import select_path  # noqa: E402
 from conftest import door
@@ -31,7 +31,7 @@ def _scene(mu=0.0, degrees=60.0, **solver):
 
 
 def pack_penetration(scene, t, y):
-    from weftsim.kernel.chain_f import penetration_at
+    from weftsim.physics.chain_f import penetration_at
 
     return penetration_at(pack_parameters(scene), t, y, 0)[0]
 

@@ -35,7 +35,7 @@ def test_mypy_finds_no_error_in_weftsim():
 def test_the_modules_mypy_skips_only_get_fewer():
     ignored = _ignored()
     assert len(ignored) <= RATCHET, f"{len(ignored)} modules skipped by mypy, at most {RATCHET}"
-    for core in ("weftsim.api", "weftsim.engines", "weftsim.errors", "weftsim.model", "weftsim.run.guards"):
+    for core in ("weftsim.api", "weftsim.engines", "weftsim.errors", "weftsim.model", "weftsim.checks.guards"):
         assert core not in ignored
 
 

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from weftsim import reference
-from weftsim.kernel.wear import deposit
+from weftsim.physics.wear import deposit
 from weftsim.input.params import LOOM_JOINT_E, WearModel
 from weftsim.model.dynamics import pack_parameters
 from weftsim.input.scene import load_scene

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 from weftsim import exudyn_engine, reference
-from weftsim.kernel import chain as kc
-from weftsim.kernel.wear import worn_clearance
+from weftsim.physics import chain as kc
+from weftsim.physics.wear import worn_clearance
 from weftsim.model.dynamics import initial_state, pack_parameters
 from weftsim.input.scene import load_scene
 from weftsim.wear import WearError, check_request

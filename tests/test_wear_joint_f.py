@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from weftsim import reference
-from weftsim.kernel import chain_f as kf
+from weftsim.physics import chain_f as kf
 from weftsim.model.dynamics import pack_parameters
 from weftsim.input.scene import SceneError, load_scene
 from weftsim.wear import predict_to_directory
@@ -100,7 +100,7 @@ def test_a_worn_e_beside_a_clearance_at_f_reads_its_own_tables():
     journal, h_j, _ = _lobe(5e-6, 2.5)
     worn = dc.replace(scene, joint=dc.replace(scene.joint, bearing_wear=tuple(bearing), journal_wear=tuple(journal)))
     round_prm, worn_prm = pack_parameters(scene), pack_parameters(worn)
-    from weftsim.kernel.chain import rocker_angle
+    from weftsim.physics.chain import rocker_angle
 
     for t, y in zip(*_states(scene, 20)):
         e_y, e_z = kf.eccentricities(round_prm, t, y)[:2]

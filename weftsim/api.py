@@ -158,7 +158,7 @@ def plausibility_checks(scene: Scene | str | os.PathLike) -> list[dict]:
     "info"), further ``numbers`` and the warning ``message``.  A run adds the after-run checks in
     ``result.plausibility["checks"]``.
     """
-    from weftsim.run.design_checks import before_run
+    from weftsim.checks.design_checks import before_run
 
     return [check.as_dict() for check in before_run(_as_scene(scene))]
 

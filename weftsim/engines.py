@@ -41,7 +41,7 @@ from typing import TYPE_CHECKING, Any, Callable, Protocol, runtime_checkable
 
 from weftsim.errors import ArgumentError, EngineError, PlausibilityWarning, RunFailed, SceneError, closest
 from weftsim.input.params import Scene
-from weftsim.run.contract import Estimate
+from weftsim.checks.contract import Estimate
 
 if TYPE_CHECKING:
     from weftsim.post.results import RunResult
@@ -200,7 +200,7 @@ def simulate(scene: Scene | str | os.PathLike, engine: str = "auto", *,
     """Simulate one scene with one engine: the one door every caller runs an engine through.
 
     The before-run design checks, the engine's pure solve (:func:`get`), then the vetting of the result
-    (:func:`weftsim.run.guards.vet_result`), once, outside the engines.  ``weftsim.simulate`` is this function.
+    (:func:`weftsim.checks.guards.vet_result`), once, outside the engines.  ``weftsim.simulate`` is this function.
 
     Parameters
     ----------
@@ -251,8 +251,8 @@ def simulate(scene: Scene | str | os.PathLike, engine: str = "auto", *,
     >>> result.status, result.path["method"]
     ('success', 'closed form')
     """
-    from weftsim.run.design_checks import before_run, warnings_of
-    from weftsim.run.guards import vet_result
+    from weftsim.checks.design_checks import before_run, warnings_of
+    from weftsim.checks.guards import vet_result
 
     chosen = get(engine)
     if progress is not None and not callable(progress):

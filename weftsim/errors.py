@@ -122,4 +122,4 @@ def require(module: str, extra: str, purpose: str) -> Any:
 
 
 class PlausibilityWarning(UserWarning):
-    """A scene value outside what a real loom is built for (weftsim.run.design_checks); the run goes on."""
+    """A scene value outside what a real loom is built for (weftsim.checks.design_checks); the run goes on."""

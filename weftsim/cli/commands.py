@@ -190,7 +190,7 @@ def _announce_run_time(scene, engines: tuple[str, ...], command: str) -> None:
     ``weftsim run`` one with the estimated size of the per-step record above LARGE_FILE_BYTES."""
     from weftsim.engines import get as engine_named
     from weftsim.post.output import _size
-    from weftsim.run.progress import LARGE_FILE_BYTES, LONG_RUN_S, SHOW_ESTIMATE_S, format_duration
+    from weftsim.checks.progress import LARGE_FILE_BYTES, LONG_RUN_S, SHOW_ESTIMATE_S, format_duration
 
     costs = [engine_named(engine).estimate(scene) for engine in engines]
     estimate = sum(cost.run_time_s for cost in costs)
@@ -219,11 +219,11 @@ STOP_SIGNALS = {signal.SIGINT: "Ctrl-C, SIGINT", signal.SIGTERM: "SIGTERM"}
 @contextlib.contextmanager
 def _stop_on_interrupt(command: str):
     """While the block runs, SIGINT (Ctrl-C) or SIGTERM asks the running engine to stop at its next
-    step and keep what it computed (weftsim.run.guards.request_stop); a second signal abandons at once.
+    step and keep what it computed (weftsim.checks.guards.request_stop); a second signal abandons at once.
 
     Yields a dict whose ``"signal"`` is the signal number once one came (else None).
     """
-    from weftsim.run.guards import clear_stop, request_stop
+    from weftsim.checks.guards import clear_stop, request_stop
 
     state = {"signal": None}
     previous = {signum: signal.getsignal(signum) for signum in STOP_SIGNALS}
@@ -308,7 +308,7 @@ def cmd_kinematics(args: argparse.Namespace) -> int:
 def _solve(scene, engine: str, label: str | None = None, announce: bool = False):
     """:func:`weftsim.api.simulate` with progress on stderr; ``announce``: first the path it takes."""
     from weftsim.api import resolve_engine, select_path, simulate
-    from weftsim.run.progress import Progress
+    from weftsim.checks.progress import Progress
 
     engine = resolve_engine(engine)
     if announce:  # `run`: its first line is the model and method it takes, and why
@@ -326,8 +326,8 @@ def _quiet(text: str) -> None:
 
 
 def _announce_checks(scene, command: str) -> None:
-    """One ``warning:`` line on stderr per before-run plausibility check that fails (weftsim.run.design_checks)."""
-    from weftsim.run.design_checks import before_run_lines
+    """One ``warning:`` line on stderr per before-run plausibility check that fails (weftsim.checks.design_checks)."""
+    from weftsim.checks.design_checks import before_run_lines
 
     for line in before_run_lines(scene):
         print(f"weftsim {command}: {line}", file=sys.stderr, flush=True)
@@ -351,7 +351,7 @@ def _report_run(result, written) -> None:
 
 
 def _interrupted_line(result, outdir: Path, signum: int) -> str:
-    from weftsim.run.guards import where
+    from weftsim.checks.guards import where
 
     t = float(result.steps["time_s"][-1]) if result.steps["time_s"].size else 0.0
     return (f"stopped by {STOP_SIGNALS[signal.Signals(signum)]} at {where(t, result.scene.drive.speed)}: the results up to "
@@ -361,7 +361,7 @@ def _interrupted_line(result, outdir: Path, signum: int) -> str:
 def cmd_run(args: argparse.Namespace) -> int:
     from weftsim.api import resolve_engine
     from weftsim.post.output import prepare_directory, write_run
-    from weftsim.run.design_checks import report_lines
+    from weftsim.checks.design_checks import report_lines
 
     scene = scene_from_args(args)
     engine = resolve_engine(args.engine)

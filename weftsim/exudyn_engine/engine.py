@@ -12,8 +12,8 @@ from typing import TYPE_CHECKING
 from weftsim.exudyn_engine.selection import adaptive, select_model, select_path, step_plan, tree_solver
 from weftsim.exudyn_engine.solver import solve
 from weftsim.model.stiffness import stiff_joints
-from weftsim.run.contract import BoundEngine, Estimate
-from weftsim.run.progress import NPZ_BYTES_PER_ROW, STEP_ROWS_PER_REVOLUTION
+from weftsim.checks.contract import BoundEngine, Estimate
+from weftsim.checks.progress import NPZ_BYTES_PER_ROW, STEP_ROWS_PER_REVOLUTION
 
 if TYPE_CHECKING:
     from weftsim.input.params import Scene

@@ -15,7 +15,7 @@ O(h^2)::
 The same formula runs inside the force callback (trial states of the onset step, so
 the force is a smooth function of the unknowns and Newton sees it) and in the
 accepted-step bookkeeping (:class:`OnsetTracker`, which then holds the value until
-separation); both take it from :mod:`weftsim.kernel.hold`, the rules' one definition.
+separation); both take it from :mod:`weftsim.physics.hold`, the rules' one definition.
 
 Held impact velocity rules (``ClearanceJoint.impact_velocity_rule``):
 
@@ -41,7 +41,7 @@ import math
 
 import numpy as np
 
-from weftsim.kernel.hold import (  # noqa: F401 - the rules' one definition, re-exported here
+from weftsim.physics.hold import (  # noqa: F401 - the rules' one definition, re-exported here
     RESTING_RATE_FRACTION,
     callback_impact_velocity,
     damping_rate,

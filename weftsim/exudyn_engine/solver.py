@@ -34,7 +34,7 @@ from weftsim.exudyn_engine.selection import (  # noqa: F401 (IDEAL_JOINT_STEP_AN
 )
 from weftsim.exudyn_engine.step_control import StepController, failure_reason
 from weftsim.exudyn_engine.sensors import add_sensors, first_nonfinite_row, sample_channels, silence, step_channels
-from weftsim.run.guards import RunGuard, failure_message, non_finite_breach
+from weftsim.checks.guards import RunGuard, failure_message, non_finite_breach
 from weftsim.input.params import Scene
 from weftsim.input.scene import IMPACT_VELOCITY_RULES, STEP_CONTROLS
 from weftsim.post.results import RunResult, angle_grid, empty_channels
@@ -154,7 +154,7 @@ def solve(scene: Scene, progress: Callable[[float], None] | None = None, callbac
     """Simulate a scene with Exudyn: the engine's pure solve (the engine contract, :mod:`weftsim.engines`).
 
     The result is not vetted here: :func:`weftsim.simulate` runs the before-run checks, this solve, then
-    :func:`weftsim.run.guards.vet_result` once, for every engine.
+    :func:`weftsim.checks.guards.vet_result` once, for every engine.
 
     Parameters
     ----------
@@ -298,7 +298,7 @@ def _solve_model(scene: Scene, model: str, progress, callback: str | None, wall0
         events.update({f"first_contact_time_{name}_s": first.get(name) for name in ("e", "f")})
     if progress is not None:
         progress(1.0)
-    # vetted once, outside the engines, by weftsim.api.simulate (weftsim.run.guards.vet_result)
+    # vetted once, outside the engines, by weftsim.api.simulate (weftsim.checks.guards.vet_result)
     return RunResult(scene, "exudyn", status, message, samples, steps, stats, events)
 
 

@@ -16,7 +16,7 @@ two revolute joints about Exudyn Z (the four-bar plane is Exudyn's XY plane, as 
 (psi = theta_EF of :mod:`weftsim.model.dynamics`: P_j = F - L_EF u(psi)).  The bearing
 centre P_b(t) = E of the prescribed rocker is not a body.  The contact enters as the tree's
 generalized force (``forceUserFunction``, :func:`weftsim.exudyn_engine.callbacks.make_tree_force`
-over the kernel's :func:`weftsim.kernel.chain.tree_joint_force`): the callback computes the
+over the kernel's :func:`weftsim.physics.chain.tree_joint_force`): the callback computes the
 journal centre and its velocity from the joint coordinates, subtracts P_b(t) and its velocity
 (closed form),
 
@@ -95,7 +95,7 @@ def build_tree(mbs: exu.MainSystem, scene: Scene, callback: str = "auto") -> Tre
 
     Initial state: the ideal mechanism at theta = 0, journal centred
     (:func:`weftsim.model.dynamics.initial_state`).  ``callback``: "auto" (:func:`weftsim.exudyn_engine.callbacks.resolve_route`),
-    "python" or "numba"; both evaluate :func:`weftsim.kernel.chain.tree_joint_force`.  Needs ``scene.joint.clearance > 0``;
+    "python" or "numba"; both evaluate :func:`weftsim.physics.chain.tree_joint_force`.  Needs ``scene.joint.clearance > 0``;
     friction (``joint.friction_coefficient`` > 0) acts at the contact point with its moments on rod and rocker.
     """
     g, m, joint = scene.geometry, scene.inertia, scene.joint

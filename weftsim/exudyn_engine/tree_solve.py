@@ -22,8 +22,8 @@ Channels, at every accepted step (docs/physics.md section 4 signs):
                      integral (F_N - F_el) delta_dot - F_T v_T dt (damping and friction work,
                      :func:`contact_work` over accepted steps)
 
-Failures as in :mod:`.solver`: the run guards of :mod:`weftsim.run.guards` after every step,
-Exudyn exceptions, non-finite values, a premature stop; :func:`weftsim.run.guards.vet_result`.
+Failures as in :mod:`.solver`: the run guards of :mod:`weftsim.checks.guards` after every step,
+Exudyn exceptions, non-finite values, a premature stop; :func:`weftsim.checks.guards.vet_result`.
 """
 
 from __future__ import annotations
@@ -53,7 +53,7 @@ from weftsim.exudyn_engine.selection import (  # noqa: F401 (re-exported: the tr
 )
 from weftsim.exudyn_engine.tree_implicit import ImplicitTree
 from weftsim.exudyn_engine.step_control import failure_reason as implicit_failure
-from weftsim.run.guards import RunGuard, failure_message, non_finite_breach
+from weftsim.checks.guards import RunGuard, failure_message, non_finite_breach
 from weftsim.input.params import Scene
 from weftsim.model.dynamics import NUMPY, ChainConstants, chain_energy, eccentricity, initial_state
 from weftsim.model.ideal import crank_side_inertia, crank_side_potential
@@ -145,8 +145,8 @@ def contact_work(y: np.ndarray, t: np.ndarray, delta: np.ndarray) -> np.ndarray:
 def worn_channels(scene: Scene, t: np.ndarray, a: np.ndarray, psi: np.ndarray, da: np.ndarray,
                   dpsi: np.ndarray) -> tuple[np.ndarray, ...]:
     """(delta, delta_dot, F_el, U_el) of a worn joint E at the tree's steps: at the local clearance
-    c0 + h_b + h_j along e (:func:`weftsim.kernel.worn_rows.worn_contact_rows`), delta_dot = e_dot . n - dc/dt."""
-    from weftsim.kernel.worn_rows import worn_contact_rows
+    c0 + h_b + h_j along e (:func:`weftsim.physics.worn_rows.worn_contact_rows`), delta_dot = e_dot . n - dc/dt."""
+    from weftsim.physics.worn_rows import worn_contact_rows
     from weftsim.model.dynamics import pack_parameters
 
     states = np.ascontiguousarray(np.column_stack([a, psi, da, dpsi]), dtype=float)
@@ -216,7 +216,7 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
     energy = np.zeros(n)
     f_el[inside] = law.elastic_force(delta[inside])
     energy[inside] = law.elastic_energy(delta[inside])
-    if scene.joint.is_worn:  # the local clearance the callback saw (weftsim.kernel.worn_rows), as the reference's
+    if scene.joint.is_worn:  # the local clearance the callback saw (weftsim.physics.worn_rows), as the reference's
         delta, rate, f_el, energy = worn_channels(scene, t, a, psi, da, dpsi)
     # A lubricated joint: the film and boundary friction dissipate at every step (the quadratic rule of
     # contact_work over all steps: the squeeze film's power peaks within a few steps, where trapezoids
@@ -383,6 +383,6 @@ def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, ca
     stats["time_per_step_us"] = 1e6 * wall_solve / max(n_done, 1)
     if progress is not None:
         progress(1.0)
-    # vetted once, outside the engines, by weftsim.api.simulate (weftsim.run.guards.vet_result)
+    # vetted once, outside the engines, by weftsim.api.simulate (weftsim.checks.guards.vet_result)
     return RunResult(scene, "exudyn", status, message, samples, steps, stats,
                      {"first_contact_time_s": model.tracker.first_contact_time, **model.tracker.counters()})

@@ -2,8 +2,8 @@
 
 The worn geometry reaches the tree's contact through the scene (``joint.bearing_wear``,
 ``joint.journal_wear``): :func:`weftsim.model.dynamics.pack_parameters` appends the wear block,
-and :func:`weftsim.kernel.chain.tree_joint_force` reads the local clearance c0 + h_b + h_j along e
-from it (:func:`weftsim.kernel.chain.clearance_along`), as the reference engine's chain does.
+and :func:`weftsim.physics.chain.tree_joint_force` reads the local clearance c0 + h_b + h_j along e
+from it (:func:`weftsim.physics.chain.clearance_along`), as the reference engine's chain does.
 
 :data:`ATTEMPTS`: a run that fails (a hard cycle) is tried again at a tighter relative tolerance, then
 on the implicit tree (generalized-alpha with error control), as the reference engine's update is

@@ -1,7 +1,7 @@
 """Planar revolute clearance joint: geometry, normal and friction force (docs/physics.md section 2).
 
 Array forms of the joint's force for analysis and tests (Flores-Ambrosio formulation; the
-one scalar definition is :mod:`weftsim.kernel.joint`, which the engines call)::
+one scalar definition is :mod:`weftsim.physics.joint`, which the engines call)::
 
              bearing (R_b), centre P_b
           .-----------.
@@ -41,10 +41,10 @@ from typing import TYPE_CHECKING, Callable, NamedTuple
 import numpy as np
 
 from weftsim.joint.contact import check_impact_velocity
-from weftsim.kernel import hold
-from weftsim.kernel import joint as kernel_joint
-from weftsim.kernel.joint import joint_parameters
-from weftsim.kernel.python import python_form
+from weftsim.physics import hold
+from weftsim.physics import joint as kernel_joint
+from weftsim.physics.joint import joint_parameters
+from weftsim.physics.python import python_form
 from weftsim.input.params import ClearanceJoint
 
 if TYPE_CHECKING:
@@ -143,7 +143,7 @@ def effective_impact_velocity(held: ArrayLike, penetration_rate: ArrayLike,
 
     ``held``: the engine's held value (onset rate floored at v_min, raised at its updates);
     under ``"max_approach"`` the current approach rate raises it further, under ``"onset"`` not
-    (:func:`weftsim.kernel.hold.effective_impact_velocity`).
+    (:func:`weftsim.physics.hold.effective_impact_velocity`).
     """
     rule = joint.impact_velocity_rule == "max_approach"
     return _EFFECTIVE_IMPACT_VELOCITY(held, penetration_rate, rule)[()]
@@ -153,7 +153,7 @@ def clearance_contact(ecc: ArrayLike, ecc_rate: ArrayLike, rel_tangential_veloci
                       impact_velocity: ArrayLike, law: _Law, joint: ClearanceJoint) -> ClearanceContact:
     """Normal and friction force of the clearance joint, with moments (arrays, broadcast).
 
-    :func:`weftsim.kernel.joint.clearance_force` at every element.
+    :func:`weftsim.physics.joint.clearance_force` at every element.
 
     Parameters
     ----------
@@ -209,7 +209,7 @@ def make_clearance_kernel(law: _Law, joint: ClearanceJoint, jit: bool = False) -
 
     Returns ``kernel(ex, ey, ex_dot, ey_dot, v_t, v_imp) -> (fx, fy, F_N, delta, delta_dot,
     M_j, M_b)``: force on the journal (N), normal force, penetration (m) and its rate (m/s),
-    friction moments about P_j and P_b (N m), from :func:`weftsim.kernel.joint.clearance_force`
+    friction moments about P_j and P_b (N m), from :func:`weftsim.physics.joint.clearance_force`
     (plain Python, or compiled with ``jit=True``), with the joint's impact-velocity rule applied
     to the held v_imp.  No argument checks: v_imp must be > 0 in contact.
     """

@@ -341,7 +341,7 @@ def run_compare(scene: Scene, outdir: str | Path, solve: Callable[[Scene, str], 
     Returns the report (:func:`compare_results`), the exit status and the line saying why it is
     not 0 (:func:`verdict`); the caller prints them.
     """
-    from weftsim.run.design_checks import report_lines
+    from weftsim.checks.design_checks import report_lines
     from weftsim.post.output import prepare_directory, write_files, write_json, write_run
 
     outdir = prepare_directory(outdir, force, scene)

@@ -176,9 +176,9 @@ class RunResult:
         E.g. ``first_contact_time_s`` (true onset, located within the step) or None.
     plausibility : dict
         Counts of a broken contact history and the law-range warnings
-        (:meth:`weftsim.run.plausibility.Plausibility.as_dict`; not for the ideal mechanism), the design
-        checks before and after the run (``checks``, :mod:`weftsim.run.design_checks`) and every after-run
-        ``warnings``, filled by :func:`weftsim.run.guards.vet_result`; empty for a result no engine vetted.
+        (:meth:`weftsim.checks.plausibility.Plausibility.as_dict`; not for the ideal mechanism), the design
+        checks before and after the run (``checks``, :mod:`weftsim.checks.design_checks`) and every after-run
+        ``warnings``, filled by :func:`weftsim.checks.guards.vet_result`; empty for a result no engine vetted.
     path : dict
         The model and method that ran and why (``{"model": ..., "method": ..., "reason": ...}``):
         what the engine's automatic selection chose for this scene, or what the scene forced.

@@ -13,7 +13,7 @@ The cross-check engine that plays ADAMS's role for the Exudyn model.  Public ent
   in segments between contact events (:mod:`.integrate`).
 - Clearance at F (``scene.joint_f``): alone, again 2 DOF (the rod turns about E of the rocker, the
   sector is driven through the contact at F); with E, the rod is free (4 DOF)
-  (:mod:`weftsim.kernel.chain_f`).  These run on the compiled path only.
+  (:mod:`weftsim.physics.chain_f`).  These run on the compiled path only.
 
 The derivation is in docs/reference-solver.md.
 """
@@ -180,7 +180,7 @@ def solve(scene: Scene, progress: Callable[[float], None] | None = None,
     """Run the reference solver on a scene: the engine's pure solve (the engine contract, :mod:`weftsim.engines`).
 
     The result is not vetted here: :func:`weftsim.simulate` runs the before-run checks, this solve, then
-    :func:`weftsim.run.guards.vet_result` once, for every engine.
+    :func:`weftsim.checks.guards.vet_result` once, for every engine.
 
     Parameters
     ----------
@@ -215,4 +215,4 @@ def solve(scene: Scene, progress: Callable[[float], None] | None = None,
     else:
         result = _solve_clearance(scene, progress, observe)
     object.__setattr__(result, "path", select_path(scene))
-    return result  # vetted once, outside the engines, by weftsim.api.simulate (weftsim.run.guards.vet_result)
+    return result  # vetted once, outside the engines, by weftsim.api.simulate (weftsim.checks.guards.vet_result)

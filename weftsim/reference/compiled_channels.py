@@ -4,7 +4,7 @@ The channels come from the equations that were integrated (see
 :func:`weftsim.reference.channels.clearance_channels` for the energy bookkeeping), at ~0.1 us per row:
 
 - the chain terms (a'', F_N, delta, e, Q3) from the compiled right-hand side
-  (:mod:`weftsim.kernel.chain`), the elastic energy from :func:`weftsim.kernel.laws.elastic_energy`;
+  (:mod:`weftsim.physics.chain`), the elastic energy from :func:`weftsim.physics.laws.elastic_energy`;
 - the crank-side terms J13, J13', U13, U13' of :mod:`weftsim.model.ideal`, which depend on
   theta only and are periodic and analytic: they are sampled from those functions once per
   mechanism (:data:`TABLE_POINTS` per revolution) and read back through a periodic cubic
@@ -22,11 +22,11 @@ import numpy as np
 from numba import njit
 
 from weftsim.input.params import Geometry, Inertia, Scene
-from weftsim.kernel.chain import (
+from weftsim.physics.chain import (
     COEF, COUPLING, GRAVITY, KIND, L_EF, L_FG, M11, M22, OMEGA, ROD_MASS, chain, local_clearance, penetration,
 )  # fmt: skip
-from weftsim.kernel import chain_f as kf
-from weftsim.kernel.laws import elastic_energy
+from weftsim.physics import chain_f as kf
+from weftsim.physics.laws import elastic_energy
 from weftsim.model.dynamics import initial_state, pack_parameters
 from weftsim.post.results import CHANNELS, JOINT_F_CHANNELS
 
@@ -209,7 +209,7 @@ def compiled_channels(scene: Scene, time: np.ndarray, states: np.ndarray, contac
         channels = dict(zip(names, np.ascontiguousarray(out.T)))
     if scene.joint.is_lubricated or scene.joint_f.is_lubricated:
         # The film and asperity channels; the asperities' potential joins the contact energy (the chain
-        # books only the film's and the boundary friction's work as dissipated, weftsim.kernel.lubricated).
+        # books only the film's and the boundary friction's work as dissipated, weftsim.physics.lubricated).
         from weftsim.joint.lubrication import lubrication_table
 
         lubricated, asperity_energy = lubrication_table(scene, prm, time, states)

@@ -1,5 +1,5 @@
 """Driver of the compiled reference path: runs :func:`weftsim.reference.compiled.advance` in
-chunks (progress, wall-time budget, buffers), applies the run guards of :mod:`weftsim.run.guards`
+chunks (progress, wall-time budget, buffers), applies the run guards of :mod:`weftsim.checks.guards`
 and builds the :class:`~weftsim.post.results.RunResult` with the compiled channels.
 
 Entry: :func:`solve_compiled` (``reference_solver.method`` = ``"numba_DOP853"``, ``"numba_RK45"``,
@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.run.guards import RunGuard, failure_message, non_finite_breach
+from weftsim.checks.guards import RunGuard, failure_message, non_finite_breach
 from weftsim.input.params import Scene
 from weftsim.reference.compiled import (
     DECOMPOSITIONS, DENSE, DONE, EVENTS, IMPLICIT_STEPS, JACOBIANS, FIRST_CONTACT, FIRST_CONTACT_F, GUARD, IMPACTS, LAST_PENETRATION, LAST_PENETRATION_F,
@@ -22,7 +22,7 @@ from weftsim.reference.compiled import (
     PEAKS, REJECTED, SEGMENTS, START, STEP_TOO_SMALL, STEPS, T, _STEP_BUFFER,
     advance,
 )  # fmt: skip
-from weftsim.kernel.chain_f import N_JOINTS
+from weftsim.physics.chain_f import N_JOINTS
 from weftsim.model.dynamics import initial_state, pack_parameters
 from weftsim.reference.integrate import _PROGRESS_EVERY
 from weftsim.post.results import RunResult

@@ -12,8 +12,8 @@ from typing import TYPE_CHECKING
 
 from weftsim.model.stiffness import stiff_joints
 from weftsim.reference import compiled_method, effective_rtol, select_path, solve
-from weftsim.run.contract import BoundEngine, Estimate
-from weftsim.run.progress import NPZ_BYTES_PER_ROW, STEP_ROWS_PER_REVOLUTION
+from weftsim.checks.contract import BoundEngine, Estimate
+from weftsim.checks.progress import NPZ_BYTES_PER_ROW, STEP_ROWS_PER_REVOLUTION
 
 if TYPE_CHECKING:
     from weftsim.input.params import Scene
@@ -34,7 +34,7 @@ REFERENCE_RTOL = {"reference scipy": 1e-9, "reference numba": 1e-5, "reference n
 # numba_DOP853 (issue 23).  Applied to a path that integrates such a joint explicitly.
 EXPLICIT_STIFF_FACTOR = 1500.0
 # Recorded step rows per revolution of the implicit path with friction, ~13 000 (3 200 steps); the dry
-# default's is weftsim.run.progress.STEP_ROWS_PER_REVOLUTION.
+# default's is weftsim.checks.progress.STEP_ROWS_PER_REVOLUTION.
 IMPLICIT_STEP_ROWS_PER_REVOLUTION = 1.3e4
 
 

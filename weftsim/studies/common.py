@@ -128,7 +128,7 @@ def solve(scene: Scene, engine: str = "reference", label: str | None = None, pro
     """Run one engine on a scene (progress on stderr for long runs); a failed run raises SimulationFailed."""
     from weftsim.engines import simulate
     from weftsim.engines import names
-    from weftsim.run.progress import Progress
+    from weftsim.checks.progress import Progress
 
     if engine not in names():
         raise StudyError(f"engine must be one of {', '.join(names())}, got {engine!r}")

@@ -4,7 +4,7 @@ Public entry::
 
     predict_to_directory(scene, hours, outdir, ...) -> dict   (the summary written to wear.json)
 
-- :mod:`weftsim.kernel.wear`: the worn clearance c(psi) the contact sees, Archard's deposit on the
+- :mod:`weftsim.physics.wear`: the worn clearance c(psi) the contact sees, Archard's deposit on the
   contact arc (compiled; the reference engine's right-hand side reads the worn geometry);
 - :mod:`.archard`: the wear of one run from its step rows;
 - :mod:`.extrapolate`: the cycle extrapolation with the adaptive update interval;
@@ -13,7 +13,7 @@ Public entry::
 
 Every loose joint wears, each with its own ``[joint_e.wear]`` / ``[joint_f.wear]`` numbers: E, F, or E
 and F together (one run simulates both; :func:`~.updates.wearing_joints`).  A worn F's tables
-follow E's in the kernel parameter array (:mod:`weftsim.kernel.chain_f`), its profiles are
+follow E's in the kernel parameter array (:mod:`weftsim.physics.chain_f`), its profiles are
 :attr:`~.updates.Update.second` (or the first when E is ideal), and every output names the joint
 (``effective_clearance_f_mm``, ``wear_profile_f.png``).  A ``--limit-clearance-mm`` applies to every
 wearing joint: ``hours_to_limit`` is the first joint's to reach it (``limit_joint``), each joint's is

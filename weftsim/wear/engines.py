@@ -78,7 +78,7 @@ def exudyn_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray) -> tup
     """:func:`engine_update` on the Exudyn engine (module docstring); raises
     :class:`~weftsim.wear.extrapolate.UpdateFailed` when every attempt of the run fails."""
     from weftsim.exudyn_engine.worn import ATTEMPTS
-    from weftsim.run.guards import stop_requested
+    from weftsim.checks.guards import stop_requested
     from weftsim.model.dynamics import pack_parameters
     from weftsim.wear.archard import rows_from_contact, wear_from_rows
     from weftsim.wear.extrapolate import UpdateFailed, WearInterrupted, wear_response, worn_scene

@@ -221,7 +221,7 @@ def simulate_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray,
     from weftsim.engines import simulate
     from weftsim.model.dynamics import pack_parameters
 
-    from weftsim.run.guards import stop_requested
+    from weftsim.checks.guards import stop_requested
 
     joints = wearing_joints(scene)
     w = joint_of(scene, joints[0]).wear  # the run's revolutions: the first wearing joint's table
@@ -321,7 +321,7 @@ def predict(scene: Scene, hours: float, updates: Sequence[Update] = (),
     ``on_update(updates)``: called after each update (storing, progress); ``stop()``: True asks to
     end after the current update.  The last update simulates the final geometry, with N = 0; or,
     when the prediction ends at a geometric limit (:func:`ended_by_limit`), extrapolates up to it.
-    A stop asked for while an update is simulated (:func:`weftsim.run.guards.request_stop`) drops it.
+    A stop asked for while an update is simulated (:func:`weftsim.checks.guards.request_stop`) drops it.
     Every loose joint wears (:func:`wearing_joints`).
     """
     if not (0.0 < hours <= MAX_HOURS):
