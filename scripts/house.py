@@ -22,7 +22,8 @@ The figures (issue 32), all read from the source with :mod:`ast` except the walk
   the figures say how the code is laid out, not how many steps a run takes); import-time module code is
   left out.  *files*: distinct files the walk enters; *stays*: maximal runs of consecutive walk entries in
   one file; *climbs*: distinct (caller, callee) function pairs of those first calls where the caller's file
-  sits on a lower floor than the callee's.
+  sits on a lower floor than the callee's; *other engine*: functions of the other engine's package the walk
+  calls (the Exudyn engine's walk entering ``weftsim/reference/`` means it depends on the reference engine).
 
 The floors, from the bottom (a module may import its own floor and the floors below it):
 
@@ -230,8 +231,10 @@ def walk(scene_name: str, engine: str) -> dict:
     stays = sum(1 for i, f in enumerate(files) if i == 0 or files[i - 1] != f)
     climbs = sorted((module_of(a.co_filename), a.co_name, module_of(b.co_filename), b.co_name) for a, b in pairs
                     if floor(module_of(a.co_filename)) < floor(module_of(b.co_filename)))
+    other = str(PACKAGE / ("reference" if engine == "exudyn" else "exudyn_engine"))
     return {"scene": scene_name, "engine": engine, "functions": len(first), "files": len(set(files)),
-            "stays": stays, "climbs": len(climbs), "climb_list": climbs}
+            "stays": stays, "climbs": len(climbs), "climb_list": climbs,
+            "other_engine": sum(1 for f in files if f.startswith(other + "/"))}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -257,7 +260,7 @@ def main(argv: list[str] | None = None) -> int:
         for engine in ("reference", "exudyn"):
             w = walk(args.scene, engine)
             print(f"walk of {w['scene']} into {engine}: {w['functions']} functions, {w['files']} files, "
-                  f"{w['stays']} stays, {w['climbs']} climbs")
+                  f"{w['stays']} stays, {w['climbs']} climbs, {w['other_engine']} functions of the other engine")
             if args.list:
                 for a, fa, b, fb in w["climb_list"]:
                     print(f"  climb: {a}.{fa} -> {b}.{fb}")

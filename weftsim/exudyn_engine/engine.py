@@ -7,12 +7,13 @@ not included): within ~3x on other scenes, enough to tell seconds from hours.
 
 from __future__ import annotations
 
+from types import SimpleNamespace
 from typing import TYPE_CHECKING
 
 from weftsim.exudyn_engine.selection import adaptive, select_model, select_path, step_plan, tree_solver
 from weftsim.exudyn_engine.solver import solve
 from weftsim.model.stiffness import stiff_joints
-from weftsim.checks.contract import BoundEngine, Estimate
+from weftsim.checks.contract import Estimate
 from weftsim.checks.progress import NPZ_BYTES_PER_ROW, STEP_ROWS_PER_REVOLUTION
 
 if TYPE_CHECKING:
@@ -61,4 +62,6 @@ def estimate(scene: Scene) -> Estimate:
     return Estimate(seconds, rows * NPZ_BYTES_PER_ROW, bool(stiff_joints(scene)) and tree_explicit(scene))
 
 
-ENGINE = BoundEngine("exudyn", select_path, estimate, solve)
+# The engine's object in the registry: its three functions under the contract's names (weftsim.engines.simulate
+# calls them directly).
+ENGINE = SimpleNamespace(name="exudyn", select_path=select_path, estimate=estimate, solve=solve)
