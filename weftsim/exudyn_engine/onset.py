@@ -145,6 +145,11 @@ def penetration_state(ex: float, ey: float, vx: float, vy: float, clearance: flo
     """delta = |e| - c and delta_dot = e_dot . e/|e| of an in-plane eccentricity (m, m/s).
 
     delta_dot is 0 when the journal is exactly centred (e = 0: no normal defined).
+
+    The kernel's :func:`weftsim.physics.joint.contact_geometry` is the same geometry as e_dot . (e / |e|);
+    this form, (e_dot . e) / |e|, rounds differently in the last bits, and the tracker's onsets and held
+    impact velocities follow it, so moving to the kernel's form changes the Exudyn engine's results at
+    round-off: left for a change that documents that (issue 32 kept every result bit for bit).
     """
     length = math.sqrt(ex * ex + ey * ey)
     if length <= 0.0:

@@ -106,6 +106,33 @@ def tangential_velocity(ex: float, ey: float, ex_dot: float, ey_dot: float, leng
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def contact_geometry(ex: float, ey: float, ex_dot: float, ey_dot: float, clearance: float) -> tuple[float, ...]:
+    """Penetration delta = |e| - c (m), its rate delta_dot = e_dot . n (m/s) and the normal n = e / |e| of an
+    eccentricity e = P_j - P_b and its rate (docs/physics.md section 2); at e = 0 (centred: no normal)
+    delta = -c, delta_dot = 0, n = 0.  Returns (delta, delta_dot, n_x, n_y).
+
+    The clearance geometry, written once: :func:`clearance_force_at` evaluates it, and the array forms of
+    :mod:`weftsim.joint.clearance` are generated from it (:func:`weftsim.physics.python.python_form`).
+    """
+    length = math.sqrt(ex * ex + ey * ey)
+    if length <= 0.0:
+        return length - clearance, 0.0, 0.0, 0.0
+    nx = ex / length
+    ny = ey / length
+    return length - clearance, ex_dot * nx + ey_dot * ny, nx, ny
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def contact_tangential_velocity(ex: float, ey: float, ex_dot: float, ey_dot: float, omega_j: float, omega_b: float,
+                                r_b: float) -> float:
+    """:func:`tangential_velocity` of an eccentricity e, its rate and the rotations, 0 at e = 0 (no normal)."""
+    length = math.sqrt(ex * ex + ey * ey)
+    if length <= 0.0:
+        return 0.0
+    return tangential_velocity(ex, ey, ex_dot, ey_dot, length, omega_j, omega_b, r_b)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def clearance_force(prm: np.ndarray, ex: float, ey: float, ex_dot: float, ey_dot: float, v_t: float,
                     v_imp: float) -> tuple[float, ...]:
     """Force of the joint at eccentricity e and its rate, with held impact velocity v_imp.
@@ -133,12 +160,10 @@ def clearance_force_at(prm: np.ndarray, clearance: float, clearance_rate: float,
     P_j and P_b (N m).
     """
     length = math.sqrt(ex * ex + ey * ey)
-    delta = length - clearance
+    delta, rate, nx, ny = contact_geometry(ex, ey, ex_dot, ey_dot, clearance)
     if length <= 0.0:
         return 0.0, 0.0, 0.0, 0.0, delta, 0.0, 0.0, 0.0
-    nx = ex / length
-    ny = ey / length
-    delta_dot = ex_dot * nx + ey_dot * ny - clearance_rate
+    delta_dot = rate - clearance_rate
     v = effective_impact_velocity(v_imp, delta_dot, prm[TRACK_MAX] != 0.0)
     f_n = normal_force(prm[KIND], prm[COEF], clearance, prm[XI], delta, delta_dot, v)
     f_t = friction_force(prm, f_n, v_t)
