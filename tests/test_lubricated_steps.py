@@ -18,6 +18,7 @@ import weftsim
 from weftsim.post.analysis import peaks
 from weftsim.reference.compiled_ros import rate_tolerance_factor
 from weftsim.model.dynamics import pack_parameters
+from conftest import door
 
 FILM = {"joint_e.lubrication.viscosity_mpa_s": 80.0}  # the loom at c = 0.02 mm, 600 rpm: no contact
 TIGHT = {"solver.reference.rtol": 1e-8, "solver.reference.atol": 1e-11}

@@ -162,7 +162,8 @@ def _import(name: str, target: str) -> Engine:
         raise EngineError(f"engine {name}: cannot import {module} ({type(exc).__name__}: {exc})") from None
     found = getattr(imported, attribute, None)
     if found is None:
-        raise EngineError(f"engine {name}: module {module} has no attribute {attribute!r}")
+        raise EngineError(f"engine {name}: module {module} has no function {attribute!r} (nor an engine object of "
+                          "that name)")
     if all(callable(getattr(found, m, None)) for m in ("select_path", "estimate", "solve")):
         return found
     if callable(found):
