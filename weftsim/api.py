@@ -141,8 +141,10 @@ def select_path(scene: Scene, engine: str = "auto") -> dict[str, str]:
 
 
 def _as_scene(scene: Scene | str | os.PathLike) -> Scene:
-    if isinstance(scene, Scene):
-        return scene
+    if isinstance(scene, Scene):  # built or changed in Python: checked as a scene file would be
+        from weftsim.input.scene import check_values
+
+        return check_values(scene, "simulate: the scene")
     if isinstance(scene, (str, os.PathLike)):
         return load_scene(scene)
     raise SceneError(f"simulate: scene must be a Scene (weftsim.load_scene), a scene file or the name of a "

@@ -136,7 +136,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--force", action="store_true",
                    help="write into an output directory that holds files weftsim did not write")
 
-    p = sub.add_parser("wear", help="predict the wear of joint E over operating hours (docs/wear.md)")
+    p = sub.add_parser("wear", help=WEAR_HELP)
     _add_wear_flags(p)
 
     p = sub.add_parser("bench", help="work-precision benchmark of every engine setting (docs/performance.md)",
@@ -158,11 +158,17 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+# What `weftsim wear` does, in the command list of `weftsim --help` (tests/test_hostile_words.py checks it names
+# both joints and the ensemble, as the command does).
+WEAR_HELP = ("predict the wear of the clearance joints (E, F, or both) over operating hours, or with --uncertain "
+             "the hours to a clearance limit as a distribution (docs/wear.md)")
+
+
 def _add_wear_flags(p: argparse.ArgumentParser) -> None:
     from weftsim.wear.command import add_flags
 
     add_scene_flags(p, shorthands=("speed_rpm", "clearance_mm", "law"))  # revolutions: set per update in [joint_e.wear]
-    add_output_flags(p, "out/<scene name>/wear")
+    add_output_flags(p, "out/<scene name>/wear, wear-exudyn on --engine exudyn, wear-ensemble with --uncertain")
     add_flags(p, positive)
 
 
@@ -170,7 +176,8 @@ def cmd_wear(args: argparse.Namespace) -> int:
     from weftsim.wear.command import run
 
     scene = scene_from_args(args)
-    where = "wear" if args.engine == "reference" else f"wear-{args.engine}"  # engines' states apart
+    # engines' states apart, and an ensemble apart from a prediction (each would replace the other's results)
+    where = "wear-ensemble" if args.uncertain else "wear" if args.engine == "reference" else f"wear-{args.engine}"
     return run(args, scene, output_directory(args, scene, where), _stop_on_interrupt)
 
 
@@ -291,7 +298,7 @@ def cmd_kinematics(args: argparse.Namespace) -> int:
     check_output_fits(rows, len(KINEMATICS_COLUMNS), outdir,
                       f"output.sample_deg = {math.degrees(step):g} over one revolution",
                       fix="a coarser output.sample_deg (any value up to 0.5 deg)")
-    outdir = prepare_directory(outdir, args.force, scene)
+    outdir = prepare_directory(outdir, args.force, scene, kind="kinematics")
     theta = np.linspace(0.0, 2.0 * math.pi, rows)
     state = linkage_state(theta, scene.geometry, scene.inertia.rocker_com)
     w = scene.drive.speed
@@ -388,7 +395,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     engine = resolve_engine(args.engine)
     outdir = output_directory(args, scene, engine)
     _check_fits(scene, outdir)
-    outdir = prepare_directory(outdir, args.force, scene)
+    outdir = prepare_directory(outdir, args.force, scene, kind="run")
     _announce_run_time(scene, (engine,), "run")
     _announce_checks(scene, "run")
     with _stop_on_interrupt("run") as stop:
@@ -482,7 +489,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
     scene = scene_from_args(args)
     outdir = output_directory(args, scene, "compare")
     _check_fits(scene, outdir, runs=2)
-    prepare_directory(outdir, args.force, scene)  # refused before the estimate is shown
+    prepare_directory(outdir, args.force, scene, kind="compare")  # refused before the estimate is shown
     with _stdout_to_stderr() if args.json else contextlib.nullcontext():  # the estimate imports Exudyn
         _announce_run_time(scene, ("reference", "exudyn"), "compare")
         _announce_checks(scene, "compare")

@@ -242,7 +242,19 @@ def _read_merged(path: Path) -> tuple[dict[str, Any], dict[str, Path]]:
     return merged, origin
 
 
+def _plain(value: Any) -> Any:
+    """A numpy scalar or array as the Python value it holds (``np.float32(0.3)`` -> 0.3, an array -> a list):
+    a script's override computed with numpy is a number like any other."""
+    if type(value).__module__ == "numpy" and hasattr(value, "tolist"):
+        return value.tolist()
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    return value
+
+
 def _convert(key: Key, value: Any, where: str) -> Any:
+    value = _plain(value)
+
     def fail(expect: str) -> SceneError:
         return SceneError(f"{where}: key '{key.path}' {expect}, got {value!r}")
 
@@ -466,6 +478,22 @@ def to_file_keys(scene: params.Scene) -> dict[str, Any]:
             obj = obj / key.scale if key.kind == "float" else [v / key.scale for v in obj]
         out[key.path] = obj
     return out
+
+
+def check_values(scene: params.Scene, where: str = "scene") -> params.Scene:
+    """``scene`` (built or changed in Python, e.g. with ``dataclasses.replace``) checked as a scene file is:
+    every key in its range, the cross-key checks.  Raises :class:`SceneError` naming the first bad key in
+    file units (``drive.speed_rpm must be > 0 and <= 5000, got -9.549``); returns ``scene``."""
+    keys = to_file_keys(scene)
+    for key in SCHEMA:
+        value = keys.get(key.path)
+        if value is None or (key.path.startswith("joint_f.") and scene.joint_f.is_ideal):
+            continue  # an optional key not given; an ideal F's keys describe nothing
+        if key.path == "mechanism.fourbar_branch":
+            continue  # stored as +1 / -1; to_file_keys gives back its sign
+        _convert(key, value, where)
+    _check_scene(scene, where, {})
+    return scene
 
 
 def apply_overrides(scene: params.Scene, overrides: dict[str, Any], where: str = "command line",

@@ -30,7 +30,7 @@ import numpy as np
 
 from weftsim.errors import OutputError, WriteFailed
 from weftsim.post.npz_guard import available_memory
-from weftsim.post.record import MANIFEST, SCENE_FILE, check_same_scene, provenance, scene_toml
+from weftsim.post.record import MANIFEST, SCENE_FILE, check_same_kind, check_same_scene, provenance, scene_toml
 from weftsim.post.results import RunResult
 
 if TYPE_CHECKING:
@@ -52,13 +52,16 @@ CSV_BYTES_PER_VALUE = 18
 MEMORY_BYTES_PER_VALUE = 24
 
 
-def prepare_directory(path: str | Path, force: bool = False, scene: Scene | None = None) -> Path:
+def prepare_directory(path: str | Path, force: bool = False, scene: Scene | None = None,
+                      kind: str | None = None) -> Path:
     """Create ``path`` (and parents) and check it is a writable directory of ours.
 
     A directory that already holds files but no weftsim manifest was not written by
     weftsim: it is refused (unless ``force``) so a run never mixes its files with others.
     With ``scene``, a directory holding the results of another resolved scene is refused too
     (unless ``force``; :func:`weftsim.post.record.check_same_scene`), before anything is written.
+    With ``kind`` (the manifest's ``"kind"`` the caller writes: ``"run"``, ``"wear"``, ``"wear ensemble"``,
+    ...), a directory holding another command's results is refused too (:func:`~weftsim.post.record.check_same_kind`).
     """
     path = Path(path)
     if path.is_dir() and not force and not (path / MANIFEST).exists() and any(path.iterdir()):
@@ -66,6 +69,8 @@ def prepare_directory(path: str | Path, force: bool = False, scene: Scene | None
             f"output directory {path} is not empty and was not written by weftsim; "
             "choose another directory with -o, or pass --force to write into it anyway"
         )
+    if kind is not None:
+        check_same_kind(path, kind, force)
     if scene is not None:
         check_same_scene(path, scene, force)
     try:
@@ -396,7 +401,7 @@ def write_run(result: RunResult, outdir: str | Path, figure: bool = True, force:
     from weftsim.post.plots import plot_channels, plot_orbit
     from weftsim.post.results import save_npz
 
-    outdir = prepare_directory(outdir, force, result.scene)
+    outdir = prepare_directory(outdir, force, result.scene, kind="run")
     what = {"kind": "run", "engine": result.engine, "scene": result.scene.name, "status": result.status}
     files = {
         "channels": ("channels.csv", lambda target: write_csv(target, {n: result.samples[n] for n in result.channel_names})),

@@ -164,7 +164,7 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
     check_request(scene, hours, engine, limit)
     if until_limit and limit is None:
         raise WearError("until_limit needs a clearance limit (--limit-clearance-mm)")
-    outdir = prepare_directory(outdir, force, scene)
+    outdir = prepare_directory(outdir, force, scene, kind="wear")
     check_engine(outdir, engine, force)
     what = {"kind": "wear", "scene": scene.name, "engine": engine, **provenance(scene)}  # from the first update on
     begin_directory(outdir, what)  # ours from the first update on: an interrupted prediction resumes here
