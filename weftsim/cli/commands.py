@@ -396,9 +396,9 @@ def cmd_run(args: argparse.Namespace) -> int:
     outdir = output_directory(args, scene, engine)
     _check_fits(scene, outdir)
     outdir = prepare_directory(outdir, args.force, scene, kind="run")
-    _announce_run_time(scene, (engine,), "run")
-    _announce_checks(scene, "run")
-    with _stop_on_interrupt("run") as stop:
+    with _stop_on_interrupt("run") as stop:  # from here a Ctrl-C stops the run (the estimate imports the engine)
+        _announce_run_time(scene, (engine,), "run")
+        _announce_checks(scene, "run")
         result = _solve(scene, engine, announce=True)
     written = write_run(result, outdir, figure=not args.no_plot, force=args.force, npz=True)
     _report_run(result, written)
@@ -430,8 +430,8 @@ def cmd_animate(args: argparse.Namespace) -> int:
     check_file_target(target)  # before the solve: a path that cannot be written fails now, not after it
     _check_fits(scene, target.parent)
     check_same_scene(target.parent, scene, args.force)  # beside the results of another scene: refused
-    _announce_run_time(scene, (engine,), "animate")
     with _stop_on_interrupt("animate"):
+        _announce_run_time(scene, (engine,), "animate")
         result = _solve(scene, engine, announce=True)
     if not result.ok:
         raise CliError(f"simulation failed: {result.message}; nothing animated", EXIT_FAILED)
@@ -500,17 +500,36 @@ def cmd_compare(args: argparse.Namespace) -> int:
     return 0
 
 
-class _SweepTerminated(KeyboardInterrupt):
-    """SIGTERM or SIGHUP during a sweep: handled as Ctrl-C is (queued cells cancelled, workers ended,
-    table rewritten, lock released), then reported with the signal's own exit status."""
+class Terminated(KeyboardInterrupt):
+    """SIGTERM or SIGHUP during a sweep or a wear ensemble: handled as Ctrl-C is (queued cells or jobs
+    cancelled, workers ended, what is finished kept), then reported with the signal's own exit status."""
 
     def __init__(self, signum: int):
         super().__init__(signum)
         self.signum = signum
 
 
+_SweepTerminated = Terminated  # its name before the ensemble took it too
+
+
 def _raise_terminated(signum, frame):
-    raise _SweepTerminated(signum)
+    raise Terminated(signum)
+
+
+@contextlib.contextmanager
+def terminated_as_interrupt():
+    """While the block runs, SIGTERM and SIGHUP raise :class:`Terminated` (a KeyboardInterrupt) in the main
+    thread, so the pool is shut down as for Ctrl-C instead of the process dying without a word."""
+    handled = (signal.SIGTERM, signal.SIGHUP)
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {sig: signal.signal(sig, _raise_terminated) for sig in handled}
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
@@ -522,8 +541,13 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     # The shorthand flags are fixed overrides of every cell, as --set is.
     fixed = list(args.set) + [f"{SCENE_FLAGS[flag]}={value!r}" if isinstance(value, float) else
                               f"{SCENE_FLAGS[flag]}={value}" for flag, value in shorthand_values(args).items()]
-    handled = (signal.SIGTERM, signal.SIGHUP)
-    previous = {sig: signal.signal(sig, _raise_terminated) for sig in handled}
+    with terminated_as_interrupt():
+        return _run_sweep(args, engine, fixed)
+
+
+def _run_sweep(args: argparse.Namespace, engine: str, fixed: list[str]) -> int:
+    from weftsim.sweep import format_report, plan_sweep, run_sweep
+
     try:
         plan = plan_sweep(args.scene, args.vary, fixed, engine, allow_large=args.yes,
                           allow_cwd_engine=args.allow_cwd_engine,
@@ -532,13 +556,10 @@ def cmd_sweep(args: argparse.Namespace) -> int:
             print(f"weftsim sweep: {note}", file=sys.stderr, flush=True)
         outdir = output_directory(args, plan.base, "sweep-" + engine.replace(":", "."))
         report = run_sweep(plan, outdir, jobs=args.jobs, scheduler=args.scheduler, cell_figures=args.cell_figures)
-    except _SweepTerminated as exc:
+    except Terminated as exc:
         name = signal.Signals(exc.signum).name
         raise CliError(f"terminated by {name}; finished cells are kept, run the same command again to resume",
                        128 + exc.signum) from None
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
     print(format_report(report))
     if report.failed:
         raise CliError(f"{report.failed} of {report.total} cells failed (see {report.table} and each failed cell's "
@@ -643,6 +664,12 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"weftsim {args.command}: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except ImportError as exc:
+        # Ctrl-C while a compiled module loads (Exudyn's) surfaces as that module's ImportError: an interruption
+        if isinstance(exc.__context__, KeyboardInterrupt) or isinstance(exc.__cause__, KeyboardInterrupt):
+            print(f"weftsim {args.command}: interrupted", file=sys.stderr)
+            return EXIT_INTERRUPTED
+        raise
 
 
 if __name__ == "__main__":

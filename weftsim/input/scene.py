@@ -78,6 +78,8 @@ def _flatten(table: dict, where: str, prefix: tuple[str, ...] = (),
     for name, value in table.items():
         path = ".".join(prefix + (name,))
         if isinstance(value, dict):
+            if not value:
+                _check_empty_table(path, where)
             flat.update(_flatten(value, where, prefix + (name,), seen))
             continue
         if path in seen:
@@ -86,6 +88,30 @@ def _flatten(table: dict, where: str, prefix: tuple[str, ...] = (),
         seen[path] = _spelling(prefix, name)
         flat[path] = value
     return flat
+
+
+def _tables() -> set[str]:
+    """Every table a scene file may hold (``joint_e``, ``joint_e.wear``, ``solver.reference``, ...)."""
+    out = set()
+    for key in SCHEMA:
+        parts = key.path.split(".")
+        out.update(".".join(parts[:i]) for i in range(1, len(parts)))
+    return out
+
+
+def _check_empty_table(path: str, where: str) -> None:
+    """An empty table says something or nothing: ``[joint_e.lubrication]`` with no key would run the dry joint
+    (the table needs its viscosity), an unknown one (``[joint_e.lubricaton]``) would be ignored: refused."""
+    tables = _tables()
+    if path not in tables:
+        close = difflib.get_close_matches(path, sorted(tables), n=1, cutoff=0.75)
+        mean = f"did you mean [{close[0]}]? " if close else ""
+        raise SceneError(f"{where}: unknown table [{shown(path)}]; {mean}a scene's tables are "
+                         f"{', '.join(sorted(t for t in tables if '.' not in t))} and the tables in them")
+    if path.endswith(".lubrication"):
+        raise SceneError(f"{where}: the table [{path}] is empty; it must give the oil's viscosity "
+                         f"({path}.viscosity_mpa_s, the other lubrication keys default), or leave the table out "
+                         "for the dry joint")
 
 
 def _read_toml(path: Path) -> dict:

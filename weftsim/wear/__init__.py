@@ -178,10 +178,22 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
     done = done[:-1]
 
     latest = list(done)
+    kept = [len(done)]  # updates the state file on disk holds
+
+    def save(updates):
+        try:
+            store.save_state(outdir, scene, updates)
+        except OSError as exc:  # a full disk, a quota: the state written before is whole (atomic writes)
+            from weftsim.errors import WriteFailed
+
+            held = f"the {kept[0]} updates before it are kept there" if kept[0] else "no update was stored yet"
+            raise WriteFailed(f"cannot write {outdir / store.STATE}: {exc.strerror or exc}; {held}: free space "
+                              "and run the same command again to resume") from None
+        kept[0] = len(updates)
 
     def on_update(updates):
         latest[:] = updates
-        store.save_state(outdir, scene, updates)
+        save(updates)
         if progress is not None and updates[-1].hours > 0.0:  # no time-left estimate from a zero fraction
             if until_limit:  # the share of the clearance's way to the limit
                 progress(min(_grown(scene, updates[-1], share=limit), 1.0))
@@ -198,7 +210,7 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
         updates = predict(scene, hours, done, on_update=on_update, stop=stop, simulate=simulator(engine))
         if until_limit and updates and _beyond(scene, updates[-1], limit):
             updates[-1] = _cut_at(scene, updates[-1], limit)
-            store.save_state(outdir, scene, updates)
+            save(updates)
         if not updates:  # stopped (Ctrl-C) before the first update was done: nothing to write
             raise KeyboardInterrupt
     except WearError as exc:

@@ -200,21 +200,27 @@ def run_ensemble(args: argparse.Namespace, scene: Scene, outdir: str | Path,
             raise CliError(f"--design-points {text!r}: give KEY=N with a whole number N from 2 to 9") from None
     if args.engine != "reference":
         raise CliError("an ensemble runs on the reference engine (--engine reference)")
+    import signal
+
+    from weftsim.cli.commands import Terminated, terminated_as_interrupt
+
     limit = args.limit_clearance_mm * 1e-3
     try:
-        data = wear_ensemble(scene, args.uncertain, SAMPLES if args.samples is None else args.samples, limit, outdir,
-                             jobs=args.jobs, scheduler=args.scheduler, seed=SEED if args.seed is None else args.seed,
-                             figures=not args.no_plot, force=args.force,
-                             chaos_runs=CHAOS_RUNS if args.chaos_runs is None else args.chaos_runs,
-                             design_points=design_points,
-                             levels=tuple(1e-3 * v for v in args.level_mm),
-                             announce=lambda text: print(text, file=sys.stderr, flush=True),
-                             **({} if args.hours is None else {"horizon": args.hours}))
+        with terminated_as_interrupt():
+            data = wear_ensemble(scene, args.uncertain, SAMPLES if args.samples is None else args.samples, limit,
+                                 outdir, jobs=args.jobs, scheduler=args.scheduler,
+                                 seed=SEED if args.seed is None else args.seed, figures=not args.no_plot,
+                                 force=args.force, chaos_runs=CHAOS_RUNS if args.chaos_runs is None else args.chaos_runs,
+                                 design_points=design_points, levels=tuple(1e-3 * v for v in args.level_mm),
+                                 announce=lambda text: print(text, file=sys.stderr, flush=True),
+                                 **({} if args.hours is None else {"horizon": args.hours}))
     except WearError as exc:
         raise CliError(str(exc)) from None
-    except KeyboardInterrupt:
-        raise CliError(f"interrupted: every job's updates so far are in {outdir}/jobs; run the same command again "
-                       "to resume", 130) from None
+    except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM / SIGHUP (Terminated): the pool is shut down
+        signum = exc.signum if isinstance(exc, Terminated) else signal.SIGINT
+        how = "interrupted" if signum == signal.SIGINT else f"terminated by {signal.Signals(signum).name}"
+        raise CliError(f"{how}: every job's updates so far are in {outdir}/jobs; run the same command again "
+                       "to resume", 128 + signum) from None
     m = data["method"]
     print(f"scene {scene.name}: hours to an effective clearance of {args.limit_clearance_mm:g} mm at E, "
           f"{data['samples']} samples ({len(data['jobs'])} simulated predictions, {data['wall_time_s']:.0f} s)")

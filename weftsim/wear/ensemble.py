@@ -59,8 +59,11 @@ def _run_jobs(jobs: list[tuple[str, Scene]], limit: float, outdir: Path, jobs_n:
 
     from weftsim.sweep.pool import executor
 
-    pool, _, stop = executor(jobs_n, scheduler, len(jobs), "reference")
+    pool, workers, stop = executor(jobs_n, scheduler, len(jobs), "reference")
     results: dict[str, dict] = {}
+    start = time.perf_counter()
+    if announce:
+        announce(f"ensemble: {len(jobs)} jobs on {workers} worker(s); a line as each ends")
     try:
         futures = {pool.submit(run_job, s, limit, str(outdir / "jobs" / name), horizon): name for name, s in jobs}
         for future in cf.as_completed(futures):
@@ -74,13 +77,22 @@ def _run_jobs(jobs: list[tuple[str, Scene]], limit: float, outdir: Path, jobs_n:
                 state = "failed: " + r["error"] if r["error"] else \
                     ("does not reach the limit" + (f": {r['never']}" if r.get("never") else
                                                    f" within {r['horizon_h']:g} h") if r.get("censored") else "done")
-                announce(f"ensemble: job {name} {state} "
-                         f"({len(results)}/{len(jobs)}, {r.get('wall_s', math.nan):.1f} s)")
+                announce(f"ensemble: job {name} {state} ({len(results)}/{len(jobs)}, {r.get('wall_s', math.nan):.1f} s)"
+                         + _time_left(time.perf_counter() - start, len(results), len(jobs)))
     except KeyboardInterrupt:
         stop(True)
         raise
     stop(False)
     return results
+
+
+def _time_left(elapsed: float, done: int, total: int) -> str:
+    """``; ~3 min left`` at the pace of the jobs so far (jobs of one ensemble cost about the same), or ''."""
+    from weftsim.run.progress import format_duration
+
+    if done >= total or done <= 0:
+        return ""
+    return f"; ~{format_duration(elapsed / done * (total - done))} left"
 
 
 def combine(scene: Scene, uncertain: list[Uncertain], dynamic: list[Uncertain], nodes: np.ndarray,
