@@ -112,7 +112,19 @@ def require(module: str, extra: str, purpose: str) -> Any:
         return importlib.import_module(module)
     except ImportError:
         raise MissingExtra(f"{purpose} needs {module}, which is not installed; install it with "
-                           f"pip install 'weftsim[{extra}]' (or pip install {module})") from None
+                           f"{install_command(extra)} (or pip install {module})") from None
+
+
+def install_command(extra: str) -> str:
+    """How to install weftsim's optional ``extra`` where this weftsim comes from: ``pip install 'weftsim[data]'``
+    for an installed package, ``pip install -e '.[data]'`` in the directory of a source checkout (there is no
+    package named weftsim to fetch for it)."""
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    if (root / "pyproject.toml").is_file() and (root / "weftsim" / "errors.py").is_file():
+        return f"pip install -e '.[{extra}]' in {root} (this source checkout)"
+    return f"pip install 'weftsim[{extra}]'"
 
 
 class PlausibilityWarning(UserWarning):

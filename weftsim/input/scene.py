@@ -487,6 +487,16 @@ def load_scene(path: str | os.PathLike, overrides: dict[str, Any] | None = None,
     return scene
 
 
+def _file_value(si: float, scale: float) -> float:
+    """``si / scale`` as the file gives it: 30 deg, not the 29.999999999999996 the division leaves of 30 * pi / 180,
+    when the 15-digit value scales back to exactly ``si`` (otherwise the quotient, unrounded)."""
+    value = si / scale
+    if scale == 1.0 or not math.isfinite(value):
+        return value
+    short = float(f"{value:.15g}")
+    return short if short * scale == si else value
+
+
 def to_file_keys(scene: params.Scene) -> dict[str, Any]:
     """The scene as flattened file keys in file units (for summaries and provenance)."""
     out: dict[str, Any] = {"name": scene.name}
@@ -501,7 +511,7 @@ def to_file_keys(scene: params.Scene) -> dict[str, Any]:
         elif key.path == "mechanism.fourbar_branch":
             obj = "+" if obj > 0 else "-"
         elif key.kind in ("float", "floats2", "floats3"):
-            obj = obj / key.scale if key.kind == "float" else [v / key.scale for v in obj]
+            obj = _file_value(obj, key.scale) if key.kind == "float" else [_file_value(v, key.scale) for v in obj]
         out[key.path] = obj
     return out
 

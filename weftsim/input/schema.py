@@ -177,7 +177,11 @@ SCHEMA: tuple[Key, ...] = (
             "(default [0.5, 1.0], a bushed pin in oscillating motion); outside it is warned about"),
     *WEAR_KEYS("joint_e", "joint"),
     *LUBRICATION_KEYS("joint_e", "joint"),
-    Key("drive.speed_rpm", "drive.speed", "float", RPM, 0, 5000, doc="constant crank speed"),
+    # At least 1 rpm: a loom jogs at 10-60 rpm; slower, the journal rests in lasting contact for hours of machine
+    # time, which the engines resolve in steps of microseconds (the reference scene: 179 steps for 0.1
+    # revolution at 400 rpm, 2421 at 4 rpm; --speed-rpm 1e-9 ran 40 s without reaching 1 % of the run).
+    Key("drive.speed_rpm", "drive.speed", "float", RPM, 1, 5000, False,
+        doc="constant crank speed (1 rpm or more: a jog is 10-60 rpm)"),
     Key("drive.revolutions", "drive.revolutions", "float", 1, 0, 1000, doc="crank revolutions to simulate"),
     Key("solver.reference.method", "reference_solver.method", "str", choices=INTEGRATORS,
         doc="method of the reference engine: scipy's, or numba_* (compiled, docs/performance.md; numba_RODAS4 "

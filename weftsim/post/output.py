@@ -275,7 +275,7 @@ def _rescue(failed: dict[str, tuple[str, Callable[[Path], Path]]]) -> tuple[Path
 
 
 def write_files(outdir: Path, what: dict, files: dict[str, tuple[str, Callable[[Path], Path]]],
-                scene: Scene | None = None) -> dict[str, Path]:
+                scene: Scene | None = None, on_write: Callable[[Path], None] | None = None) -> dict[str, Path]:
     """Write a set of files into ``outdir`` under its manifest; keep what fails elsewhere.
 
     Parameters
@@ -290,6 +290,8 @@ def write_files(outdir: Path, what: dict, files: dict[str, tuple[str, Callable[[
     scene : Scene, optional
         The scene of these results: the manifest records it resolved and the command line
         (:func:`weftsim.post.record.provenance`), and ``scene.toml`` holds it as a scene file.
+    on_write : callable, optional
+        Called with each file's path before it is written (progress on a long write).
 
     Returns
     -------
@@ -308,6 +310,8 @@ def write_files(outdir: Path, what: dict, files: dict[str, tuple[str, Callable[[
     begin_directory(outdir, what)
     written, failed, reasons = {}, {}, {}
     for kind, (name, write) in files.items():
+        if on_write is not None:
+            on_write(outdir / name)
         try:
             written[kind] = write(outdir / name)
         except OSError as exc:
@@ -387,7 +391,7 @@ def output_rows(scene: Scene) -> float:
 
 
 def write_run(result: RunResult, outdir: str | Path, figure: bool = True, force: bool = False,
-              npz: bool = False) -> dict[str, Path]:
+              npz: bool = False, on_write: Callable[[Path], None] | None = None) -> dict[str, Path]:
     """Write ``channels.csv``, ``summary.json``, ``channels.png`` and (clearance joint) ``orbit.png``
     for one run, atomically each.
 
@@ -413,4 +417,4 @@ def write_run(result: RunResult, outdir: str | Path, figure: bool = True, force:
         files["figure"] = ("channels.png", lambda target: write_figure(target, plot_channels([result])))
         if result.scene.loose_joints:  # one orbit panel per joint with a clearance (E, F)
             files["orbit"] = ("orbit.png", lambda target: write_figure(target, plot_orbit(result)))
-    return write_files(outdir, what, files, scene=result.scene)
+    return write_files(outdir, what, files, scene=result.scene, on_write=on_write)

@@ -1,4 +1,4 @@
-"""Wear ensembles: the hours to a clearance limit as a distribution over uncertain inputs (docs/wear.md section 7).
+"""Wear ensembles: the hours to a clearance limit as a distribution over uncertain inputs (docs/wear.md section 9).
 
 Public entry::
 

@@ -1,4 +1,4 @@
-"""One simulated wear prediction of an ensemble: run to a clearance limit, resumably (docs/wear.md section 7).
+"""One simulated wear prediction of an ensemble: run to a clearance limit, resumably (docs/wear.md section 9).
 
 :func:`run_job` is what the ensemble sends to the sweep machinery's pool (a local process pool or a
 Dask cluster, :func:`weftsim.sweep.pool.executor`): plain data in (the scene, the limit, a

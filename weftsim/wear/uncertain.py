@@ -1,7 +1,7 @@
 """Uncertain inputs of a wear ensemble: ``KEY=DISTRIBUTION`` texts, sampling, quantiles and their confidence.
 
 ``--uncertain joint_e.wear.wear_coefficient=lognormal(1e-7,0.6)`` names a scene key and a distribution
-in the key's file units (docs/wear.md section 7):
+in the key's file units (docs/wear.md section 9):
 
 - ``normal(mean,sd)``, ``lognormal(median,sigma_of_log)``, ``uniform(low,high)``,
   ``triangular(low,mode,high)``;
