@@ -349,7 +349,7 @@ def cmd_kinematics(args: argparse.Namespace) -> int:
         "csv": ("kinematics.csv", lambda target: write_csv(target, columns)),
         "png": ("kinematics.png", lambda target: write_figure(target, plot_kinematics(
             columns["crank_angle_deg"], columns["rapier_displacement_m"], columns["rapier_velocity_m_s"],
-            columns["rapier_acceleration_m_s2"], title))),
+            columns["rapier_acceleration_m_s2"], title, columns["transmission_angle_deg"]))),
     }, scene=scene)
     csv, png = written["csv"], written["png"]
     s, v, a = columns["rapier_displacement_m"], columns["rapier_velocity_m_s"], columns["rapier_acceleration_m_s2"]

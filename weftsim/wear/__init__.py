@@ -314,17 +314,18 @@ def _write_results(scene: Scene, updates: list, hours: float, limit: float | Non
         files[f"journal_profile_{joint}"] = (f"wear_profile_journal_{joint}.csv",
                                              lambda p, j=joint: store.write_profiles(p, updates, "journal", j))
     if figures:
-        from weftsim.wear.figures import growth_figure, profile_figure
+        from weftsim.wear.figures import conditions, growth_figure, profile_figure
 
         engine_tag = "" if engine == "reference" else f" ({engine} engine)"
         for joint in joints:
-            title = f"{scene.name}: wear at {joint.upper()}{engine_tag}"
+            title = f"{scene.name}: wear at {joint.upper()}{engine_tag}\n{conditions(scene, (joint,))}"
             files[f"profile_figure_{joint}"] = (
                 f"wear_profile_{joint}.png", lambda p, j=joint, t=title: write_figure(p, profile_figure(scene, updates, t, j)))
         name = "".join(joints)
-        title = f"{scene.name}: wear at {' and '.join(j.upper() for j in joints)}{engine_tag}"
+        title = f"{scene.name}: wear at {' and '.join(j.upper() for j in joints)}{engine_tag}\n{conditions(scene, joints)}"
+        limit_mm = None if limit is None else 1e3 * limit
         files["growth_figure"] = (f"wear_growth_{name}.png",
-                                  lambda p: write_figure(p, growth_figure(columns, title, joints)))
+                                  lambda p: write_figure(p, growth_figure(columns, title, joints, limit_mm)))
     written = write_files(outdir, what, files, scene=scene)
     data["files"] = {k: str(v) for k, v in written.items()}
     return data

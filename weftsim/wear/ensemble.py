@@ -324,9 +324,13 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
     if figures:
         from weftsim.wear.ensemble_figures import band_figure, cdf_figure, shares_figure
 
-        title = f"{scene.name}: wear at E, {samples} samples"
+        from weftsim.wear.figures import conditions
+
+        title = f"{scene.name}: wear at E, nominal {conditions(scene)}\n{samples} samples; uncertain: " + \
+            ", ".join(u.key.rpartition(".")[2] for u in parsed)
         files["cdf_figure"] = ("ensemble_cdf.png", lambda p: write_figure(p, cdf_figure(hours[:, -1], data, title)))
-        files["band_figure"] = ("ensemble_band.png", lambda p: write_figure(p, band_figure(band, title)))
+        files["band_figure"] = ("ensemble_band.png",
+                                lambda p: write_figure(p, band_figure(band, title, 1e3 * limit)))
         files["shares_figure"] = ("ensemble_shares.png", lambda p: write_figure(p, shares_figure(data, title)))
     written = write_files(outdir, what, files, scene=scene)  # scene.toml: the nominal scene
     data["files"] = {k: str(v) for k, v in written.items()}
