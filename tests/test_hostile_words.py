@@ -114,3 +114,17 @@ def test_summary_json_gives_typed_degrees_back_and_names_its_ratios():
     names = set(Plausibility.__dataclass_fields__)
     assert "max_penetration_over_clearance" in names and "max_penetration_ratio" not in names
     assert "damping_bound_enforced" in names and "damping_is_defect" not in names
+
+
+def test_every_command_a_message_names_exists():
+    """`weftsim list` was named by a refusal and does not exist: every command the code names in quotes or
+    backticks (`weftsim X`, ``weftsim X``, 'weftsim X') is one of the command line's."""
+    from weftsim.cli.commands import COMMANDS
+
+    named = set()
+    for path in (ROOT / "weftsim").rglob("*.py"):
+        named |= {(m.group(1), str(path.relative_to(ROOT))) for m in
+                  re.finditer(r"[`'\"]weftsim ([a-z][a-z-]*)", path.read_text(encoding="utf-8"))}
+    prose = {"writes"}  # a sentence that starts "weftsim writes ..." inside quotes, not a command
+    unknown = sorted((word, file) for word, file in named if word not in COMMANDS and word not in prose)
+    assert not unknown, unknown
