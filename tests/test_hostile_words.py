@@ -83,8 +83,8 @@ def test_the_readme_states_no_test_count_that_goes_stale():
 def test_a_missing_extra_in_a_checkout_says_how_to_install_it_there():
     from weftsim.errors import install_command
 
-    assert install_command("data").startswith("pip install -e '.[data]' in ")
-    assert str(ROOT) in install_command("data")
+    assert install_command("data", ROOT) == f"pip install -e '.[data]' in {ROOT} (this source checkout)"
+    assert install_command("data", ROOT / "weftsim") == "pip install 'weftsim[data]'"  # an installed package
 
 
 def test_the_after_run_line_says_which_checks_cover_the_start_up():

@@ -115,13 +115,13 @@ def require(module: str, extra: str, purpose: str) -> Any:
                            f"{install_command(extra)} (or pip install {module})") from None
 
 
-def install_command(extra: str) -> str:
+def install_command(extra: str, root: Any = None) -> str:
     """How to install weftsim's optional ``extra`` where this weftsim comes from: ``pip install 'weftsim[data]'``
     for an installed package, ``pip install -e '.[data]'`` in the directory of a source checkout (there is no
-    package named weftsim to fetch for it)."""
+    package named weftsim to fetch for it).  ``root``: the directory above the package (default: this one's)."""
     from pathlib import Path
 
-    root = Path(__file__).resolve().parent.parent
+    root = Path(__file__).resolve().parent.parent if root is None else Path(root)
     if (root / "pyproject.toml").is_file() and (root / "weftsim" / "errors.py").is_file():
         return f"pip install -e '.[{extra}]' in {root} (this source checkout)"
     return f"pip install 'weftsim[{extra}]'"

@@ -44,6 +44,7 @@ from weftsim.cli.grammar import (  # noqa: F401 (CliError, add_scene_flags, scen
 )
 from weftsim.errors import WeftsimError
 from weftsim.post.record import set_command
+from weftsim.cli.signals import Terminated, terminated_as_interrupt  # noqa: F401 (Terminated: for subcommands)
 from weftsim.cli.exitcodes import EXIT_DISAGREE, EXIT_FAILED, EXIT_USAGE  # noqa: F401 (re-exported)
 
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a command stopped by Ctrl-C
@@ -529,38 +530,6 @@ def cmd_compare(args: argparse.Namespace) -> int:
     if status:
         raise CliError(problem, status)
     return 0
-
-
-class Terminated(KeyboardInterrupt):
-    """SIGTERM or SIGHUP during a sweep or a wear ensemble: handled as Ctrl-C is (queued cells or jobs
-    cancelled, workers ended, what is finished kept), then reported with the signal's own exit status."""
-
-    def __init__(self, signum: int):
-        super().__init__(signum)
-        self.signum = signum
-
-
-_SweepTerminated = Terminated  # its name before the ensemble took it too
-
-
-def _raise_terminated(signum, frame):
-    raise Terminated(signum)
-
-
-@contextlib.contextmanager
-def terminated_as_interrupt():
-    """While the block runs, SIGTERM and SIGHUP raise :class:`Terminated` (a KeyboardInterrupt) in the main
-    thread, so the pool is shut down as for Ctrl-C instead of the process dying without a word."""
-    handled = (signal.SIGTERM, signal.SIGHUP)
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = {sig: signal.signal(sig, _raise_terminated) for sig in handled}
-    try:
-        yield
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:

@@ -69,10 +69,10 @@ def prepare_directory(path: str | Path, force: bool = False, scene: Scene | None
             f"output directory {path} is not empty and was not written by weftsim; "
             "choose another directory with -o, or pass --force to write into it anyway"
         )
+    if scene is not None:  # first: results of another scene are named by the keys that differ
+        check_same_scene(path, scene, force)
     if kind is not None:
         check_same_kind(path, kind, force)
-    if scene is not None:
-        check_same_scene(path, scene, force)
     try:
         path.mkdir(parents=True, exist_ok=True)
     except FileExistsError:

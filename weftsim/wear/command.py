@@ -202,7 +202,7 @@ def run_ensemble(args: argparse.Namespace, scene: Scene, outdir: str | Path,
         raise CliError("an ensemble runs on the reference engine (--engine reference)")
     import signal
 
-    from weftsim.cli.commands import Terminated, terminated_as_interrupt
+    from weftsim.cli.signals import Terminated, terminated_as_interrupt
 
     limit = args.limit_clearance_mm * 1e-3
     try:
