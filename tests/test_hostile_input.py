@@ -109,3 +109,13 @@ def test_a_scene_changed_in_python_is_checked_as_a_file_is(change, key):
     scene = change(weftsim.load_scene("reference", revolutions=0.1))
     with pytest.raises(SceneError, match=key.replace(".", r"\.")):
         weftsim.simulate(scene, "reference")
+
+
+@pytest.mark.parametrize("call, kind", [
+    (lambda: weftsim.load_scene("reference", overrides=[1, 2]), "overrides must be a mapping"),
+    (lambda: weftsim.simulate(weftsim.load_scene("ideal", revolutions=0.05), "reference").to_pandas("sample"),
+     "which must be 'samples' or 'steps'"),
+])
+def test_a_wrong_argument_of_the_interface_is_a_weftsim_error(call, kind):
+    with pytest.raises(WeftsimError, match=kind):
+        call()

@@ -32,8 +32,9 @@ class EngineError(WeftsimError, ValueError):
     """An engine name that is not one of :data:`weftsim.api.ENGINE_NAMES`."""
 
 
-class ArgumentError(WeftsimError, TypeError):
-    """A function of the Python interface got an argument of the wrong kind (names it and what it takes)."""
+class ArgumentError(WeftsimError, TypeError, ValueError):
+    """A function of the Python interface got an argument of the wrong kind or value (names it and what it
+    takes); a TypeError and a ValueError both, for code written against either."""
 
 
 class OutputError(WeftsimError, OSError):
