@@ -43,7 +43,7 @@ def captured_outdir(monkeypatch):
         seen["outdir"] = Path(outdir)
         return 0
 
-    monkeypatch.setattr("weftsim.wear.command.run", run)
+    monkeypatch.setattr("weftsim.cli.wear.run", run)
     return seen
 
 

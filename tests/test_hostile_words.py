@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from weftsim.cli.commands import WEAR_HELP, build_parser
-from weftsim.wear.command import ENSEMBLE_SECTION
+from weftsim.cli.wear import ENSEMBLE_SECTION
 from weftsim.wear.uncertain import SIGNATURES
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -89,7 +89,7 @@ def test_a_missing_extra_in_a_checkout_says_how_to_install_it_there():
 
 def test_the_after_run_line_says_which_checks_cover_the_start_up():
     """Pin pressure and p x v from revolution 2 on; the law's range (Hertz, delta/c) over the whole run, said so."""
-    from weftsim.run.design_checks import summary_line
+    from weftsim.checks.design_checks import summary_line
 
     def check(name, value, limit=None):
         return {"name": name, "stage": "after", "table": "joint_e", "value": value, "limit": limit,
@@ -107,7 +107,7 @@ def test_summary_json_gives_typed_degrees_back_and_names_its_ratios():
     like limits.max_penetration_ratio (over the journal radius)."""
     import weftsim
     from weftsim.input.scene import to_file_keys
-    from weftsim.run.plausibility import Plausibility
+    from weftsim.checks.plausibility import Plausibility
 
     keys = to_file_keys(weftsim.load_scene("loom"))
     assert keys["mechanism.crank_inclination_deg"] == 30.0 and keys["mechanism.rocker_arm_angle_deg"] == 90.0

@@ -88,7 +88,7 @@ def _run_jobs(jobs: list[tuple[str, Scene]], limit: float, outdir: Path, jobs_n:
 
 def _time_left(elapsed: float, done: int, total: int) -> str:
     """``; ~3 min left`` at the pace of the jobs so far (jobs of one ensemble cost about the same), or ''."""
-    from weftsim.run.progress import format_duration
+    from weftsim.checks.progress import format_duration
 
     if done >= total or done <= 0:
         return ""
