@@ -127,7 +127,7 @@ def _fingerprint(scene) -> tuple:
     """Everything a wear prediction of ``scene`` depends on: the kernel's parameters (geometry, inertia, the
     joints' laws, materials, friction, film), the speed, and Archard's numbers at E (k, the hardnesses, and the
     bearing's length and radii that spread the worn volume into a depth, weftsim.wear.archard)."""
-    from weftsim.reference.dynamics import pack_parameters
+    from weftsim.model.dynamics import pack_parameters
 
     j = scene.joint
     w = j.wear
