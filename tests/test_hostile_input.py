@@ -4,7 +4,6 @@ form and numpy numbers as overrides, the parameter classes raising WeftsimErrors
 
 from __future__ import annotations
 
-import dataclasses
 import math
 
 import numpy as np
@@ -12,7 +11,7 @@ import pytest
 
 import weftsim
 from weftsim.errors import SceneError, WeftsimError
-from weftsim.input.params import ClearanceJoint, Drive, Lubrication
+from weftsim.input.params import ClearanceJoint, Lubrication
 from weftsim.input.scene import SCHEMA, load_scene
 from weftsim.sweep.grid import parse_set
 
@@ -97,18 +96,6 @@ def test_the_parameter_classes_raise_weftsim_errors(make):
     with pytest.raises(WeftsimError) as err:
         make()
     assert isinstance(err.value, ValueError) and "\n" not in str(err.value)  # still a ValueError for old code
-
-
-@pytest.mark.parametrize("change, key", [
-    (lambda s: dataclasses.replace(s, drive=Drive(speed=-1.0, revolutions=0.1)), "drive.speed_rpm"),
-    (lambda s: dataclasses.replace(s, geometry=dataclasses.replace(s.geometry, l_oe=-1.0)), "mechanism.l_oe_mm"),
-    (lambda s: dataclasses.replace(s, limits=dataclasses.replace(s.limits, max_steps=-3)), "limits.max_steps"),
-])
-def test_a_scene_changed_in_python_is_checked_as_a_file_is(change, key):
-    """dataclasses.replace builds a scene no loader saw: simulate checks it key by key, in file units."""
-    scene = change(weftsim.load_scene("reference", revolutions=0.1))
-    with pytest.raises(SceneError, match=key.replace(".", r"\.")):
-        weftsim.simulate(scene, "reference")
 
 
 @pytest.mark.parametrize("call, kind", [

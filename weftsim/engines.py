@@ -184,10 +184,8 @@ def get(name: str) -> Engine:
 
 
 def _as_scene(scene: Scene | str | os.PathLike) -> Scene:
-    if isinstance(scene, Scene):  # built or changed in Python: checked as a scene file would be
-        from weftsim.input.scene import check_values
-
-        return check_values(scene, "simulate: the scene")
+    if isinstance(scene, Scene):
+        return scene
     if isinstance(scene, (str, os.PathLike)):
         from weftsim.input.scene import load_scene
 

@@ -516,22 +516,6 @@ def to_file_keys(scene: params.Scene) -> dict[str, Any]:
     return out
 
 
-def check_values(scene: params.Scene, where: str = "scene") -> params.Scene:
-    """``scene`` (built or changed in Python, e.g. with ``dataclasses.replace``) checked as a scene file is:
-    every key in its range, the cross-key checks.  Raises :class:`SceneError` naming the first bad key in
-    file units (``drive.speed_rpm must be > 0 and <= 5000, got -9.549``); returns ``scene``."""
-    keys = to_file_keys(scene)
-    for key in SCHEMA:
-        value = keys.get(key.path)
-        if value is None or (key.path.startswith("joint_f.") and scene.joint_f.is_ideal):
-            continue  # an optional key not given; an ideal F's keys describe nothing
-        if key.path == "mechanism.fourbar_branch":
-            continue  # stored as +1 / -1; to_file_keys gives back its sign
-        _convert(key, value, where)
-    _check_scene(scene, where, {})
-    return scene
-
-
 def apply_overrides(scene: params.Scene, overrides: dict[str, Any], where: str = "command line",
                     refuse_ideal_keys: bool = True) -> params.Scene:
     """``scene`` with dotted file keys replaced (file units), validated as :func:`load_scene` validates.
