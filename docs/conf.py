@@ -40,6 +40,9 @@ extensions = [
     "sphinx.ext.autosummary",
     "sphinx.ext.napoleon",
     "sphinx.ext.mathjax",
+    # MathJax from the site itself, not a CDN: the equations show without a network (issue 35;
+    # scripts/check_offline_math.py checks the built pages).
+    "sphinx-mathjax-offline",
     "sphinx.ext.viewcode",
     "myst_parser",
     "sphinx_gallery.gen_gallery",
@@ -47,11 +50,11 @@ extensions = [
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
-exclude_patterns = ["_build", "data"]
+exclude_patterns = ["_build", "data", "sg_execution_times.rst", "*/sg_execution_times.rst"]  # left by builds before they were off
 
 # Markdown: headings get anchors so that pages can link to sections (physics.md#3-contact-force-laws).
 myst_heading_anchors = 3
-# $...$ inline and $$...$$ display maths (amsmath: align and friends), rendered by MathJax.
+# $...$ inline and $$...$$ display maths (amsmath: align and friends), rendered by the site's own MathJax.
 myst_enable_extensions = ["dollarmath", "amsmath"]
 
 # The docstrings are numpydoc; napoleon reads them without demanding numpydoc's full section set.
@@ -89,6 +92,9 @@ sphinx_gallery_conf = {
     "remove_config_comments": True,
     "within_subsection_order": "_gallery.LoomFirstSortKey",  # the loom run first, then by file name
     "show_memory": False,
+    # No sg_execution_times pages: their table loads jQuery and DataTables from CDNs (the site must work offline,
+    # scripts/check_offline_math.py); the build log gives the examples' times.
+    "write_computation_times": False,
     "matplotlib_animations": True,
     "image_scrapers": ("matplotlib", "_gallery.weftsim_figures"),
     "capture_repr": ("_repr_html_",),  # no "<Figure size ...>" lines under the code

@@ -32,4 +32,6 @@ start=$(date +%s)
          "cause this: rm -rf docs/_build and build again" >&2
     exit 1
 }
+# The equations must show without a network: MathJax from the site, every formula typeset by it offline.
+"$python" scripts/check_offline_math.py docs/_build/html || { echo "build_docs: the equations do not show offline" >&2; exit 1; }
 echo "build_docs: docs/_build/html/index.html built with $python in $(( $(date +%s) - start )) s" >&2

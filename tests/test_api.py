@@ -3,6 +3,7 @@ bundled_scenes) and its one exception hierarchy."""
 
 import dataclasses
 import math
+import re
 import sys
 from pathlib import Path
 
@@ -128,10 +129,13 @@ def test_missing_optional_packages_name_the_extra(monkeypatch, tmp_path):
     result = weftsim.simulate(weftsim.load_scene("ideal", revolutions=0.1), engine="reference")
     monkeypatch.setitem(sys.modules, "pandas", None)  # import pandas now raises ImportError
     monkeypatch.setitem(sys.modules, "xarray", None)
-    with pytest.raises(weftsim.MissingExtra, match=r"needs pandas.*pip install 'weftsim\[data\]'"):
+    from weftsim.errors import install_command
+
+    hint = re.escape(install_command("data"))  # 'weftsim[data]' installed, '.[data]' in a checkout
+    with pytest.raises(weftsim.MissingExtra, match=r"needs pandas.*" + hint):
         result.to_pandas()
     (tmp_path / "sweep.json").write_text("{}")
-    with pytest.raises(weftsim.MissingExtra, match=r"load_sweep needs xarray.*'weftsim\[data\]'"):
+    with pytest.raises(weftsim.MissingExtra, match=r"load_sweep needs xarray.*" + hint):
         weftsim.load_sweep(tmp_path)
 
 

@@ -276,7 +276,7 @@ def test_a_run_of_two_revolutions_is_judged_on_its_second_and_the_law_on_the_who
     hertz = checks[("joint_e", "hertz_pressure")]
     assert hertz.numbers["peak_force_n"] == run.steps["contact_force_N"].max()
     assert hertz.value == run.plausibility["peak_pressure_pa"]  # the same number plausibility.assess judges
-    assert checks[("joint_e", "penetration")].value == run.plausibility["max_penetration_ratio"]
+    assert checks[("joint_e", "penetration")].value == run.plausibility["max_penetration_over_clearance"]
 
 
 def test_a_warning_of_a_run_shorter_than_two_revolutions_says_the_start_up_impact_counts(run):

@@ -188,7 +188,7 @@ def _edit_scene(edit):
     (_edit_scene(lambda s: s["joint"].update(clearance=-1)), ["`clearance` must be >= 0"]),
     (_edit_scene(lambda s: s["joint"].update(clearance="abc")), ["scene.joint.clearance must be a number"]),
     (_edit_scene(lambda s: s["joint"].update(law="nope")), ["joint_e.law' must be one of"]),
-    (_edit_scene(lambda s: s["drive"].update(speed=0)), ["drive.speed_rpm' must be > 0"]),
+    (_edit_scene(lambda s: s["drive"].update(speed=0)), ["drive.speed_rpm' must be >= 1"]),
     (_edit_scene(lambda s: s.update(bogus=1)), ["unknown field(s) bogus"]),
     (_edit_scene(lambda s: s["joint"].update(bearing_wear=[1e-3] * 7)), ["wear profiles"]),
     (_edit_scene(lambda s: s["geometry"].update(fourbar_branch=7)), ["fourbar_branch must be 1 or -1"]),

@@ -112,8 +112,17 @@ def test_a_hand_edited_state_is_refused_by_its_own_history(finished, tmp_path, n
 
 
 def _interrupted(arrays, dropped):
-    """The state as a Ctrl-C leaves it ``dropped`` updates before the end (no checksum: an older state)."""
-    return {k: (v[:-dropped] if k != "scene" else v) for k, v in arrays.items() if k != "digest"}
+    """The state as a Ctrl-C leaves it ``dropped`` updates before the end (weftsim writes the checksum with it)."""
+    return _signed({k: (v[:-dropped] if k != "scene" else v) for k, v in arrays.items() if k != "digest"})
+
+
+def _signed(arrays):
+    """``arrays`` with the checksum of their numbers as they are."""
+    from weftsim.wear.resume import digest
+
+    out = {k: v for k, v in arrays.items() if k != "digest"}
+    out["digest"] = np.array(digest(out))
+    return out
 
 
 def test_consistently_scaled_rates_break_the_update_rule(finished, tmp_path):
@@ -123,7 +132,8 @@ def test_consistently_scaled_rates_break_the_update_rule(finished, tmp_path):
     for name in ("rate_bearing_e", "rate_journal_e", "volume_rate_e"):
         arrays[name] = arrays[name].copy()
         arrays[name][-1] *= 1.1
-    _refused(finished[0], _copy(finished, tmp_path, arrays), "more revolutions than joint_e.wear.max_clearance_change")
+    _refused(finished[0], _copy(finished, tmp_path, _signed(arrays)),
+             "more revolutions than joint_e.wear.max_clearance_change")
 
 
 def test_edited_last_rates_are_not_extrapolated(finished, tmp_path):
@@ -133,7 +143,7 @@ def test_edited_last_rates_are_not_extrapolated(finished, tmp_path):
     for name in ("rate_bearing_e", "rate_journal_e", "volume_rate_e"):
         arrays[name] = arrays[name].copy()
         arrays[name][-1] *= 1.1
-    summary = predict_to_directory(finished[0], HOURS, _copy(finished, tmp_path, arrays), figures=False)
+    summary = predict_to_directory(finished[0], HOURS, _copy(finished, tmp_path, _signed(arrays)), figures=False)
     assert summary["final_effective_clearance_e_mm"] == finished[3]["final_effective_clearance_e_mm"]
     assert summary["wear_volume_mm3"] == finished[3]["wear_volume_mm3"]
 
@@ -161,7 +171,7 @@ def test_fewer_hours_than_stored_says_so(finished, tmp_path):
 
 def test_an_interrupted_state_resumes_to_the_uninterrupted_answer(finished, tmp_path):
     """The two last updates dropped, as after a Ctrl-C: the resume recomputes them, bit for bit."""
-    arrays = _interrupted(finished[2], 2)
+    arrays = _signed(_interrupted(finished[2], 2))
     summary = predict_to_directory(finished[0], HOURS, _copy(finished, tmp_path, arrays), figures=False)
     for key in ("final_effective_clearance_e_mm", "wear_volume_mm3", "updates", "hours_reached"):
         assert summary[key] == finished[3][key], key

@@ -111,20 +111,21 @@ def test_build_docs_uses_the_checkout_venv_that_the_readme_command_makes(tmp_pat
     """The README's command installs the docs extra into .venv: the script must build with that Python
     (issue 25: it ran python3 and stopped), checking the extra and running sphinx-build, arguments passed on."""
     calls = _run_build_docs(tmp_path, None, with_venv=True)
-    assert len(calls) == 3 and all(call.startswith("python ") for call in calls), calls
+    assert len(calls) == 4 and all(call.startswith("python ") for call in calls), calls
     assert "import sphinx" in calls[0]
     assert calls[1].startswith("python -m sphinx -W") and calls[1].endswith("-D plot_gallery=0")
     assert calls[2] == "python scripts/check_anchors.py docs/_build/html"
+    assert calls[3] == "python scripts/check_offline_math.py docs/_build/html"  # the equations show offline
 
 
 def test_build_docs_falls_back_to_python3_and_obeys_PYTHON(tmp_path):
     calls = _run_build_docs(tmp_path / "bare", None, with_venv=False)
-    assert [call.split()[0] for call in calls] == ["python3"] * 3
+    assert [call.split()[0] for call in calls] == ["python3"] * 4
     chosen = tmp_path / "chosen" / "python"
     _fake_python(chosen, tmp_path / "chosen.log")
     (tmp_path / "chosen.log").touch()
     _run_build_docs(tmp_path / "env", str(chosen), with_venv=True)
-    assert len((tmp_path / "chosen.log").read_text().splitlines()) == 3
+    assert len((tmp_path / "chosen.log").read_text().splitlines()) == 4
     assert not (tmp_path / "env" / "calls.log").read_text()  # neither .venv's nor PATH's python ran
 
 

@@ -101,7 +101,7 @@ BAD_SCENES = [
     ("[joint_e]\nrestitution = 1.2", ["joint_e.restitution", "1.2"]),
     ("[joint_e.bearing_material]\npoisson_ratio = 0.5", ["poisson_ratio", "0.5", "< 0.5"]),
     ("[joint_e.journal_material]\npoisson_ratio = -0.1", ["poisson_ratio", "-0.1", ">= 0"]),
-    ("[drive]\nspeed_rpm = 0", ["drive.speed_rpm", "0", "> 0"]),
+    ("[drive]\nspeed_rpm = 0", ["drive.speed_rpm", "0", ">= 1"]),
     ("[drive]\nspeed_rpm = -400", ["drive.speed_rpm", "-400"]),
     ("[drive]\nspeed_rpm = nan", ["drive.speed_rpm", "nan", "finite"]),
     ("[drive]\nspeed_rpm = \"fast\"", ["drive.speed_rpm", "'fast'", "number"]),

@@ -53,6 +53,9 @@ def scene_overrides(overrides: Mapping[str, Any] | None = None, where: str = "ov
     A flag that is None is not given.  Raises :class:`SceneError` for an unknown flag (with the
     closest one) or a key given both ways.
     """
+    if overrides is not None and not isinstance(overrides, Mapping):
+        raise ArgumentError(f"{where}: overrides must be a mapping of dotted scene keys to values, e.g. "
+                            f"{{'joint_e.clearance_mm': 0.5}}, got {type(overrides).__name__} {overrides!r:.40}")
     merged = dict(overrides or {})
     for flag, value in flags.items():
         key = SCENE_FLAGS.get(flag)

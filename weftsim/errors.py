@@ -38,8 +38,9 @@ class EngineError(WeftsimError, ValueError):
     """An engine name that is not one of :data:`weftsim.api.ENGINE_NAMES`."""
 
 
-class ArgumentError(WeftsimError, TypeError):
-    """A function of the Python interface got an argument of the wrong kind (names it and what it takes)."""
+class ArgumentError(WeftsimError, TypeError, ValueError):
+    """A function of the Python interface got an argument of the wrong kind or value (names it and what it
+    takes); a TypeError and a ValueError both, for code written against either."""
 
 
 class OutputError(WeftsimError, OSError):
@@ -118,7 +119,19 @@ def require(module: str, extra: str, purpose: str) -> Any:
         return importlib.import_module(module)
     except ImportError:
         raise MissingExtra(f"{purpose} needs {module}, which is not installed; install it with "
-                           f"pip install 'weftsim[{extra}]' (or pip install {module})") from None
+                           f"{install_command(extra)} (or pip install {module})") from None
+
+
+def install_command(extra: str, root: Any = None) -> str:
+    """How to install weftsim's optional ``extra`` where this weftsim comes from: ``pip install 'weftsim[data]'``
+    for an installed package, ``pip install -e '.[data]'`` in the directory of a source checkout (there is no
+    package named weftsim to fetch for it).  ``root``: the directory above the package (default: this one's)."""
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent if root is None else Path(root)
+    if (root / "pyproject.toml").is_file() and (root / "weftsim" / "errors.py").is_file():
+        return f"pip install -e '.[{extra}]' in {root} (this source checkout)"
+    return f"pip install 'weftsim[{extra}]'"
 
 
 class PlausibilityWarning(UserWarning):

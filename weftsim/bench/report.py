@@ -164,7 +164,7 @@ def write_report(report: dict, outdir: str | Path, force: bool = False) -> list[
     from weftsim.post.output import (begin_directory, finish_directory, prepare_directory, write_figure, write_json,
                                      write_text)
 
-    outdir = prepare_directory(outdir, force)
+    outdir = prepare_directory(outdir, force, kind="bench")
     begin_directory(outdir, {"kind": "bench", "mode": report["mode"]})
     written = {"md": write_text(outdir / "bench.md", markdown(report))}
     for case in report["cases"]:

@@ -256,7 +256,7 @@ def write_targets(report: dict, outdir: str | Path, force: bool = False) -> list
     from weftsim.bench.report import machine_info
     from weftsim.post.output import begin_directory, finish_directory, prepare_directory, write_json, write_text
 
-    outdir = prepare_directory(outdir, force)
+    outdir = prepare_directory(outdir, force, kind="bench")
     begin_directory(outdir, {"kind": "bench", "mode": "targets"})
     report.setdefault("machine", machine_info())
     written = {"md": write_text(outdir / "targets.md", markdown(report)),

@@ -338,15 +338,30 @@ def _short(check: dict) -> str:
 
 def summary_line(checks: list[dict], stage: str) -> str:
     """The numbers of one stage's checks (dicts of :meth:`Check.as_dict`) in one line, grouped by joint."""
+    start = max((c["numbers"].get("from_time_s", 0.0) for c in checks if c["stage"] == stage), default=0.0)
+    # After a run of two or more revolutions the machine's loads are judged from revolution 2 on, the contact
+    # law's range (Hertz pressure, delta/c) over the whole run, start-up impact included: said apart.
+    whole = stage == "after" and start > 0.0
     groups: dict = {}
+    law: dict = {}
     for check in checks:
         if check["stage"] == stage:
-            groups.setdefault(check["table"], []).append(_short(check))
-    parts = [(f"{table}: " if table else "") + ", ".join(texts) for table, texts in groups.items()]
-    start = max((c["numbers"].get("from_time_s", 0.0) for c in checks if c["stage"] == stage), default=0.0)
+            into = law if whole and check["name"] in WHOLE_RUN_CHECKS else groups
+            into.setdefault(check["table"], []).append(_short(check))
+
+    def joined(by_table: dict) -> str:
+        return "; ".join((f"{table}: " if table else "") + ", ".join(texts) for table, texts in by_table.items())
+
     when = ("before the run (ideal mechanism)" if stage == "before" else
-            f"of the run from t = {start:.4g} s (revolution 2 on)" if start > 0.0 else "of the run")
-    return f"design checks {when}: " + "; ".join(parts)
+            f"of the run from t = {start:.4g} s (revolution 2 on)" if whole else "of the run")
+    text = f"design checks {when}: " + joined(groups)
+    if law:
+        text += f"; the contact law's range over the whole run, the start-up impact included: {joined(law)}"
+    return text
+
+
+# The after-run checks judged over the whole run (the contact law's range), not from revolution 2 on.
+WHOLE_RUN_CHECKS = ("hertz_pressure", "penetration")
 
 
 def format_lines(result: RunResult) -> list[str]:

@@ -106,16 +106,18 @@ class Plausibility:
         Largest (F_N - F_el) / (xi F_el) = delta_dot / v_imp of the run (0 without contact).
     damping_limit : float
         ``limits.max_damping_ratio``.
-    damping_is_defect : bool
-        True under ``joint_e.impact_velocity_rule = "max_approach"``, which bounds the ratio.
+    damping_bound_enforced : bool
+        True under ``joint_e.impact_velocity_rule = "max_approach"``, which bounds the ratio: there a step above
+        ``damping_limit`` is a defect (``damping_steps`` counts them; 0, none), under ``onset`` a warning.
     negative_penetration_steps : int
         Steps of a contact segment with delta < -``roundoff_m`` (defect).
     min_penetration_in_contact_m : float or None
         Smallest delta of a contact step, m.
     roundoff_m : float
         Round-off of delta, m (:func:`roundoff_penetration`).
-    max_penetration_ratio : float
-        Largest delta / c.
+    max_penetration_over_clearance : float
+        Largest delta / c, the law's validity measure (not ``limits.max_penetration_ratio``, which bounds delta
+        over the journal radius R_j during the run).
     peak_pressure_pa : float
         Hertz line-contact pressure at the peak contact force, Pa.
     yield_pressure_pa : float or None
@@ -130,11 +132,11 @@ class Plausibility:
     damping_steps: int
     max_damping_ratio: float
     damping_limit: float
-    damping_is_defect: bool
+    damping_bound_enforced: bool
     negative_penetration_steps: int
     min_penetration_in_contact_m: float | None
     roundoff_m: float
-    max_penetration_ratio: float
+    max_penetration_over_clearance: float
     peak_pressure_pa: float
     yield_pressure_pa: float | None
     warnings: tuple[str, ...]
@@ -144,7 +146,7 @@ class Plausibility:
         out = []
         if self.nonpositive_onsets:
             out.append(f"{self.nonpositive_onsets} of {self.onsets} contact onsets have a non-positive approach rate")
-        if self.damping_steps and self.damping_is_defect:
+        if self.damping_steps and self.damping_bound_enforced:
             out.append(f"{self.damping_steps} contact steps have a damping force above limits.max_damping_ratio = "
                        f"{self.damping_limit:g} times the law's xi x the elastic force (largest "
                        f"{self.max_damping_ratio:.3g})")
@@ -300,11 +302,11 @@ def assess(result: RunResult) -> Plausibility | None:
         damping_steps=e.damping_steps + f.damping_steps,
         max_damping_ratio=max(e.max_damping_ratio, f.max_damping_ratio),
         damping_limit=e.damping_limit,
-        damping_is_defect=e.damping_is_defect or f.damping_is_defect,
+        damping_bound_enforced=e.damping_bound_enforced or f.damping_bound_enforced,
         negative_penetration_steps=e.negative_penetration_steps + f.negative_penetration_steps,
         min_penetration_in_contact_m=min(present) if present else None,
         roundoff_m=max(e.roundoff_m, f.roundoff_m),
-        max_penetration_ratio=max(e.max_penetration_ratio, f.max_penetration_ratio),
+        max_penetration_over_clearance=max(e.max_penetration_over_clearance, f.max_penetration_over_clearance),
         peak_pressure_pa=max(e.peak_pressure_pa, f.peak_pressure_pa),
         yield_pressure_pa=e.yield_pressure_pa if f.yield_pressure_pa is None else (
             f.yield_pressure_pa if e.yield_pressure_pa is None else min(e.yield_pressure_pa, f.yield_pressure_pa)),
@@ -337,11 +339,11 @@ def _assess_joint(result, scene, steps, table: str) -> Plausibility:
         damping_steps=damping_steps,
         max_damping_ratio=float(ratio.max()),
         damping_limit=limit,
-        damping_is_defect=joint.impact_velocity_rule == "max_approach",
+        damping_bound_enforced=joint.impact_velocity_rule == "max_approach",
         negative_penetration_steps=int(np.count_nonzero(mode & (delta < -roundoff))),
         min_penetration_in_contact_m=float(delta[mode].min()) if mode.any() else None,
         roundoff_m=roundoff,
-        max_penetration_ratio=max_penetration_ratio,
+        max_penetration_over_clearance=max_penetration_ratio,
         peak_pressure_pa=peak_pressure,
         yield_pressure_pa=yield_pressure,
         warnings=tuple(validity_warnings(scene, law, max_penetration_ratio, peak_pressure, yield_pressure,
@@ -366,7 +368,7 @@ def first_defect_row(result: RunResult, report: Plausibility) -> int:
         starts = onset_rows(mode)
         bad_onsets = starts[np.asarray(steps["penetration_rate_m_s"])[starts] <= 0.0]
         rows.extend(bad_onsets[:1].tolist())
-        if report.damping_steps and report.damping_is_defect:
+        if report.damping_steps and report.damping_bound_enforced:
             excess = np.flatnonzero(damping_excess(damping_ratio(steps, make_law(scene.joint)), report.damping_limit))
             rows.extend(excess[:1].tolist())
         negative = np.flatnonzero(mode & (np.asarray(steps["penetration_m"]) < -report.roundoff_m))

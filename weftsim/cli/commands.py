@@ -44,6 +44,7 @@ from weftsim.cli.grammar import (  # noqa: F401 (CliError, add_scene_flags, scen
 )
 from weftsim.errors import WeftsimError
 from weftsim.post.record import set_command
+from weftsim.cli.signals import Terminated, terminated_as_interrupt  # noqa: F401 (Terminated: for subcommands)
 from weftsim.errors import EXIT_DISAGREE, EXIT_FAILED, EXIT_USAGE  # noqa: F401 (re-exported)
 
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a command stopped by Ctrl-C
@@ -136,7 +137,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--force", action="store_true",
                    help="write into an output directory that holds files weftsim did not write")
 
-    p = sub.add_parser("wear", help="predict the wear of joint E over operating hours (docs/wear.md)")
+    p = sub.add_parser("wear", help=WEAR_HELP)
     _add_wear_flags(p)
 
     p = sub.add_parser("bench", help="work-precision benchmark of every engine setting (docs/performance.md)",
@@ -158,11 +159,17 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+# What `weftsim wear` does, in the command list of `weftsim --help` (tests/test_hostile_words.py checks it names
+# both joints and the ensemble, as the command does).
+WEAR_HELP = ("predict the wear of the clearance joints (E, F, or both) over operating hours, or with --uncertain "
+             "the hours to a clearance limit as a distribution (docs/wear.md)")
+
+
 def _add_wear_flags(p: argparse.ArgumentParser) -> None:
     from weftsim.cli.wear import add_flags
 
     add_scene_flags(p, shorthands=("speed_rpm", "clearance_mm", "law"))  # revolutions: set per update in [joint_e.wear]
-    add_output_flags(p, "out/<scene name>/wear")
+    add_output_flags(p, "out/<scene name>/wear, wear-exudyn on --engine exudyn, wear-ensemble with --uncertain")
     add_flags(p, positive)
 
 
@@ -170,7 +177,8 @@ def cmd_wear(args: argparse.Namespace) -> int:
     from weftsim.cli.wear import run
 
     scene = scene_from_args(args)
-    where = "wear" if args.engine == "reference" else f"wear-{args.engine}"  # engines' states apart
+    # engines' states apart, and an ensemble apart from a prediction (each would replace the other's results)
+    where = "wear-ensemble" if args.uncertain else "wear" if args.engine == "reference" else f"wear-{args.engine}"
     return run(args, scene, output_directory(args, scene, where), _stop_on_interrupt)
 
 
@@ -208,6 +216,36 @@ def _announce_run_time(scene, engines: tuple[str, ...], command: str) -> None:
         print(f"weftsim {command}: warning: the per-step record will be ~{_size(size)} (held in memory, written "
               f"compressed to result.npz): {why}; fewer drive.revolutions make it smaller", file=sys.stderr,
               flush=True)
+    csv = _csv_bytes(scene) * len(engines)
+    if command in ("run", "compare") and csv + size > LARGE_OUTPUT_BYTES:
+        print(f"weftsim {command}: warning: the results will be ~{_size(csv + size)} on disk (~{_size(csv)} of "
+              f"channels.csv: output.sample_deg = {math.degrees(scene.output.sample_angle):g} over "
+              f"{scene.drive.revolutions:g} revolutions); writing them takes a while after the run (each file is "
+              "announced); a coarser output.sample_deg or fewer drive.revolutions make them smaller",
+              file=sys.stderr, flush=True)
+
+
+# Results above this size are announced before the run, and each file as it is written (a 1000-revolution
+# run of the loom wrote 160 MB of CSV and 418 MB of NPZ in 98 s after its progress had reached 100 %).
+LARGE_OUTPUT_BYTES = 50e6
+
+
+def _csv_bytes(scene) -> float:
+    """Estimated bytes of one run's channels.csv (rows x columns x characters a value)."""
+    from weftsim.post.output import CSV_BYTES_PER_VALUE, output_rows
+    from weftsim.post.results import scene_channels
+
+    return output_rows(scene) * len(scene_channels(scene)) * CSV_BYTES_PER_VALUE
+
+
+def _writing_announcer(scene, engines: tuple[str, ...], command: str):
+    """For results above LARGE_OUTPUT_BYTES, a callback saying on stderr which file is being written; else None."""
+    from weftsim.engines import get as engine_named
+
+    size = _csv_bytes(scene) + max(engine_named(engine).estimate(scene).step_bytes for engine in engines)
+    if size <= LARGE_OUTPUT_BYTES:
+        return None
+    return lambda path: print(f"weftsim {command}: writing {path} ...", file=sys.stderr, flush=True)
 
 
 # Signals that stop a run gracefully: the engine ends at its next step and what it computed is
@@ -283,7 +321,7 @@ def cmd_kinematics(args: argparse.Namespace) -> int:
     check_output_fits(rows, len(KINEMATICS_COLUMNS), outdir,
                       f"output.sample_deg = {math.degrees(step):g} over one revolution",
                       fix="a coarser output.sample_deg (any value up to 0.5 deg)")
-    outdir = prepare_directory(outdir, args.force, scene)
+    outdir = prepare_directory(outdir, args.force, scene, kind="kinematics")
     columns = kinematics(scene)
     rpm = scene.drive.speed * 30 / math.pi
     title = f"{scene.name}: ideal rapier motion at {rpm:g} rpm"
@@ -291,7 +329,7 @@ def cmd_kinematics(args: argparse.Namespace) -> int:
         "csv": ("kinematics.csv", lambda target: write_csv(target, columns)),
         "png": ("kinematics.png", lambda target: write_figure(target, plot_kinematics(
             columns["crank_angle_deg"], columns["rapier_displacement_m"], columns["rapier_velocity_m_s"],
-            columns["rapier_acceleration_m_s2"], title))),
+            columns["rapier_acceleration_m_s2"], title, columns["transmission_angle_deg"]))),
     }, scene=scene)
     csv, png = written["csv"], written["png"]
     s, v, a = columns["rapier_displacement_m"], columns["rapier_velocity_m_s"], columns["rapier_acceleration_m_s2"]
@@ -367,12 +405,13 @@ def cmd_run(args: argparse.Namespace) -> int:
     engine = resolve_engine(args.engine)
     outdir = output_directory(args, scene, engine)
     _check_fits(scene, outdir)
-    outdir = prepare_directory(outdir, args.force, scene)
-    _announce_run_time(scene, (engine,), "run")
-    _announce_checks(scene, "run")
-    with _stop_on_interrupt("run") as stop:
+    outdir = prepare_directory(outdir, args.force, scene, kind="run")
+    with _stop_on_interrupt("run") as stop:  # from here a Ctrl-C stops the run (the estimate imports the engine)
+        _announce_run_time(scene, (engine,), "run")
+        _announce_checks(scene, "run")
         result = _solve(scene, engine, announce=True)
-    written = write_run(result, outdir, figure=not args.no_plot, force=args.force, npz=True)
+    written = write_run(result, outdir, figure=not args.no_plot, force=args.force, npz=True,
+                        on_write=_writing_announcer(scene, (engine,), "run"))
     _report_run(result, written)
     report_lines(result, "run")
     if stop["signal"] is not None and not result.ok:
@@ -402,8 +441,8 @@ def cmd_animate(args: argparse.Namespace) -> int:
     check_file_target(target)  # before the solve: a path that cannot be written fails now, not after it
     _check_fits(scene, target.parent)
     check_same_scene(target.parent, scene, args.force)  # beside the results of another scene: refused
-    _announce_run_time(scene, (engine,), "animate")
     with _stop_on_interrupt("animate"):
+        _announce_run_time(scene, (engine,), "animate")
         result = _solve(scene, engine, announce=True)
     if not result.ok:
         raise CliError(f"simulation failed: {result.message}; nothing animated", EXIT_FAILED)
@@ -462,7 +501,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
     scene = scene_from_args(args)
     outdir = output_directory(args, scene, "compare")
     _check_fits(scene, outdir, runs=2)
-    prepare_directory(outdir, args.force, scene)  # refused before the estimate is shown
+    prepare_directory(outdir, args.force, scene, kind="compare")  # refused before the estimate is shown
     with _stdout_to_stderr() if args.json else contextlib.nullcontext():  # the estimate imports Exudyn
         _announce_run_time(scene, ("reference", "exudyn"), "compare")
         _announce_checks(scene, "compare")
@@ -474,19 +513,6 @@ def cmd_compare(args: argparse.Namespace) -> int:
     return 0
 
 
-class _SweepTerminated(KeyboardInterrupt):
-    """SIGTERM or SIGHUP during a sweep: handled as Ctrl-C is (queued cells cancelled, workers ended,
-    table rewritten, lock released), then reported with the signal's own exit status."""
-
-    def __init__(self, signum: int):
-        super().__init__(signum)
-        self.signum = signum
-
-
-def _raise_terminated(signum, frame):
-    raise _SweepTerminated(signum)
-
-
 def cmd_sweep(args: argparse.Namespace) -> int:
     from weftsim.api import SCENE_FLAGS, resolve_engine, scene_overrides
     from weftsim.sweep import format_report, plan_sweep, run_sweep
@@ -496,8 +522,13 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     # The shorthand flags are fixed overrides of every cell, as --set is.
     fixed = list(args.set) + [f"{SCENE_FLAGS[flag]}={value!r}" if isinstance(value, float) else
                               f"{SCENE_FLAGS[flag]}={value}" for flag, value in shorthand_values(args).items()]
-    handled = (signal.SIGTERM, signal.SIGHUP)
-    previous = {sig: signal.signal(sig, _raise_terminated) for sig in handled}
+    with terminated_as_interrupt():
+        return _run_sweep(args, engine, fixed)
+
+
+def _run_sweep(args: argparse.Namespace, engine: str, fixed: list[str]) -> int:
+    from weftsim.sweep import format_report, plan_sweep, run_sweep
+
     try:
         plan = plan_sweep(args.scene, args.vary, fixed, engine, allow_large=args.yes,
                           allow_cwd_engine=args.allow_cwd_engine,
@@ -506,13 +537,10 @@ def cmd_sweep(args: argparse.Namespace) -> int:
             print(f"weftsim sweep: {note}", file=sys.stderr, flush=True)
         outdir = output_directory(args, plan.base, "sweep-" + engine.replace(":", "."))
         report = run_sweep(plan, outdir, jobs=args.jobs, scheduler=args.scheduler, cell_figures=args.cell_figures)
-    except _SweepTerminated as exc:
+    except Terminated as exc:
         name = signal.Signals(exc.signum).name
         raise CliError(f"terminated by {name}; finished cells are kept, run the same command again to resume",
                        128 + exc.signum) from None
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
     print(format_report(report))
     if report.failed:
         raise CliError(f"{report.failed} of {report.total} cells failed (see {report.table} and each failed cell's "
@@ -617,6 +645,12 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"weftsim {args.command}: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except ImportError as exc:
+        # Ctrl-C while a compiled module loads (Exudyn's) surfaces as that module's ImportError: an interruption
+        if isinstance(exc.__context__, KeyboardInterrupt) or isinstance(exc.__cause__, KeyboardInterrupt):
+            print(f"weftsim {args.command}: interrupted", file=sys.stderr)
+            return EXIT_INTERRUPTED
+        raise
 
 
 if __name__ == "__main__":

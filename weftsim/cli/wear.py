@@ -17,6 +17,27 @@ if TYPE_CHECKING:
     from weftsim.input.params import Scene
 
 
+# Where the docs explain ensembles: the one place the command line names it (tests/test_hostile_words.py checks
+# that this section of docs/wear.md is the one about ensembles).
+ENSEMBLE_SECTION = "docs/wear.md section 9"
+SAMPLES, SEED, CHAOS_RUNS = 1000, 0, 6  # the ensemble's defaults (weftsim.wear.ensemble.CHAOS_RUNS: the same)
+# The flags only an ensemble reads, by their argparse names: given without --uncertain they are refused.
+ENSEMBLE_ONLY = ("samples", "seed", "chaos_runs", "level_mm", "design_points", "jobs", "scheduler")
+
+
+def seed(text: str) -> int:
+    """An argparse type: a whole number >= 0 (numpy's generators take no negative seed)."""
+    import argparse
+
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be a whole number >= 0, got {text!r}")
+    return value
+
+
 def add_flags(p: argparse.ArgumentParser, positive: Callable[[Callable[[str], float]], Callable[[str], float]]) -> None:
     """Flags of ``weftsim wear SCENE --hours H [--engine E] [--limit-clearance-mm X]`` beside the shared
     scene and output flags."""
@@ -29,14 +50,20 @@ def add_flags(p: argparse.ArgumentParser, positive: Callable[[Callable[[str], fl
                    help="clearance limit for every wearing joint: wear.json gives the hours at which each joint's "
                         "effective clearance reaches it and the first of them (the joint to service first)")
     p.add_argument("--no-plot", action="store_true", help="skip the figures")
-    ens = p.add_argument_group("ensemble (docs/wear.md section 7)")
+    from weftsim.wear.uncertain import ALLOWED
+
+    ens = p.add_argument_group(f"ensemble ({ENSEMBLE_SECTION}); these flags need --uncertain")
     ens.add_argument("--uncertain", action="append", default=[], metavar="KEY=DISTRIBUTION",
-                     help="an uncertain scene key, in its file units: normal(mean,sd), lognormal(median,sigma_of_log), "
-                          "uniform(low,high) or triangular(low,mode,high); repeatable. Needs --limit-clearance-mm")
-    ens.add_argument("--samples", type=int, default=1000, help="ensemble samples (default 1000; cost no simulation)")
-    ens.add_argument("--seed", type=int, default=0, help="seed of the ensemble's sampling (default 0)")
-    ens.add_argument("--chaos-runs", type=int, default=6, help="predictions of the nominal design point differing "
-                     "in the last bits of k, sampling the chaotic scatter (default 6)")
+                     help=f"an uncertain scene key (dotted, or its last part as --set takes it), in its file units: "
+                          f"{ALLOWED} (walther: a viscosity key, from the oil's nu at 40 and 100 C and a "
+                          "temperature range); repeatable. Needs --limit-clearance-mm; results in "
+                          "out/<scene name>/wear-ensemble")
+    ens.add_argument("--samples", type=int, default=None, help=f"ensemble samples (default {SAMPLES}; cost no "
+                     "simulation)")
+    ens.add_argument("--seed", type=seed, default=None, help="seed of the ensemble's sampling, a whole number "
+                     ">= 0 (default 0)")
+    ens.add_argument("--chaos-runs", type=int, default=None, help="predictions of the nominal design point differing "
+                     f"in the last bits of k, sampling the chaotic scatter (default {CHAOS_RUNS})")
     ens.add_argument("--level-mm", action="append", type=positive(float), default=[], metavar="X",
                      help="also give the hours to an effective clearance of X mm (below the limit); repeatable")
     ens.add_argument("--design-points", action="append", default=[], metavar="KEY=N",
@@ -62,13 +89,19 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     limit = None if args.limit_clearance_mm is None else args.limit_clearance_mm * 1e-3
     if args.uncertain:
         return run_ensemble(args, scene, outdir, stop_on_interrupt)
+    given = [name for name in ENSEMBLE_ONLY if getattr(args, name) not in (None, [])]
+    if given:
+        flags = ", ".join("--" + name.replace("_", "-") for name in given)
+        raise CliError(f"{flags} {'sets' if len(given) == 1 else 'set'} an ensemble and need(s) --uncertain "
+                       "KEY=DISTRIBUTION (with --limit-clearance-mm); without --uncertain `weftsim wear` predicts "
+                       "one scene: leave them out")
     if args.hours is None and limit is None:
         raise CliError("--hours or --limit-clearance-mm is required (or --uncertain KEY=DISTRIBUTION with "
                        "--limit-clearance-mm for an ensemble)")
     until_limit = args.hours is None  # predict until the clearance limit
     hours = MAX_HOURS if until_limit else args.hours
     check_request(scene, hours, args.engine, limit)  # a WearError is one line, exit 2
-    outdir = prepare_directory(outdir, args.force, scene)
+    outdir = prepare_directory(outdir, args.force, scene, kind="wear")
     try:
         check_engine(outdir, args.engine, args.force)  # a state of the other engine: one line, or --force
     except StateMismatch as exc:
@@ -167,19 +200,27 @@ def run_ensemble(args: argparse.Namespace, scene: Scene, outdir: str | Path,
             raise CliError(f"--design-points {text!r}: give KEY=N with a whole number N from 2 to 9") from None
     if args.engine != "reference":
         raise CliError("an ensemble runs on the reference engine (--engine reference)")
+    import signal
+
+    from weftsim.cli.signals import Terminated, terminated_as_interrupt
+
     limit = args.limit_clearance_mm * 1e-3
     try:
-        data = wear_ensemble(scene, args.uncertain, args.samples, limit, outdir, jobs=args.jobs,
-                             scheduler=args.scheduler, seed=args.seed, figures=not args.no_plot, force=args.force,
-                             chaos_runs=args.chaos_runs, design_points=design_points,
-                             levels=tuple(1e-3 * v for v in args.level_mm),
-                             announce=lambda text: print(text, file=sys.stderr, flush=True),
-                             **({} if args.hours is None else {"horizon": args.hours}))
+        with terminated_as_interrupt():
+            data = wear_ensemble(scene, args.uncertain, SAMPLES if args.samples is None else args.samples, limit,
+                                 outdir, jobs=args.jobs, scheduler=args.scheduler,
+                                 seed=SEED if args.seed is None else args.seed, figures=not args.no_plot,
+                                 force=args.force, chaos_runs=CHAOS_RUNS if args.chaos_runs is None else args.chaos_runs,
+                                 design_points=design_points, levels=tuple(1e-3 * v for v in args.level_mm),
+                                 announce=lambda text: print(text, file=sys.stderr, flush=True),
+                                 **({} if args.hours is None else {"horizon": args.hours}))
     except WearError as exc:
         raise CliError(str(exc)) from None
-    except KeyboardInterrupt:
-        raise CliError(f"interrupted: every job's updates so far are in {outdir}/jobs; run the same command again "
-                       "to resume", 130) from None
+    except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM / SIGHUP (Terminated): the pool is shut down
+        signum = exc.signum if isinstance(exc, Terminated) else signal.SIGINT
+        how = "interrupted" if signum == signal.SIGINT else f"terminated by {signal.Signals(signum).name}"
+        raise CliError(f"{how}: every job's updates so far are in {outdir}/jobs; run the same command again "
+                       "to resume", 128 + signum) from None
     m = data["method"]
     print(f"scene {scene.name}: hours to an effective clearance of {args.limit_clearance_mm:g} mm at E, "
           f"{data['samples']} samples ({len(data['jobs'])} simulated predictions, {data['wall_time_s']:.0f} s)")
@@ -201,8 +242,11 @@ def run_ensemble(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     if reach["fraction"] < 1.0 and data.get("hours_of_those_reaching"):
         print("  of those reaching it: " + ", ".join(f"{name} {text_hours(q['hours'], horizon)}" for name, q in
                                                      data["hours_of_those_reaching"].items()))
-    print("  shares of the spread: " + ", ".join(f"{k} {100 * v['share']:.0f} %" for k, v in
-                                                 sorted(data["shares"].items(), key=lambda kv: -kv[1]["share"])))
+    if any(v["share"] > 0.0 for v in data["shares"].values()):
+        print("  shares of the spread: " + ", ".join(f"{k} {100 * v['share']:.0f} %" for k, v in
+                                                     sorted(data["shares"].items(), key=lambda kv: -kv[1]["share"])))
+    else:
+        print("  shares of the spread: none (the hours to the limit are the same in every sample)")
     for path in data["files"].values():
         print(f"  wrote {path}")
     return 0

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from weftsim.errors import SceneError
 
 
 @dataclass(frozen=True)
@@ -200,7 +201,7 @@ class Lubrication:
     def __post_init__(self):
         problem = lubrication_problem(self)
         if problem is not None:
-            raise ValueError(problem)
+            raise SceneError(problem)
 
     @property
     def model_code(self) -> int:
@@ -318,7 +319,7 @@ class ClearanceJoint:
     def __post_init__(self):
         problem = joint_problem(self)
         if problem is not None:
-            raise ValueError(problem)
+            raise SceneError(problem)
 
     @property
     def is_ideal(self) -> bool:

@@ -78,6 +78,8 @@ def _flatten(table: dict, where: str, prefix: tuple[str, ...] = (),
     for name, value in table.items():
         path = ".".join(prefix + (name,))
         if isinstance(value, dict):
+            if not value:
+                _check_empty_table(path, where)
             flat.update(_flatten(value, where, prefix + (name,), seen))
             continue
         if path in seen:
@@ -86,6 +88,30 @@ def _flatten(table: dict, where: str, prefix: tuple[str, ...] = (),
         seen[path] = _spelling(prefix, name)
         flat[path] = value
     return flat
+
+
+def _tables() -> set[str]:
+    """Every table a scene file may hold (``joint_e``, ``joint_e.wear``, ``solver.reference``, ...)."""
+    out = set()
+    for key in SCHEMA:
+        parts = key.path.split(".")
+        out.update(".".join(parts[:i]) for i in range(1, len(parts)))
+    return out
+
+
+def _check_empty_table(path: str, where: str) -> None:
+    """An empty table says something or nothing: ``[joint_e.lubrication]`` with no key would run the dry joint
+    (the table needs its viscosity), an unknown one (``[joint_e.lubricaton]``) would be ignored: refused."""
+    tables = _tables()
+    if path not in tables:
+        close = difflib.get_close_matches(path, sorted(tables), n=1, cutoff=0.75)
+        mean = f"did you mean [{close[0]}]? " if close else ""
+        raise SceneError(f"{where}: unknown table [{shown(path)}]; {mean}a scene's tables are "
+                         f"{', '.join(sorted(t for t in tables if '.' not in t))} and the tables in them")
+    if path.endswith(".lubrication"):
+        raise SceneError(f"{where}: the table [{path}] is empty; it must give the oil's viscosity "
+                         f"({path}.viscosity_mpa_s, the other lubrication keys default), or leave the table out "
+                         "for the dry joint")
 
 
 def _read_toml(path: Path) -> dict:
@@ -242,7 +268,19 @@ def _read_merged(path: Path) -> tuple[dict[str, Any], dict[str, Path]]:
     return merged, origin
 
 
+def _plain(value: Any) -> Any:
+    """A numpy scalar or array as the Python value it holds (``np.float32(0.3)`` -> 0.3, an array -> a list):
+    a script's override computed with numpy is a number like any other."""
+    if type(value).__module__ == "numpy" and hasattr(value, "tolist"):
+        return value.tolist()
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    return value
+
+
 def _convert(key: Key, value: Any, where: str) -> Any:
+    value = _plain(value)
+
     def fail(expect: str) -> SceneError:
         return SceneError(f"{where}: key '{key.path}' {expect}, got {value!r}")
 
@@ -449,6 +487,16 @@ def load_scene(path: str | os.PathLike, overrides: dict[str, Any] | None = None,
     return scene
 
 
+def _file_value(si: float, scale: float) -> float:
+    """``si / scale`` as the file gives it: 30 deg, not the 29.999999999999996 the division leaves of 30 * pi / 180,
+    when the 15-digit value scales back to exactly ``si`` (otherwise the quotient, unrounded)."""
+    value = si / scale
+    if scale == 1.0 or not math.isfinite(value):
+        return value
+    short = float(f"{value:.15g}")
+    return short if short * scale == si else value
+
+
 def to_file_keys(scene: params.Scene) -> dict[str, Any]:
     """The scene as flattened file keys in file units (for summaries and provenance)."""
     out: dict[str, Any] = {"name": scene.name}
@@ -463,7 +511,7 @@ def to_file_keys(scene: params.Scene) -> dict[str, Any]:
         elif key.path == "mechanism.fourbar_branch":
             obj = "+" if obj > 0 else "-"
         elif key.kind in ("float", "floats2", "floats3"):
-            obj = obj / key.scale if key.kind == "float" else [v / key.scale for v in obj]
+            obj = _file_value(obj, key.scale) if key.kind == "float" else [_file_value(v, key.scale) for v in obj]
         out[key.path] = obj
     return out
 

@@ -52,6 +52,20 @@ class Key:
 
 
 MM, DEG, GPA, MPA, RPM = 1e-3, math.pi / 180.0, 1e9, 1e6, 2.0 * math.pi / 60.0
+# Upper bounds of the machine's keys: far beyond any loom (a linkage of a few hundred mm, members of a few
+# kg, a 20 mm pin, steel at 210 GPa), so that only a typo or a unit slip meets them, and a value past them
+# is refused naming its key instead of failing later with a message about something else.
+LENGTH_MM = 1e4  # 10 m
+PIN_MM = 1e3
+MASS_KG = 1e3
+INERTIA_KG_M2 = 1e3
+SPEED_M_S = 10.0  # friction ramp and impact-velocity floor: the journal's sliding speed is ~1 m/s
+MODULUS_GPA = 1e4  # diamond: 1.2e3 GPa
+STRESS_MPA = 1e5
+VISCOSITY_MPA_S = 1e5  # a gear oil well below freezing is ~1e4 mPa s
+# Tolerances of the solvers: below 1e-14 (50 eps) a step's error estimate is round-off and the step control
+# chases it to a collapse (solver.reference.atol = 1e-20 collapsed the first step to 3e-17 s).
+TOLERANCE_FLOOR = 1e-14
 
 
 def WEAR_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 - a constant-like key factory
@@ -86,12 +100,12 @@ def LUBRICATION_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 -
     at = f"{table}.lubrication."
     to = f"{joint}.lubrication."
     return (
-        Key(at + "viscosity_mpa_s", to + "viscosity", "float", 1e-3, 0, None, False,
+        Key(at + "viscosity_mpa_s", to + "viscosity", "float", 1e-3, 0, VISCOSITY_MPA_S, False,
             doc="dynamic viscosity of the oil at operating temperature (ISO VG 220 at 60 C: ~80 mPa s); 0 = no film"),
         Key(at + "model", to + "model", "str", choices=params.FILM_MODELS,
             doc="film model: finite (finite-length bearing, default), short (Ocvirk), long (Sommerfeld) or "
                 "short_half (Flores et al.'s short bearing)"),
-        Key(at + "roughness_um", to + "roughness", "float", 1e-6, 0,
+        Key(at + "roughness_um", to + "roughness", "float", 1e-6, 0, 100,
             doc="combined RMS roughness of journal and bearing (default 0.4 um, two ground surfaces)"),
         Key(at + "asperity_density_radius_roughness", to + "asperity_density_radius_roughness", "float", 1, 0, 1,
             False, doc="Greenwood-Tripp eta beta sigma (default 0.04); 0 = no asperity contact"),
@@ -109,69 +123,73 @@ SCHEMA: tuple[Key, ...] = (
         doc="beta, arc A-B of the spherical 4R"),
     Key("mechanism.rocker_arm_angle_deg", "geometry.rocker_arm_angle", "float", DEG, -360, 360, False, False,
         doc="theta_OE0, angle of OE from +y towards +z at phi = 0"),
-    Key("mechanism.l_oe_mm", "geometry.l_oe", "float", MM, 0, doc="rocker arm OE"),
-    Key("mechanism.l_ef_mm", "geometry.l_ef", "float", MM, 0, doc="connecting rod EF"),
-    Key("mechanism.l_fg_mm", "geometry.l_fg", "float", MM, 0, doc="sector arm FG"),
-    Key("mechanism.l_og_mm", "geometry.l_og", "float", MM, 0, doc="frame O-G"),
+    Key("mechanism.l_oe_mm", "geometry.l_oe", "float", MM, 0, LENGTH_MM, doc="rocker arm OE"),
+    Key("mechanism.l_ef_mm", "geometry.l_ef", "float", MM, 0, LENGTH_MM, doc="connecting rod EF"),
+    Key("mechanism.l_fg_mm", "geometry.l_fg", "float", MM, 0, LENGTH_MM, doc="sector arm FG"),
+    Key("mechanism.l_og_mm", "geometry.l_og", "float", MM, 0, LENGTH_MM, doc="frame O-G"),
     Key("mechanism.fourbar_branch", "geometry.fourbar_branch", "str", choices=tuple(BRANCHES),
         doc="assembly branch of the four-bar (docs/physics.md section 1: \"+\")"),
-    Key("mechanism.sector_pitch_radius_mm", "geometry.sector_pitch_radius", "float", MM, 0, doc="d5"),
-    Key("mechanism.pinion_pitch_radius_mm", "geometry.pinion_pitch_radius", "float", MM, 0, doc="d6"),
-    Key("mechanism.rapier_gear_pitch_radius_mm", "geometry.rapier_gear_pitch_radius", "float", MM, 0, doc="d7"),
-    Key("inertia.crank_inertia_kg_m2", "inertia.crank_inertia", "float", 1, 0, doc="J1 about A"),
-    Key("inertia.coupler_mass_kg", "inertia.coupler_mass", "float", 1, 0, doc="m2 (centre of mass at O)"),
-    Key("inertia.coupler_inertia_kg_m2", "inertia.coupler_inertia", "floats3", 1, 0,
+    Key("mechanism.sector_pitch_radius_mm", "geometry.sector_pitch_radius", "float", MM, 0, LENGTH_MM, doc="d5"),
+    Key("mechanism.pinion_pitch_radius_mm", "geometry.pinion_pitch_radius", "float", MM, 0, LENGTH_MM, doc="d6"),
+    Key("mechanism.rapier_gear_pitch_radius_mm", "geometry.rapier_gear_pitch_radius", "float", MM, 0, LENGTH_MM, doc="d7"),
+    Key("inertia.crank_inertia_kg_m2", "inertia.crank_inertia", "float", 1, 0, INERTIA_KG_M2, doc="J1 about A"),
+    Key("inertia.coupler_mass_kg", "inertia.coupler_mass", "float", 1, 0, MASS_KG, doc="m2 (centre of mass at O)"),
+    Key("inertia.coupler_inertia_kg_m2", "inertia.coupler_inertia", "floats3", 1, 0, INERTIA_KG_M2,
         doc="principal inertia of the coupler about O in [b, c, b x c]"),
-    Key("inertia.rocker_mass_kg", "inertia.rocker_mass", "float", 1, 0, doc="m3"),
-    Key("inertia.rocker_com_mm", "inertia.rocker_com", "float", MM, None, doc="rocker centre of mass on OE from O"),
-    Key("inertia.rocker_inertia_kg_m2", "inertia.rocker_inertia", "float", 1, 0, doc="J3 about D"),
-    Key("inertia.rod_mass_kg", "inertia.rod_mass", "float", 1, 0, doc="m4 (centre of mass mid EF)"),
-    Key("inertia.rod_inertia_kg_m2", "inertia.rod_inertia", "float", 1, 0, doc="J4 about its centre of mass"),
-    Key("inertia.sector_inertia_kg_m2", "inertia.sector_inertia", "float", 1, 0, doc="J5 about G"),
-    Key("inertia.pinion_gear_inertia_kg_m2", "inertia.pinion_gear_inertia", "float", 1, 0, doc="J67"),
-    Key("inertia.rapier_mass_kg", "inertia.rapier_mass", "float", 1, 0, doc="m8"),
-    Key("inertia.gravity_m_s2", "inertia.gravity", "float", 1, 0, doc="g along -z"),
+    Key("inertia.rocker_mass_kg", "inertia.rocker_mass", "float", 1, 0, MASS_KG, doc="m3"),
+    Key("inertia.rocker_com_mm", "inertia.rocker_com", "float", MM, -LENGTH_MM, LENGTH_MM, False, doc="rocker centre of mass on OE from O"),
+    Key("inertia.rocker_inertia_kg_m2", "inertia.rocker_inertia", "float", 1, 0, INERTIA_KG_M2, doc="J3 about D"),
+    Key("inertia.rod_mass_kg", "inertia.rod_mass", "float", 1, 0, MASS_KG, doc="m4 (centre of mass mid EF)"),
+    Key("inertia.rod_inertia_kg_m2", "inertia.rod_inertia", "float", 1, 0, INERTIA_KG_M2, doc="J4 about its centre of mass"),
+    Key("inertia.sector_inertia_kg_m2", "inertia.sector_inertia", "float", 1, 0, INERTIA_KG_M2, doc="J5 about G"),
+    Key("inertia.pinion_gear_inertia_kg_m2", "inertia.pinion_gear_inertia", "float", 1, 0, INERTIA_KG_M2, doc="J67"),
+    Key("inertia.rapier_mass_kg", "inertia.rapier_mass", "float", 1, 0, MASS_KG, doc="m8"),
+    Key("inertia.gravity_m_s2", "inertia.gravity", "float", 1, 0, 100, doc="g along -z"),
     Key("joint_e.clearance_mm", "joint.clearance", "float", MM, 0, 5, False, doc="radial clearance c; 0 = ideal joint"),
-    Key("joint_e.journal_radius_mm", "joint.journal_radius", "float", MM, 0, doc="R_j"),
-    Key("joint_e.bearing_length_mm", "joint.bearing_length", "float", MM, 0, doc="L_b"),
+    Key("joint_e.journal_radius_mm", "joint.journal_radius", "float", MM, 0, PIN_MM, doc="R_j"),
+    Key("joint_e.bearing_length_mm", "joint.bearing_length", "float", MM, 0, PIN_MM, doc="L_b"),
     Key("joint_e.law", "joint.law", "str", doc="contact force law (see weftsim.joint.contact.LAWS)"),
     Key("joint_e.restitution", "joint.restitution", "float", 1, 0, 1, True, False, doc="coefficient of restitution ce"),
     Key("joint_e.friction_coefficient", "joint.friction_coefficient", "float", 1, 0, 2, False,
         doc="mu of the modified Coulomb law; 0 = off"),
-    Key("joint_e.friction_velocities_m_s", "joint.friction_velocities", "floats2", 1, 0,
+    Key("joint_e.friction_velocities_m_s", "joint.friction_velocities", "floats2", 1, 0, SPEED_M_S,
         doc="[v0, v1] of the friction ramp, v0 < v1"),
-    Key("joint_e.min_impact_velocity_m_s", "joint.min_impact_velocity", "float", 1, 0,
+    Key("joint_e.min_impact_velocity_m_s", "joint.min_impact_velocity", "float", 1, 0, SPEED_M_S,
         doc="floor on the held impact velocity"),
     Key("joint_e.impact_velocity_rule", "joint.impact_velocity_rule", "str", choices=IMPACT_VELOCITY_RULES,
         doc="held impact velocity: largest approach rate since onset, or the onset value alone"),
-    Key("joint_e.journal_material.youngs_modulus_gpa", "joint.journal_material.youngs_modulus", "float", GPA, 0),
+    Key("joint_e.journal_material.youngs_modulus_gpa", "joint.journal_material.youngs_modulus", "float", GPA, 0, MODULUS_GPA),
     Key("joint_e.journal_material.poisson_ratio", "joint.journal_material.poisson_ratio", "float", 1, 0, 0.5,
         False, True),
-    Key("joint_e.bearing_material.youngs_modulus_gpa", "joint.bearing_material.youngs_modulus", "float", GPA, 0),
+    Key("joint_e.bearing_material.youngs_modulus_gpa", "joint.bearing_material.youngs_modulus", "float", GPA, 0, MODULUS_GPA),
     Key("joint_e.bearing_material.poisson_ratio", "joint.bearing_material.poisson_ratio", "float", 1, 0, 0.5,
         False, True),
-    Key("joint_e.journal_material.yield_strength_mpa", "joint.journal_material.yield_strength", "float", MPA, 0,
+    Key("joint_e.journal_material.yield_strength_mpa", "joint.journal_material.yield_strength", "float", MPA, 0, STRESS_MPA,
         doc="optional; peak contact pressure above 1.67 x this (first yield) is warned about"),
-    Key("joint_e.bearing_material.yield_strength_mpa", "joint.bearing_material.yield_strength", "float", MPA, 0,
+    Key("joint_e.bearing_material.yield_strength_mpa", "joint.bearing_material.yield_strength", "float", MPA, 0, STRESS_MPA,
         doc="optional; as for the journal (the smaller of the two counts)"),
-    Key("joint_e.bearing_material.max_pressure_mpa", "joint.bearing_material.max_pressure", "float", MPA, 0,
+    Key("joint_e.bearing_material.max_pressure_mpa", "joint.bearing_material.max_pressure", "float", MPA, 0, STRESS_MPA,
         doc="optional; the bushing's permitted projected pin pressure F / (d B): a peak above it is warned about"),
-    Key("joint_e.bearing_material.max_pv_mpa_m_s", "joint.bearing_material.max_pv", "float", MPA, 0,
+    Key("joint_e.bearing_material.max_pv_mpa_m_s", "joint.bearing_material.max_pv", "float", MPA, 0, 1e4,
         doc="optional; the bushing's permitted p x v (MPa x m/s): a cycle mean above it is warned about"),
-    Key("joint_e.design_clearance_per_mille", "joint.design_clearance", "floats2", 1e-3, 0, None, False,
+    Key("joint_e.design_clearance_per_mille", "joint.design_clearance", "floats2", 1e-3, 0, 500, False,
         doc="optional; [low, high] design range of the radial clearance over the pin diameter, per mille "
             "(default [0.5, 1.0], a bushed pin in oscillating motion); outside it is warned about"),
     *WEAR_KEYS("joint_e", "joint"),
     *LUBRICATION_KEYS("joint_e", "joint"),
-    Key("drive.speed_rpm", "drive.speed", "float", RPM, 0, 5000, doc="constant crank speed"),
+    # At least 1 rpm: a loom jogs at 10-60 rpm; slower, the journal rests in lasting contact for hours of machine
+    # time, which the engines resolve in steps of microseconds (the reference scene: 179 steps for 0.1
+    # revolution at 400 rpm, 2421 at 4 rpm; --speed-rpm 1e-9 ran 40 s without reaching 1 % of the run).
+    Key("drive.speed_rpm", "drive.speed", "float", RPM, 1, 5000, False,
+        doc="constant crank speed (1 rpm or more: a jog is 10-60 rpm)"),
     Key("drive.revolutions", "drive.revolutions", "float", 1, 0, 1000, doc="crank revolutions to simulate"),
     Key("solver.reference.method", "reference_solver.method", "str", choices=INTEGRATORS,
         doc="method of the reference engine: scipy's, or numba_* (compiled, docs/performance.md; numba_RODAS4 "
             "linearly implicit, numba_DOP853_RODAS4 implicit in contact); auto = numba_DOP853, or with friction "
             "numba_DOP853_RODAS4 at rtol <= 1e-6, or with a lubricated joint numba_RODAS4 (the fastest paths "
             "meeting the accuracy targets)"),
-    Key("solver.reference.rtol", "reference_solver.rtol", "float", 1, 0, 1e-2, doc="relative tolerance"),
-    Key("solver.reference.atol", "reference_solver.atol", "float", 1, 0, 1e-2, doc="absolute tolerance"),
+    Key("solver.reference.rtol", "reference_solver.rtol", "float", 1, TOLERANCE_FLOOR, 1e-2, False, doc="relative tolerance"),
+    Key("solver.reference.atol", "reference_solver.atol", "float", 1, TOLERANCE_FLOOR, 1e-2, False, doc="absolute tolerance"),
     Key("solver.reference.max_step_deg", "reference_solver.max_step", "float", DEG, 0, 90,
         doc="largest step, as crank angle"),
     Key("solver.exudyn.model", "exudyn_solver.model", "str", choices=EXUDYN_MODELS,
@@ -180,7 +198,7 @@ SCHEMA: tuple[Key, ...] = (
     Key("solver.exudyn.step_control", "exudyn_solver.step_control", "str", choices=STEP_CONTROLS,
         doc="rigid_body model: adaptive (step from a local error estimate: large in free flight, small "
             "through impacts) or fixed (step_size_s)"),
-    Key("solver.exudyn.local_error_m", "exudyn_solver.local_error", "float", 1, 0, 1e-3,
+    Key("solver.exudyn.local_error_m", "exudyn_solver.local_error", "float", 1, TOLERANCE_FLOOR, 1e-3, False,
         doc="rigid_body model, adaptive, and kinematic_tree, implicit: tolerance of the local error estimate "
             "of the journal centre at E per step"),
     Key("solver.exudyn.step_size_s", "exudyn_solver.step_size", "float", 1, 0, 1e-2,
@@ -190,7 +208,8 @@ SCHEMA: tuple[Key, ...] = (
         doc="rigid_body model: generalized-alpha spectral radius (<= 0.9 for smooth constraint torques; the "
             "kinematic tree's implicit solver takes 1, it has no constraints)"),
     Key("solver.exudyn.modified_newton", "exudyn_solver.modified_newton", "bool", doc="modified Newton"),
-    Key("solver.exudyn.newton_relative_tolerance", "exudyn_solver.newton_relative_tolerance", "float", 1, 0, 1e-2),
+    Key("solver.exudyn.newton_relative_tolerance", "exudyn_solver.newton_relative_tolerance", "float", 1, TOLERANCE_FLOOR, 1e-2,
+        False),
     Key("solver.exudyn.newton_max_iterations", "exudyn_solver.newton_max_iterations", "int", 1, 0, 1000),
     Key("solver.exudyn.callback", "exudyn_solver.callback", "str", choices=CALLBACK_ROUTES,
         doc="contact callback route; auto = fastest measured"),
@@ -200,22 +219,22 @@ SCHEMA: tuple[Key, ...] = (
             "in the joint, explicit without (the faster of the two for each, docs/performance.md)"),
     Key("solver.exudyn.explicit_method", "exudyn_solver.explicit_method", "str", choices=EXPLICIT_METHODS,
         doc="kinematic_tree model: explicit solver with automatic step size"),
-    Key("solver.exudyn.relative_tolerance", "exudyn_solver.relative_tolerance", "float", 1, 0, 1e-2,
+    Key("solver.exudyn.relative_tolerance", "exudyn_solver.relative_tolerance", "float", 1, TOLERANCE_FLOOR, 1e-2, False,
         doc="kinematic_tree model: relative tolerance of the step-size control"),
-    Key("solver.exudyn.absolute_tolerance", "exudyn_solver.absolute_tolerance", "float", 1, 0, 1e-2,
+    Key("solver.exudyn.absolute_tolerance", "exudyn_solver.absolute_tolerance", "float", 1, TOLERANCE_FLOOR, 1e-2, False,
         doc="kinematic_tree model: absolute tolerance (joint angles in rad, rates in rad/s)"),
     Key("output.sample_deg", "output.sample_angle", "float", DEG, 0, 0.5, True, False,
         doc="output grid spacing in crank angle (0.5 deg or finer)"),
-    Key("compare.first_contact_angle_deg", "compare.first_contact_angle", "float", DEG, 0),
-    Key("compare.first_revolution_peaks", "compare.first_revolution_peaks", "float", 1, 0,
+    Key("compare.first_contact_angle_deg", "compare.first_contact_angle", "float", DEG, 0, 360),
+    Key("compare.first_revolution_peaks", "compare.first_revolution_peaks", "float", 1, 0, 1,
         doc="relative tolerance on first-revolution maxima"),
-    Key("compare.rms", "compare.rms", "float", 1, 0, doc="relative tolerance on RMS over revolutions 2..N"),
-    Key("compare.percentile_99", "compare.percentile_99", "float", 1, 0, doc="relative tolerance on 99th percentiles"),
-    Key("compare.ideal_curves", "compare.ideal_curves", "float", 1, 0,
+    Key("compare.rms", "compare.rms", "float", 1, 0, 1, doc="relative tolerance on RMS over revolutions 2..N"),
+    Key("compare.percentile_99", "compare.percentile_99", "float", 1, 0, 1, doc="relative tolerance on 99th percentiles"),
+    Key("compare.ideal_curves", "compare.ideal_curves", "float", 1, 0, 1,
         doc="ideal joint: largest difference at any sample, relative to the peak"),
-    Key("limits.max_wall_time_s", "limits.max_wall_time", "float", 1, 0, None, False,
+    Key("limits.max_wall_time_s", "limits.max_wall_time", "float", 1, 0, 1e7, False,
         doc="wall-clock budget of one run; 0 = no limit (the run fails when it is spent)"),
-    Key("limits.max_steps", "limits.max_steps", "int", 1, 0, None, False,
+    Key("limits.max_steps", "limits.max_steps", "int", 1, 0, 10**10, False,
         doc="budget of accepted solver steps; 0 = no limit"),
     Key("limits.max_penetration_ratio", "limits.max_penetration", "float", 1, 0, 1, True, False,
         doc="the run fails when the penetration exceeds this fraction of the journal radius"),
@@ -223,9 +242,9 @@ SCHEMA: tuple[Key, ...] = (
         doc="step-size collapse: the smallest step either engine may take"),
     Key("limits.max_energy_error", "limits.max_energy_error", "float", 1, 0, 1, True, False,
         doc="the run fails when the energy balance misses by more than this fraction of the largest kinetic energy"),
-    Key("limits.max_rapier_acceleration_m_s2", "limits.max_rapier_acceleration", "float", 1, 0,
+    Key("limits.max_rapier_acceleration_m_s2", "limits.max_rapier_acceleration", "float", 1, 0, 1e6,
         doc="largest rapier acceleration a rapier head is built for (default 3000 m/s2); above it is warned about"),
-    Key("limits.max_damping_ratio", "limits.max_damping_ratio", "float", 1, 0, None, True,
+    Key("limits.max_damping_ratio", "limits.max_damping_ratio", "float", 1, 0, 1e6, True,
         doc="damping force bound, multiple of xi x the elastic force (delta_dot / v_imp): <= 1 in an isolated "
             "impact and under max_approach (beyond it the run fails); the onset rule exceeds it (a warning)"),
 )

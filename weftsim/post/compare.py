@@ -344,7 +344,7 @@ def run_compare(scene: Scene, outdir: str | Path, solve: Callable[[Scene, str], 
     from weftsim.checks.design_checks import report_lines
     from weftsim.post.output import prepare_directory, write_files, write_json, write_run
 
-    outdir = prepare_directory(outdir, force, scene)
+    outdir = prepare_directory(outdir, force, scene, kind="compare")
     results = {engine: solve(scene, engine) for engine in ("reference", "exudyn")}
     for engine, result in results.items():
         write_run(result, outdir / engine, figure=False, force=force)

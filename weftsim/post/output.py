@@ -30,7 +30,7 @@ import numpy as np
 
 from weftsim.errors import OutputError, WriteFailed
 from weftsim.post.npz_guard import available_memory
-from weftsim.post.record import MANIFEST, SCENE_FILE, check_same_scene, provenance, scene_toml
+from weftsim.post.record import MANIFEST, SCENE_FILE, check_same_kind, check_same_scene, provenance, scene_toml
 from weftsim.post.results import RunResult
 
 if TYPE_CHECKING:
@@ -52,13 +52,16 @@ CSV_BYTES_PER_VALUE = 18
 MEMORY_BYTES_PER_VALUE = 24
 
 
-def prepare_directory(path: str | Path, force: bool = False, scene: Scene | None = None) -> Path:
+def prepare_directory(path: str | Path, force: bool = False, scene: Scene | None = None,
+                      kind: str | None = None) -> Path:
     """Create ``path`` (and parents) and check it is a writable directory of ours.
 
     A directory that already holds files but no weftsim manifest was not written by
     weftsim: it is refused (unless ``force``) so a run never mixes its files with others.
     With ``scene``, a directory holding the results of another resolved scene is refused too
     (unless ``force``; :func:`weftsim.post.record.check_same_scene`), before anything is written.
+    With ``kind`` (the manifest's ``"kind"`` the caller writes: ``"run"``, ``"wear"``, ``"wear ensemble"``,
+    ...), a directory holding another command's results is refused too (:func:`~weftsim.post.record.check_same_kind`).
     """
     path = Path(path)
     if path.is_dir() and not force and not (path / MANIFEST).exists() and any(path.iterdir()):
@@ -66,8 +69,10 @@ def prepare_directory(path: str | Path, force: bool = False, scene: Scene | None
             f"output directory {path} is not empty and was not written by weftsim; "
             "choose another directory with -o, or pass --force to write into it anyway"
         )
-    if scene is not None:
+    if scene is not None:  # first: results of another scene are named by the keys that differ
         check_same_scene(path, scene, force)
+    if kind is not None:
+        check_same_kind(path, kind, force)
     try:
         path.mkdir(parents=True, exist_ok=True)
     except FileExistsError:
@@ -270,7 +275,7 @@ def _rescue(failed: dict[str, tuple[str, Callable[[Path], Path]]]) -> tuple[Path
 
 
 def write_files(outdir: Path, what: dict, files: dict[str, tuple[str, Callable[[Path], Path]]],
-                scene: Scene | None = None) -> dict[str, Path]:
+                scene: Scene | None = None, on_write: Callable[[Path], None] | None = None) -> dict[str, Path]:
     """Write a set of files into ``outdir`` under its manifest; keep what fails elsewhere.
 
     Parameters
@@ -285,6 +290,8 @@ def write_files(outdir: Path, what: dict, files: dict[str, tuple[str, Callable[[
     scene : Scene, optional
         The scene of these results: the manifest records it resolved and the command line
         (:func:`weftsim.post.record.provenance`), and ``scene.toml`` holds it as a scene file.
+    on_write : callable, optional
+        Called with each file's path before it is written (progress on a long write).
 
     Returns
     -------
@@ -303,6 +310,8 @@ def write_files(outdir: Path, what: dict, files: dict[str, tuple[str, Callable[[
     begin_directory(outdir, what)
     written, failed, reasons = {}, {}, {}
     for kind, (name, write) in files.items():
+        if on_write is not None:
+            on_write(outdir / name)
         try:
             written[kind] = write(outdir / name)
         except OSError as exc:
@@ -382,7 +391,7 @@ def output_rows(scene: Scene) -> float:
 
 
 def write_run(result: RunResult, outdir: str | Path, figure: bool = True, force: bool = False,
-              npz: bool = False) -> dict[str, Path]:
+              npz: bool = False, on_write: Callable[[Path], None] | None = None) -> dict[str, Path]:
     """Write ``channels.csv``, ``summary.json``, ``channels.png`` and (clearance joint) ``orbit.png``
     for one run, atomically each.
 
@@ -396,7 +405,7 @@ def write_run(result: RunResult, outdir: str | Path, figure: bool = True, force:
     from weftsim.post.plots import plot_channels, plot_orbit
     from weftsim.post.results import save_npz
 
-    outdir = prepare_directory(outdir, force, result.scene)
+    outdir = prepare_directory(outdir, force, result.scene, kind="run")
     what = {"kind": "run", "engine": result.engine, "scene": result.scene.name, "status": result.status}
     files = {
         "channels": ("channels.csv", lambda target: write_csv(target, {n: result.samples[n] for n in result.channel_names})),
@@ -408,4 +417,4 @@ def write_run(result: RunResult, outdir: str | Path, figure: bool = True, force:
         files["figure"] = ("channels.png", lambda target: write_figure(target, plot_channels([result])))
         if result.scene.loose_joints:  # one orbit panel per joint with a clearance (E, F)
             files["orbit"] = ("orbit.png", lambda target: write_figure(target, plot_orbit(result)))
-    return write_files(outdir, what, files, scene=result.scene)
+    return write_files(outdir, what, files, scene=result.scene, on_write=on_write)

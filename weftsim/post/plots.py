@@ -126,13 +126,18 @@ def plot_channels(results: Sequence[RunResult], labels: Sequence[str] | None = N
     return channel_panels(curves, title or (results[0].scene.name + " (last revolution)"))
 
 
-def plot_kinematics(angle_deg: np.ndarray, s: np.ndarray, v: np.ndarray, a: np.ndarray, title: str = "") -> Figure:
-    """Ideal rapier displacement, velocity and acceleration over one revolution."""
-    fig = figure(figsize=(8, 8))
-    axes = fig.subplots(3, 1, sharex=True)
-    for ax, y, label in zip(axes, (s * 1e3, v, a), ("displacement [mm]", "velocity [m/s]", "acceleration [m/s²]")):
+def plot_kinematics(angle_deg: np.ndarray, s: np.ndarray, v: np.ndarray, a: np.ndarray, title: str = "",
+                    transmission_deg: np.ndarray | None = None) -> Figure:
+    """Ideal rapier displacement, velocity and acceleration over one revolution, and with ``transmission_deg``
+    the four-bar's transmission angle at F (90 deg is ideal; near 0 or 180 deg the four-bar is close to a dead point)."""
+    panels = [(s * 1e3, "rapier displacement [mm]"), (v, "rapier velocity [m/s]"), (a, "rapier acceleration [m/s²]")]
+    if transmission_deg is not None:
+        panels.append((transmission_deg, "transmission angle at F [deg]"))
+    fig = figure(figsize=(8, 2.7 * len(panels)))
+    axes = fig.subplots(len(panels), 1, sharex=True)
+    for ax, (y, label) in zip(axes, panels):
         ax.plot(angle_deg, y, lw=1.2)
-        ax.set_ylabel("rapier " + label)
+        ax.set_ylabel(label)
         ax.grid(alpha=0.3)
     axes[-1].set_xlabel("crank angle [deg]")
     axes[-1].set_xlim(0, 360)
@@ -152,6 +157,9 @@ def contact_onsets(steps: dict[str, np.ndarray]) -> np.ndarray:
 
     return onset_rows(contact_mode(steps))
 
+
+# A penetration above this fraction of the clearance is visible in the orbit: the panel says what it is.
+PENETRATION_NOTE = 0.05
 
 # The channels of each joint's orbit: eccentricity y, z and the held impact velocity (0 in free flight).
 ORBIT_CHANNELS = {"e": ("eccentricity_y_m", "eccentricity_z_m", "impact_velocity_m_s"),
@@ -218,6 +226,12 @@ def _orbit_panel(fig, ax, steps: dict, channels: tuple[str, str, str], clearance
                    label="first impact")
         fig.colorbar(dots, ax=ax, shrink=0.8, label="impact velocity δ̇⁻ [m/s]")
     ax.set_aspect("equal")
+    beyond = float(np.max(np.hypot(y_mm, z_mm), initial=0.0)) - c_mm  # the largest penetration, mm
+    if beyond > PENETRATION_NOTE * c_mm:  # a stiff joint of a small clearance: the orbit leaves the circle visibly
+        ax.text(0.5, 0.98, f"drawn at true scale: the journal centre lies outside the circle by the contact's\n"
+                f"penetration δ = |e| - c, up to {1e3 * beyond:.3g} µm = {beyond / c_mm:.2g} c (compliant contact)",
+                transform=ax.transAxes, ha="center", va="top", fontsize=7,
+                bbox={"facecolor": "white", "alpha": 0.8, "edgecolor": "0.7"})
     reach = 1.15 * max(c_mm, float(np.max(np.hypot(y_mm, z_mm), initial=0.0)))
     ax.set_xlim(-reach, reach)
     ax.set_ylim(-reach, reach)

@@ -132,6 +132,43 @@ def _shown(value: Any) -> str:
     return "-" if value is None else _toml_value(value)
 
 
+# The command that writes each kind of output directory (the manifest's "kind"), for the refusal below.
+COMMAND_OF_KIND = {"run": "weftsim run", "compare": "weftsim compare", "kinematics": "weftsim kinematics",
+                   "wear": "weftsim wear", "wear ensemble": "weftsim wear --uncertain", "study": "weftsim study",
+                   "bench": "weftsim bench"}
+
+
+def recorded_kind(outdir: str | Path) -> str | None:
+    """The ``kind`` the manifest of ``outdir`` records (``"run"``, ``"wear"``, ...), or None."""
+    path = Path(outdir) / MANIFEST
+    if not path.is_file():  # also a pipe, whose reading would wait forever
+        return None
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError, RecursionError):
+        return None
+    kind = data.get("kind") if isinstance(data, dict) else None
+    return kind if isinstance(kind, str) else None
+
+
+def check_same_kind(outdir: str | Path, kind: str, force: bool = False) -> None:
+    """Refuse to write results of ``kind`` into ``outdir`` when it holds another command's results (a wear
+    prediction's ``wear_state.npz`` beside an ensemble's ``ensemble.json`` would replace each other).
+
+    Raises
+    ------
+    OutputError
+        Naming the command whose results are there, ``-o`` and ``--force`` (unless ``force``).
+    """
+    old = recorded_kind(outdir)
+    if old is None or old == kind or force:
+        return
+    theirs = COMMAND_OF_KIND.get(old, repr(old))
+    ours = COMMAND_OF_KIND.get(kind, repr(kind))
+    raise OutputError(f"{outdir} holds the results of `{theirs}`, which `{ours}` would replace; choose another "
+                      "directory with -o, or pass --force to replace them")
+
+
 def check_same_scene(outdir: str | Path, scene: Scene, force: bool = False) -> None:
     """Refuse to write results of ``scene`` into ``outdir`` when it holds results of another scene.
 

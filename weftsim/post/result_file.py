@@ -267,6 +267,9 @@ def read_npz(path: str | os.PathLike):
             if has_f != (not scene.joint_f.is_ideal):
                 raise _fail(path, "it holds joint F's channels but its scene has F ideal" if has_f else
                             "its scene gives F a clearance but it holds no joint F channels")
+            problem = channels_problem(names, scene)
+            if problem:
+                raise _fail(path, problem)
             tables = {}
             for table in TABLES:
                 tables[table] = {}
@@ -282,6 +285,26 @@ def read_npz(path: str | os.PathLike):
                          meta["solver_stats"], meta["events"], meta["plausibility"], meta["path"])
     except ValueError as exc:
         raise _fail(path, str(exc)) from None
+
+
+def channels_problem(names: tuple[str, ...], scene: params.Scene) -> str:
+    """What is wrong with a saved result's channel groups against its scene ('' if nothing): every run of a
+    scene has exactly :func:`weftsim.post.results.scene_channels` (a lubricated joint's film channels, and only
+    a lubricated joint's), so a file edited to drop or add a group is refused, not read as another run."""
+    from weftsim.post.results import LUBRICATION_CHANNELS, LUBRICATION_CHANNELS_F, scene_channels
+
+    expected = scene_channels(scene)
+    for group, table, joint in ((LUBRICATION_CHANNELS, "joint_e", scene.joint),
+                                (LUBRICATION_CHANNELS_F, "joint_f", scene.joint_f)):
+        has, needs = group[0] in names, group[0] in expected
+        if has and not needs:
+            state = "ideal" if joint.is_ideal else "dry (no [" + table + ".lubrication])"
+            return f"it holds the film channels of {table} ({group[0]}, ...) but its scene's joint is {state}"
+        if needs and not has:
+            return f"its scene's {table} is lubricated but it holds no film channels ({group[0]}, ...)"
+    if set(names) != set(expected):
+        return f"its channels are not those of a run of its scene ({', '.join(sorted(set(names) ^ set(expected)))})"
+    return ""
 
 
 def check_times(path: Path, meta: dict, scene: params.Scene, tables: dict) -> None:

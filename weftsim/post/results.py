@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
-from weftsim.errors import require
+from weftsim.errors import ArgumentError, require
 from weftsim.input.params import Scene
 
 if TYPE_CHECKING:
@@ -262,7 +262,7 @@ class RunResult:
             pandas is not installed (it comes with the optional extra ``weftsim[data]``).
         """
         if which not in ("samples", "steps"):
-            raise ValueError(f"which must be 'samples' or 'steps', got {which!r}")
+            raise ArgumentError(f"to_pandas: which must be 'samples' or 'steps', got {which!r}")
         pd = require("pandas", "data", "RunResult.to_pandas")
         table = self.samples if which == "samples" else self.steps
         frame = pd.DataFrame({name: np.array(table[name]) for name in self.channel_names})

@@ -101,8 +101,9 @@ def integrate_compiled(scene: Scene, progress: Callable[[float], None] | None = 
         t = fst[T]
         breach = None
         if code == GUARD:
-            breach = guard.check(penetration=None if scene.joint.is_ideal else fst[LAST_PENETRATION],
-                                 penetration_f=None if scene.joint_f.is_ideal else fst[LAST_PENETRATION_F],
+            # -inf marks a step out of contact (no penetration to check), not a non-finite state
+            breach = guard.check(penetration=_in_contact(fst[LAST_PENETRATION], scene.joint.is_ideal),
+                                 penetration_f=_in_contact(fst[LAST_PENETRATION_F], scene.joint_f.is_ideal),
                                  step_size=fst[LAST_STEP], steps=int(ist[STEPS]) - steps_seen)  # fmt: skip
         elif code == STEP_TOO_SMALL:
             breach = guard.check(step_size=10.0 * np.spacing(t), steps=0)
@@ -159,6 +160,11 @@ def integrate_compiled(scene: Scene, progress: Callable[[float], None] | None = 
     if progress is not None and status == "success":
         progress(1.0)
     return steps, samples, stats, events, status, message
+
+
+def _in_contact(penetration: float, ideal: bool) -> float | None:
+    """The last step's penetration for the guard: None at an ideal joint or a step out of contact (-inf)."""
+    return None if ideal or penetration == -math.inf else float(penetration)
 
 
 def solve_compiled(scene: Scene, progress: Callable[[float], None] | None = None, method: str | None = None,

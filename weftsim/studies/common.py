@@ -84,7 +84,7 @@ def open_directory(outdir: Path, force: bool, scene: Scene) -> Path:
     another scene or other overrides is refused unless ``force``)."""
     from weftsim.post.output import prepare_directory
 
-    return prepare_directory(outdir, force, scene)
+    return prepare_directory(outdir, force, scene, kind="study")
 
 
 def record(scene: Scene, overrides: dict) -> dict:

@@ -187,7 +187,10 @@ def parse_vary(text: str) -> Axis:
 def _number_list(key: Key, text: str, flag: str) -> list[float]:
     """``v0,v1`` of a list-valued key (``friction_velocities_m_s``): its numbers; sizes checked here."""
     size = LIST_SIZES[key.kind]
-    parts = [part.strip() for part in text.split(",")]
+    inner = text.strip()
+    if inner.startswith("[") and inner.endswith("]"):  # the TOML form a scene file writes: [1e-4, 2e-4]
+        inner = inner[1:-1]
+    parts = [part.strip() for part in inner.split(",")]
     if len(parts) != size:
         raise SweepError(f"{flag}: '{key.path}' takes a list of {size} numbers separated by commas "
                          f"(e.g. {key.path}={','.join(['1e-4', '2e-4', '1e-3'][:size])}), got {text!r}")

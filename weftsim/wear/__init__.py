@@ -166,7 +166,7 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
     check_request(scene, hours, engine, limit)
     if until_limit and limit is None:
         raise WearError("until_limit needs a clearance limit (--limit-clearance-mm)")
-    outdir = prepare_directory(outdir, force, scene)
+    outdir = prepare_directory(outdir, force, scene, kind="wear")
     check_engine(outdir, engine, force)
     what = {"kind": "wear", "scene": scene.name, "engine": engine, **provenance(scene)}  # from the first update on
     begin_directory(outdir, what)  # ours from the first update on: an interrupted prediction resumes here
@@ -180,10 +180,22 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
     done = done[:-1]
 
     latest = list(done)
+    kept = [len(done)]  # updates the state file on disk holds
+
+    def save(updates):
+        try:
+            store.save_state(outdir, scene, updates)
+        except OSError as exc:  # a full disk, a quota: the state written before is whole (atomic writes)
+            from weftsim.errors import WriteFailed
+
+            held = f"the {kept[0]} updates before it are kept there" if kept[0] else "no update was stored yet"
+            raise WriteFailed(f"cannot write {outdir / store.STATE}: {exc.strerror or exc}; {held}: free space "
+                              "and run the same command again to resume") from None
+        kept[0] = len(updates)
 
     def on_update(updates):
         latest[:] = updates
-        store.save_state(outdir, scene, updates)
+        save(updates)
         if progress is not None and updates[-1].hours > 0.0:  # no time-left estimate from a zero fraction
             if until_limit:  # the share of the clearance's way to the limit
                 progress(min(_grown(scene, updates[-1], share=limit), 1.0))
@@ -200,7 +212,7 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
         updates = predict(scene, hours, done, on_update=on_update, stop=stop, simulate=simulator(engine))
         if until_limit and updates and _beyond(scene, updates[-1], limit):
             updates[-1] = _cut_at(scene, updates[-1], limit)
-            store.save_state(outdir, scene, updates)
+            save(updates)
         if not updates:  # stopped (Ctrl-C) before the first update was done: nothing to write
             raise KeyboardInterrupt
     except WearError as exc:
@@ -304,17 +316,18 @@ def _write_results(scene: Scene, updates: list, hours: float, limit: float | Non
         files[f"journal_profile_{joint}"] = (f"wear_profile_journal_{joint}.csv",
                                              lambda p, j=joint: store.write_profiles(p, updates, "journal", j))
     if figures:
-        from weftsim.wear.figures import growth_figure, profile_figure
+        from weftsim.wear.figures import conditions, growth_figure, profile_figure
 
         engine_tag = "" if engine == "reference" else f" ({engine} engine)"
         for joint in joints:
-            title = f"{scene.name}: wear at {joint.upper()}{engine_tag}"
+            title = f"{scene.name}: wear at {joint.upper()}{engine_tag}\n{conditions(scene, (joint,))}"
             files[f"profile_figure_{joint}"] = (
                 f"wear_profile_{joint}.png", lambda p, j=joint, t=title: write_figure(p, profile_figure(scene, updates, t, j)))
         name = "".join(joints)
-        title = f"{scene.name}: wear at {' and '.join(j.upper() for j in joints)}{engine_tag}"
+        title = f"{scene.name}: wear at {' and '.join(j.upper() for j in joints)}{engine_tag}\n{conditions(scene, joints)}"
+        limit_mm = None if limit is None else 1e3 * limit
         files["growth_figure"] = (f"wear_growth_{name}.png",
-                                  lambda p: write_figure(p, growth_figure(columns, title, joints)))
+                                  lambda p: write_figure(p, growth_figure(columns, title, joints, limit_mm)))
     written = write_files(outdir, what, files, scene=scene)
     data["files"] = {k: str(v) for k, v in written.items()}
     return data

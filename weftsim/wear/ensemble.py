@@ -1,4 +1,4 @@
-"""Wear ensembles: the hours to a clearance limit as a distribution over uncertain inputs (docs/wear.md section 7).
+"""Wear ensembles: the hours to a clearance limit as a distribution over uncertain inputs (docs/wear.md section 9).
 
 Public entry::
 
@@ -59,8 +59,11 @@ def _run_jobs(jobs: list[tuple[str, Scene]], limit: float, outdir: Path, jobs_n:
 
     from weftsim.sweep.pool import executor
 
-    pool, _, stop = executor(jobs_n, scheduler, len(jobs), "reference")
+    pool, workers, stop = executor(jobs_n, scheduler, len(jobs), "reference")
     results: dict[str, dict] = {}
+    start = time.perf_counter()
+    if announce:
+        announce(f"ensemble: {len(jobs)} jobs on {workers} worker(s); a line as each ends")
     try:
         futures = {pool.submit(run_job, s, limit, str(outdir / "jobs" / name), horizon): name for name, s in jobs}
         for future in cf.as_completed(futures):
@@ -74,13 +77,22 @@ def _run_jobs(jobs: list[tuple[str, Scene]], limit: float, outdir: Path, jobs_n:
                 state = "failed: " + r["error"] if r["error"] else \
                     ("does not reach the limit" + (f": {r['never']}" if r.get("never") else
                                                    f" within {r['horizon_h']:g} h") if r.get("censored") else "done")
-                announce(f"ensemble: job {name} {state} "
-                         f"({len(results)}/{len(jobs)}, {r.get('wall_s', math.nan):.1f} s)")
+                announce(f"ensemble: job {name} {state} ({len(results)}/{len(jobs)}, {r.get('wall_s', math.nan):.1f} s)"
+                         + _time_left(time.perf_counter() - start, len(results), len(jobs)))
     except KeyboardInterrupt:
         stop(True)
         raise
     stop(False)
     return results
+
+
+def _time_left(elapsed: float, done: int, total: int) -> str:
+    """``; ~3 min left`` at the pace of the jobs so far (jobs of one ensemble cost about the same), or ''."""
+    from weftsim.checks.progress import format_duration
+
+    if done >= total or done <= 0:
+        return ""
+    return f"; ~{format_duration(elapsed / done * (total - done))} left"
 
 
 def combine(scene: Scene, uncertain: list[Uncertain], dynamic: list[Uncertain], nodes: np.ndarray,
@@ -200,6 +212,7 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
         ``{key: n}``: n design points (2 to 9) for a simulated key instead of 3 (docs/wear.md section 9).
     """
     from weftsim.post.output import begin_directory, prepare_directory, write_csv, write_figure, write_files, write_json
+    from weftsim.post.record import provenance
     from weftsim.wear import check_request
 
     texts = [f"{k}={v}" for k, v in uncertain.items()] if isinstance(uncertain, dict) else list(uncertain)
@@ -208,6 +221,8 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
         raise WearError("an ensemble needs at least one --uncertain KEY=DISTRIBUTION")
     if not (isinstance(samples, int) and 10 <= samples <= 10**6):
         raise WearError(f"--samples must be a whole number from 10 to 1000000, got {samples!r}")
+    if isinstance(seed, bool) or not (isinstance(seed, int) and seed >= 0):  # before any simulation runs
+        raise WearError(f"--seed must be a whole number >= 0, got {seed!r}")
     if not (isinstance(chaos_runs, int) and 1 <= chaos_runs <= 50):
         raise WearError(f"--chaos-runs must be a whole number from 1 to 50, got {chaos_runs!r}")
     from weftsim.wear.extrapolate import MAX_HOURS
@@ -218,6 +233,11 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
     if not scene.joint_f.is_ideal:  # its H/k rescaling and its clearance curve are joint E's
         raise WearError("an ensemble predicts the wear at E with F ideal so far; `weftsim wear SCENE --hours H` "
                         "predicts F and E with F (docs/wear.md); set joint_f.clearance_mm = 0 for the ensemble")
+    from dataclasses import replace
+
+    from weftsim.wear.uncertain_keys import check_uncertain_key
+
+    parsed = [replace(u, key=check_uncertain_key(u.key, scene)) for u in parsed]  # dotted keys from here on
     job_list, dynamic, nodes = plan(scene, parsed, chaos_runs, design_points)
     job_horizon = min(10.0 * horizon, MAX_HOURS)
     for name, s in job_list:
@@ -225,6 +245,12 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
             raise WearError(f"the design point {name} starts at a clearance of {1e3 * s.joint.clearance:g} mm, not "
                             f"below the limit {1e3 * limit:g} mm: narrow the clearance's distribution or raise "
                             "the limit")
+    start = min(s.joint.clearance for _, s in job_list)  # the band's lowest clearance (combine's ``start``)
+    for level in levels:
+        if not (isinstance(level, (int, float)) and start < level < limit):
+            raise WearError(f"--level-mm {1e3 * level:g}: a level must lie between the starting clearance "
+                            f"{1e3 * start:g} mm and the limit {1e3 * limit:g} mm (the limit itself is always "
+                            "reported)")
     if announce is not None:
         from weftsim.wear.extrapolate import update_time
 
@@ -233,8 +259,8 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
                  f"{chaos_runs - 1} more chaos run(s)); one update of the nominal scene ~{update_time(scene):.2g} s, "
                  f"~{math.log(limit / scene.joint.clearance) / math.log1p(scene.joint.wear.max_clearance_change):.0f} "
                  "updates a prediction; the samples cost no simulation")
-    outdir = prepare_directory(outdir, force)
-    what = {"kind": "wear ensemble", "scene": scene.name}
+    outdir = prepare_directory(outdir, force, scene, kind="wear ensemble")
+    what = {"kind": "wear ensemble", "scene": scene.name, **provenance(scene)}  # the command and resolved scene
     begin_directory(outdir, what)
     wall0 = time.perf_counter()
     results = _run_jobs(job_list, limit, outdir, jobs, scheduler, announce, job_horizon)
@@ -298,11 +324,15 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
     if figures:
         from weftsim.wear.ensemble_figures import band_figure, cdf_figure, shares_figure
 
-        title = f"{scene.name}: wear at E, {samples} samples"
+        from weftsim.wear.figures import conditions
+
+        title = f"{scene.name}: wear at E, nominal {conditions(scene)}\n{samples} samples; uncertain: " + \
+            ", ".join(u.key.rpartition(".")[2] for u in parsed)
         files["cdf_figure"] = ("ensemble_cdf.png", lambda p: write_figure(p, cdf_figure(hours[:, -1], data, title)))
-        files["band_figure"] = ("ensemble_band.png", lambda p: write_figure(p, band_figure(band, title)))
+        files["band_figure"] = ("ensemble_band.png",
+                                lambda p: write_figure(p, band_figure(band, title, 1e3 * limit)))
         files["shares_figure"] = ("ensemble_shares.png", lambda p: write_figure(p, shares_figure(data, title)))
-    written = write_files(outdir, what, files)
+    written = write_files(outdir, what, files, scene=scene)  # scene.toml: the nominal scene
     data["files"] = {k: str(v) for k, v in written.items()}
     return data
 

@@ -94,16 +94,17 @@ def plan(scene: Scene, uncertain: list[Uncertain], chaos_runs: int = 6, design_p
     """(jobs as (name, scene), the dynamic inputs, their design values (nodes, dims)); checks every design scene.
 
     The chaos runs are made at the centre point (index ``points // 2`` of every key)."""
-    from weftsim.input.scene import SceneError, apply_overrides, to_file_keys
+    from weftsim.input.scene import SceneError, apply_overrides
+    from weftsim.wear.uncertain_keys import check_uncertain_key, resolve
 
-    keys = to_file_keys(scene)
+    # the names --set takes (a dotted key or its unique last part), each a key that changes the wear at E
+    uncertain = [replace(u, key=check_uncertain_key(u.key, scene)) for u in uncertain]
+    design_points = {resolve(k): n for k, n in (design_points or {}).items()}
     seen = set()
     for u in uncertain:
         if u.key in seen:
             raise WearError(f"--uncertain {u.key} is given twice")
         seen.add(u.key)
-        if u.key not in keys or u.key == "name":
-            raise WearError(f"--uncertain {u.key}: not a scene key (weftsim list shows them)")
         if u.key in RESCALED and not np.all(u.ppf(np.array([1e-6, 0.5, 1 - 1e-6])) > 0.0):
             raise WearError(f"--uncertain {u.text}: {u.key} must stay > 0; a lognormal keeps it positive")
     dynamic = [u for u in uncertain if u.key not in RESCALED]

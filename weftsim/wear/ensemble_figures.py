@@ -39,18 +39,40 @@ def cdf_figure(hours: np.ndarray, data: dict, title: str = "") -> Figure:
         ax.axvline(q["hours"], color="C1", lw=1)
         if q["low"] is not None and q["high"] is not None and np.isfinite(q["low"]) and np.isfinite(q["high"]):
             ax.axvspan(q["low"], q["high"], color="C1", alpha=0.2)
-        ax.text(q["hours"], 0.02, f" {name} {q['hours']:.4g} h", rotation=90, va="bottom", fontsize=8)
+        # The curve crosses the line at p: right of it the curve is above p, left of it below, so a label
+        # right of the line and below p (or left of it and above p) sits on empty ground.
+        p = float(name[1:]) / 100.0
+        low_side = p < 0.5
+        ax.annotate(f"{name} {q['hours']:.4g} h", (q["hours"], p), xytext=(4 if low_side else -4, -6 if low_side else 6),
+                    textcoords="offset points", ha="left" if low_side else "right",
+                    va="top" if low_side else "bottom", fontsize=8,
+                    bbox={"facecolor": "white", "alpha": 0.8, "edgecolor": "none", "pad": 1.0})
     if x.size or horizon:
-        ax.set_xscale("log")
+        _log_hours_axis(ax)
     ax.set_ylim(0.0, 1.0)
-    ax.set_xlabel(f"hours to an effective clearance of {data['limit_clearance_mm']:g} mm")
+    ax.set_xlabel(f"hours to an effective clearance of {data['limit_clearance_mm']:g} mm (the limit) [h]")
     ax.set_ylabel("probability of reaching it earlier")
-    ax.set_title(title)
+    ax.set_title(title, fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
+    fig.tight_layout()
     return fig
 
 
-def band_figure(band: dict, title: str = "") -> Figure:
+def _log_hours_axis(ax) -> None:
+    """A log axis of hours with labels that do not collide: majors at each decade over more than 2.5 decades, at
+    1, 2 and 5 of each decade over fewer, finer within one; written plainly (2000, 5e+04), no minor labels."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    ax.set_xscale("log")
+    low, high = ax.get_xlim()
+    decades = np.log10(high / low) if low > 0.0 and high > low else 1.0
+    subs = (1.0,) if decades > 2.5 else (1.0, 2.0, 5.0) if decades > 0.7 else (1.0, 1.5, 2.0, 3.0, 5.0, 7.0)
+    ax.xaxis.set_major_locator(LogLocator(base=10.0, subs=subs, numticks=12))
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.3g}"))
+    ax.xaxis.set_minor_formatter(NullFormatter())
+
+
+def band_figure(band: dict, title: str = "", limit_mm: float | None = None) -> Figure:
     """Effective clearance against hours: median and the 10-90 % band; with censored samples (a quantile
     beyond the horizon is inf) a second panel gives the fraction of samples reaching each clearance."""
     censored = "fraction_reaching" in band and np.any(np.asarray(band["fraction_reaching"]) < 1.0)
@@ -64,9 +86,11 @@ def band_figure(band: dict, title: str = "") -> Figure:
     for q, style, name in ((p10, ":", "10 %"), (p50, "-", "median"), (p90, "--", "90 %")):
         if np.any(np.isfinite(q)):
             ax.plot(np.where(np.isfinite(q), q, np.nan), c, color="C0", ls=style, label=name)
-    ax.set_xlabel("operating hours" + (" (where the quantile is reached within the horizon)" if censored else ""))
-    ax.set_ylabel("effective clearance at E (mm)")
-    ax.set_title(title)
+    if limit_mm is not None:
+        ax.axhline(limit_mm, color="C3", ls="--", lw=1, label=f"limit {limit_mm:g} mm")
+    ax.set_xlabel("operating hours [h]" + (" (where the quantile is reached within the horizon)" if censored else ""))
+    ax.set_ylabel("effective clearance at E [mm]")
+    ax.set_title(title, fontsize=9)
     ax.legend(loc="lower right")
     ax.grid(True, alpha=0.3)
     if censored:
@@ -75,7 +99,7 @@ def band_figure(band: dict, title: str = "") -> Figure:
         ax2.set_xlim(0, 100)
         ax2.set_xlabel("samples reaching the clearance within the horizon (%)")
         ax2.grid(True, alpha=0.3)
-        fig.tight_layout()
+    fig.tight_layout()
     return fig
 
 
@@ -91,6 +115,6 @@ def shares_figure(data: dict, title: str = "") -> Figure:
         ax.text(s, i, f" {100 * s:.0f} % (rho {r:+.2f})", va="center", fontsize=8)
     ax.set_xlim(0, 1.15)
     ax.set_xlabel("share of the spread of log(hours to the limit); red: more of it, fewer hours")
-    ax.set_title(title)
+    ax.set_title(title, fontsize=9)
     fig.tight_layout()
     return fig

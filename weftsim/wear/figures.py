@@ -18,6 +18,20 @@ if TYPE_CHECKING:
     from weftsim.wear.extrapolate import Update
 
 
+def conditions(scene: Scene, joints: Sequence[str] = ("e",)) -> str:
+    """What a wear figure's numbers depend on, for its title: the speed and each joint's Archard k and
+    hardnesses, bearing/journal (``600 rpm; E: k = 1e-07, H 2000/2000 MPa``)."""
+    import math
+
+    rpm = scene.drive.speed * 30.0 / math.pi
+    parts = []
+    for j in joints:
+        w = (scene.joint if j == "e" else scene.joint_f).wear
+        parts.append(f"{j.upper()}: k = {w.wear_coefficient:.3g}, H {w.bearing_hardness / 1e6:g}/"
+                     f"{w.journal_hardness / 1e6:g} MPa")
+    return f"{rpm:g} rpm; " + "; ".join(parts)
+
+
 def _chosen(updates, count: int = 6):
     """About ``count`` updates spread over the run, first and last included."""
     idx = np.unique(np.linspace(0, len(updates) - 1, min(count, len(updates))).round().astype(int))
@@ -51,6 +65,8 @@ def profile_figure(scene: Scene, updates: Sequence[Update], title: str = "", joi
         ax.set_rlabel_position(label_angle(psi, np.max(radii, axis=0)))
         ax.yaxis.set_major_locator(MaxNLocator(4))
         ax.tick_params(labelsize=7)
+        for label in ax.get_yticklabels():  # legible where a lobe of the profile still passes under a label
+            label.set_bbox({"facecolor": "white", "alpha": 0.8, "edgecolor": "none", "pad": 1.0})
     # One legend for both panels, below them, inside the figure (drawn beside a polar axes it was clipped).
     handles, labels = fig.axes[0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", ncol=min(len(labels), 6), fontsize=8, frameon=False,
@@ -63,9 +79,10 @@ def profile_figure(scene: Scene, updates: Sequence[Update], title: str = "", joi
 
 def label_angle(psi: np.ndarray, radius: np.ndarray) -> float:
     """Angle, deg, for a polar panel's radial labels: where the curves stay closest to the centre (the labels
-    then sit on empty ground, not on a lobe of the profile)."""
-    candidates = np.arange(22.5, 360.0, 45.0)  # between the angle labels at every 45 deg
-    reach = [np.max(radius[np.abs((np.degrees(psi) - a + 180.0) % 360.0 - 180.0) <= 22.5]) for a in candidates]
+    then sit on empty ground, not on a lobe of the profile).  Candidates every 15 deg off the 45 deg grid lines,
+    each judged by the curves within 20 deg of it (a label is about that wide at mid radius)."""
+    candidates = np.array([a for a in np.arange(7.5, 360.0, 15.0) if abs((a + 22.5) % 45.0 - 22.5) > 5.0])
+    reach = [np.max(radius[np.abs((np.degrees(psi) - a + 180.0) % 360.0 - 180.0) <= 20.0]) for a in candidates]
     return float(candidates[int(np.argmin(reach))])
 
 
@@ -79,9 +96,10 @@ def statistic_label(name: str) -> str:
     return f"{word} at {joint.upper()}" if joint else word
 
 
-def growth_figure(columns: dict, title: str = "", joints: Sequence[str] = ("e",)) -> Figure:
+def growth_figure(columns: dict, title: str = "", joints: Sequence[str] = ("e",),
+                  limit_mm: float | None = None) -> Figure:
     """Effective clearance, contact force and rapier acceleration against operating hours (``wear.csv`` columns),
-    the clearance and contact force of each wearing joint."""
+    the clearance and contact force of each wearing joint; ``limit_mm``: the clearance limit, marked."""
     fig = figure(figsize=(7, 8))
     hours = columns["hours"]
     at = " and ".join(j.upper() for j in joints)
@@ -94,10 +112,12 @@ def growth_figure(columns: dict, title: str = "", joints: Sequence[str] = ("e",)
         for name in (names if isinstance(names, tuple) else (names,)):
             ax.plot(hours, columns[name], marker=".", label=statistic_label(name) if isinstance(names, tuple) else None)
         ax.set_ylabel(label, fontsize=8)
+        if k == 0 and limit_mm is not None:
+            ax.axhline(limit_mm, color="C3", ls="--", lw=1, label=f"limit {limit_mm:g} mm")
         if isinstance(names, tuple):
             ax.legend(fontsize=7)
         ax.grid(True, alpha=0.3)
-    fig.axes[-1].set_xlabel("operating hours")
+    fig.axes[-1].set_xlabel("operating hours [h]")
     if title:
         fig.suptitle(title)
     fig.tight_layout()

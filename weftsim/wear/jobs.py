@@ -1,4 +1,4 @@
-"""One simulated wear prediction of an ensemble: run to a clearance limit, resumably (docs/wear.md section 7).
+"""One simulated wear prediction of an ensemble: run to a clearance limit, resumably (docs/wear.md section 9).
 
 :func:`run_job` is what the ensemble sends to the sweep machinery's pool (a local process pool or a
 Dask cluster, :func:`weftsim.sweep.pool.executor`): plain data in (the scene, the limit, a
@@ -21,7 +21,34 @@ if TYPE_CHECKING:
     from weftsim.input.params import Scene
 
 CURVE = "curve.json"
-CURVE_VERSION = 2  # 2: two-ended hours, one update simulated at the limit (older curves are run again)
+CURVE_VERSION = 3  # 2: two-ended hours, one update simulated at the limit; 3: a digest (older curves are run again)
+
+
+def _digest(result: dict) -> str:
+    """SHA-256 of the curve's result as written: a hand-edited curve.json no longer matches it."""
+    import hashlib
+
+    return hashlib.sha256(json.dumps(result, sort_keys=True, allow_nan=False).encode()).hexdigest()
+
+
+def curve_problem(stored: object, identity: str, limit: float, horizon: float) -> str | None:
+    """Why a job's ``curve.json`` cannot be reused (another request, an older version, edited or damaged:
+    the job is then run again, resuming its wear state), or None."""
+    if not isinstance(stored, dict) or not isinstance(stored.get("result"), dict):
+        return "not a curve"
+    if (stored.get("scene"), stored.get("limit"), stored.get("version"), stored.get("horizon")) != \
+            (identity, limit, CURVE_VERSION, horizon):
+        return "another scene, limit, horizon or version"
+    result = stored["result"]
+    try:
+        if stored.get("digest") != _digest(result):
+            return "edited or damaged (its digest does not match)"
+    except (TypeError, ValueError):
+        return "damaged"
+    hours, clearance = result.get("hours"), result.get("clearance_m")
+    if not (isinstance(hours, list) and isinstance(clearance, list) and len(hours) == len(clearance) >= 1):
+        return "its hours and clearances differ in number"
+    return None
 
 
 def run_job(scene: Scene, limit: float, directory: str, horizon: float | None = None) -> dict:
@@ -44,15 +71,13 @@ def run_job(scene: Scene, limit: float, directory: str, horizon: float | None = 
     directory.mkdir(parents=True, exist_ok=True)
     identity = store.scene_identity(scene)
     done_file = directory / CURVE
-    if done_file.exists():
+    if done_file.is_file():
         try:
             stored = json.loads(done_file.read_text())
-            if stored.get("scene") == identity and stored.get("limit") == limit \
-                    and stored.get("version") == CURVE_VERSION \
-                    and stored.get("horizon", MAX_HOURS) == horizon:
-                return {**stored["result"], "reused": True}
-        except (OSError, ValueError, KeyError, TypeError):
-            pass  # damaged: run it again (the state below resumes it)
+        except (OSError, ValueError, RecursionError):
+            stored = None  # damaged: run it again (the state below resumes it)
+        if curve_problem(stored, identity, limit, horizon) is None:
+            return {**stored["result"], "reused": True}
     wall0, cpu0 = time.perf_counter(), time.process_time()
     c0 = scene.joint.clearance
     try:
@@ -100,7 +125,8 @@ def run_job(scene: Scene, limit: float, directory: str, horizon: float | None = 
     result["cpu_s"] = time.process_time() - cpu0  # the worker's CPU (user + sys): the cost on a shared machine
     if result["error"] is None:
         done_file.write_text(json.dumps({"scene": identity, "limit": limit, "horizon": horizon,
-                                          "version": CURVE_VERSION, "result": result}, allow_nan=False))
+                                          "version": CURVE_VERSION, "result": result, "digest": _digest(result)},
+                                         allow_nan=False))
     return result
 
 

@@ -15,8 +15,9 @@ therefore refuses, with one line naming what is wrong, a state that
 - disagrees with its own history: update 0 starts unworn at 0 h, and each later update's hours,
   revolutions and profiles are exactly the previous update advanced over its N revolutions
   (:func:`weftsim.wear.extrapolate.advance`; measured: equal to the last bit);
-- does not match the SHA-256 checksum stored with its numbers (states written before the checksum
-  have none and get the other checks only);
+- does not match the SHA-256 checksum stored with its numbers, or has none: every state that names its
+  joints was written with one (only a legacy state of joint E alone may predate it, and gets the other
+  checks only);
 - disagrees with the scene's wear model: each update's wear volume per revolution equals its two
   profiles' volumes (measured to 6e-16 relative), the journal's share of it is the bearing's
   hardness ratio (Archard: V_j / V_b = H_b / H_j), and no N exceeds what the update rule allows.
@@ -133,6 +134,10 @@ def read_state(path: Path, scene: Scene) -> list[Update]:
     written_response = response
     if legacy:
         response = _legacy_response(response)
+    if stored is None and not legacy:  # every state naming its joints was written with its checksum
+        raise StateMismatch(f"{path}: its checksum ('digest') is missing: weftsim has written one with every state "
+                            "that names its joints (bearing_e, ...), so it was removed or the file damaged, and a "
+                            f"resume would extrapolate from numbers nothing vouches for{_advice(path)}")
     problem = (_value_problem(data, response) or _history_problem(data, scene, joints)
                or _model_problem(data, scene, joints))
     if not problem and stored is not None:

@@ -1,7 +1,7 @@
 """Uncertain inputs of a wear ensemble: ``KEY=DISTRIBUTION`` texts, sampling, quantiles and their confidence.
 
 ``--uncertain joint_e.wear.wear_coefficient=lognormal(1e-7,0.6)`` names a scene key and a distribution
-in the key's file units (docs/wear.md section 7):
+in the key's file units (docs/wear.md section 9):
 
 - ``normal(mean,sd)``, ``lognormal(median,sigma_of_log)``, ``uniform(low,high)``,
   ``triangular(low,mode,high)``;
@@ -24,7 +24,12 @@ import numpy as np
 
 from weftsim.errors import WearError
 
-KINDS = {"normal": 2, "lognormal": 2, "uniform": 2, "triangular": 3, "walther": 4}
+# Each distribution and its parameters, in the key's file units: the one source of the parser, its
+# messages and the command line's help (``weftsim wear --help``).
+SIGNATURES = {"normal": ("mean", "sd"), "lognormal": ("median", "sigma_of_log"), "uniform": ("low", "high"),
+              "triangular": ("low", "mode", "high"), "walther": ("nu40", "nu100", "t_low", "t_high")}
+KINDS = {kind: len(names) for kind, names in SIGNATURES.items()}
+ALLOWED = ", ".join(f"{kind}({','.join(names)})" for kind, names in SIGNATURES.items())
 # Density of a mineral oil, g/cm^3 at 15 C, and its fall per kelvin (the dynamic viscosity is nu times it;
 # mineral gear oils of ISO VG 100-460 have 0.87-0.90 at 15 C; the thermal fall moves eta by 4 % over 60 K).
 OIL_DENSITY_15C, OIL_DENSITY_PER_K = 0.88, 6.5e-4
@@ -63,8 +68,7 @@ class Uncertain:
 
 def parse_uncertain(text: str) -> Uncertain:
     """``KEY=KIND(a,b[,c])`` -> :class:`Uncertain`; WearError (one line) for anything else."""
-    allowed = ("normal(mean,sd), lognormal(median,sigma_of_log), uniform(low,high), triangular(low,mode,high), "
-               "walther(nu40,nu100,t_low,t_high)")
+    allowed = ALLOWED
     m = _TEXT.match(text)
     if not m or m.group(2) not in KINDS:
         raise WearError(f"--uncertain {text!r}: give KEY=DISTRIBUTION with one of {allowed}")
@@ -137,9 +141,16 @@ def quantile_interval(values: np.ndarray, p: float, confidence: float = 0.9) -> 
 
 
 def rank_shares(inputs: dict[str, np.ndarray], output: np.ndarray) -> dict[str, tuple[float, float]]:
-    """Per input: (Spearman rank correlation with ``output``, its share rho^2 / sum rho^2 of the spread)."""
+    """Per input: (Spearman rank correlation with ``output``, its share rho^2 / sum rho^2 of the spread).
+
+    An output without spread (every sample the same, e.g. all censored) has no shares to give: every input
+    gets (0, 0), not a share of nothing (nor scipy's warning about a constant input).
+    """
     from scipy import stats
 
+    output = np.asarray(output, dtype=float)
+    if output.size < 2 or np.all(output == output.flat[0]):
+        return {name: (0.0, 0.0) for name in inputs}
     rho = {}
     for name, x in inputs.items():
         x = np.asarray(x, dtype=float)
