@@ -134,6 +134,8 @@ SCHEMA: tuple[Key, ...] = (
     Key("joint_e.clearance_mm", "joint.clearance", "float", MM, 0, 5, False, doc="radial clearance c; 0 = ideal joint"),
     Key("joint_e.journal_radius_mm", "joint.journal_radius", "float", MM, 0, doc="R_j"),
     Key("joint_e.bearing_length_mm", "joint.bearing_length", "float", MM, 0, doc="L_b"),
+    Key("joint_e.bushing_wall_mm", "joint.bushing_wall", "float", MM, 0,
+        doc="t, the bushing's radial wall to its housing (the cylindrical law's stiffness depends on it)"),
     Key("joint_e.law", "joint.law", "str", doc="contact force law (see weftsim.joint.contact.LAWS)"),
     Key("joint_e.restitution", "joint.restitution", "float", 1, 0, 1, True, False, doc="coefficient of restitution ce"),
     Key("joint_e.friction_coefficient", "joint.friction_coefficient", "float", 1, 0, 2, False,
