@@ -199,19 +199,24 @@ def markdown(conv, hertz, rows) -> str:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--fit", action="store_true", help="run the FE grid and print the law's constants")
-    ap.add_argument("--quick", action="store_true", help="skip the convergence study and the Hertz limit")
+    ap.add_argument("--quick", action="store_true",
+                    help="keep the convergence study and the Hertz limit of the earlier run's JSON")
     ap.add_argument("--out", default=str(ROOT / "docs" / "data" / "cylinder_fe.json"))
     args = ap.parse_args(argv)
     joint = loom_joint()
     start = time.process_time()
     result = {"wall_mm": joint.bushing_wall * 1e3, "check_h0_mm": CHECK_H0_MM}
+    previous = json.loads(Path(args.out).read_text()) if Path(args.out).exists() else {}
+    if not args.fit:  # keep the fit of an earlier --fit run
+        result.update({k: previous[k] for k in ("fit_grid", "fit") if k in previous})
     if args.fit:
         grid = fe_grid(joint, FIT_CLEARANCES_MM, FIT_WALLS_MM, CHECK_H0_MM * 1e-3)
         result["fit_grid"] = grid
         result["fit"] = fit_constants(grid, joint.journal_radius)
         print("CYLINDRICAL_FIT =", result["fit"])
-    conv = [] if args.quick else convergence(joint)
-    hertz = [] if args.quick else hertz_limit(joint)
+    # --quick keeps the convergence study and the Hertz limit of an earlier full run
+    conv = previous.get("convergence", []) if args.quick else convergence(joint)
+    hertz = previous.get("hertz", []) if args.quick else hertz_limit(joint)
     rows = check(joint, fe_grid(joint, CHECK_CLEARANCES_MM, (joint.bushing_wall * 1e3,), CHECK_H0_MM * 1e-3))
     worst = max(abs(r["cylindrical_um"] / r["approach_um"] - 1.0) for r in rows)
     result.update(convergence=conv, hertz=hertz, check=rows, worst_cylindrical_error=worst,

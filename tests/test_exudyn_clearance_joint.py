@@ -26,7 +26,7 @@ from weftsim.exudyn_engine.onset import (
 from weftsim.input.params import ClearanceJoint
 
 C = 0.25e-3
-JOINT = ClearanceJoint(clearance=C, law="variable_kd")
+JOINT = ClearanceJoint(clearance=C, law="variable_kd", bushing_wall=4e-3)  # the wall: for the cylindrical law
 
 
 def test_onset_interpolation_is_exact_for_linear_motion():
