@@ -130,7 +130,13 @@ def _ring_points(r: float, radius: float, mesh: Mesh, depth: float) -> np.ndarra
     return np.column_stack([r * np.cos(phi), r * np.sin(phi)])
 
 
-def _triangulate(points: np.ndarray, keep) -> np.ndarray:
+def _triangulate(points: np.ndarray, keep, surface: int) -> tuple[np.ndarray, np.ndarray]:
+    """Delaunay triangles of ``points`` whose centroid ``keep`` accepts, and the points they use.
+
+    A point no kept triangle uses (qhull leaves out a point nearly coincident with another, and a
+    sliver may be all that touched it) is dropped and the triangles renumbered; the first ``surface``
+    points (the contact nodes) must all be used, or the mesh is refused.
+    """
     from scipy.spatial import Delaunay
 
     tri = Delaunay(points).simplices
@@ -139,7 +145,13 @@ def _triangulate(points: np.ndarray, keep) -> np.ndarray:
                         - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1]))
     centroid = p.mean(axis=1)
     scale = np.max(np.abs(points)) ** 2
-    return tri[(area > 1e-12 * scale) & keep(centroid)]
+    tri = tri[(area > 1e-12 * scale) & keep(centroid)]
+    used = np.zeros(len(points), bool)
+    used[tri.ravel()] = True
+    if not used[:surface].all():
+        raise RuntimeError("the mesh lost a contact node (choose another h0)")
+    number = np.cumsum(used) - 1
+    return points[used], number[tri]
 
 
 def pin_mesh(model: PinBushing, mesh: Mesh, theta: np.ndarray):
@@ -162,8 +174,7 @@ def pin_mesh(model: PinBushing, mesh: Mesh, theta: np.ndarray):
     pts.append(np.zeros((1, 2)))
     points = np.vstack(pts)
     points[:, 1] = np.where(np.abs(points[:, 1]) < 1e-12 * R, 0.0, points[:, 1])
-    tri = _triangulate(points, lambda x: np.ones(len(x), bool))
-    return points, tri
+    return _triangulate(points, lambda x: np.ones(len(x), bool), len(theta))
 
 
 def bushing_mesh(model: PinBushing, mesh: Mesh, theta: np.ndarray):
@@ -183,7 +194,7 @@ def bushing_mesh(model: PinBushing, mesh: Mesh, theta: np.ndarray):
         pts.append(_ring_points(r, model.radius, mesh, r - Rb))
     points = np.vstack(pts)
     points[:, 1] = np.where(np.abs(points[:, 1]) < 1e-12 * Rb, 0.0, points[:, 1])
-    tri = _triangulate(points, lambda x: np.hypot(x[:, 0], x[:, 1]) > Rb * (1 + 1e-9))
+    points, tri = _triangulate(points, lambda x: np.hypot(x[:, 0], x[:, 1]) > Rb * (1 + 1e-9), len(theta))
     return points, tri, Ro
 
 
