@@ -12,7 +12,8 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from scipy.integrate import quad, solve_ivp
+from scipy.integrate import quad
+from test_contact import single_mass_restitution  # m delta_ddot = -F_N, DOP853 to the separation
 
 import weftsim
 from weftsim.joint.contact import LAWS, exact_hysteresis, make_law, restored_restitution
@@ -25,25 +26,6 @@ def joint():
     return replace(weftsim.load_scene("loom").joint, law="cylindrical")
 
 
-def free_impact(law, mass, v0):
-    """-v_separation / v0 of a mass m hitting the law at v0 (DOP853 at rtol 1e-11, event at separation)."""
-    force = law.scalar()
-
-    def rhs(t, y):
-        return (y[1], -force(y[0], y[1], v0) / mass)
-
-    def separation(t, y):
-        return y[0]
-
-    separation.terminal, separation.direction = True, -1
-    k, n = law.coefficient, law.exponent
-    depth = ((n + 1.0) * 0.5 * mass * v0**2 / k) ** (1.0 / (n + 1.0))  # elastic estimate of the deepest approach
-    sol = solve_ivp(rhs, (0.0, 1e3 * depth / v0), (0.0, v0), method="DOP853", rtol=1e-11,
-                    atol=1e-13 * max(depth, v0), events=separation)
-    assert sol.status == 1, sol.message
-    return -sol.y_events[0][0, 1] / v0
-
-
 @pytest.mark.parametrize("ce", [0.3, 0.6, 0.9])
 def test_a_free_impact_returns_the_laws_restitution(joint, ce):
     law = make_law(replace(joint, restitution=ce))
@@ -52,7 +34,7 @@ def test_a_free_impact_returns_the_laws_restitution(joint, ce):
         # the hysteresis factor solves the exact restitution relation; the ODE is solved at rtol 1e-11 and the
         # separation event located to ~1e-12, so 1e-8 is far above the solver's noise and far below the
         # Lankarani-Nikravesh factor's error on this law (0.913 for 0.9, 0.684 for 0.3)
-        assert free_impact(law, 2.8, v0) == pytest.approx(ce, abs=1e-8)
+        assert single_mass_restitution(law, 2.8, v0) == pytest.approx(ce, abs=1e-8)
     assert restored_restitution(0.75 * (1.0 - ce**2)) - ce > 0.01  # the LN factor would fail this test
 
 
