@@ -4,8 +4,8 @@
 
 1. Mesh convergence: the approach at 1, 10 and 50 kN (per 30 mm) on four meshes halving h0, the
    change between the two finest (must be < 1 %) and a fit delta(h) = delta_inf + C h^p.
-2. The Hertz limit: contact half-width and peak pressure of the FE model against Hertz's line contact
-   (Johnson 1985, eq. 4.43-4.45) at 1 kN as the clearance grows against the contact width.
+2. The Hertz limit: contact half-width and peak pressure of the FE model (mesh at b/60) against Hertz's
+   line contact (Johnson 1985, eq. 4.43-4.45) at 1 kN as the clearance grows against the contact width.
 3. (--fit) The FE grid c = 0.02, 0.05, 0.1, 0.25 mm x t = 2.5, 4, 6 mm x 1-50 kN and the least-squares
    fit of the cylindrical law's constants (weftsim.joint.contact.CYLINDRICAL_FIT).
 4. The check: the loom's joint (R = 15 mm, L = 30 mm, steel in aluminium bronze, the wall of
@@ -72,16 +72,17 @@ def convergence(joint) -> list[dict]:
 
 def hertz_limit(joint) -> list[dict]:
     rows = []
-    for c_mm in (0.25, 1.0, 3.0):
+    for c_mm in (0.25, 1.0, 3.0, 6.0):
         model = PinBushing.from_joint(replace(joint, clearance=c_mm * 1e-3), joint.bushing_wall)
-        fe = PinBushingFE(model, Mesh(h0=0.0125e-3, fine_deg=8.0, candidate_deg=15.0))
         load = 1e3 / joint.bearing_length
-        s = fe.solve(load)
         b, p0 = hertz_line_contact(model, load)
+        fine = math.degrees(3.0 * b / model.radius)
+        fe = PinBushingFE(model, Mesh(h0=b / 60.0, fine_deg=fine, candidate_deg=fine + 20.0))
+        s = fe.solve(load)
         # the FE contact's half-width and peak from a least-squares semi-ellipse through the nodal pressures
         x = (model.radius + model.clearance) * np.sin(s.angles)
         inside = s.pressure > 0.0
-        grid = np.linspace(0.7, 1.3, 601) * b
+        grid = np.linspace(0.8, 1.2, 801) * b
         errs = [np.sum((s.pressure[inside] - _ellipse_fit(x[inside], s.pressure[inside], bb)[1]) ** 2) for bb in grid]
         b_fe = float(grid[int(np.argmin(errs))])
         p_fe = _ellipse_fit(x[inside], s.pressure[inside], b_fe)[0]

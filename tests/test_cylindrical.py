@@ -107,32 +107,36 @@ def test_fe_approach_converges_in_the_mesh(joint, clearance):
     finest = np.abs(a[-1] / a[-2] - 1.0)
     # the issue's criterion: within 1 % between the two finest meshes (measured 0.02-0.15 %)
     assert np.all(finest < 0.01), finest
-    # and converging: each halving changes the approach less than the one before
-    assert np.all(np.abs(a[2] - a[1]) < np.abs(a[1] - a[0]))
+    # and converging: each mesh is closer to the finest than the one before (the changes are 0.01-0.1 %,
+    # where the sign of one halving's change may flip: at c = 0.25 mm and 50 kN 0.004 % then 0.03 %)
+    assert np.all(np.abs(a[1] - a[2]) <= np.abs(a[0] - a[2]))
 
 
 @pytest.mark.slow
 def test_fe_tends_to_hertz_where_the_clearance_is_large_against_the_contact_width(joint):
     """At 1 kN the contact's half-width b and peak pressure p0 (a semi-ellipse fitted through the FE nodal
-    pressures) approach Hertz's line contact as b/R falls (c = 0.25, 1 and 3 mm: b/R = 0.047, 0.024,
-    0.014): measured errors in scripts/cylinder_fe_check.py's table (docs/clearance-joint.md)."""
+    pressures, the mesh at b/60) approach Hertz's line contact as b/R falls: c = 0.25, 1, 3 and 6 mm give
+    b/R = 0.047, 0.024, 0.015, 0.011 and measured errors in b of -1.65, -1.25, -1.1, -0.9 % (p0: +1.7,
+    +1.2, +1.0, +0.9 %); on a mesh at b/30 the errors of the last three no longer fall (1.25-1.3 %: the
+    mesh, not the geometry, then sets them)."""
     pytest.importorskip("skfem")
     from weftsim.studies.cylinder_fe import hertz_line_contact
 
     errors = []
     load = 1e3 / joint.bearing_length
-    for clearance in (0.25e-3, 1e-3, 3e-3):
-        fe = _fe(joint, clearance, 0.0125e-3, fine=8.0)
+    for clearance in (0.25e-3, 1e-3, 3e-3, 6e-3):
+        fe0 = _fe(joint, clearance, 1e-3, fine=1.0)  # only for its model
+        b, p0 = hertz_line_contact(fe0.model, load)
+        fe = _fe(joint, clearance, b / 60.0, fine=math.degrees(3.0 * b / joint.journal_radius))
         s = fe.solve(load)
-        b, p0 = hertz_line_contact(fe.model, load)
         x = (fe.model.radius + fe.model.clearance) * np.sin(s.angles)
         inside = s.pressure > 0.0
-        best = min(np.linspace(0.7, 1.3, 601) * b, key=lambda bb: _ellipse_residual(x[inside], s.pressure[inside], bb))
+        best = min(np.linspace(0.8, 1.2, 801) * b, key=lambda bb: _ellipse_residual(x[inside], s.pressure[inside], bb))
         p_fit = _ellipse_p0(x[inside], s.pressure[inside], best)
         errors.append((abs(best / b - 1.0), abs(p_fit / p0 - 1.0)))
     errors = np.array(errors)
-    assert np.all(np.diff(errors[:, 0]) < 0.0) and np.all(np.diff(errors[:, 1]) < 0.0), errors
-    assert np.all(errors[-1] < 0.03), errors  # at b/R = 0.014 within 3 % of Hertz (measured below 2 %)
+    assert np.all(np.diff(errors[:, 0]) <= 0.0) and np.all(np.diff(errors[:, 1]) < 0.0), errors
+    assert np.all(errors[-1] < 0.015), errors  # at b/R = 0.011 within 1.5 % of Hertz (measured 0.9 %)
 
 
 def _ellipse_p0(x, p, b):

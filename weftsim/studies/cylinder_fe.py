@@ -130,8 +130,10 @@ def _ring_points(r: float, radius: float, mesh: Mesh, depth: float) -> np.ndarra
     return np.column_stack([r * np.cos(phi), r * np.sin(phi)])
 
 
-def _triangulate(points: np.ndarray, keep, surface: int) -> tuple[np.ndarray, np.ndarray]:
-    """Delaunay triangles of ``points`` whose centroid ``keep`` accepts, and the points they use.
+def _triangulate(points: np.ndarray, keep, surface: int, plane: np.ndarray | None = None
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """Delaunay triangles of ``points`` (of their images ``plane`` if given) whose centroid ``keep``
+    accepts, and the points they use.
 
     A point no kept triangle uses (qhull leaves out a point nearly coincident with another, and a
     sliver may be all that touched it) is dropped and the triangles renumbered; the first ``surface``
@@ -139,7 +141,7 @@ def _triangulate(points: np.ndarray, keep, surface: int) -> tuple[np.ndarray, np
     """
     from scipy.spatial import Delaunay
 
-    tri = Delaunay(points).simplices
+    tri = Delaunay(points if plane is None else plane).simplices
     p = points[tri]
     area = 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
                         - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1]))
@@ -194,7 +196,10 @@ def bushing_mesh(model: PinBushing, mesh: Mesh, theta: np.ndarray):
         pts.append(_ring_points(r, model.radius, mesh, r - Rb))
     points = np.vstack(pts)
     points[:, 1] = np.where(np.abs(points[:, 1]) < 1e-12 * Rb, 0.0, points[:, 1])
-    points, tri = _triangulate(points, lambda x: np.hypot(x[:, 0], x[:, 1]) > Rb * (1 + 1e-9), len(theta))
+    # triangulated in the plane (R_b theta, r), where the half ring is a rectangle (convex: no triangle spans
+    # the bore, none is lost to it), the triangles then taken back with their corners
+    plane = np.column_stack([Rb * np.arctan2(points[:, 1], points[:, 0]), np.hypot(points[:, 0], points[:, 1])])
+    points, tri = _triangulate(points, lambda x: np.ones(len(x), bool), len(theta), plane)
     return points, tri, Ro
 
 
