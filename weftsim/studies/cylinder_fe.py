@@ -97,10 +97,10 @@ def _size(h0: float, grading: float, h_max: float, distance: np.ndarray) -> np.n
 
 def _march(total: float, size) -> np.ndarray:
     """Positions 0 = s_0 < s_1 < ... < s_n = total with steps ~ size(s), rescaled to end at ``total``."""
-    s = [0.0]
-    while s[-1] < total:
-        s.append(s[-1] + float(size(s[-1])))
-    s = np.asarray(s)
+    marks = [0.0]
+    while marks[-1] < total:
+        marks.append(marks[-1] + float(size(marks[-1])))
+    s = np.asarray(marks)
     if len(s) > 2 and (s[-1] - total) > 0.5 * (s[-1] - s[-2]):
         s = s[:-1]
     return s * (total / s[-1]) if s[-1] > 0 else s
