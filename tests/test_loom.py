@@ -91,16 +91,21 @@ def default_run(loom):
     return weftsim.simulate(loom, engine="exudyn")
 
 
-def test_run_at_the_defaults_carries_the_ideal_mean_load_and_warns_nothing(loom, default_run):
+def test_run_at_the_defaults_carries_the_ideal_mean_load_and_warns_of_its_impacts(loom, default_run):
     assert default_run.ok, default_run.message
     s = default_run.samples
     rev2 = (s["time_s"] >= loom.drive.period) & (s["time_s"] < 2.0 * loom.drive.period)
     ideal = ideal_pin_loads(loom, "e")
     # At 20 um the pin bears on its bushing all through revolution 2 but near the two force reversals: its
     # mean force is the ideal joint's (Newton-Euler of the chain behind E) plus the impacts' share, measured
-    # 0.4 % (9197 N against 9160 N); 2 % is five times that.
+    # 0.5 % (9209 N against 9160 N; 0.4 % under the former variable_kd law); 2 % is four times that.
     assert float(np.mean(s["contact_force_N"][rev2])) == pytest.approx(float(np.mean(ideal.force)), rel=0.02)
-    assert not [c.message for c in after_run(default_run) if c.verdict == "warning"]
+    # The law changed (issue 37): the FE-checked cylindrical law is 3-15 times stiffer than the former
+    # variable_kd on this pin, so the dry new joint's impacts at the two force reversals peak at about
+    # 23 kN and 4500 m/s2 of rapier acceleration (11.7 kN and 2200 m/s2 before): above the rapier's
+    # 3000 m/s2 and the bushing's 27.6 MPa of projected pin pressure.  Those two, and nothing else, warn.
+    warned = sorted(c.name for c in after_run(default_run) if c.verdict == "warning")
+    assert warned == ["pin_pressure", "rapier_acceleration"]
 
 
 def test_design_checks_after_a_run_read_revolution_two_on(default_run):
@@ -139,7 +144,22 @@ def test_both_engines_agree_on_the_start_up_impact(speed_rpm, clearance_mm):
     assert ref.ok and exu.ok, (ref.message, exu.message)
     report = compare_results(exu, ref)
     checks = {c["name"]: c for c in report["checks"]}
-    assert report["status"] == "agree", [c for c in report["checks"] if not c["passed"]]
+    failed = [c for c in report["checks"] if not c["passed"]]
+    if (speed_rpm, clearance_mm) == (800, 0.25):
+        # Under the cylindrical law (issue 37) the impacts after the start-up one are hard enough at 800 rpm and
+        # 0.25 mm that the torque's first-revolution maximum is already a draw of the chaotic sequence on the
+        # Exudyn engine, though both engines reach it at 40.4 deg: Exudyn's chaos runs (crank speed x (1 + k
+        # 1e-9), k = 0..3) give 8821, 9063, 9044 and 8953 N m (at 40.4 or 45.3 deg), the reference engine
+        # 8982 N m, inside that band; at rtol 1e-9 on both engines compare agrees.  compare judges it because
+        # the angles coincide (its rule: weftsim.post.compare.set_by_different_impacts): that one check may
+        # fail here, and the start-up impact's torque maximum, the reproducible one, must then agree.
+        from weftsim.post.compare import startup_impact_max
+
+        if failed and [c["name"] for c in failed] == ["driving_torque_Nm: first revolution max"]:
+            se, sr = (startup_impact_max(r, "driving_torque_Nm") for r in (exu, ref))
+            assert se == pytest.approx(sr, rel=scene.compare.first_revolution_peaks)
+            failed = []
+    assert not failed, failed
     for name in ("contact_force_N", "rapier_acceleration_m_s2"):
         assert f"{name}: first revolution max" in checks
     apart = abs(_max_angle_deg(exu, "driving_torque_Nm") - _max_angle_deg(ref, "driving_torque_Nm"))

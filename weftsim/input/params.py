@@ -258,7 +258,10 @@ class ClearanceJoint:
     journal_radius : float
         R_j, m.  Bearing radius R_b = R_j + c.
     bearing_length : float
-        L_b, axial length of the bearing, m (used by ``elastic_foundation``).
+        L_b, axial length of the bearing, m (used by ``elastic_foundation`` and ``cylindrical``).
+    bushing_wall : float or None
+        t, radial wall thickness of the bushing between its bore and the housing (the link's eye), m;
+        used by the ``cylindrical`` law (its stiffness is fitted with the wall), None = not given.
     journal_material, bearing_material : Material
     law : str
         Name of the contact force law in :data:`weftsim.joint.contact.LAWS`.
@@ -293,6 +296,7 @@ class ClearanceJoint:
     clearance: float
     journal_radius: float = 10e-3
     bearing_length: float = 20e-3
+    bushing_wall: float | None = None
     journal_material: Material = field(default_factory=Material)
     bearing_material: Material = field(default_factory=Material)
     law: str
@@ -352,6 +356,9 @@ def joint_problem(joint: ClearanceJoint) -> str | None:
         if not _positive_finite(value):
             unit = "m/s" if name == "min_impact_velocity" else "m"
             return f"`{name}` must be > 0 ({unit}), got {value!r}"
+    wall = joint.bushing_wall
+    if wall is not None and not _positive_finite(wall):
+        return f"`bushing_wall` must be > 0 (m) or None (not given), got {wall!r}"
     if not isinstance(joint.law, str) or not joint.law:
         return f"`law` must name a contact law (weftsim.joint.contact.LAWS), got {joint.law!r}"
     ce = joint.restitution

@@ -148,6 +148,8 @@ SCHEMA: tuple[Key, ...] = (
     Key("joint_e.clearance_mm", "joint.clearance", "float", MM, 0, 5, False, doc="radial clearance c; 0 = ideal joint"),
     Key("joint_e.journal_radius_mm", "joint.journal_radius", "float", MM, 0, PIN_MM, doc="R_j"),
     Key("joint_e.bearing_length_mm", "joint.bearing_length", "float", MM, 0, PIN_MM, doc="L_b"),
+    Key("joint_e.bushing_wall_mm", "joint.bushing_wall", "float", MM, 0, PIN_MM,
+        doc="optional; t, the bushing's radial wall to its housing (the cylindrical law needs it)"),
     Key("joint_e.law", "joint.law", "str", doc="contact force law (see weftsim.joint.contact.LAWS)"),
     Key("joint_e.restitution", "joint.restitution", "float", 1, 0, 1, True, False, doc="coefficient of restitution ce"),
     Key("joint_e.friction_coefficient", "joint.friction_coefficient", "float", 1, 0, 2, False,
@@ -271,7 +273,8 @@ REQUIRED_SECTIONS = ("mechanism", "inertia", "joint_e", "drive")
 # Model options inside those sections that are not part of the machine: they default.
 OPTIONAL = ("joint_e.impact_velocity_rule", "joint_e.journal_material.yield_strength_mpa",
             "joint_e.bearing_material.yield_strength_mpa", "joint_e.bearing_material.max_pressure_mpa",
-            "joint_e.bearing_material.max_pv_mpa_m_s", "joint_e.design_clearance_per_mille") \
+            "joint_e.bearing_material.max_pv_mpa_m_s", "joint_e.design_clearance_per_mille",
+            "joint_e.bushing_wall_mm") \
     + tuple(key.path for key in WEAR_KEYS("joint_e", "joint")) \
     + tuple(key.path for key in LUBRICATION_KEYS("joint_e", "joint"))
 # [joint_f] is optional as a whole (absent: the ideal revolute joint at F).  Given a clearance > 0, F takes

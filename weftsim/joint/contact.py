@@ -441,9 +441,108 @@ class ElasticFoundation(_Law):
                 "length_modulus": joint.bearing_length * math.pi / 2.0 * joint.effective_modulus}
 
 
+EXACT_RESTITUTION_FLOOR = 0.05
+
+
+def exact_hysteresis(restitution: float) -> float:
+    """xi whose single-mass impact returns exactly ``restitution`` (the inverse of :func:`restored_restitution`).
+
+    For every law of the family F_N = F_el(delta) (1 + xi delta_dot / v_imp) the restored ce solves
+    phi(-xi ce) = phi(xi), phi(z) = z - ln(1 + z), whatever F_el (:func:`restored_restitution`); here that
+    equation is solved for xi at the requested ce (0 < ce <= 1), so the law restores ce to solver precision
+    over the whole range (Lankarani-Nikravesh's 3 (1 - ce^2) / 4 is its first-order form as ce -> 1).
+    Below ce = :data:`EXACT_RESTITUTION_FLOOR` the root sits closer to xi = 1 / ce than a double resolves
+    (1 - xi ce = 1.6e-8 at ce = 0.05, ~1e-21 at 0.02), so such a ce is refused with one line.
+    """
+    if not EXACT_RESTITUTION_FLOOR <= restitution <= 1.0:
+        raise ValueError(f"`restitution` must be in [{EXACT_RESTITUTION_FLOOR}, 1] for the cylindrical law's exact "
+                         f"damping, got {restitution}")
+    if restitution == 1.0:
+        return 0.0
+    from scipy.optimize import brentq
+
+    ce = restitution
+    # phi(-xi ce) - phi(xi) = -(1 - ce^2) xi^2 / 2 + (1 + ce^3) xi^3 / 3 + ... < 0 below 1.5 (1 - ce^2) / (1 + ce^3),
+    # and -> +inf as xi ce -> 1: the root xi > 0 (not the trivial xi = 0) lies between.
+    lo = 0.1 * (1.0 - ce * ce)
+    hi = (1.0 / ce) * (1.0 - 1e-15)
+    return brentq(lambda xi: _excess_over_log(-xi * ce) - _excess_over_log(xi), lo, hi, xtol=1e-300, rtol=1e-15)
+
+
+@dataclass(frozen=True)
+class Cylindrical(_Law):
+    """The conformal pin in its bushing, fitted to a plane-strain finite-element model (issue 37).
+
+    F_el = k delta^n, a power law in the approach delta (the multibody penetration |e| - c), with
+
+        k = L_b E* R^(1 - n) exp(k0 + k1 ln(c/R) + k2 ln(t/R)),    n = n0 + n1 ln(c/R) + n2 ln(t/R),
+
+    R the pin's radius, c the clearance, t the bushing's wall to a rigid housing
+    (``bushing_wall``), L_b the bushing's length and E* the joint's effective modulus.  The form is Pereira,
+    Ramalho & Ambrosio's (Nonlinear Dyn. 63, 2011: k delta^n with n falling as the clearance grows, fitted to
+    finite elements); their constants are for a bushing in a thick plate, and are 40-100 % too compliant
+    for a 4 mm bronze wall on a steel eye (docs/clearance-joint.md, "The cylindrical law"), so the
+    constants (:data:`CYLINDRICAL_FIT`) are refitted to :mod:`weftsim.studies.cylinder_fe` over
+    1-50 kN on 30 mm, 0.02 <= c <= 0.25 mm and 2.5 <= t <= 6 mm at R = 15 mm, steel on aluminium
+    bronze (scripts/cylinder_fe_check.py prints the fit and the check).  Continuous at onset (F = 0
+    and dF/d delta = 0 at delta = 0 for n > 1).  Damping: xi of :func:`exact_hysteresis`, so a free
+    impact restores the requested ce for any ce in (0, 1].
+    """
+
+    clearance: float = 0.0  # c, m
+    stiffness_coefficient: float = 0.0  # k, N/m^n
+    power: float = 1.5  # n
+
+    name: ClassVar[str] = "cylindrical"
+    valid_restitution: ClassVar[tuple[float, float]] = (EXACT_RESTITUTION_FLOOR, 1.0)
+    valid_penetration_ratio: ClassVar[float | None] = None
+    penetration_basis: ClassVar[str] = ("fitted to a plane-strain FE model of the conformal pin in its bushing "
+                                         "(1-50 kN on 30 mm, arcs up to +-50 deg): no bound on delta / c")
+    kind: ClassVar[int] = kernel.LAW_CYLINDRICAL
+
+    hysteresis_factor = staticmethod(exact_hysteresis)
+
+    @property
+    def exponent(self) -> float:  # type: ignore[override]
+        return self.power
+
+    @property
+    def coefficient(self) -> float:
+        """k, N/m^n."""
+        return self.stiffness_coefficient
+
+    @property
+    def parameters(self) -> tuple[float, float, float, float]:
+        """(kind, k, c, xi), the exponent n packed in kind (:func:`weftsim.physics.laws.cylindrical_kind`)."""
+        return kernel.cylindrical_kind(self.power), self.stiffness_coefficient, self.clearance, self.hysteresis
+
+    @staticmethod
+    def _parameters(joint: ClearanceJoint) -> dict:
+        if joint.bushing_wall is None:
+            raise ValueError("the `cylindrical` law needs the bushing's wall to its housing "
+                             "(joint_e.bushing_wall_mm, > 0)")
+        k, n = cylindrical_fit(joint.journal_radius, joint.clearance, joint.bushing_wall,
+                               joint.bearing_length, joint.effective_modulus)
+        return {"clearance": joint.clearance, "stiffness_coefficient": k, "power": n}
+
+
+# (k0, k1, k2, n0, n1, n2) of Cylindrical, fitted by scripts/cylinder_fe_check.py (least squares in ln F).
+CYLINDRICAL_FIT = (-0.55645, -0.58399, -0.34812, 1.17208, -0.029507, -0.00074290)
+
+
+def cylindrical_fit(radius: float, clearance: float, wall: float, length: float,
+                    effective_modulus: float, fit: tuple = CYLINDRICAL_FIT) -> tuple[float, float]:
+    """(k, n) of :class:`Cylindrical`: k = L E* R^(1 - n) exp(k0 + k1 ln rho + k2 ln tau), n = n0 + n1 ln rho
+    + n2 ln tau, rho = c / R, tau = t / R (SI units; k in N/m^n)."""
+    k0, k1, k2, n0, n1, n2 = fit
+    lr, lt = math.log(clearance / radius), math.log(wall / radius)
+    n = n0 + n1 * lr + n2 * lt
+    return length * effective_modulus * radius ** (1.0 - n) * math.exp(k0 + k1 * lr + k2 * lt), n
+
+
 LAWS: dict[str, type[_Law]] = {
     law.name: law
-    for law in (LankaraniNikravesh, VariableKD, Flores, HuntCrossley, Gonthier, ElasticFoundation)
+    for law in (LankaraniNikravesh, VariableKD, Flores, HuntCrossley, Gonthier, ElasticFoundation, Cylindrical)
 }
 
 

@@ -13,9 +13,13 @@ impact velocity v_imp (m/s, > 0) and hysteresis factor xi.  A law is four number
 ``LAW_CONSTANT``       k = K_LN, N/m^1.5          k
 ``LAW_VARIABLE_KD``    a = (pi/8) E*, Pa          a sqrt(2 delta (3c + 2 delta)^2 / (c + delta)^3)
 ``LAW_ELASTIC_FOUND.`` b = L_b (pi/2) E*, N/m     b / sqrt(2 (c + delta))
+``LAW_CYLINDRICAL``    k, N/m^n                   k delta^(n - 1.5), exponent n packed in kind
 =====================  =========================  =========================================
 
-plus the clearance c (m, used by the delta-dependent laws) and xi.  :mod:`weftsim.joint.contact` builds
+plus the clearance c (m, used by the delta-dependent laws) and xi.  ``LAW_CYLINDRICAL`` is the power law
+F_el = k delta^n of the conformal pin in its bushing (``cylindrical``); its exponent n in [1, 3) travels in
+``kind`` itself, kind = LAW_CYLINDRICAL + (n - 1) / 2 (:func:`cylindrical_kind`), so every engine's parameter
+block and every kernel signature stay as they are (the other laws' kinds are whole numbers).  :mod:`weftsim.joint.contact` builds
 them from a joint (``law.parameters``) and documents each law and its sources (Lankarani &
 Nikravesh 1990, Bai & Zhao 2013, Liu, Zhang & Yang 2007, ...).  The functions take floats and
 return floats, never check their arguments (speed), and are compiled with numba; ``fn.py_func``
@@ -29,7 +33,20 @@ import math
 import numpy as np
 from numba import njit
 
-LAW_CONSTANT, LAW_VARIABLE_KD, LAW_ELASTIC_FOUNDATION = 0, 1, 2
+LAW_CONSTANT, LAW_VARIABLE_KD, LAW_ELASTIC_FOUNDATION, LAW_CYLINDRICAL = 0, 1, 2, 3
+
+
+def cylindrical_kind(exponent: float) -> float:
+    """``kind`` of the power law F_el = k delta^n: LAW_CYLINDRICAL + (n - 1) / 2, for 1 <= n < 3."""
+    if not 1.0 <= exponent < 3.0:
+        raise ValueError(f"the cylindrical law's exponent must be in [1, 3), got {exponent}")
+    return LAW_CYLINDRICAL + 0.5 * (exponent - 1.0)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def power_exponent(kind: float) -> float:
+    """n of a ``LAW_CYLINDRICAL`` kind (the inverse of :func:`cylindrical_kind`)."""
+    return 1.0 + 2.0 * (kind - LAW_CYLINDRICAL)
 
 # Below x = delta / c = 1/4 the energy integrals of the delta-dependent laws are summed as binomial
 # series (their closed forms cancel catastrophically as x -> 0); 32 terms: 0.25^32 ~ 5e-20, far below
@@ -65,6 +82,8 @@ def stiffness(kind: float, coef: float, clearance: float, delta: float) -> float
         return coef * math.sqrt(2.0 * d * w * w / (s * s * s))
     if kind == LAW_ELASTIC_FOUNDATION:
         return coef / math.sqrt(2.0 * (clearance + d))
+    if kind >= LAW_CYLINDRICAL:
+        return coef * d ** (power_exponent(kind) - 1.5) if d > 0.0 else 0.0
     return coef
 
 
@@ -97,7 +116,7 @@ def damping_coefficient(kind: float, coef: float, clearance: float, xi: float, d
 def elastic_energy(kind: float, coef: float, clearance: float, delta: float) -> float:
     """W = integral_0^delta F_el(s) ds, J (0 for delta <= 0).
 
-    Constant K: W = k delta^2.5 / 2.5.  variable_kd: W = a sqrt(2) c^2.5 g(x), x = delta / c,
+    Constant K: W = k delta^2.5 / 2.5; cylindrical: W = k delta^(n+1) / (n + 1).  variable_kd: W = a sqrt(2) c^2.5 g(x), x = delta / c,
     g(x) = 4/5 u^2.5 - 2 u^1.5 - 2 u^-0.5 + 16/5 with u = 1 + x.  elastic_foundation:
     W = (b / sqrt(2)) c^2 h(x), h(x) = sqrt(x (1 + x)) (2x - 3) / 4 + 3/4 asinh(sqrt(x)).
     Below x = :data:`SERIES_LIMIT` g and h are summed as binomial series (relative error ~1e-14).
@@ -106,6 +125,9 @@ def elastic_energy(kind: float, coef: float, clearance: float, delta: float) -> 
         return 0.0
     if kind == LAW_CONSTANT:
         return coef * delta**2.5 / 2.5
+    if kind >= LAW_CYLINDRICAL:
+        n = power_exponent(kind)
+        return coef * delta ** (n + 1.0) / (n + 1.0)
     c = clearance
     x = delta / c
     if kind == LAW_VARIABLE_KD:

@@ -80,6 +80,42 @@ def stiffness_curve(joint: ClearanceJoint, points: int = CURVE_POINTS, extent: f
     }
 
 
+COMPARISON_LOADS_KN = (1.0, 10.0, 50.0)
+FE_CHECKED = "cylindrical"  # the law checked against the FE model of the pin in its bushing (issue 37)
+
+
+def law_comparison(joint: ClearanceJoint, loads_kn=COMPARISON_LOADS_KN) -> list[dict]:
+    """Every law of the library on ``joint`` (its own clearance, pin, bushing and materials): the approach
+    delta at which its elastic force carries each load, and its ratio to the FE-checked law's
+    (:data:`FE_CHECKED`, within 10 % of the plane-strain FE model: docs/physics.md, "The cylindrical law").
+    A law the joint cannot build (the cylindrical law without ``bushing_wall``) gets its reason instead."""
+    from dataclasses import replace
+
+    from scipy.optimize import brentq
+
+    from weftsim.joint.contact import LAWS, make_law
+
+    def approach(law, force):
+        return brentq(lambda d: float(law.elastic_force(d)) - force, 1e-14, 1.0, xtol=1e-16, rtol=1e-12)
+
+    rows, checked = [], None
+    for name in sorted(LAWS, key=lambda n: (n != FE_CHECKED, n)):
+        try:
+            law = make_law(replace(joint, law=name))
+        except ValueError as err:
+            rows.append({"law": name, "error": str(err)})
+            continue
+        row = {"law": name, "fe_checked": name == FE_CHECKED, "exponent": law.exponent,
+               "approach_um": [approach(law, f * 1e3) * 1e6 for f in loads_kn]}
+        if name == FE_CHECKED:
+            checked = row["approach_um"]
+        rows.append(row)
+    for row in rows:
+        if checked is not None and "approach_um" in row:
+            row["over_fe_checked"] = [a / b for a, b in zip(row["approach_um"], checked)]
+    return rows
+
+
 def contact_steps(result: RunResult, revolution: int) -> dict[str, np.ndarray]:
     """Steps in contact of one revolution with K(delta) and D(delta, v_imp) from the scene's law."""
     from weftsim.joint.contact import make_law
@@ -178,6 +214,8 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
         "stiffness_lankarani_nikravesh": curve["stiffness_constant"],
         "curve": curve["numbers"],
         "plotted_revolution": revolution + 1,
+        "laws_on_the_scene": {"scene": base.name, "clearance_mm": base.joint.clearance * 1e3,
+                              "loads_kN": list(COMPARISON_LOADS_KN), "laws": law_comparison(base.joint)},
         "revolution": in_contact,
         "run": common.run_metrics(result),
         "files": sorted(p.name for p in written.values()),
@@ -197,6 +235,19 @@ def format_report(report: dict) -> str:
         "  d ln K / d ln delta at " + ", ".join(f"{k} mm: {v:.3f}" for k, v in c["stiffness_log_slope"].items()),
         "  d ln D / d ln delta at " + ", ".join(f"{k} mm: {v:.3f}" for k, v in c["damping_log_slope"].items()),
     ]
+    on = report.get("laws_on_the_scene")
+    if on:
+        loads = " / ".join(f"{f:g}" for f in on["loads_kN"])
+        lines.append(f"  every law on {on['scene']}'s joint (c = {on['clearance_mm']:g} mm): approach at {loads} kN, "
+                     f"and against the FE-checked {FE_CHECKED}")
+        for row in on["laws"]:
+            if "error" in row:
+                lines.append(f"    {row['law']:<20} not on this joint: {row['error']}")
+                continue
+            um = " / ".join(f"{a:.3g}" for a in row["approach_um"])
+            ratio = (" x " + " / ".join(f"{x:.2f}" for x in row["over_fe_checked"])) if "over_fe_checked" in row else ""
+            mark = "  (FE-checked)" if row["fe_checked"] else ""
+            lines.append(f"    {row['law']:<20} {um} um{ratio}{mark}")
     if r:
         lines.append(f"  revolution {report['plotted_revolution']}: in contact "
                      f"{100 * r['time_fraction_in_contact']:.1f}% of the time, "
