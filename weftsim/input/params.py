@@ -297,8 +297,8 @@ def oil_problem(lub: Lubrication) -> str | None:
                 "one way (the grade, or its two viscosities)")
     if lub.oil and grade_problem(lub.oil):
         return grade_problem(lub.oil)
-    if custom and custom_problem(lub.oil_nu40, lub.oil_nu100):
-        return custom_problem(lub.oil_nu40, lub.oil_nu100)
+    if lub.oil_nu40 > 0.0 and lub.oil_nu100 > 0.0 and custom_problem(lub.oil_nu40, lub.oil_nu100):
+        return custom_problem(lub.oil_nu40, lub.oil_nu100)  # one of the two alone: weftsim.joint.bearing says so
     if lub.has_oil and lub.viscosity > 0.0 and lub.film_temperature is None:
         return ("`lubrication.viscosity` and `lubrication.oil` are both given: give the oil (its viscosity then follows "
                 "from the film temperature) or a fixed viscosity, not both")

@@ -129,6 +129,9 @@ def resolve_scene(scene):
         lub = part.lubrication
         if lub is None or not lub.has_oil:
             continue
+        if (lub.oil_nu40 > 0.0) != (lub.oil_nu100 > 0.0):
+            raise SceneError(f"{_table(name)}.lubrication: a custom oil needs both oil.nu40_mm2_s and oil.nu100_mm2_s "
+                             "(its kinematic viscosities at 40 and 100 C)")
         if lub.viscosity > 0.0 and lub.film_temperature is None:
             raise SceneError(f"{_table(name)}.lubrication: viscosity_mpa_s and oil are both given: give the oil (its "
                              "viscosity then follows from the film temperature) or a fixed viscosity_mpa_s, not both")
