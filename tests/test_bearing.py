@@ -233,3 +233,24 @@ def test_the_command_line(tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["points"] == saved["points"]
     assert main(["bearing", "loom", "-o", str(tmp_path / "dry")]) == 2
     assert "joint E is dry" in capsys.readouterr().err
+
+
+def test_a_run_takes_the_oils_viscosity_at_the_film_temperature():
+    """A scene built in Python with an oil (no film temperature yet) runs at the viscosity of its heat balance, as a
+    loaded scene does; the design checks report the temperature (summary.json's plausibility block)."""
+    import weftsim
+    from weftsim.kernel.joint import VISCOSITY
+    from weftsim.reference.dynamics import pack_parameters
+
+    oil = {"joint_e.lubrication.oil": "ISO_VG_220", "joint_e.lubrication.ambient_temperature_c": 40.0,
+           "drive.revolutions": 0.02}
+    loaded = weftsim.load_scene("loom", oil)
+    built = replace(loaded, joint=replace(loaded.joint, lubrication=Lubrication(viscosity=0.0, oil="ISO VG 220",
+                                                                                ambient_temperature=40.0)))
+    result = weftsim.simulate(built, "reference")
+    lub = result.scene.joint.lubrication
+    assert lub.film_temperature == pytest.approx(loaded.joint.lubrication.film_temperature, rel=1e-9)
+    assert pack_parameters(result.scene)[VISCOSITY] == pytest.approx(float(lub.oil_model.viscosity(
+        lub.film_temperature)), rel=1e-12)
+    check = next(c for c in result.plausibility["checks"] if c["name"] == "film_temperature")
+    assert check["value"] == pytest.approx(lub.film_temperature) and check["numbers"]["viscosity_pa_s"] == lub.viscosity
