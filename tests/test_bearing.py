@@ -208,8 +208,9 @@ def test_bearing_report_and_stribeck_curve():
     report = weftsim.bearing(scene)
     mean, peak = report["points"]["mean"], report["points"]["peak"]
     assert mean["load_n"] < peak["load_n"] and mean["journal_speed_rad_s"] == peak["journal_speed_rad_s"]
-    # The pre-run film temperature is the mean point's.
+    # The pre-run film temperature is the mean point's, and the peak runs in the same film.
     assert mean["film_temperature_c"] == pytest.approx(scene.joint.lubrication.film_temperature, rel=1e-9)
+    assert peak["viscosity_pa_s"] == mean["viscosity_pa_s"] and peak["heat"] is None
     json.dumps(report)  # JSON-ready
     mu = np.asarray(report["stribeck"]["friction_coefficient"])
     assert mu[0] == pytest.approx(0.1, rel=0.1)  # boundary: the asperities carry, mu_b = 0.1
@@ -254,3 +255,14 @@ def test_a_run_takes_the_oils_viscosity_at_the_film_temperature():
         lub.film_temperature)), rel=1e-12)
     check = next(c for c in result.plausibility["checks"] if c["name"] == "film_temperature")
     assert check["value"] == pytest.approx(lub.film_temperature) and check["numbers"]["viscosity_pa_s"] == lub.viscosity
+
+
+def test_a_bearing_that_cannot_shed_its_heat_is_refused():
+    """Self-contained (no oil flow) with no heat path through the housing: no temperature balances the friction
+    power, and the scene says so in one line."""
+    import weftsim
+
+    with pytest.raises(SceneError, match="has no solution below") as info:
+        weftsim.load_scene("loom", {"joint_e.lubrication.oil": "ISO_VG_220", "joint_e.lubrication.oil_supply": "sump",
+                                    "joint_e.lubrication.housing_heat_transfer_w_k": 0.0})
+    assert "\n" not in str(info.value)

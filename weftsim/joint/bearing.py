@@ -3,8 +3,9 @@
 The calculation a designer makes first (ISO 7902-1 / DIN 31652's steps, on the joint's own kernel): the
 ideal mechanism's loads on the pin (:func:`weftsim.mechanism.pin_loads.ideal_pin_loads`) give two steady
 operating points, the **mean** load at the mean sliding speed and the **peak** load at the same speed; at each
-the journal is a steadily loaded bearing (:mod:`weftsim.joint.steady`), with the film at its effective
-temperature (:mod:`weftsim.joint.heat`, when the scene names an oil) or at the scene's fixed viscosity.  The
+the journal is a steadily loaded bearing (:mod:`weftsim.joint.steady`), with the film at the mean point's
+effective temperature (:mod:`weftsim.joint.heat`, when the scene names an oil: the peak lasts a fraction of a
+cycle, too short to heat the film) or at the scene's fixed viscosity.  The
 relative sliding speed v = R_j |omega_rel| becomes a journal speed omega = v / R_j in a still bushing.
 ``load`` and ``journal_rpm`` evaluate any other operating point instead (the bearing alone).  The Stribeck
 curve is the friction coefficient of the same bearing against journal speed at the point's load, each speed
@@ -60,13 +61,16 @@ def mean_operating_point(scene, name: str) -> tuple[float, float, float]:
         scene, name).journal_radius
 
 
-def operating_point(joint, load: float, omega: float) -> dict:
+def operating_point(joint, load: float, omega: float, film: dict | None = None) -> dict:
     """One steady point as a dict: the :class:`~weftsim.joint.steady.SteadyPoint` numbers, and the heat balance
-    (``heat``; None for a fixed viscosity)."""
+    (``heat``; None for a fixed viscosity, or when ``film``, another point's dict, gives the film's temperature)."""
     from weftsim.joint.heat import heat_balance
     from weftsim.joint.steady import steady_point
 
     lub = joint.lubrication
+    if film is not None:
+        point = steady_point(joint, load, omega, film["viscosity_pa_s"])
+        return {**point.as_dict(), "film_temperature_c": film["film_temperature_c"], "heat": None}
     if lub.has_oil:
         balance = heat_balance(joint, load, omega)
         return {**balance.point.as_dict(), "film_temperature_c": balance.temperature_c, "heat": balance.as_dict()}
@@ -110,7 +114,10 @@ def bearing(scene, joint: str = "e", load: float | None = None, journal_rpm: flo
            "ambient_temperature_c": lub.ambient_temperature if lub.has_oil else None,
            "clearance_mm": 1e3 * part.clearance, "journal_diameter_mm": 2e3 * part.journal_radius,
            "bearing_length_mm": 1e3 * part.bearing_length, "roughness_um": 1e6 * lub.roughness,
-           "points": {name: operating_point(part, w, o) for name, (w, o) in points.items()}}
+           "points": {}}
+    for name, (w, o) in points.items():  # the peak's film is the mean's: a peak lasts too short to heat it
+        film = out["points"].get("mean") if name == "peak" else None
+        out["points"][name] = operating_point(part, w, o, film)
     if curve:
         first_load, first_omega = next(iter(points.values()))
         out["stribeck"] = {"load_n": first_load, "operating_speed_rad_s": first_omega,
