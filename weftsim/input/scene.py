@@ -302,8 +302,11 @@ def _set_checked(scene: params.Scene, target: str, value: Any, where: str) -> pa
 LUBRICATION_TABLES = (("joint_e", "joint"), ("joint_f", "joint_f"))
 
 
-# The keys that name the lubricant of a [<joint>.lubrication] table: a fixed viscosity, or an oil.
+# The keys that name the lubricant of a [<joint>.lubrication] table: a fixed viscosity, or an oil; and every key
+# that matters only with an oil (its properties and the heat balance's).
 VISCOSITY_KEY, OIL_KEYS = "viscosity_mpa_s", ("oil", "oil.nu40_mm2_s", "oil.nu100_mm2_s")
+HEAT_KEYS = OIL_KEYS + ("oil.density_kg_m3", "oil.heat_capacity_j_kg_k", "ambient_temperature_c",
+                        "housing_heat_transfer_w_k", "oil_supply")
 
 
 def _names_oil(flat: dict, prefix: str) -> bool:

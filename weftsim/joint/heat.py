@@ -121,8 +121,8 @@ def heat_balance(joint, load: float, omega: float, viscosity=None, oil=None, amb
             if high >= limit:
                 raise SceneError(f"the plain bearing's heat balance has no solution below {limit:.4g} C (where the "
                                  f"oil thins to 2 mm^2/s): the friction power {at(limit)[1].power_loss_w:.4g} W "
-                                 "outgrows what the oil flow and the housing carry off; a thicker oil, more "
-                                 "clearance or more cooling (housing_heat_transfer_w_k)")
+                                 "outgrows what the oil flow and the housing carry off; a thicker oil, a larger "
+                                 "pin or more cooling (housing_heat_transfer_w_k)")
             low, step = high, 2.0 * step
         temperature = brentq(lambda t: at(t)[0], low, high, xtol=TEMPERATURE_TOL)
     point = at(temperature)[1]
