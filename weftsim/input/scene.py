@@ -321,7 +321,8 @@ def _check_lubrication_given(flat: dict, where: str, before: params.Scene | None
         oil, viscosity = _names_oil(flat, prefix), flat.get(prefix + VISCOSITY_KEY) not in (None, 0, 0.0)
         if oil and viscosity:
             raise SceneError(f"{where}: keys '{prefix}{VISCOSITY_KEY}' and '{prefix}oil' are both given: give the "
-                             "oil (its viscosity then follows from the film temperature) or a fixed viscosity, not both")
+                             "oil (its viscosity then follows from the film temperature) or a fixed viscosity, not "
+                             "both")
         if before is not None and getattr(before, attr).lubrication is not None:
             continue
         if any(k.startswith(prefix) for k in flat) and not (oil or prefix + VISCOSITY_KEY in flat):
@@ -417,8 +418,8 @@ def scene_from_keys(flat: dict[str, Any], where: str = "scene", origin: dict[str
 
 
 def _film_temperature(scene: params.Scene, where: str) -> params.Scene:
-    """``scene`` with each oiled joint's viscosity at its film temperature (:func:`weftsim.joint.bearing.resolve_scene`);
-    a heat balance without a solution is a SceneError naming ``where``."""
+    """``scene`` with each oiled joint's viscosity at its film temperature
+    (:func:`weftsim.joint.bearing.resolve_scene`); a heat balance without a solution is a SceneError naming ``where``."""
     from weftsim.joint.bearing import resolve_scene
 
     try:

@@ -6,7 +6,7 @@ operating points, the **mean** load at the mean sliding speed and the **peak** l
 the journal is a steadily loaded bearing (:mod:`weftsim.joint.steady`), with the film at the mean point's
 effective temperature (:mod:`weftsim.joint.heat`, when the scene names an oil: the peak lasts a fraction of a
 cycle, too short to heat the film) or at the scene's fixed viscosity.  The
-relative sliding speed v = R_j |omega_rel| becomes a journal speed omega = v / R_j in a still bushing.
+relative sliding speed v = R_j abs(omega_rel) becomes a journal speed omega = v / R_j in a still bushing.
 ``load`` and ``journal_rpm`` evaluate any other operating point instead (the bearing alone).  The Stribeck
 curve is the friction coefficient of the same bearing against journal speed at the point's load, each speed
 at its own film temperature.
@@ -153,7 +153,7 @@ def resolve_scene(scene):
         try:
             resolved, _ = with_film_temperature(part, mean, omega)
         except SceneError as exc:
-            raise SceneError(f"{_table(name)}.lubrication at the ideal mechanism's mean pin load {mean / 1e3:.4g} kN and "
-                             f"sliding speed {omega * part.journal_radius:.3g} m/s: {exc}") from None
+            raise SceneError(f"{_table(name)}.lubrication at the ideal mechanism's mean pin load {mean / 1e3:.4g} kN "
+                             f"and sliding speed {omega * part.journal_radius:.3g} m/s: {exc}") from None
         scene = replace(scene, **{"joint" if name == "e" else "joint_f": resolved})
     return scene

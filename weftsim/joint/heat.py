@@ -19,7 +19,8 @@ eta(T) is the oil's (:mod:`weftsim.joint.oil`), P_f, Q and Qs follow from the st
 balance is one equation in T_eff: g(T) = P_f - heat out.  g(T_amb) = P_f > 0 and the oil thins as T rises; the
 first root above T_amb is the temperature a bearing warming from ambient settles at.  It is bracketed by steps
 from T_amb of 0.5 K, doubled each time (:data:`STEP_K`), up to the oil's limit (nu = 2 mm^2/s, or 200 C), and
-found by Brent's method to :data:`TEMPERATURE_TOL`; power in equals heat out there to ~1e-9 relative (tests/test_bearing.py checks 1e-6).
+found by Brent's method to :data:`TEMPERATURE_TOL`; power in equals heat out there to ~1e-14 relative
+(tests/test_bearing.py checks 1e-6).
 No root below the limit: the bearing overheats (a :class:`weftsim.errors.SceneError` saying so).
 """
 

@@ -13,7 +13,7 @@ check                    value                                        limit (sce
 ``hertz_pressure``       Hertz line-contact pressure at peak force    1.67 x the smaller ``yield_strength_mpa``
 ``penetration``          largest delta / c (after the run only)       the law's range (:mod:`weftsim.joint.contact`)
 ``rapier_acceleration``  peak of abs(rapier acceleration)             ``limits.max_rapier_acceleration_m_s2``
-``film_temperature``     effective film temperature of an oiled joint none: reported (:mod:`weftsim.joint.heat`)
+``film_temperature``     film temperature of an oiled joint           none: reported (:mod:`weftsim.joint.heat`)
 =======================  ===========================================  ============================================
 
 *Before the run* (:func:`before_run`) the loads come from the ideal mechanism at the scene's speed
