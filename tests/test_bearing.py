@@ -297,3 +297,26 @@ def test_the_bearing_check_of_joint_f():
     assert report["points"]["peak"]["load_n"] == pytest.approx(float(loads.force.max()), rel=1e-12)
     assert report["points"]["mean"]["journal_speed_rad_s"] == pytest.approx(
         float(loads.sliding_speed.mean()) / scene.joint_f.journal_radius, rel=1e-12)
+
+
+def test_joint_f_takes_es_lubricant_whole(tmp_path):
+    """F given a clearance alone takes E's lubricant; switching E between a fixed viscosity and an oil on the command
+    line switches F's with it (never a film naming neither, or both)."""
+    from weftsim.input.scene import apply_overrides, load_scene
+
+    base = {"joint_f.clearance_mm": 0.02, "joint_e.lubrication.viscosity_mpa_s": 80.0}
+    scene = load_scene("loom", base)
+    assert scene.joint_f.lubrication.viscosity == 0.08 and not scene.joint_f.lubrication.has_oil
+    oiled = apply_overrides(scene, {"joint_e.lubrication.oil": "ISO_VG_220"})
+    for lub in (oiled.joint.lubrication, oiled.joint_f.lubrication):
+        assert lub.oil == "ISO_VG_220" and lub.film_temperature is not None
+        assert lub.viscosity == pytest.approx(float(lub.oil_model.viscosity(lub.film_temperature)), rel=1e-12)
+    back = apply_overrides(oiled, {"joint_e.lubrication.viscosity_mpa_s": 50.0})
+    assert back.joint_f.lubrication.viscosity == 0.05 and not back.joint_f.lubrication.has_oil
+    # A file giving the viscosity, the command line the oil: the oil replaces it, at both joints.
+    (tmp_path / "oiled.toml").write_text('extends = "loom"\n[joint_f]\nclearance_mm = 0.02\n'
+                                         '[joint_e.lubrication]\nviscosity_mpa_s = 80.0\n')
+    again = load_scene(tmp_path / "oiled.toml", {"joint_e.lubrication.oil": "ISO_VG_220"})
+    assert again.joint_f.lubrication.film_temperature == pytest.approx(oiled.joint_f.lubrication.film_temperature)
+    with pytest.raises(SceneError, match="both given"):
+        load_scene("loom", {**base, "joint_e.lubrication.oil": "ISO_VG_220"})  # one source naming both
