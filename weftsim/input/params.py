@@ -184,9 +184,10 @@ class Lubrication:
         mu_b of the boundary friction on the asperity load (modified Coulomb, with the joint's
         ``friction_velocities``).  Default 0.1 (boundary-lubricated steel on steel or bronze).
     film_floor_ratio : float
-        The film force is evaluated no closer than h_min = film_floor_ratio x sigma: below that film
-        thickness its pressure field is held at the floor's while the asperities take the rest, so the
-        film force stays finite where the dry law starts (e = c).  Default 1 (film ratio 1).
+        A numerical guard: the film force is evaluated no closer than h_min = film_floor_ratio x sigma, so it
+        stays finite where the dry law starts (e = c); below that film its pressure field is held at the
+        floor's while the asperities take the rest.  In [0.25, 4] (the rough film's table reaches
+        sigma / 4); default 1 (film ratio 1).
     """
 
     viscosity: float
@@ -231,8 +232,9 @@ def lubrication_problem(lub: Lubrication) -> str | None:
     if not (_number(mu) and 0.0 <= mu <= 2.0):
         return f"`lubrication.boundary_friction_coefficient` must be in [0, 2], got {mu!r}"
     floor = lub.film_floor_ratio
-    if not (_number(floor) and 0.0 < floor <= 4.0):
-        return f"`lubrication.film_floor_ratio` must be in (0, 4] (film floor / sigma), got {floor!r}"
+    if not (_number(floor) and 0.25 <= floor <= 4.0):
+        return (f"`lubrication.film_floor_ratio` must be in [0.25, 4] (film floor / sigma; the rough film is tabulated "
+                f"down to h_min = sigma / 4), got {floor!r}")
     return None
 
 

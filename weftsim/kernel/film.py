@@ -87,9 +87,10 @@ N_XI = 49
 N_WIDTH, WIDTH_MIN, WIDTH_MAX = 9, 0.25, 4.0
 LOG_WIDTH_STEP = math.log(WIDTH_MAX / WIDTH_MIN) / (N_WIDTH - 1)
 # Rough surfaces (Patir and Cheng's average flow, weftsim.kernel.flow_factors): the fourth axis is
-# r = sigma / (h_min + sigma) = 1 / (1 + h_min / sigma), uniform on [0, R_MAX]: r = 0 the smooth film,
-# R_MAX = 0.8 a minimum film of sigma / 4.
-N_R, R_MAX = 9, 0.8
+# r = sigma / (h_min + sigma) = 1 / (1 + h_min / sigma) on [0, R_MAX] (r = 0 the smooth film, R_MAX = 0.8 a minimum
+# film of sigma / 4), r = R_MAX (1 - (1 - v)^2) with v uniform: nodes at h_min / sigma = inf, 1.86, 0.67, 0.33, 0.25,
+# crowding where the flow factors change fastest.
+N_R, R_MAX = 5, 0.8
 # First 16 hex digits of the SHA-256 of the stored table (scripts/make_film_table.py writes this
 # line).  numba freezes the table into the compiled code and keys its cache by this file, so a new
 # table must change this file; a table that does not match is not used (NaN forces).
@@ -114,7 +115,8 @@ def table_widths() -> np.ndarray:
 
 def table_roughness_axis() -> np.ndarray:
     """The table's r = sigma / (h_min + sigma) (0: smooth surfaces)."""
-    return np.linspace(0.0, R_MAX, N_R)
+    v = np.linspace(0.0, 1.0, N_R)
+    return R_MAX * (1.0 - (1.0 - v) ** 2)
 
 
 def roughness_of(eps: float, r: float) -> float:
