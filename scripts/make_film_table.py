@@ -5,13 +5,13 @@ Usage::
     python scripts/make_film_table.py [--check] [--jobs 2]
 
 Solves Reynolds' equation with cavitation (:func:`weftsim.joint.reynolds.film`) on every node of the
-grid of :mod:`weftsim.kernel.film` (roughness axis r = sigma / (h_min + sigma) x B/D x eccentricity ratio
-x squeeze-velocity angle; r = 0 the smooth film, r > 0 Patir and Cheng's average-flow equation) and
+grid of :mod:`weftsim.kernel.film` (roughness axis s = exp(-0.56 h_min / sigma) x B/D x eccentricity ratio
+x squeeze-velocity angle; s = 0 the smooth film, s > 0 Patir and Cheng's average-flow equation) and
 stores the scaled dimensionless force.  Deterministic: the same code gives the same table.  About
 64 000 solves, some 30 CPU minutes (``--jobs`` processes share them; ``--keep DIR`` saves each finished
 slice and resumes from them).  ``--check`` instead compares the
 kernel's interpolated force with fresh solves at random points between the nodes and prints the
-largest relative errors.  Writing the table also writes its digest into film.py (``TABLE_DIGEST``):
+largest relative errors.  Writing the table also writes its digest into weftsim/kernel/finite_film.py (``TABLE_DIGEST``):
 numba freezes the table into the compiled functions and keys its cache by that source file, so the
 file must change.
 """
@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from weftsim.joint import reynolds
-from weftsim.kernel import film
+from weftsim.kernel import film, finite_film
 
 TABLE = Path(film.__file__).with_name("film_table.npz")
 
@@ -65,7 +65,7 @@ def build(jobs: int, keep: Path | None) -> np.ndarray:
             out[m, k] = block
             if keep is not None:
                 np.save(keep / f"slice_{m}_{k}.npy", block)
-            print(f"r = {film.table_roughness_axis()[m]:.2f}, B/D = {film.table_widths()[k]:.3f} done "
+            print(f"s = {film.table_roughness_axis()[m]:.3f}, B/D = {film.table_widths()[k]:.3f} done "
                   f"({n}/{len(tasks)}), {time.perf_counter() - start:.0f} s", flush=True)
     return out
 
@@ -79,15 +79,16 @@ def check(points: int) -> None:
         eps = 1.0 - (1.0 - u) ** 2
         xi = rng.uniform(-math.pi, math.pi)
         width = math.exp(rng.uniform(math.log(film.WIDTH_MIN), math.log(film.WIDTH_MAX)))
-        r = 0.0 if n % 4 == 0 else rng.uniform(0.0, film.R_MAX)
-        sigma = film.roughness_of(eps, r)
+        ratio = math.inf if n % 4 == 0 else math.exp(rng.uniform(math.log(film.RATIO_MIN), math.log(20.0)))
+        sigma = (1.0 - eps) / ratio  # sigma / c
+        r = math.exp(-film.ROUGH_DECAY * ratio)
         exact = np.asarray(reynolds.film(eps, xi, width, roughness=sigma))
         got = np.asarray(film.rough_finite_force(eps, xi, width, sigma))
         err = float(np.hypot(*(got - exact)) / np.hypot(*exact))
         kind = "smooth" if r == 0.0 else "rough"
         worst[kind] = max(worst[kind], err)
         print(f"eps {eps:.4f} xi {math.degrees(xi):7.1f} B/D {width:.3f} h_min/sigma "
-              f"{(1 / r - 1) if r else math.inf:7.3f}: relative error {err:.2e}")
+              f"{ratio:7.3f}: relative error {err:.2e}")
     print(f"largest: smooth {worst['smooth']:.2e}, rough {worst['rough']:.2e}")
 
 
@@ -105,7 +106,7 @@ def main() -> None:
         args.keep.mkdir(parents=True, exist_ok=True)
     table = build(args.jobs, args.keep)
     np.savez_compressed(TABLE, force=table)
-    source = Path(film.__file__)
+    source = Path(finite_film.__file__)
     text = re.sub(r'^TABLE_DIGEST = ".*"$', f'TABLE_DIGEST = "{film.table_digest(table)}"', source.read_text(),
                   flags=re.MULTILINE)
     source.write_text(text)
