@@ -124,3 +124,44 @@ def test_the_smooth_limit_has_no_asperity_load_to_speak_of():
     f_smooth = asperity_share(smooth, C, C)[0]
     assert f_smooth == pytest.approx(f_rough * math.sqrt(1e-9 / SIGMA), rel=0.05)
     assert asperity_share(smooth, C, C + 2e-6)[0] == 0.0
+
+
+# --- the loom ------------------------------------------------------------------------------------------------
+
+NO_OIL = {"joint_e.clearance_mm": 0.1, "joint_e.law": "variable_kd",  # explicit: the loom's default law may change
+          "joint_e.lubrication.viscosity_mpa_s": 1e-9}
+
+
+@pytest.fixture(scope="module")
+def dry_loom():
+    import weftsim
+
+    return weftsim.simulate(weftsim.load_scene("loom", {k: v for k, v in NO_OIL.items() if "lubrication" not in k}),
+                            engine="reference")
+
+
+@pytest.mark.parametrize(("roughness_um", "bound"), [(0.001, 0.02), (0.4, 0.05)])
+def test_no_oil_is_the_dry_loom(dry_loom, roughness_um, bound):
+    """The loom at 600 rpm, c = 0.1 mm, no oil (1e-9 mPa s) with the asperities on: smooth surfaces (1 nm) are the
+    dry joint, revolution 2's peaks within 2 % (measured 0.16 % on the rapier acceleration, 0.05 % on the joint's
+    load: 6435.8 against 6446.4 m/s2, 32.15 against 32.14 kN); real roughness (0.4 um) a rough dry joint close to it
+    (the issue asks no number: measured 2.2 % on the acceleration's negative peak, -6303 against -6445 m/s2, 1.5 %
+    on the torque's, 0.7 % on the load; 5 % here).  The former continuation of the asperities beyond c gave
+    40 464 and 10 161 m/s2."""
+    import weftsim
+    from weftsim.post.analysis import peaks
+
+    run = weftsim.simulate(weftsim.load_scene("loom", {**NO_OIL, "joint_e.lubrication.roughness_um": roughness_um}),
+                           engine="reference")
+    assert run.ok and dry_loom.ok, (run.message, dry_loom.message)
+    got, dry = peaks(run, 1), peaks(dry_loom, 1)
+    for name in ("rapier_acceleration_m_s2", "driving_torque_Nm"):
+        for side in ("min", "max"):
+            assert got[name][side] == pytest.approx(dry[name][side], rel=bound), (name, side)
+    assert got["joint_force_N"]["max"] == pytest.approx(dry["joint_force_N"]["max"], rel=bound)
+    # The energy closes with the dissipating asperities (the reference engine integrates their loss as a state):
+    # measured 1e-6 of the largest kinetic energy; the dry run's own residual at rtol 1e-5 is ~3e-6.
+    s = run.steps
+    balance = (s["kinetic_energy_J"] + s["potential_energy_J"] + s["contact_energy_J"] + s["dissipated_energy_J"]
+               - s["driving_work_J"])  # fmt: skip
+    assert np.max(np.abs(balance - balance[0])) < 2e-4 * np.max(s["kinetic_energy_J"])

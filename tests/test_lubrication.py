@@ -260,18 +260,24 @@ def test_engines_agree_on_a_lubricated_run(runs):
     assert _energy_residual(tree.steps) < 2e-3
 
 
-@pytest.mark.parametrize("clearance_mm", [0.02, 0.1])
-def test_engines_agree_on_the_lubricated_loom(clearance_mm):
+@pytest.mark.parametrize(("clearance_mm", "viscosity"), [(0.02, 80.0), (0.1, 80.0), (0.02, 10.0)])
+def test_engines_agree_on_the_lubricated_loom(clearance_mm, viscosity):
     """`weftsim run loom` with oil on both engines (the reference engine's RODAS4, the Exudyn tree's
     generalized-alpha), a quarter revolution at 600 rpm: a full film at 0.02 mm, a film gone at the floor with
-    asperities carrying at 0.1 mm.  Within the dry runs' first-revolution tolerance (measured over one
+    asperities carrying at 0.1 mm, and the mixed regime of thin oil (10 mPa s at 0.02 mm: the rough film and the
+    dissipating asperities share the load).  Within the dry runs' first-revolution tolerance (measured over one
     revolution: maxima within 1.3e-3, the smallest film ratio 8.7988 against 8.8058 at 0.02 mm)."""
-    scene = load_scene("loom", {**OIL, "drive.revolutions": 0.25, "joint_e.clearance_mm": clearance_mm})
+    scene = load_scene("loom", {**OIL, "drive.revolutions": 0.25, "joint_e.clearance_mm": clearance_mm,
+                                "joint_e.lubrication.viscosity_mpa_s": viscosity, "joint_e.law": "variable_kd"})
     ref, tree = solve(scene), weftsim.simulate(scene, "exudyn")
     assert ref.ok and tree.ok, (ref.message, tree.message)
     tolerance = scene.compare.first_revolution_peaks
-    for name in ("driving_torque_Nm", "film_force_N", "rapier_acceleration_m_s2"):
+    for name in ("driving_torque_Nm", "film_force_N", "rapier_acceleration_m_s2", "joint_force_N"):
         assert np.abs(tree.steps[name]).max() == pytest.approx(np.abs(ref.steps[name]).max(), rel=tolerance), name
+    if viscosity == 10.0:  # mixed: the asperities carry part of the load on both engines
+        assert ref.steps["asperity_force_N"].max() > 0.0
+        assert tree.steps["asperity_force_N"].max() == pytest.approx(ref.steps["asperity_force_N"].max(),
+                                                                     rel=tolerance)
     if clearance_mm == 0.02:  # a full film: both engines read its thinnest point, never at the floor
         assert tree.steps["film_ratio"].min() == pytest.approx(ref.steps["film_ratio"].min(), rel=tolerance)
         assert ref.steps["film_ratio"].min() > 3.0

@@ -184,9 +184,10 @@ class Lubrication:
         mu_b of the boundary friction on the asperity load (modified Coulomb, with the joint's
         ``friction_velocities``).  Default 0.1 (boundary-lubricated steel on steel or bronze).
     film_floor_ratio : float
-        The film force is evaluated no closer than h_min = film_floor_ratio x sigma: below that film
-        thickness its pressure field is held at the floor's while the asperities take the rest, so the
-        film force stays finite where the dry law starts (e = c).  Default 1 (film ratio 1).
+        A numerical guard: the film force is evaluated no closer than h_min = film_floor_ratio x sigma, so it
+        stays finite where the dry law starts (e = c); below that film its pressure field is held at the
+        floor's while the asperities take the rest.  In [0.25, 4] (the rough film's table reaches
+        sigma / 4); default 1 (film ratio 1).
     oil : str
         An ISO 3448 grade (``"ISO VG 220"``, :func:`weftsim.joint.oil.grade_names`): the viscosity then follows
         from the film's temperature (:mod:`weftsim.joint.heat`) instead of ``viscosity``.  Empty: not given.
@@ -204,7 +205,7 @@ class Lubrication:
         carries heat off) or ``"sump"`` (self-contained: the heat leaves through the housing alone).
     film_temperature : float or None
         The effective film temperature (C) the heat balance found for the scene's operating point, with
-        ``viscosity`` the oil's viscosity there; None until computed (:func:`weftsim.joint.heat.resolve_scene`).
+        ``viscosity`` the oil's viscosity there; None until computed (:func:`weftsim.joint.bearing.resolve_scene`).
     """
 
     viscosity: float
@@ -274,8 +275,9 @@ def lubrication_problem(lub: Lubrication) -> str | None:
     if not (_number(mu) and 0.0 <= mu <= 2.0):
         return f"`lubrication.boundary_friction_coefficient` must be in [0, 2], got {mu!r}"
     floor = lub.film_floor_ratio
-    if not (_number(floor) and 0.0 < floor <= 4.0):
-        return f"`lubrication.film_floor_ratio` must be in (0, 4] (film floor / sigma), got {floor!r}"
+    if not (_number(floor) and 0.25 <= floor <= 4.0):
+        return (f"`lubrication.film_floor_ratio` must be in [0.25, 4] (film floor / sigma; the rough film is tabulated "
+                f"down to h_min = sigma / 4), got {floor!r}")
     return oil_problem(lub)
 
 

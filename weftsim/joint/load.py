@@ -24,6 +24,7 @@ from weftsim.input.params import Scene
 from weftsim.kernel import chain as kc
 from weftsim.kernel import chain_f as kf
 from weftsim.kernel.joint import BEARING_RADIUS, friction_force, tangential_velocity
+from weftsim.joint.lubrication import joint_states
 from weftsim.kernel.lubricated import L_FX, L_FY, is_lubricated, lubricated_force
 from weftsim.post.results import JOINT_FORCE_CHANNELS, JOINT_FORCE_CHANNELS_F, LOAD_FALLBACK
 
@@ -53,21 +54,15 @@ def joint_force_rows(prm: np.ndarray, time: np.ndarray, states: np.ndarray, f_n_
                      out_e: np.ndarray, out_f: np.ndarray) -> None:
     """|f| of joint E and F (where loose) at each row into out_e, out_f (n,), N; ``f_n_*`` the dry law's F_N."""
     jf = prm[kf.JOINT_F:kf.JOINT_F + kc.N_JOINT]
-    e_only = prm[kf.TOPOLOGY] == kf.E_ONLY
+    has_e = prm[kf.TOPOLOGY] != kf.F_ONLY
+    has_f = prm[kf.TOPOLOGY] != kf.E_ONLY
     for i in range(time.size):
-        t = time[i]
-        y = states[i]
-        if e_only:
-            e_y, e_z, v_y, v_z, _, _, dphi = kc.eccentricity(prm, t, y)[:7]
-            c = kc.local_clearance(prm, t, e_y, e_z, v_y, v_z, y)[0]
-            out_e[i] = _force(prm, c, e_y, e_z, v_y, v_z, y[3], prm[kc.OMEGA] * dphi, f_n_e[i])
-            continue
-        q = kf.eccentricities(prm, t, y)
-        e_y, e_z, ve_y, ve_z, f_y, f_z, vf_y, vf_z, w_rocker, dpsi, da = q
-        c_e, _, c_f, _ = kf.local_clearances(prm, t, y, q)
-        if prm[kf.TOPOLOGY] == kf.E_AND_F:
-            out_e[i] = _force(prm, c_e, e_y, e_z, ve_y, ve_z, dpsi, w_rocker, f_n_e[i])
-        out_f[i] = _force(jf, c_f, f_y, f_z, vf_y, vf_z, dpsi, da, f_n_f[i])
+        (c, e_y, e_z, v_y, v_z, w_j, w_b), joint_f = joint_states(prm, time[i], states[i])
+        if has_e:
+            out_e[i] = _force(prm, c, e_y, e_z, v_y, v_z, w_j, w_b, f_n_e[i])
+        if has_f:
+            c, e_y, e_z, v_y, v_z, w_j, w_b = joint_f
+            out_f[i] = _force(jf, c, e_y, e_z, v_y, v_z, w_j, w_b, f_n_f[i])
 
 
 def joint_force_table(scene: Scene, prm: np.ndarray, time: np.ndarray, states: np.ndarray,
