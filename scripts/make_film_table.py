@@ -1,4 +1,4 @@
-"""Build the finite-bearing table that weftsim.kernel.film interpolates (weftsim/kernel/film_table.npz).
+"""Build the finite-bearing table that weftsim.physics.film interpolates (weftsim/physics/film_table.npz).
 
 Usage::
 

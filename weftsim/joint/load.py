@@ -8,7 +8,7 @@ joint, the film's and the asperities' force with their boundary friction
 The design checks, ``compare``, the plots, the wear report and sweeps read it (:func:`joint_load`), so an
 oiled joint is judged by the load its film carries as a dry one by its contact's.
 
-Rows are reference-engine states (:func:`weftsim.reference.dynamics.initial_state` layout), as in
+Rows are reference-engine states (:func:`weftsim.model.dynamics.initial_state` layout), as in
 :mod:`weftsim.joint.lubrication`; the Exudyn rigid-body model measures the connector's force directly
 (:mod:`weftsim.exudyn_engine.sensors`).
 """
