@@ -5,13 +5,13 @@ Usage::
     python scripts/make_film_table.py [--check] [--jobs 2]
 
 Solves Reynolds' equation with cavitation (:func:`weftsim.joint.reynolds.film`) on every node of the
-grid of :mod:`weftsim.kernel.film` (roughness axis s = exp(-0.56 h_min / sigma) x B/D x eccentricity ratio
+grid of :mod:`weftsim.physics.film` (roughness axis s = exp(-0.56 h_min / sigma) x B/D x eccentricity ratio
 x squeeze-velocity angle; s = 0 the smooth film, s > 0 Patir and Cheng's average-flow equation) and
 stores the scaled dimensionless force.  Deterministic: the same code gives the same table.  About
 64 000 solves, some 30 CPU minutes (``--jobs`` processes share them; ``--keep DIR`` saves each finished
 slice and resumes from them).  ``--check`` instead compares the
 kernel's interpolated force with fresh solves at random points between the nodes and prints the
-largest relative errors.  Writing the table also writes its digest into weftsim/kernel/finite_film.py (``TABLE_DIGEST``):
+largest relative errors.  Writing the table also writes its digest into weftsim/physics/finite_film.py (``TABLE_DIGEST``):
 numba freezes the table into the compiled functions and keys its cache by that source file, so the
 file must change.
 """
@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from weftsim.joint import reynolds
-from weftsim.kernel import film, finite_film
+from weftsim.physics import film, finite_film
 
 TABLE = Path(film.__file__).with_name("film_table.npz")
 

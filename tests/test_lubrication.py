@@ -135,7 +135,7 @@ def test_asperity_load_is_continuous_and_its_potential_is_its_integral():
     # Continuous: no step between neighbours larger than the largest slope times the spacing, x 1.01.
     slope = np.max(np.abs(np.gradient(load, ecc)))
     assert np.max(np.abs(np.diff(load))) <= 1.01 * slope * (ecc[1] - ecc[0])
-    # Beyond c: held at its value at c (the dry law takes it over there: weftsim.kernel.lubricated.asperity_share,
+    # Beyond c: held at its value at c (the dry law takes it over there: weftsim.physics.lubricated.asperity_share,
     # tests/test_asperity_contact.py).
     at = np.searchsorted(ecc, C)
     assert np.all(load[at + 1:] == asperity_load(COEF, SIGMA, C, C, R, L)[0])

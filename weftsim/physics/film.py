@@ -86,7 +86,7 @@ N_U, U_MAX = 29, 0.9
 N_XI = 49
 N_WIDTH, WIDTH_MIN, WIDTH_MAX = 9, 0.25, 4.0
 LOG_WIDTH_STEP = math.log(WIDTH_MAX / WIDTH_MIN) / (N_WIDTH - 1)
-# Rough surfaces (Patir and Cheng's average flow, weftsim.kernel.flow_factors): the fourth axis is
+# Rough surfaces (Patir and Cheng's average flow, weftsim.physics.flow_factors): the fourth axis is
 # s = exp(-0.56 h_min / sigma), uniform on [0, S_MAX] (s = 0 the smooth film, S_MAX a minimum film of sigma / 4):
 # the pressure flow factor is 1 - 0.9 s at the thinnest film, so the force is close to linear in s, flat where the
 # film is thick (nodes at h_min / sigma = inf, 2.73, 1.49, 0.76, 0.25).

@@ -81,7 +81,7 @@ def joint_parameters(joint: ClearanceJoint, law: _Law) -> np.ndarray:
 
 def asperity_hysteresis(restitution: float) -> float:
     """kappa of the asperities' loading and unloading branches (1 +- kappa) F_a: their loop returns the share
-    (1 - kappa) / (1 + kappa) = e^2 of the work done on it (:mod:`weftsim.kernel.lubricated`)."""
+    (1 - kappa) / (1 + kappa) = e^2 of the work done on it (:mod:`weftsim.physics.lubricated`)."""
     return (1.0 - restitution**2) / (1.0 + restitution**2)
 
 

@@ -15,7 +15,7 @@ at every eccentricity, in contact or not::
   the squeeze and wedge terms see the true motion.  The film force then stays finite where the dry law
   starts (its squeeze term grows as (1 - eps^2)^-2.5 towards eps = 1).  The film's shear torques act on
   journal and bearing; its power -(f.e_dot + T_j omega_j + T_b omega_b) is dissipated.
-- **Asperities.** F_a(|e|) of :func:`weftsim.kernel.asperity.asperity_load`, zero while h_min >= 4 sigma, up to
+- **Asperities.** F_a(|e|) of :func:`weftsim.physics.asperity.asperity_load`, zero while h_min >= 4 sigma, up to
   |e| = c; beyond c the dry law takes it over (:func:`asperity_share`: the solids carry max(F_a(c), F_el)
   elastically).  That elastic share has a potential U_a (stored); on it the asperities' hysteresis loop
   (:func:`asperity_normal`: (1 +- kappa) on loading and unloading, kappa from the joint's restitution) dissipates
@@ -37,14 +37,14 @@ import math
 
 from numba import njit
 
-from weftsim.kernel.asperity import asperity_load
-from weftsim.kernel.film import film_force
-from weftsim.kernel.joint import (
+from weftsim.physics.asperity import asperity_load
+from weftsim.physics.film import film_force
+from weftsim.physics.joint import (
     ASPERITY_COEF, ASPERITY_HYSTERESIS, BEARING_LENGTH, BEARING_RADIUS, BOUNDARY_MU, CLEARANCE, COEF, FILM_FLOOR,
     FILM_MODEL, JOURNAL_RADIUS, KIND, LUBRICATED, ROUGHNESS, V0, V1, V_MIN, VISCOSITY, connector_friction_force_at,
     tangential_velocity,
 )  # fmt: skip
-from weftsim.kernel.laws import elastic_energy, elastic_force, friction_factor
+from weftsim.physics.laws import elastic_energy, elastic_force, friction_factor
 
 # Outputs of lubricated_force, in order (the channels of weftsim.joint.lubrication read them by these indices).
 (L_FX, L_FY, L_MJ, L_MB, L_FILM, L_ASPERITY, L_FILM_TORQUE, L_ASPERITY_ENERGY, L_DISSIPATED, L_FILM_POWER) = range(10)
@@ -116,7 +116,7 @@ def handover_depth(prm, clearance: float, load: float, delta: float) -> float:
 def asperity_share(prm, clearance: float, ecc: float) -> tuple[float, float]:
     """(F_s, U_s): the elastic load the asperities carry at |e| = ``ecc`` (N) and its potential (J).
 
-    Up to |e| = c (the mean planes touch) Greenwood and Tripp's F_a (:func:`weftsim.kernel.asperity.asperity_load`).
+    Up to |e| = c (the mean planes touch) Greenwood and Tripp's F_a (:func:`weftsim.physics.asperity.asperity_load`).
     Beyond c the asperities are pressed into the bulk and the dry law's contact (elastic force F_el(delta),
     delta = |e| - c) takes their load over: F_s = max(F_a(c) - F_el(delta), 0), so that the solids carry
     max(F_a(c), F_el(delta)) elastically, never more than the dry law once it carries F_a(c), and exactly the

@@ -210,7 +210,7 @@ def compiled_channels(scene: Scene, time: np.ndarray, states: np.ndarray, contac
     if scene.joint.is_lubricated or scene.joint_f.is_lubricated:
         # The film and asperity channels; the asperities' potential joins the contact energy (the chain
         # books the film's, the boundary friction's and the asperities' hysteresis work as dissipated,
-        # weftsim.kernel.lubricated).
+        # weftsim.physics.lubricated).
         from weftsim.joint.lubrication import lubrication_table
 
         lubricated, asperity_energy = lubrication_table(scene, prm, time, states)
