@@ -129,7 +129,10 @@ def test_energy_balance_closes(one_revolution):
 def test_joint_f_channels(one_revolution):
     name, r = one_revolution
     st = r.steps
-    assert tuple(st) == CHANNELS + JOINT_F_CHANNELS
+    # The joint's load of each loose joint (weftsim.joint.load) follows the contact channels.
+    loads = ("joint_force_f_N",) if name == "F only" else ("joint_force_N", "joint_force_f_N")
+    assert tuple(st) == CHANNELS + JOINT_F_CHANNELS + loads
+    np.testing.assert_array_equal(st["joint_force_f_N"], st["contact_force_f_N"])  # dry and frictionless
     t_f = r.events["first_contact_time_f_s"]
     assert t_f is not None and 0.0 < t_f < r.scene.drive.period
     before = st["time_s"] < t_f
@@ -167,7 +170,7 @@ def test_friction_at_f_closes_the_energy_balance(case):
 
 def test_e_only_results_have_no_joint_f_channels():
     r = solve(_scene(C, 0.0, 0.05))
-    assert r.ok and tuple(r.steps) == CHANNELS and "first_contact_time_f_s" not in r.events
+    assert r.ok and tuple(r.steps) == CHANNELS + ("joint_force_N",) and "first_contact_time_f_s" not in r.events
 
 
 def _errors_after_startup(result):

@@ -92,8 +92,11 @@ DIGEST_PLATFORM = ("2.", "0.6")  # numpy, numba version prefixes of the developm
 def test_dry_scene_is_bit_for_bit_the_former_joint():
     result = solve(load_scene("reference", {"drive.revolutions": 0.3}))
     assert not any(name in result.steps for name in LUBRICATION_CHANNELS)
+    # The joint's load (weftsim.joint.load, issue 30) came later: for this dry frictionless joint it is its contact
+    # force, bit for bit; the digest covers the channels of the former joint.
+    np.testing.assert_array_equal(result.steps["joint_force_N"], result.steps["contact_force_N"])
     digest = hashlib.sha256()
-    for name in sorted(result.steps):
+    for name in sorted(set(result.steps) - {"joint_force_N"}):
         digest.update(name.encode())
         digest.update(np.ascontiguousarray(result.steps[name]).tobytes())
     if not (np.__version__.startswith(DIGEST_PLATFORM[0]) and numba.__version__.startswith(DIGEST_PLATFORM[1])):
@@ -132,14 +135,14 @@ def test_asperity_load_is_continuous_and_its_potential_is_its_integral():
     # Continuous: no step between neighbours larger than the largest slope times the spacing, x 1.01.
     slope = np.max(np.abs(np.gradient(load, ecc)))
     assert np.max(np.abs(np.diff(load))) <= 1.01 * slope * (ecc[1] - ecc[0])
-    # Beyond c: continued with the slope at c (C1): the one-sided difference quotients agree there.
+    # Beyond c: held at its value at c (the dry law takes it over there: weftsim.physics.lubricated.asperity_share,
+    # tests/test_asperity_contact.py).
     at = np.searchsorted(ecc, C)
-    inside = (load[at - 1] - load[at - 2]) / (ecc[1] - ecc[0])
-    beyond = (load[-1] - load[-2]) / (ecc[1] - ecc[0])
-    assert beyond == pytest.approx(inside, rel=1e-2)  # first differences lag by h/2 |F''|: ~1e-3 measured
-    # dU/d|e| = F_a: the trapezoid of F_a against U's change; trapezoid error (h^2/12) |F''| ~ 1e-7 relative.
+    assert np.all(load[at + 1:] == asperity_load(COEF, SIGMA, C, C, R, L)[0])
+    # dU/d|e| = F_a up to c: the trapezoid of F_a against U's change; trapezoid error (h^2/12) |F''| ~ 1e-7 relative.
     integral = np.concatenate([[0.0], np.cumsum(0.5 * (load[1:] + load[:-1]) * np.diff(ecc))])
-    np.testing.assert_allclose(energy - energy[0], integral, rtol=1e-5, atol=1e-6 * energy[-1])
+    inside = slice(0, at)
+    np.testing.assert_allclose((energy - energy[0])[inside], integral[inside], rtol=1e-5, atol=1e-6 * energy[at])
 
 
 def test_asperity_quadrature_is_converged():
@@ -174,12 +177,6 @@ def test_asperity_gauss_jacobi_rule_matches_a_fine_legendre_rule():
             energy = scale * SIGMA * np.sum(w * p * base) / (asperity.F52_EXPONENT + 1.0)
             got = asperity_load(COEF, SIGMA, c, e, R, L)
             worst = max(worst, abs(got[0] / force - 1.0), abs(got[1] / energy - 1.0))
-            # The stiffness enters beyond c (the C1 continuation): the slope of the load there.
-            stiff = scale / SIGMA * np.sum(w * asperity.F52_EXPONENT * p / np.where(base > 0, base, 1.0)
-                                           * np.cos(theta) ** 2)  # fmt: skip
-            beyond = asperity_load(COEF, SIGMA, c, c + 1e-9, R, L)[0] - asperity_load(COEF, SIGMA, c, c, R, L)[0]
-            if ratio == 0.0:
-                worst = max(worst, abs(beyond / 1e-9 / stiff - 1.0))
     # Measured 1.6e-11, the reference's own round-off (6 points: 1e-8; the former 24-point Gauss-Legendre
     # rule: 1.4e-11).
     assert worst < 1e-10
@@ -264,18 +261,24 @@ def test_engines_agree_on_a_lubricated_run(runs):
     assert _energy_residual(tree.steps) < 2e-3
 
 
-@pytest.mark.parametrize("clearance_mm", [0.02, 0.1])
-def test_engines_agree_on_the_lubricated_loom(clearance_mm):
+@pytest.mark.parametrize(("clearance_mm", "viscosity"), [(0.02, 80.0), (0.1, 80.0), (0.02, 10.0)])
+def test_engines_agree_on_the_lubricated_loom(clearance_mm, viscosity):
     """`weftsim run loom` with oil on both engines (the reference engine's RODAS4, the Exudyn tree's
     generalized-alpha), a quarter revolution at 600 rpm: a full film at 0.02 mm, a film gone at the floor with
-    asperities carrying at 0.1 mm.  Within the dry runs' first-revolution tolerance (measured over one
+    asperities carrying at 0.1 mm, and the mixed regime of thin oil (10 mPa s at 0.02 mm: the rough film and the
+    dissipating asperities share the load).  Within the dry runs' first-revolution tolerance (measured over one
     revolution: maxima within 1.3e-3, the smallest film ratio 8.7988 against 8.8058 at 0.02 mm)."""
-    scene = load_scene("loom", {**OIL, "drive.revolutions": 0.25, "joint_e.clearance_mm": clearance_mm})
+    scene = load_scene("loom", {**OIL, "drive.revolutions": 0.25, "joint_e.clearance_mm": clearance_mm,
+                                "joint_e.lubrication.viscosity_mpa_s": viscosity, "joint_e.law": "variable_kd"})
     ref, tree = solve(scene), weftsim.simulate(scene, "exudyn")
     assert ref.ok and tree.ok, (ref.message, tree.message)
     tolerance = scene.compare.first_revolution_peaks
-    for name in ("driving_torque_Nm", "film_force_N", "rapier_acceleration_m_s2"):
+    for name in ("driving_torque_Nm", "film_force_N", "rapier_acceleration_m_s2", "joint_force_N"):
         assert np.abs(tree.steps[name]).max() == pytest.approx(np.abs(ref.steps[name]).max(), rel=tolerance), name
+    if viscosity == 10.0:  # mixed: the asperities carry part of the load on both engines
+        assert ref.steps["asperity_force_N"].max() > 0.0
+        assert tree.steps["asperity_force_N"].max() == pytest.approx(ref.steps["asperity_force_N"].max(),
+                                                                     rel=tolerance)
     if clearance_mm == 0.02:  # a full film: both engines read its thinnest point, never at the floor
         assert tree.steps["film_ratio"].min() == pytest.approx(ref.steps["film_ratio"].min(), rel=tolerance)
         assert ref.steps["film_ratio"].min() > 3.0

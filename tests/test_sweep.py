@@ -335,3 +335,23 @@ def test_reference_engine_sweep_of_twelve_cells(tmp_path):
             assert float(contact[(clearance, rpm)]) > 0.0
             # Paper Figs. 12-13: the impacts at E raise the rapier acceleration above the ideal peak.
             assert peak[(clearance, rpm)] > peak[(0.0, rpm)]
+
+
+def test_the_sweep_table_has_each_joints_load_and_its_film_and_asperity_shares():
+    """Issue 35: a cell without oil showed its dry law's 2 kN where the joint carried 54.9 kN on its asperities.
+    The table now has joint_force_N (film + asperities + dry law), film_force_N and asperity_force_N: their peaks
+    are the run's (a lubricated cell), a dry cell's film and asperity columns are empty (None)."""
+    from weftsim.input.scene import load_scene
+    from weftsim.post.analysis import peaks
+    from weftsim.reference import solve
+    from weftsim.sweep.cell import cell_metrics
+
+    oiled = solve(load_scene("reference", {"drive.revolutions": 0.1, "joint_e.lubrication.viscosity_mpa_s": 80.0}))
+    dry = solve(load_scene("reference", {"drive.revolutions": 0.1}))
+    metrics, first = cell_metrics(oiled), peaks(oiled, 0)
+    for channel in ("joint_force_N", "film_force_N", "asperity_force_N", "contact_force_N"):
+        assert metrics[f"{channel}_rev1_peak"] == max(abs(first[channel]["min"]), abs(first[channel]["max"]))
+    assert metrics["joint_force_N_rev1_peak"] > metrics["contact_force_N_rev1_peak"]  # the film carries load
+    dry_metrics = cell_metrics(dry)
+    assert dry_metrics["film_force_N_rev1_peak"] is None and dry_metrics["asperity_force_N_rev1_peak"] is None
+    assert dry_metrics["joint_force_N_rev1_peak"] == dry_metrics["contact_force_N_rev1_peak"]

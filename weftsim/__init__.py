@@ -16,6 +16,9 @@ simulate(scene, engine="auto")
 estimate(scene, engine="auto"), select_path(scene, engine="auto")
     What a run will cost, and which model and method it takes.  The engines and a plug-in's registration:
     :mod:`weftsim.engines`.
+bearing(scene, joint="e", load_kn=None, journal_rpm=None)
+    The steady plain-bearing check of an oiled joint: Sommerfeld number, eccentricity, film ratio, friction,
+    power loss, film temperature, regime and the Stribeck curve (docs/lubricated-joint.md).
 plausibility_checks(scene)
     The checks that need no simulation: reflected mass, pin pressure, p x v, clearance ratio,
     rapier acceleration against their limits (docs/plausibility.md).
@@ -44,6 +47,7 @@ from weftsim.version import __version__  # noqa: F401 (weftsim.__version__)
 from weftsim.api import (
     DEFAULT_ENGINE,
     ENGINE_NAMES,
+    bearing,
     bundled_scenes,
     compare,
     estimate,
@@ -91,6 +95,7 @@ __all__ = [
     "WearError",
     "WeftsimError",
     "WriteFailed",
+    "bearing",
     "bundled_scenes",
     "compare",
     "estimate",

@@ -44,25 +44,36 @@ def _row(jp, clearance, e_y, e_z, v_y, v_z, w_j, w_b, out, i):
 
 
 @njit(cache=True, error_model="numpy")
+def joint_states(prm: np.ndarray, t: float, y: np.ndarray):
+    """((c, e_y, e_z, v_y, v_z, w_j, w_b) of joint E, the same of joint F) at the state ``y`` (reference layout):
+    the local clearance along e (a worn joint's; round: c0), eccentricity and its rate, the journal's and the
+    bearing's rates about the joint axis.  A joint without clearance in the state's layout: zeros."""
+    none = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    if prm[kf.TOPOLOGY] == kf.E_ONLY:
+        e_y, e_z, v_y, v_z, _, _, dphi = kc.eccentricity(prm, t, y)[:7]
+        c = kc.local_clearance(prm, t, e_y, e_z, v_y, v_z, y)[0]
+        return (c, e_y, e_z, v_y, v_z, y[3], prm[kc.OMEGA] * dphi), none
+    q = kf.eccentricities(prm, t, y)
+    e_y, e_z, ve_y, ve_z, f_y, f_z, vf_y, vf_z, w_rocker, dpsi, da = q
+    c_e, _, c_f, _ = kf.local_clearances(prm, t, y, q)
+    joint_e = (c_e, e_y, e_z, ve_y, ve_z, dpsi, w_rocker) if prm[kf.TOPOLOGY] == kf.E_AND_F else none
+    return joint_e, (c_f, f_y, f_z, vf_y, vf_z, dpsi, da)
+
+
+@njit(cache=True, error_model="numpy")
 def lubrication_rows(prm: np.ndarray, time: np.ndarray, states: np.ndarray, out_e: np.ndarray,
                      out_f: np.ndarray) -> None:
     """The lubricated joints' rows (h_min, h_min/sigma, |f_film|, F_a, T_j, U_a) into out_e, out_f (n, 6)."""
     jf = prm[kf.JOINT_F:kf.JOINT_F + kc.N_JOINT]
-    e_only = prm[kf.TOPOLOGY] == kf.E_ONLY
+    has_e = prm[kf.TOPOLOGY] != kf.F_ONLY
+    has_f = prm[kf.TOPOLOGY] != kf.E_ONLY
     for i in range(time.size):
-        t = time[i]
-        y = states[i]
-        if e_only:
-            e_y, e_z, v_y, v_z, _, _, dphi = kc.eccentricity(prm, t, y)[:7]
-            c = kc.local_clearance(prm, t, e_y, e_z, v_y, v_z, y)[0]
-            _row(prm, c, e_y, e_z, v_y, v_z, y[3], prm[kc.OMEGA] * dphi, out_e, i)
-            continue
-        q = kf.eccentricities(prm, t, y)
-        e_y, e_z, ve_y, ve_z, f_y, f_z, vf_y, vf_z, w_rocker, dpsi, da = q
-        c_e, _, c_f, _ = kf.local_clearances(prm, t, y, q)  # a worn joint's clearance along e (round: c0)
-        if prm[kf.TOPOLOGY] == kf.E_AND_F:
-            _row(prm, c_e, e_y, e_z, ve_y, ve_z, dpsi, w_rocker, out_e, i)
-        _row(jf, c_f, f_y, f_z, vf_y, vf_z, dpsi, da, out_f, i)
+        (c, e_y, e_z, v_y, v_z, w_j, w_b), joint_f = joint_states(prm, time[i], states[i])
+        if has_e:
+            _row(prm, c, e_y, e_z, v_y, v_z, w_j, w_b, out_e, i)
+        if has_f:
+            c, e_y, e_z, v_y, v_z, w_j, w_b = joint_f
+            _row(jf, c, e_y, e_z, v_y, v_z, w_j, w_b, out_f, i)
 
 
 def lubrication_table(scene: Scene, prm: np.ndarray, time: np.ndarray,

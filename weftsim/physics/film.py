@@ -86,6 +86,12 @@ N_U, U_MAX = 29, 0.9
 N_XI = 49
 N_WIDTH, WIDTH_MIN, WIDTH_MAX = 9, 0.25, 4.0
 LOG_WIDTH_STEP = math.log(WIDTH_MAX / WIDTH_MIN) / (N_WIDTH - 1)
+# Rough surfaces (Patir and Cheng's average flow, weftsim.physics.flow_factors): the fourth axis is
+# s = exp(-0.56 h_min / sigma), uniform on [0, S_MAX] (s = 0 the smooth film, S_MAX a minimum film of sigma / 4):
+# the pressure flow factor is 1 - 0.9 s at the thinnest film, so the force is close to linear in s, flat where the
+# film is thick (nodes at h_min / sigma = inf, 2.73, 1.49, 0.76, 0.25).
+N_R, ROUGH_DECAY, RATIO_MIN = 5, 0.56, 0.25
+S_MAX = math.exp(-ROUGH_DECAY * RATIO_MIN)
 # First 16 hex digits of the SHA-256 of the stored table (scripts/make_film_table.py writes this
 # line).  numba freezes the table into the compiled code and keys its cache by this file, so a new
 # table must change this file; a table that does not match is not used (NaN forces).
@@ -106,6 +112,16 @@ def table_angles() -> np.ndarray:
 def table_widths() -> np.ndarray:
     """The table's B/D."""
     return WIDTH_MIN * np.exp(LOG_WIDTH_STEP * np.arange(N_WIDTH))
+
+
+def table_roughness_axis() -> np.ndarray:
+    """The table's s = exp(-0.56 h_min / sigma) (0: smooth surfaces)."""
+    return np.linspace(0.0, S_MAX, N_R)
+
+
+def roughness_of(eps: float, s: float) -> float:
+    """sigma / c of the film of eccentricity ratio eps and s = exp(-0.56 h_min / sigma), h_min = c (1 - eps)."""
+    return 0.0 if s <= 0.0 else -ROUGH_DECAY * (1.0 - eps) / math.log(s)
 
 
 @njit(cache=True, error_model="numpy")
