@@ -25,3 +25,7 @@ compiled code (one compilation per machine, loaded from numba's cache afterwards
 callers that run off the hot path call the same source in plain Python (:mod:`.python`: no
 compilation), and array callers map it over their elements.  A fix to the physics lands in one place.
 """
+
+from weftsim.physics.compiled_cache import use_keyed_cache
+
+use_keyed_cache()
