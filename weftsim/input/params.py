@@ -112,20 +112,35 @@ class Material:
         return (1.0 - self.poisson_ratio**2) / self.youngs_modulus
 
 
+WEAR_REGIMES = ("boundary", "dry")  # of the solid contact (the dry law's load): weftsim.wear.regimes
+
+
 @dataclass(frozen=True)
 class WearModel:
     """Archard wear of a clearance joint and the cycle extrapolation that integrates it (docs/wear.md).
 
     Archard's law: the volume a surface of hardness H loses is V = k F_N s / H (Archard, J. Appl.
-    Phys. 24, 1953), with the dimensionless wear coefficient k of the pair and the sliding distance s.
+    Phys. 24, 1953), with the dimensionless wear coefficient k of the pair and the sliding distance s;
+    k / H is the specific wear rate (mm^3/(N m) with H in N/mm^2 and s in m, times 1e3).  k depends on the
+    regime of the contact (docs/wear.md section 5, :mod:`weftsim.wear.regimes`, with the tables it comes from):
+
+    - the **solid contact** (the dry law's load beyond e = c, the only load of a joint without an oil film)
+      wears with ``dry_wear_coefficient`` (unlubricated metal on metal) or ``boundary_wear_coefficient``
+      (a grease or oil layer on the surfaces, no hydrodynamic film), as ``regime`` says;
+    - the **asperity load** of an oil-lubricated joint in the mixed regime (Greenwood-Tripp, the load the
+      film does not carry) wears with ``mixed_wear_coefficient``; the film's load wears nothing.
 
     Attributes
     ----------
-    wear_coefficient : float
-        k, dimensionless.  Default 1e-7: mild, boundary-lubricated wear of a steel pair; k spans
-        1e-2 (severe, dry) to below 1e-6 (mild, lubricated) (Archard 1953; Rabinowicz, Friction and
-        Wear of Materials, 2nd ed. 1995), dry mild steel on mild steel 7e-3 (Archard and Hirst,
-        Proc. R. Soc. A 236, 1956).  Predicted hours scale exactly as H / k (docs/wear.md).
+    regime : str
+        ``"boundary"`` (default) or ``"dry"``: which of the two coefficients the solid contact takes.
+    dry_wear_coefficient, boundary_wear_coefficient, mixed_wear_coefficient : float
+        k of each regime, dimensionless.  Defaults: steel on steel, 5e-3 clean (Rabinowicz's table of
+        adhesive wear coefficients, like metals), 1e-7 boundary and mixed (the lower end of his "excellent
+        lubrication", 2e-6 to 1e-7).
+    wear_coefficient : float or None
+        One k for every load of the joint, overriding the three above (the key of scenes written before the
+        regimes; None: the regime keys apply).
     bearing_hardness, journal_hardness : float
         H of each surface, Pa (default 2.0e9: through-hardened steel, ~200 HB).
     max_clearance_change : float
@@ -139,13 +154,29 @@ class WearModel:
         Points of the tabulated wear profiles h_b(psi), h_j(psi) over 360 deg.
     """
 
-    wear_coefficient: float = 1e-7
+    wear_coefficient: float | None = None
     bearing_hardness: float = 2.0e9
     journal_hardness: float = 2.0e9
     max_clearance_change: float = 0.02
     revolutions_per_update: int = 4
     settle_revolutions: int = 1
     profile_points: int = 360
+    regime: str = "boundary"
+    dry_wear_coefficient: float = 5e-3
+    boundary_wear_coefficient: float = 1e-7
+    mixed_wear_coefficient: float = 1e-7
+
+    @property
+    def contact_wear_coefficient(self) -> float:
+        """k of the solid contact's load (the dry law's): ``wear_coefficient`` if given, else the regime's."""
+        if self.wear_coefficient is not None:
+            return self.wear_coefficient
+        return self.dry_wear_coefficient if self.regime == "dry" else self.boundary_wear_coefficient
+
+    @property
+    def asperity_wear_coefficient(self) -> float:
+        """k of the asperity load of a lubricated joint (mixed regime): ``wear_coefficient`` if given."""
+        return self.mixed_wear_coefficient if self.wear_coefficient is None else self.wear_coefficient
 
 
 # Film models of Lubrication.model (the codes of weftsim.kernel.film: MODEL_FINITE, MODEL_SHORT, MODEL_LONG,

@@ -60,8 +60,17 @@ def WEAR_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 - a cons
         # k spans 1e-2 (severe, dry) to below 1e-6 (Archard 1953; Rabinowicz 1995); hardness from soft
         # polymer bushings (~10 MPa) to ceramics and diamond (~1e5 MPa).  Beyond these the wear per update
         # dwarfs the clearance and the cycle extrapolation cannot follow it (issue 24).
+        Key(f"{table}.wear.regime", f"{joint}.wear.regime", "str", choices=params.WEAR_REGIMES,
+            doc="regime of the solid contact: \"boundary\" (default: grease or oil on the surfaces, no film) or "
+                "\"dry\" (unlubricated); an oil film's asperities take mixed_wear_coefficient"),
+        Key(f"{table}.wear.dry_wear_coefficient", f"{joint}.wear.dry_wear_coefficient", "float", 1, 0, 1e-2, True,
+            False, doc="Archard's k of unlubricated contact (default 5e-3, steel on steel; docs/wear.md section 5)"),
+        Key(f"{table}.wear.boundary_wear_coefficient", f"{joint}.wear.boundary_wear_coefficient", "float", 1, 0,
+            1e-2, True, False, doc="Archard's k of boundary-lubricated contact (default 1e-7)"),
+        Key(f"{table}.wear.mixed_wear_coefficient", f"{joint}.wear.mixed_wear_coefficient", "float", 1, 0, 1e-2,
+            True, False, doc="Archard's k of the asperity load of an oil-lubricated joint (default 1e-7)"),
         Key(f"{table}.wear.wear_coefficient", f"{joint}.wear.wear_coefficient", "float", 1, 0, 1e-2, True, False,
-            doc="Archard's dimensionless wear coefficient k (default 1e-7, mild lubricated steel; 1e-2 severe dry wear)"),
+            doc="one Archard k for every load of the joint, overriding the regime keys (optional)"),
         Key(f"{table}.wear.bearing_hardness_mpa", f"{joint}.wear.bearing_hardness", "float", MPA, 1, 1e5, False,
             doc="hardness H of the bearing surface (default 2000 MPa, hardened steel)"),
         Key(f"{table}.wear.journal_hardness_mpa", f"{joint}.wear.journal_hardness", "float", MPA, 1, 1e5, False,

@@ -33,7 +33,7 @@ import numpy as np
 
 from weftsim.errors import WearError
 from weftsim.wear.censored import censored_quantile, fraction_interval, json_hours
-from weftsim.wear.ensemble_design import (DESIGN_QUANTILES, RESCALED, _lagrange, centre_name,  # noqa: F401
+from weftsim.wear.ensemble_design import (DESIGN_QUANTILES, RESCALED, k_scale, _lagrange, centre_name,  # noqa: F401
                                           interpolate, plan)
 from weftsim.wear.jobs import hours_at, run_job
 from weftsim.wear.uncertain import Uncertain, latin_hypercube, parse_uncertain, rank_shares
@@ -119,9 +119,7 @@ def combine(scene: Scene, uncertain: list[Uncertain], dynamic: list[Uncertain], 
     values = {v.key: v.ppf(u[:, i]) for i, v in enumerate(uncertain)}
     base = to_file_keys(scene)
     share_b = results[centre]["bearing_share"]
-    scale = np.ones(samples)
-    if "joint_e.wear.wear_coefficient" in values:
-        scale *= base["joint_e.wear.wear_coefficient"] / values["joint_e.wear.wear_coefficient"]
+    scale = k_scale(scene, values, samples)
     hb = values.get("joint_e.wear.bearing_hardness_mpa", base["joint_e.wear.bearing_hardness_mpa"])
     hj = values.get("joint_e.wear.journal_hardness_mpa", base["joint_e.wear.journal_hardness_mpa"])
     scale /= share_b * base["joint_e.wear.bearing_hardness_mpa"] / hb \

@@ -202,6 +202,7 @@ def _response(steps: dict, t0: float, joints: Sequence[str] = ("e",)) -> dict:
 def _sliding(wear: RunWear, per_rev: float, joint: str) -> dict:
     return {f"sliding_distance_per_rev_{joint}_m": wear.sliding_distance * per_rev,
             f"sliding_work_per_rev_{joint}_J": wear.sliding_work * per_rev,
+            f"asperity_work_per_rev_{joint}_J": wear.asperity_work * per_rev,
             # Archard's load: the mean of F_N weighted by the sliding ds = |v_T| dt (not by dt)
             f"contact_force_sliding_mean_{joint}_N": wear.sliding_work / wear.sliding_distance
             if wear.sliding_distance > 0.0 else math.nan}
@@ -296,8 +297,8 @@ def next_update(scene: Scene, hours_done: float, revolutions_done: float, bearin
             raise WearError(
                 f"the wear is too fast to extrapolate: the {w.revolutions_per_update} revolutions of an update alone "
                 f"grow the clearance at {joint.upper()} by {100 * grown:.3g} %, more than "
-                f"joint_{joint}.wear.max_clearance_change = {100 * jw.max_clearance_change:g} % (wear_coefficient "
-                f"{jw.wear_coefficient:g}, hardness {jw.bearing_hardness / 1e6:g} / {jw.journal_hardness / 1e6:g} MPa: "
+                f"joint_{joint}.wear.max_clearance_change = {100 * jw.max_clearance_change:g} % (wear coefficient "
+                f"{jw.contact_wear_coefficient:g}, hardness {jw.bearing_hardness / 1e6:g} / {jw.journal_hardness / 1e6:g} MPa: "
                 f"check [joint_{joint}.wear])")
         parts.append(part)
         n = min(n, allowed)

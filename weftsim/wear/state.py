@@ -24,7 +24,11 @@ JOINT_RESPONSE = ("contact_force_{j}_mean_N", "contact_force_{j}_p99_N", "contac
                   "film_ratio_min_{j}", "film_ratio_mean_{j}", "mixed_fraction_{j}", "sliding_distance_per_rev_{j}_m",
                   "sliding_work_per_rev_{j}_J", "contact_force_sliding_mean_{j}_N")
 JOINTS = ("e", "f")
-RESPONSE = MECHANISM_RESPONSE + tuple(name.format(j=j) for j in JOINTS for name in JOINT_RESPONSE)
+# Columns added after the layout above was first stored, appended so that a state written before them loads
+# (their values NaN, weftsim.wear.resume): the asperities' share of the sliding work (the mixed regime's k).
+LATER_RESPONSE = ("asperity_work_per_rev_{j}_J",)
+EARLIER_RESPONSE = MECHANISM_RESPONSE + tuple(name.format(j=j) for j in JOINTS for name in JOINT_RESPONSE)
+RESPONSE = EARLIER_RESPONSE + tuple(name.format(j=j) for j in JOINTS for name in LATER_RESPONSE)
 # The columns of a state written before the joints were named (joint E alone), in their stored order, and
 # their names now: such a state still loads (weftsim.wear.resume).
 LEGACY_RESPONSE = ("rapier_acceleration_rms_m_s2", "rapier_acceleration_p99_m_s2", "driving_torque_rms_Nm",
@@ -58,4 +62,17 @@ def scene_identity(scene: Scene) -> str:
     keys = to_file_keys(scene)
     if scene.joint_f.is_ideal:
         keys = {k: v for k, v in keys.items() if not k.startswith("joint_f.wear.")}
+    # The wear regimes' keys at their defaults are the single k = 1e-7 a state written before them knew:
+    # the same scene (its identity written as then).
+    for table in ("joint_e", "joint_f"):
+        at = f"{table}.wear."
+        if all(keys.get(at + name, value) == value for name, value in REGIME_DEFAULTS.items()):
+            for name in REGIME_DEFAULTS:
+                keys.pop(at + name, None)
+            if keys.get(at + "wear_coefficient", 0.0) is None:
+                keys[at + "wear_coefficient"] = REGIME_DEFAULTS["boundary_wear_coefficient"]
     return json.dumps(keys, sort_keys=True, default=str)
+
+
+REGIME_DEFAULTS = {"regime": "boundary", "dry_wear_coefficient": 5e-3, "boundary_wear_coefficient": 1e-7,
+                   "mixed_wear_coefficient": 1e-7}  # weftsim.input.params.WearModel's defaults
