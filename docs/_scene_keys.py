@@ -16,6 +16,10 @@ from weftsim.input.params import Scene
 # Unit suffixes of the key names, longest first: (suffix, unit as shown, factor to SI). The factor is
 # checked against each key's conversion (Key.scale), so a unit shown here is the unit the loader reads.
 UNITS: tuple[tuple[str, str, float], ...] = (
+    ("_j_kg_k", "J/(kg K)", 1.0),
+    ("_mm2_s", "mm²/s", 1e-6),
+    ("_kg_m3", "kg/m³", 1.0),
+    ("_w_k", "W/K", 1.0),
     ("_mpa_m_s", "MPa m/s", 1e6),
     ("_mpa_s", "mPa s", 1e-3),
     ("_um", "µm", 1e-6),
@@ -31,6 +35,7 @@ UNITS: tuple[tuple[str, str, float], ...] = (
     ("_kg", "kg", 1.0),
     ("_s", "s", 1.0),
     ("_m", "m", 1.0),
+    ("_c", "°C", 1.0),
 )
 
 # Where each key belongs in the physics: (prefix of the dotted key, page#anchor, section title); the

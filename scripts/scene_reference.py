@@ -17,10 +17,12 @@ def main() -> None:
     print("|---|---|---|---|")
     for key in SCHEMA:
         value = defaults[key.path]
-        if value is None:  # an optional key without a default
-            value = "not set"
+        if key.path.endswith("lubrication.housing_heat_transfer_w_k"):
+            value = "estimated"
+        elif value is None or value == "" or (key.path.endswith(("oil.nu40_mm2_s", "oil.nu100_mm2_s")) and not value):
+            value = "not set"  # an optional key without a default
         elif key.path.endswith("lubrication.viscosity_mpa_s"):
-            value = "required in the table"
+            value = "required in the table, or oil"
         elif isinstance(value, float):
             value = f"{value:.6g}"
         elif isinstance(value, list):

@@ -12,6 +12,9 @@ load_scene(scene, overrides=None, **flags)
     A scene file or bundled scene name, with overrides in file units.
 simulate(scene, engine="auto")
     Run one engine; returns a :class:`RunResult` (``to_pandas()``, ``samples``, ``steps``).
+bearing(scene, joint="e", load_kn=None, journal_rpm=None)
+    The steady plain-bearing check of an oiled joint: Sommerfeld number, eccentricity, film ratio, friction,
+    power loss, film temperature, regime and the Stribeck curve (docs/lubricated-joint.md).
 plausibility_checks(scene)
     The checks that need no simulation: reflected mass, pin pressure, p x v, clearance ratio,
     rapier acceleration against their limits (docs/plausibility.md).
@@ -37,6 +40,7 @@ from weftsim.version import __version__  # noqa: F401 (weftsim.__version__)
 from weftsim.api import (
     DEFAULT_ENGINE,
     ENGINE_NAMES,
+    bearing,
     bundled_scenes,
     load_result,
     load_scene,
@@ -79,6 +83,7 @@ __all__ = [
     "WearError",
     "WeftsimError",
     "WriteFailed",
+    "bearing",
     "bundled_scenes",
     "load_result",
     "load_scene",

@@ -198,6 +198,11 @@ def simulate(scene: Scene | str | os.PathLike, engine: str = "auto", *,
         raise ArgumentError(f"simulate: progress must be None or a function called with the completed fraction "
                             f"(e.g. lambda f: print(f)), got {type(progress).__name__} {progress!r:.40}")
     scene = _as_scene(scene)
+    if any(getattr(scene, attr).lubrication is not None and getattr(scene, attr).lubrication.has_oil
+           for attr in ("joint", "joint_f")):
+        from weftsim.joint.bearing import resolve_scene
+
+        scene = resolve_scene(scene)  # the oil's viscosity at the film temperature of this scene's operating point
     for text in warnings_of(before_run(scene)):
         if on_warning is None:
             warnings.warn(text, PlausibilityWarning, stacklevel=2)
@@ -207,6 +212,47 @@ def simulate(scene: Scene | str | os.PathLike, engine: str = "auto", *,
     if raise_on_failure and not result.ok:
         raise RunFailed(f"simulation failed: {result.message}", result)
     return result
+
+
+def bearing(scene: Scene | str | os.PathLike, joint: str = "e", load_kn: float | None = None,
+            journal_rpm: float | None = None, stribeck: bool = True) -> dict:
+    """The steady plain-bearing check of a lubricated joint (``weftsim bearing``; docs/lubricated-joint.md).
+
+    Parameters
+    ----------
+    scene : Scene, str or path-like
+        A scene whose joint ``joint`` has a clearance and oil (``[joint_e.lubrication]`` with ``oil`` or
+        ``viscosity_mpa_s``).
+    joint : {"e", "f"}
+    load_kn, journal_rpm : float, optional
+        Another operating point: the bearing alone under this load (kN), its journal turning at this speed (rpm)
+        in a still bushing.  Each defaults to the ideal mechanism's mean; without either, the mechanism's mean
+        and peak load at its mean sliding speed.
+    stribeck : bool
+        Add the Stribeck curve (friction coefficient against journal speed at the first point's load).
+
+    Returns
+    -------
+    dict
+        ``points`` (``mean`` and ``peak``, or ``given``): Sommerfeld number, eccentricity ratio, attitude angle,
+        minimum film and film ratio, friction torque and coefficient, power loss, flows, the film temperature and
+        its heat balance, the regime; ``stribeck``: the curve; the joint's geometry and oil (SI units in the keys).
+
+    Raises
+    ------
+    weftsim.errors.SceneError
+        One line: an ideal or dry joint, a load or speed not > 0, a heat balance without a solution.
+    """
+    from weftsim.joint.bearing import bearing as check
+
+    import math
+
+    scene = _as_scene(scene)
+    for value, name in ((load_kn, "load_kn (--load-kn, kN)"), (journal_rpm, "journal_rpm (--journal-rpm)")):
+        number = isinstance(value, (int, float)) and not isinstance(value, bool)
+        if value is not None and not (number and math.isfinite(value) and value > 0.0):
+            raise SceneError(f"bearing: {name} must be a number > 0, got {value!r}")
+    return check(scene, joint, None if load_kn is None else 1e3 * load_kn, journal_rpm, stribeck)
 
 
 def plausibility_checks(scene: Scene | str | os.PathLike) -> list[dict]:

@@ -1,4 +1,4 @@
-"""Command line: ``weftsim scenes | kinematics | run | animate | compare | sweep | study | bench | wear``.  Thin: parse,
+"""Command line: ``weftsim scenes | kinematics | run | animate | compare | sweep | study | bench | wear | bearing``.  Thin: parse,
 call the Python interface (:mod:`weftsim.api`), report.
 
 One grammar for the scene of every command: ``SCENE`` is a file or the name of a bundled scene,
@@ -139,6 +139,10 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("wear", help="predict the wear of joint E over operating hours (docs/wear.md)")
     _add_wear_flags(p)
 
+    p = sub.add_parser("bearing", help="steady plain-bearing check of an oiled joint: film, friction, temperature, "
+                       "Stribeck curve (docs/lubricated-joint.md)")
+    _add_bearing_flags(p)
+
     p = sub.add_parser("bench", help="work-precision benchmark of every engine setting (docs/performance.md)",
                        description="Time every engine setting on an easy and two hard scenes against a converged "
                        "solution: tables, log-log figures and JSON.  The full mode takes ~30 min on 2 cores.  "
@@ -164,6 +168,21 @@ def _add_wear_flags(p: argparse.ArgumentParser) -> None:
     add_scene_flags(p, shorthands=("speed_rpm", "clearance_mm", "law"))  # revolutions: set per update in [joint_e.wear]
     add_output_flags(p, "out/<scene name>/wear")
     add_flags(p, positive)
+
+
+def _add_bearing_flags(p: argparse.ArgumentParser) -> None:
+    from weftsim.cli.bearing import add_flags
+
+    add_scene_flags(p, shorthands=("speed_rpm", "clearance_mm"))
+    add_output_flags(p, "out/<scene name>/bearing")
+    add_flags(p)
+
+
+def cmd_bearing(args: argparse.Namespace) -> int:
+    from weftsim.cli.bearing import run
+
+    scene = scene_from_args(args)
+    return run(args, scene, output_directory(args, scene, "bearing"))
 
 
 def cmd_wear(args: argparse.Namespace) -> int:
@@ -601,7 +620,7 @@ def cmd_scenes(args: argparse.Namespace) -> int:
 
 COMMANDS = {"scenes": cmd_scenes, "kinematics": cmd_kinematics, "run": cmd_run, "animate": cmd_animate,
             "compare": cmd_compare,
-            "sweep": cmd_sweep, "study": cmd_study, "bench": cmd_bench, "wear": cmd_wear}
+            "sweep": cmd_sweep, "study": cmd_study, "bench": cmd_bench, "wear": cmd_wear, "bearing": cmd_bearing}
 
 
 def _one_line(text: str) -> str:

@@ -54,8 +54,13 @@ def inherit_joint_f(flat: dict[str, Any]) -> tuple[dict[str, Any], tuple[str, ..
     """
     out = dict(flat)
     taken = []
+    lubricant = ("lubrication.viscosity_mpa_s", "lubrication.oil", "lubrication.oil.nu40_mm2_s",
+                 "lubrication.oil.nu100_mm2_s")
+    own_lubricant = any("joint_f." + rest in out for rest in lubricant)
     for rest in _f_keys():
         mine, hers = "joint_f." + rest, "joint_e." + rest
+        if own_lubricant and rest in lubricant:
+            continue  # F names its own lubricant (a viscosity or an oil): E's other one is not F's
         if mine not in out and hers in out:
             out[mine] = out[hers]
             taken.append(rest)

@@ -218,6 +218,24 @@ class Lubrication:
         The film force is evaluated no closer than h_min = film_floor_ratio x sigma: below that film
         thickness its pressure field is held at the floor's while the asperities take the rest, so the
         film force stays finite where the dry law starts (e = c).  Default 1 (film ratio 1).
+    oil : str
+        An ISO 3448 grade (``"ISO VG 220"``, :func:`weftsim.joint.oil.grade_names`): the viscosity then follows
+        from the film's temperature (:mod:`weftsim.joint.heat`) instead of ``viscosity``.  Empty: not given.
+    oil_nu40, oil_nu100 : float
+        A custom oil instead of a grade: kinematic viscosities at 40 and 100 C, m^2/s (0: not given).
+    oil_density, oil_heat_capacity : float
+        The oil's density at 15 C (kg/m^3, default 880) and specific heat (J/(kg K), default 2000).
+    ambient_temperature : float
+        Temperature of the air around the joint and of the oil fed to it, C (default 25).
+    housing_heat_transfer : float or None
+        Heat flow from the bearing to the ambient per kelvin, k A, W/K; None: estimated
+        (:func:`weftsim.joint.heat.housing_estimate`).
+    oil_supply : str
+        ``"fed"`` (default: oil at the ambient temperature floods the film at its thickest line and its flow
+        carries heat off) or ``"sump"`` (self-contained: the heat leaves through the housing alone).
+    film_temperature : float or None
+        The effective film temperature (C) the heat balance found for the scene's operating point, with
+        ``viscosity`` the oil's viscosity there; None until computed (:func:`weftsim.joint.heat.resolve_scene`).
     """
 
     viscosity: float
@@ -227,11 +245,36 @@ class Lubrication:
     roughness_radius_ratio: float = 1e-3
     boundary_friction_coefficient: float = 0.1
     film_floor_ratio: float = 1.0
+    oil: str = ""
+    oil_nu40: float = 0.0
+    oil_nu100: float = 0.0
+    oil_density: float = 880.0
+    oil_heat_capacity: float = 2000.0
+    ambient_temperature: float = 25.0
+    housing_heat_transfer: float | None = None
+    oil_supply: str = "fed"
+    film_temperature: float | None = None
 
     def __post_init__(self):
         problem = lubrication_problem(self)
         if problem is not None:
             raise ValueError(problem)
+
+    @property
+    def has_oil(self) -> bool:
+        """True when an oil is named (grade or viscosities): the viscosity follows from the film temperature."""
+        return bool(self.oil) or self.oil_nu40 > 0.0 or self.oil_nu100 > 0.0
+
+    @property
+    def oil_model(self):
+        """The :class:`weftsim.joint.oil.Oil` named, or None."""
+        from weftsim.joint.oil import Oil, grade_oil
+
+        if self.oil:
+            return grade_oil(self.oil, self.oil_density, self.oil_heat_capacity)
+        if self.has_oil:
+            return Oil("custom", self.oil_nu40, self.oil_nu100, self.oil_density, self.oil_heat_capacity)
+        return None
 
     @property
     def model_code(self) -> int:
@@ -264,6 +307,41 @@ def lubrication_problem(lub: Lubrication) -> str | None:
     floor = lub.film_floor_ratio
     if not (_number(floor) and 0.0 < floor <= 4.0):
         return f"`lubrication.film_floor_ratio` must be in (0, 4] (film floor / sigma), got {floor!r}"
+    return oil_problem(lub)
+
+
+OIL_SUPPLIES = ("fed", "sump")
+
+
+def oil_problem(lub: Lubrication) -> str | None:
+    """One line naming the first invalid oil field of ``lub`` (:class:`Lubrication`), or None."""
+    from weftsim.joint.oil import custom_problem, grade_problem
+
+    if not isinstance(lub.oil, str):
+        return f"`lubrication.oil` must be a grade name such as 'ISO VG 220', got {lub.oil!r}"
+    for name in ("oil_nu40", "oil_nu100", "oil_density", "oil_heat_capacity", "ambient_temperature"):
+        if not _number(getattr(lub, name)):
+            return f"`lubrication.{name}` must be a finite number, got {getattr(lub, name)!r}"
+    custom = lub.oil_nu40 > 0.0 or lub.oil_nu100 > 0.0
+    if lub.oil and custom:
+        return ("`lubrication.oil` names a grade and `lubrication.oil_nu40`/`oil_nu100` give viscosities: give the oil "
+                "one way (the grade, or its two viscosities)")
+    if lub.oil and grade_problem(lub.oil):
+        return grade_problem(lub.oil)
+    if lub.oil_nu40 > 0.0 and lub.oil_nu100 > 0.0 and custom_problem(lub.oil_nu40, lub.oil_nu100):
+        return custom_problem(lub.oil_nu40, lub.oil_nu100)  # one of the two alone: weftsim.joint.bearing says so
+    if lub.has_oil and lub.viscosity > 0.0 and lub.film_temperature is None:
+        return ("`lubrication.viscosity` and `lubrication.oil` are both given: give the oil (its viscosity then follows "
+                "from the film temperature) or a fixed viscosity, not both")
+    if not (lub.oil_density > 0.0 and lub.oil_heat_capacity > 0.0):
+        return "`lubrication.oil_density` and `oil_heat_capacity` must be > 0 (kg/m^3 at 15 C, J/(kg K))"
+    if not -40.0 <= lub.ambient_temperature <= 150.0:
+        return f"`lubrication.ambient_temperature` must be in [-40, 150] C, got {lub.ambient_temperature!r}"
+    heat = lub.housing_heat_transfer
+    if heat is not None and not (_number(heat) and heat >= 0.0):
+        return f"`lubrication.housing_heat_transfer` must be >= 0 (W/K) or None (estimated), got {heat!r}"
+    if lub.oil_supply not in OIL_SUPPLIES:
+        return f"`lubrication.oil_supply` must be one of {OIL_SUPPLIES}, got {lub.oil_supply!r}"
     return None
 
 

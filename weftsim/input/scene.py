@@ -302,16 +302,41 @@ def _set_checked(scene: params.Scene, target: str, value: Any, where: str) -> pa
 LUBRICATION_TABLES = (("joint_e", "joint"), ("joint_f", "joint_f"))
 
 
-def _check_lubrication_given(keys, where: str, before: params.Scene | None = None) -> None:
-    """A ``[<joint>.lubrication]`` table must name ``viscosity_mpa_s`` (unless ``before`` already has a film)."""
-    keys = list(keys)
+# The keys that name the lubricant of a [<joint>.lubrication] table: a fixed viscosity, or an oil.
+VISCOSITY_KEY, OIL_KEYS = "viscosity_mpa_s", ("oil", "oil.nu40_mm2_s", "oil.nu100_mm2_s")
+
+
+def _names_oil(flat: dict, prefix: str) -> bool:
+    return any(flat.get(prefix + k) not in (None, "", 0, 0.0) for k in OIL_KEYS)
+
+
+def _check_lubrication_given(flat: dict, where: str, before: params.Scene | None = None) -> None:
+    """A ``[<joint>.lubrication]`` table must name its lubricant, ``viscosity_mpa_s`` or an ``oil``, not both
+    (``before``: the scene overridden, whose film may already name it).  ``flat``: the keys given, file values."""
     for table, attr in LUBRICATION_TABLES:
         prefix = f"{table}.lubrication."
+        oil, viscosity = _names_oil(flat, prefix), flat.get(prefix + VISCOSITY_KEY) not in (None, 0, 0.0)
+        if oil and viscosity:
+            raise SceneError(f"{where}: keys '{prefix}{VISCOSITY_KEY}' and '{prefix}oil' are both given: give the "
+                             "oil (its viscosity then follows from the film temperature) or a fixed viscosity, not both")
         if before is not None and getattr(before, attr).lubrication is not None:
             continue
-        if any(k.startswith(prefix) for k in keys) and prefix + "viscosity_mpa_s" not in keys:
-            raise SceneError(f"{where}: missing required key '{prefix}viscosity_mpa_s'; a [{table}.lubrication] "
-                             "table must give the oil's viscosity (the other lubrication keys default)")
+        if any(k.startswith(prefix) for k in flat) and not (oil or prefix + VISCOSITY_KEY in flat):
+            raise SceneError(f"{where}: missing required key '{prefix}{VISCOSITY_KEY}' or '{prefix}oil'; a "
+                             f"[{table}.lubrication] table must give the oil's viscosity or name the oil (the other "
+                             "lubrication keys default)")
+
+
+def _switch_lubricant(flat: dict, overrides: dict) -> None:
+    """An override naming the lubricant replaces the file's: ``--set ...oil=...`` drops the file's
+    ``viscosity_mpa_s`` and ``--set ...viscosity_mpa_s=...`` its oil (``flat`` is changed in place)."""
+    for table, _ in LUBRICATION_TABLES:
+        prefix = f"{table}.lubrication."
+        if _names_oil(overrides, prefix) and prefix + VISCOSITY_KEY not in overrides:
+            flat.pop(prefix + VISCOSITY_KEY, None)
+        if prefix + VISCOSITY_KEY in overrides and not _names_oil(overrides, prefix):
+            for key in OIL_KEYS:
+                flat.pop(prefix + key, None)
 
 
 def _check_scene(scene: params.Scene, where: str, origin: dict[str, Path]) -> None:
@@ -373,6 +398,7 @@ def scene_from_keys(flat: dict[str, Any], where: str = "scene", origin: dict[str
         raise SceneError(f"{where}: key 'name' must be a non-empty line of printable characters "
                          f"(no newline or escape sequence), got {name!r}")
     scene = params.Scene(name=name, source=where)
+    _check_lubrication_given(flat, where)
     for path, value in flat.items():
         if path in TOP_LEVEL:
             continue
@@ -383,9 +409,19 @@ def scene_from_keys(flat: dict[str, Any], where: str = "scene", origin: dict[str
             value = BRANCHES[value]
         scene = _set_checked(scene, key.target, value, src)
     scene = replace(scene, joint_f_inherits=inherited)
-    _check_lubrication_given(flat, where)
     _check_scene(scene, where, origin)
-    return scene
+    return _film_temperature(scene, where)
+
+
+def _film_temperature(scene: params.Scene, where: str) -> params.Scene:
+    """``scene`` with each oiled joint's viscosity at its film temperature (:func:`weftsim.joint.bearing.resolve_scene`);
+    a heat balance without a solution is a SceneError naming ``where``."""
+    from weftsim.joint.bearing import resolve_scene
+
+    try:
+        return resolve_scene(scene)
+    except SceneError as exc:
+        raise SceneError(f"{where}: {exc}") from None
 
 
 def load_scene(path: str | os.PathLike, overrides: dict[str, Any] | None = None,
@@ -421,6 +457,7 @@ def load_scene(path: str | os.PathLike, overrides: dict[str, Any] | None = None,
     path = scene_source(path)
     flat, origin = _read_merged(path)
     flat.setdefault("name", path.stem)
+    _switch_lubricant(flat, {k: v for k, v in (overrides or {}).items() if v is not None})
     for dotted, value in (overrides or {}).items():
         if value is None:
             continue
@@ -460,12 +497,18 @@ def to_file_keys(scene: params.Scene) -> dict[str, Any]:
                 break  # a dry joint's lubrication keys: None, as any unset optional key
         if obj is None:  # an optional key the scene does not give
             pass
+        elif key.path.endswith(".lubrication." + VISCOSITY_KEY) and _lubrication_of(scene, key).has_oil:
+            continue  # the viscosity follows from the oil (at the film temperature): the oil's keys say it
         elif key.path == "mechanism.fourbar_branch":
             obj = "+" if obj > 0 else "-"
         elif key.kind in ("float", "floats2", "floats3"):
             obj = obj / key.scale if key.kind == "float" else [v / key.scale for v in obj]
         out[key.path] = obj
     return out
+
+
+def _lubrication_of(scene: params.Scene, key: Key) -> params.Lubrication:
+    return getattr(scene, key.target.partition(".")[0]).lubrication
 
 
 def apply_overrides(scene: params.Scene, overrides: dict[str, Any], where: str = "command line",
@@ -486,6 +529,8 @@ def apply_overrides(scene: params.Scene, overrides: dict[str, Any], where: str =
     from weftsim.input.joint_keys import ideal_joint_keys, ideal_key_message, resync_joint_f
 
     before = scene
+    given = {k: v for k, v in overrides.items() if v is not None}
+    scene = _switched_scene(scene, given)
     for dotted, value in overrides.items():
         if value is None:
             continue
@@ -500,9 +545,25 @@ def apply_overrides(scene: params.Scene, overrides: dict[str, Any], where: str =
             value = BRANCHES[value]
         scene = _set_checked(scene, key.target, value, where)
     scene = resync_joint_f(scene, {key for key, value in overrides.items() if value is not None})
-    _check_lubrication_given([k for k, v in overrides.items() if v is not None], where, before)
+    _check_lubrication_given(given, where, before)
     _check_scene(scene, where, {})
     idle = ideal_joint_keys(scene, [key for key, value in overrides.items() if value is not None])
     if idle and refuse_ideal_keys:
         raise SceneError(ideal_key_message(idle[0], where))
+    return _film_temperature(scene, where)
+
+
+def _switched_scene(scene: params.Scene, given: dict[str, Any]) -> params.Scene:
+    """``scene`` ready for ``given`` overrides: an override naming an oil clears a fixed viscosity, one giving
+    ``viscosity_mpa_s`` clears the oil (:func:`_switch_lubricant` on a scene)."""
+    for table, attr in LUBRICATION_TABLES:
+        prefix = f"{table}.lubrication."
+        lub = getattr(scene, attr).lubrication
+        if lub is None:
+            continue
+        if _names_oil(given, prefix) and prefix + VISCOSITY_KEY not in given:
+            lub = replace(lub, viscosity=0.0, film_temperature=None)
+        elif prefix + VISCOSITY_KEY in given and not _names_oil(given, prefix):
+            lub = replace(lub, oil="", oil_nu40=0.0, oil_nu100=0.0, film_temperature=None)
+        scene = replace(scene, **{attr: replace(getattr(scene, attr), lubrication=lub)})
     return scene

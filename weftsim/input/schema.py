@@ -110,6 +110,25 @@ def LUBRICATION_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 -
             doc="friction coefficient on the asperity load (default 0.1)"),
         Key(at + "film_floor_ratio", to + "film_floor_ratio", "float", 1, 0, 4,
             doc="the film force is evaluated no closer than this many RMS roughnesses (default 1)"),
+        # The oil and the heat balance (weftsim.joint.oil, weftsim.joint.heat): instead of viscosity_mpa_s.
+        Key(at + "oil", to + "oil", "str",
+            doc="an ISO 3448 grade (\"ISO VG 220\"): the viscosity follows from the film temperature of the "
+                "bearing's heat balance (instead of viscosity_mpa_s)"),
+        Key(at + "oil.nu40_mm2_s", to + "oil_nu40", "float", 1e-6, 0, None, False,
+            doc="a custom oil instead of a grade: kinematic viscosity at 40 C"),
+        Key(at + "oil.nu100_mm2_s", to + "oil_nu100", "float", 1e-6, 0, None, False,
+            doc="a custom oil: kinematic viscosity at 100 C (ASTM D341 through the two)"),
+        Key(at + "oil.density_kg_m3", to + "oil_density", "float", 1, 0,
+            doc="density of the oil at 15 C (default 880, a mineral oil)"),
+        Key(at + "oil.heat_capacity_j_kg_k", to + "oil_heat_capacity", "float", 1, 0,
+            doc="specific heat of the oil (default 2000)"),
+        Key(at + "ambient_temperature_c", to + "ambient_temperature", "float", 1, -40, 150, False, False,
+            doc="temperature of the air around the joint and of the oil fed to it (default 25 C)"),
+        Key(at + "housing_heat_transfer_w_k", to + "housing_heat_transfer", "float", 1, 0, None, False,
+            doc="heat flow through the housing to the air per kelvin, k A (default: estimated for the pin's eye)"),
+        Key(at + "oil_supply", to + "oil_supply", "str", choices=params.OIL_SUPPLIES,
+            doc="fed (oil at ambient temperature floods the film and carries heat off, default) or sump "
+                "(self-contained: heat through the housing alone)"),
     )
 
 

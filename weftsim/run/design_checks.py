@@ -13,6 +13,7 @@ check                    value                                        limit (sce
 ``hertz_pressure``       Hertz line-contact pressure at peak force    1.67 x the smaller ``yield_strength_mpa``
 ``penetration``          largest delta / c (after the run only)       the law's range (:mod:`weftsim.joint.contact`)
 ``rapier_acceleration``  peak of abs(rapier acceleration)             ``limits.max_rapier_acceleration_m_s2``
+``film_temperature``     effective film temperature of an oiled joint none: reported (:mod:`weftsim.joint.heat`)
 =======================  ===========================================  ============================================
 
 *Before the run* (:func:`before_run`) the loads come from the ideal mechanism at the scene's speed
@@ -177,7 +178,18 @@ def joint_checks_before(scene: Scene, joint_name: str) -> list[Check]:
     pv = loads.force / (2.0 * joint.journal_radius * joint.bearing_length) * loads.sliding_speed
     out += pressure_checks("before", table, joint, float(loads.force.max()), float(loads.force.mean()),
                            float(pv.mean()), float(pv.max()), float(loads.sliding_speed.max()))
-    return out
+    return out + film_temperature_checks(table, joint)
+
+
+def film_temperature_checks(table: str, joint) -> list[Check]:
+    """``film_temperature`` (info) of an oiled joint: the effective film temperature the heat balance found at the
+    ideal mechanism's mean load and sliding speed, and the viscosity the run takes there (weftsim.joint.heat)."""
+    lub = joint.lubrication
+    if lub is None or not lub.has_oil or lub.film_temperature is None:
+        return []
+    numbers = {"viscosity_pa_s": lub.viscosity, "ambient_c": lub.ambient_temperature}
+    return [Check("film_temperature", "before", table, lub.film_temperature, None, "C", f"{table}.lubrication.oil",
+                  "info", numbers)]
 
 
 def rapier_check(scene: Scene, stage: str, peak: float, numbers: dict | None = None, note: str = "") -> Check:
@@ -333,6 +345,9 @@ def _short(check: dict) -> str:
     if name == "penetration":
         limit = check["limit"]
         return f"delta/c {value:.3g}" + (f" (law's range {limit:g})" if limit is not None else " (law: no bound)")
+    if name == "film_temperature":
+        return (f"film {value:.4g} C at {numbers['ambient_c']:.4g} C ambient "
+                f"({1e3 * numbers['viscosity_pa_s']:.4g} mPa s)")
     return f"rapier acceleration {value:.4g} m/s2 peak" + _limit(check, 1.0, "")
 
 

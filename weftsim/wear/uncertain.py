@@ -23,11 +23,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from weftsim.errors import WearError
+from weftsim.joint.oil import DENSITY_15C, DENSITY_PER_K
 
 KINDS = {"normal": 2, "lognormal": 2, "uniform": 2, "triangular": 3, "walther": 4}
-# Density of a mineral oil, g/cm^3 at 15 C, and its fall per kelvin (the dynamic viscosity is nu times it;
-# mineral gear oils of ISO VG 100-460 have 0.87-0.90 at 15 C; the thermal fall moves eta by 4 % over 60 K).
-OIL_DENSITY_15C, OIL_DENSITY_PER_K = 0.88, 6.5e-4
+# Density of a mineral oil, g/cm^3 at 15 C, and its fall per kelvin (weftsim.joint.oil, in kg/m^3 there).
+OIL_DENSITY_15C, OIL_DENSITY_PER_K = 1e-3 * DENSITY_15C, 1e-3 * DENSITY_PER_K
 
 _TEXT = re.compile(r"^\s*([A-Za-z0-9_.]+)\s*=\s*([a-z]+)\s*\(([^()]*)\)\s*$")
 
@@ -97,15 +97,12 @@ def parse_uncertain(text: str) -> Uncertain:
 def walther_viscosity(nu40: float, nu100: float, t_c: np.ndarray) -> np.ndarray:
     """Dynamic viscosity (mPa s) at ``t_c`` (C) of an oil with kinematic viscosities nu40, nu100 (mm^2/s).
 
-    Walther's relation as ASTM D341 writes it, log10 log10(nu + 0.7) = A - B log10 T (T in K), through
-    the two points; times the density OIL_DENSITY_15C - OIL_DENSITY_PER_K (t - 15) of a mineral oil.
+    Walther's relation of ASTM D341 through the two points (:func:`weftsim.joint.oil.walther_kinematic`), times
+    the density of a mineral oil (:func:`weftsim.joint.oil.density`, OIL_DENSITY_15C at 15 C).
     """
-    t = np.asarray(t_c, dtype=float) + 273.15
-    z40, z100 = (math.log10(math.log10(v + 0.7)) for v in (nu40, nu100))
-    b = (z40 - z100) / (math.log10(373.15) - math.log10(313.15))
-    a = z40 + b * math.log10(313.15)
-    nu = 10.0 ** (10.0 ** (a - b * np.log10(t))) - 0.7
-    return nu * (OIL_DENSITY_15C - OIL_DENSITY_PER_K * (np.asarray(t_c, dtype=float) - 15.0))
+    from weftsim.joint.oil import density, walther_kinematic
+
+    return walther_kinematic(nu40, nu100, t_c) * density(1e3 * OIL_DENSITY_15C, t_c) * 1e-3
 
 
 def latin_hypercube(n: int, dims: int, rng: np.random.Generator) -> np.ndarray:

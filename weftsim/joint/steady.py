@@ -1,0 +1,115 @@
+"""The steadily loaded plain bearing: where the joint's kernel carries a load, and what that costs.
+
+A journal of radius R spinning at omega (N = omega / 2 pi rev/s) in a still bearing of length L and radial
+clearance c carries a steady load W where the force of the joint's kernel balances it
+(:func:`weftsim.kernel.steady.steady_force`: oil film, asperities and their boundary friction, the dry law
+beyond e = c; the same functions the transient engines integrate).  By symmetry that force depends on |e|
+alone (its direction turns with e), so |e| is the root of |f(|e|)| = W (Brent's method; |f| grows with |e|),
+and the attitude angle is the angle between the load and the line of centres.  Then (Raimondi and Boyd,
+ASLE Trans. 1, 1958; Shigley's Mechanical Engineering Design, ch. 12):
+
+- Sommerfeld number S = (R/c)^2 eta N / P, P = W / (2 R L) the projected pressure;
+- eccentricity ratio eps = |e| / c, minimum film h_min = c - |e| (0 once the dry law carries), film ratio
+  h_min / sigma;
+- friction torque T = -M_j on the journal, friction coefficient f = T / (W R), power loss P_f = T omega;
+- the regime by the film ratio, as the regime map (docs/lubricated-joint.md): hydrodynamic above 3, mixed
+  from 1 to 3, boundary below 1;
+- the film's inlet and side flow Q, Qs (:mod:`weftsim.joint.film_flow`) at the eccentricity the film is
+  evaluated at (the film floor holds it below c - h_floor).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+# Film ratios that bound the regimes (the regime map's, weftsim.studies.regime).
+HYDRODYNAMIC_RATIO, MIXED_RATIO = 3.0, 1.0
+# Relative tolerance of the eccentricity root (brentq xtol = this x c): the load balances to ~1e-12 relative.
+ECCENTRICITY_TOL = 1e-13
+
+
+@dataclass(frozen=True)
+class SteadyPoint:
+    """One steady operating point of a plain bearing (SI units; module docstring)."""
+
+    load_n: float
+    journal_speed_rad_s: float
+    viscosity_pa_s: float
+    sommerfeld: float
+    eccentricity_ratio: float
+    attitude_angle_deg: float
+    min_film_m: float
+    film_ratio: float
+    friction_torque_nm: float
+    friction_coefficient: float
+    power_loss_w: float
+    film_force_n: float
+    asperity_load_n: float
+    dry_force_n: float
+    inlet_flow_m3_s: float
+    side_flow_m3_s: float
+    regime: str
+
+    def as_dict(self) -> dict:
+        """JSON-ready (plain floats and the regime's name)."""
+        return asdict(self)
+
+
+def regime_of(ratio: float) -> str:
+    """``"hydrodynamic"`` (film ratio > 3), ``"mixed"`` (1-3) or ``"boundary"`` (< 1)."""
+    return "hydrodynamic" if ratio > HYDRODYNAMIC_RATIO else "mixed" if ratio >= MIXED_RATIO else "boundary"
+
+
+def joint_block(joint) -> np.ndarray:
+    """The kernel's parameter block of a lubricated :class:`weftsim.input.params.ClearanceJoint`."""
+    from weftsim.joint.contact import make_law
+    from weftsim.kernel.joint import joint_parameters
+
+    return joint_parameters(joint, make_law(joint))
+
+
+def steady_point(joint, load: float, omega: float, viscosity: float, prm: np.ndarray | None = None) -> SteadyPoint:
+    """The :class:`SteadyPoint` of ``joint`` (lubricated) under ``load`` (N) at journal speed ``omega`` (rad/s)
+    with the film at ``viscosity`` (Pa s).  ``prm``: the joint's block, if already built (:func:`joint_block`)."""
+    from scipy.optimize import brentq
+
+    from weftsim.joint.film_flow import flow_variables
+    from weftsim.kernel.joint import VISCOSITY
+    from weftsim.kernel.steady import steady_force
+
+    prm = (joint_block(joint) if prm is None else prm).copy()
+    prm[VISCOSITY] = viscosity
+    c, radius, length = joint.clearance, joint.journal_radius, joint.bearing_length
+    lub = joint.lubrication
+
+    def force(ecc: float) -> float:
+        fy, fz = steady_force(prm, c, ecc, omega)[:2]
+        return math.hypot(fy, fz) - load
+
+    lo, hi = 1e-9 * c, c
+    if force(lo) >= 0.0:  # a load the centred journal carries already (only W = 0)
+        ecc = lo
+    else:
+        while force(hi) < 0.0:  # beyond c: the dry law carries the rest
+            hi = c + 2.0 * (hi - c + 1e-9 * c)
+            if hi - c > radius:
+                raise ValueError(f"the joint carries no load of {load:g} N within a penetration of R_j")
+        ecc = brentq(force, lo, hi, xtol=ECCENTRICITY_TOL * c, rtol=1e-15)
+    fy, fz, m_j, film, asperity, dry = steady_force(prm, c, ecc, omega)
+    attitude = math.degrees(math.atan2(abs(fz), -fy)) if load > 0.0 else 90.0
+    torque = -m_j
+    pressure = load / (2.0 * radius * length)
+    n = omega / (2.0 * math.pi)
+    sommerfeld = (radius / c) ** 2 * viscosity * n / pressure if pressure > 0.0 else math.inf
+    h_min = max(c - ecc, 0.0)
+    ratio = h_min / lub.roughness
+    eps_film = min(ecc, c - lub.film_floor_ratio * lub.roughness) / c
+    q_in, q_side = flow_variables(eps_film, length / (2.0 * radius))
+    scale = radius * c * n * length
+    numbers = (load, omega, viscosity, sommerfeld, ecc / c, attitude, h_min, ratio, torque,
+               torque / (load * radius) if load > 0.0 else math.inf, torque * omega, film, asperity, dry,
+               q_in * scale, q_side * scale)
+    return SteadyPoint(*(float(x) for x in numbers), regime_of(ratio))
