@@ -224,7 +224,9 @@ def test_cli_wear_ends_at_the_limit_unless_past_limit(tmp_path):
     assert data["final_effective_clearance_e_mm"] == pytest.approx(0.26, rel=1e-9)
     assert "reaches the limit 0.26 mm" in data["ended"]
     last = ended.stdout.strip().splitlines()[-1]
-    assert last == f"  at E: {data['hours_to_limit']:.6g} h to the limit 0.26 mm", last
+    days = data["calendar_days_to_limit_e"]  # 24 h a day, 7 days a week, no stops: hours / 24
+    assert days == pytest.approx(data["hours_to_limit"] / 24.0, rel=1e-12)
+    assert last.startswith(f"  at E: {data['hours_to_limit']:.6g} h of running = {days:.4g} calendar days"), last
     table = np.genfromtxt(out / "wear.csv", delimiter=",", names=True)
     assert np.all(table["effective_clearance_e_mm"] < 0.26)  # no update beyond it is simulated
     past = run_cli("wear", REFERENCE, "--hours", 4, "--limit-clearance-mm", 0.26, "--past-limit", "-o",

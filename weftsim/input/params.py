@@ -506,10 +506,20 @@ LOOM_JOINT_E = ClearanceJoint(clearance=0.25e-3, law="variable_kd")
 
 @dataclass(frozen=True)
 class Drive:
-    """Constant crank speed and run length."""
+    """Crank speed and run length; the drive law of a stop-start's transient (:func:`weftsim.kernel.chain.crank_motion`).
+
+    ``law``: ``"constant"`` (theta = omega t: every run of a scene file), ``"run_down"`` (omega until
+    ``ramp_start``, then to rest over ``ramp`` s) or ``"start_up"`` (at rest until ``ramp_start``, then to omega
+    over ``ramp`` s, the journal resting on the bearing's wall at t = 0: no film).  The transients are set by
+    the duty cycle (:mod:`weftsim.wear.duty`), not by scene keys; ``start_angle`` is the crank angle at t = 0.
+    """
 
     speed: float = 400.0 * (2.0 * math.pi / 60.0)  # omega, rad/s (same rounding as a scene file's 400 rpm)
     revolutions: float = 2.0
+    law: str = "constant"
+    ramp_start: float = 0.0  # s
+    ramp: float = 0.0  # s
+    start_angle: float = 0.0  # rad
 
     @property
     def period(self) -> float:
@@ -519,6 +529,38 @@ class Drive:
     @property
     def end_time(self) -> float:
         return self.revolutions * self.period
+
+
+@dataclass(frozen=True)
+class Duty:
+    """How a loom runs in a day (``[duty]``; :mod:`weftsim.wear.duty`, docs/wear.md section 12).
+
+    Attributes
+    ----------
+    stops_per_hour : float
+        Stops per hour of running (warp and weft breaks, other stops); each is a run-down to rest and a start-up
+        from rest with the film built up again from zero, whose simulated wear is added per hour of running.
+        0 (default): the steady prediction alone.
+    stop_minutes : float
+        Mean time the loom stands per stop, min (repair of the break): the calendar time, not the wear.
+    hours_per_day, days_per_week : float
+        The loom's scheduled hours (24 = three shifts) and working days.
+    startup_revolutions, rundown_revolutions : float
+        Crank revolutions of the start-up ramp from rest to full speed and of the run-down to rest.
+    """
+
+    stops_per_hour: float = 0.0
+    stop_minutes: float = 2.87
+    hours_per_day: float = 24.0
+    days_per_week: float = 7.0
+    startup_revolutions: float = 1.0
+    rundown_revolutions: float = 1.0
+
+    def calendar_days(self, running_hours: float) -> float:
+        """Calendar days for ``running_hours`` of running: each running hour costs 1 + stops x stop time of the
+        scheduled hours, hours_per_day of them a working day, days_per_week working days a week."""
+        scheduled = running_hours * (1.0 + self.stops_per_hour * self.stop_minutes / 60.0)
+        return scheduled / self.hours_per_day * 7.0 / self.days_per_week
 
 
 @dataclass(frozen=True)
@@ -651,6 +693,7 @@ class Scene:
     # Joint F (rod 4 - sector 5): ideal unless a scene gives it a clearance (docs/clearance-f.md).
     joint_f: ClearanceJoint = field(default_factory=lambda: replace(LOOM_JOINT_E, clearance=0.0))
     drive: Drive = field(default_factory=Drive)
+    duty: Duty = field(default_factory=Duty)
     reference_solver: ReferenceSolver = field(default_factory=ReferenceSolver)
     exudyn_solver: ExudynSolver = field(default_factory=ExudynSolver)
     output: Output = field(default_factory=Output)

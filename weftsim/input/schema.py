@@ -193,6 +193,17 @@ SCHEMA: tuple[Key, ...] = (
     *LUBRICATION_KEYS("joint_e", "joint"),
     Key("drive.speed_rpm", "drive.speed", "float", RPM, 0, 5000, doc="constant crank speed"),
     Key("drive.revolutions", "drive.revolutions", "float", 1, 0, 1000, doc="crank revolutions to simulate"),
+    # The duty cycle (weftsim wear; docs/wear.md section 12), all optional.
+    Key("duty.stops_per_hour", "duty.stops_per_hour", "float", 1, 0, 120, False,
+        doc="loom stops per running hour (warp and weft breaks); each adds a simulated run-down and start-up's wear"),
+    Key("duty.stop_minutes", "duty.stop_minutes", "float", 1, 0, 600, False,
+        doc="mean standstill per stop, min (default 2.87: a warp break's repair, Haque et al. 2019)"),
+    Key("duty.hours_per_day", "duty.hours_per_day", "float", 1, 0, 24, doc="scheduled hours a day (24: three shifts)"),
+    Key("duty.days_per_week", "duty.days_per_week", "float", 1, 0, 7, doc="working days a week"),
+    Key("duty.startup_revolutions", "duty.startup_revolutions", "float", 1, 0, 20,
+        doc="crank revolutions of the start-up ramp from rest (default 1: full speed within the first pick)"),
+    Key("duty.rundown_revolutions", "duty.rundown_revolutions", "float", 1, 0, 20,
+        doc="crank revolutions of the run-down to rest (default 1)"),
     Key("solver.reference.method", "reference_solver.method", "str", choices=INTEGRATORS,
         doc="method of the reference engine: scipy's, or numba_* (compiled, docs/performance.md; numba_RODAS4 "
             "linearly implicit, numba_DOP853_RODAS4 implicit in contact); auto = numba_DOP853, or with friction "

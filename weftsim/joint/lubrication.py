@@ -55,7 +55,7 @@ def lubrication_rows(prm: np.ndarray, time: np.ndarray, states: np.ndarray, out_
         if e_only:
             e_y, e_z, v_y, v_z, _, _, dphi = kc.eccentricity(prm, t, y)[:7]
             c = kc.local_clearance(prm, t, e_y, e_z, v_y, v_z, y)[0]
-            _row(prm, c, e_y, e_z, v_y, v_z, y[3], prm[kc.OMEGA] * dphi, out_e, i)
+            _row(prm, c, e_y, e_z, v_y, v_z, y[3], kc.crank_rate(prm, t) * dphi, out_e, i)
             continue
         q = kf.eccentricities(prm, t, y)
         e_y, e_z, ve_y, ve_z, f_y, f_z, vf_y, vf_z, w_rocker, dpsi, da = q

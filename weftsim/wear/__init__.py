@@ -222,6 +222,31 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
                           engine=engine, reached_limit=reached)
 
 
+def duty_summary(scene: Scene, updates: list, data: dict) -> dict:
+    """``wear.json``'s duty-cycle fields: the duty (``duty_text``), the calendar days to the limit of each joint
+    (``calendar_days_to_limit_<j>``, :meth:`~weftsim.input.params.Duty.calendar_days`) and the stop-starts' share
+    of the worn volume over the prediction (``stop_start_share_<j>``, N-weighted over the updates)."""
+    import numpy as np
+
+    from weftsim.wear.extrapolate import wearing_joints
+
+    duty = scene.duty
+    out = {"duty_text": f"{duty.hours_per_day:g} h a day, {duty.days_per_week:g} days a week, {duty.stops_per_hour:g} "
+                        f"stops an hour of {duty.stop_minutes:g} min",
+           "stops_per_hour": duty.stops_per_hour}
+    for j in wearing_joints(scene):
+        hours = data.get(f"hours_to_limit_{j}")
+        out[f"calendar_days_to_limit_{j}"] = None if hours is None else duty.calendar_days(hours)
+        rows = [(u.step_revolutions * u.part(j).volume_rate, u.response.get(f"stop_start_share_{j}", 0.0))
+                for u in updates if u.step_revolutions > 0.0]
+        volume = np.array([r[0] for r in rows]) if rows else np.zeros(0)
+        share = np.nan_to_num(np.array([r[1] for r in rows], dtype=float)) if rows else np.zeros(0)
+        out[f"stop_start_share_{j}"] = float(np.dot(volume, share) / volume.sum()) if volume.sum() > 0.0 else 0.0
+    if data.get("hours_to_limit") is not None:
+        out["calendar_days_to_limit"] = duty.calendar_days(data["hours_to_limit"])
+    return out
+
+
 def reached_text(scene: Scene, data: dict) -> str:
     """How far a prediction got: "after 460.2 h at an effective clearance of 1.04 mm at E" (``data``: the
     summary of :func:`_write_results`), with the hours to the limit where it was reached before."""
@@ -313,6 +338,7 @@ def _write_results(scene: Scene, updates: list, hours: float, limit: float | Non
         from weftsim.wear.censored import limit_note
 
         data.update(limit_note(scene, updates, limit, data.get("hours_to_limit")))
+    data.update(duty_summary(scene, updates, data))
     columns = store.table(scene, updates)
     files = {
         "state": (store.STATE, lambda p: p),

@@ -21,7 +21,7 @@ from numba import njit
 
 from weftsim.post.analysis import time_weights
 from weftsim.kernel import chain_f as kf
-from weftsim.kernel.chain import BEARING_RADIUS, OMEGA, chain, eccentricity, local_clearance, rocker_angle
+from weftsim.kernel.chain import BEARING_RADIUS, chain, crank_rate, eccentricity, local_clearance, rocker_angle
 from weftsim.kernel.asperity import asperity_half_angle, asperity_load
 from weftsim.kernel.joint import (
     ASPERITY_COEF, BEARING_LENGTH, JOURNAL_RADIUS, N_JOINT, ROUGHNESS, tangential_velocity,
@@ -55,7 +55,7 @@ def contact_rows(prm: np.ndarray, time: np.ndarray, states: np.ndarray, contact:
         f_n = chain(prm, t, y, contact[i], impact[i], d)[1]
         ecc_y, ecc_z, v_y, v_z, _, _, dphi = eccentricity(prm, t, y)[:7]
         c = local_clearance(prm, t, ecc_y, ecc_z, v_y, v_z, y)[0]
-        _row(prm, f_n, c, ecc_y, ecc_z, v_y, v_z, rocker_angle(prm, t), prm[OMEGA] * dphi, y[1], y[3], out[i])
+        _row(prm, f_n, c, ecc_y, ecc_z, v_y, v_z, rocker_angle(prm, t), crank_rate(prm, t) * dphi, y[1], y[3], out[i])
 
 
 @njit(cache=True, error_model="numpy")
@@ -75,7 +75,7 @@ def rows_from_contact(prm: np.ndarray, time: np.ndarray, states: np.ndarray, f_d
         y = states[i]
         ecc_y, ecc_z, v_y, v_z, _, _, dphi = eccentricity(prm, t, y)[:7]
         c = local_clearance(prm, t, ecc_y, ecc_z, v_y, v_z, y)[0]
-        _row(prm, f_dry[i], c, ecc_y, ecc_z, v_y, v_z, rocker_angle(prm, t), prm[OMEGA] * dphi, y[1], y[3], out[i])
+        _row(prm, f_dry[i], c, ecc_y, ecc_z, v_y, v_z, rocker_angle(prm, t), crank_rate(prm, t) * dphi, y[1], y[3], out[i])
         if out[i, 0] > 0.0 and v_t[i] == v_t[i]:
             out[i, 1] = v_t[i]
 

@@ -151,9 +151,11 @@ def limit_lines(data: dict, joints: list[str]) -> list[str]:
                          f"{data[f'final_effective_clearance_{j}_mm']:.4g} mm after {data['hours_reached']:.6g} h)")
             continue
         days = data.get(f"calendar_days_to_limit_{j}")
-        when = "" if days is None else f" of running, {days:.4g} calendar days ({data['duty_text']})"
+        when = "" if days is None else f" of running = {days:.4g} calendar days ({data['duty_text']})"
         first = " (first)" if len(joints) > 1 and data.get("limit_joint") == j else ""
-        lines.append(f"  at {j.upper()}{first}: {hours:.6g} h{when} to the limit {limit:g} mm")
+        share = data.get(f"stop_start_share_{j}") or 0.0
+        stops = f"; {100 * share:.3g} % of the wear from stop-starts" if data.get("stops_per_hour") else ""
+        lines.append(f"  at {j.upper()}{first}: {hours:.6g} h{when} to the limit {limit:g} mm{stops}")
     if data.get("hours_to_limit") is None and data.get("note"):
         lines.append(f"  {data['note']}")
     return lines

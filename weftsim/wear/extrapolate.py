@@ -284,6 +284,16 @@ def next_update(scene: Scene, hours_done: float, revolutions_done: float, bearin
         wear, response = run(scene, bearing, journal)
     else:
         wear, response = run(scene, bearing, journal, second)
+    if scene.duty.stops_per_hour > 0.0:  # the stop-starts' wear on this geometry, per revolution of running
+        from weftsim.wear.duty import with_stops
+
+        engine = "reference" if simulate is None or simulate is simulate_update else "exudyn"
+        worn = worn_scene(scene, bearing, journal, w.settle_revolutions + w.revolutions_per_update)
+        try:
+            wear, stops = with_stops(worn, wear, w.revolutions_per_update, engine)
+        except WearError as exc:
+            raise UpdateFailed(str(exc)) from None
+        response = {**response, **stops}
     per_rev = 1.0 / w.revolutions_per_update
     profiles = [(bearing, journal)] + ([second] if second is not None else [])
     runs = [wear] + ([wear.second] if second is not None else [])

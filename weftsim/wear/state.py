@@ -26,7 +26,8 @@ JOINT_RESPONSE = ("contact_force_{j}_mean_N", "contact_force_{j}_p99_N", "contac
 JOINTS = ("e", "f")
 # Columns added after the layout above was first stored, appended so that a state written before them loads
 # (their values NaN, weftsim.wear.resume): the asperities' share of the sliding work (the mixed regime's k).
-LATER_RESPONSE = ("asperity_work_per_rev_{j}_J",)
+LATER_RESPONSE = ("asperity_work_per_rev_{j}_J", "stop_start_volume_{j}_mm3", "stop_start_share_{j}",
+                  "stop_start_start_up_share_{j}", "film_temperature_{j}_C", "roughness_{j}_um")
 EARLIER_RESPONSE = MECHANISM_RESPONSE + tuple(name.format(j=j) for j in JOINTS for name in JOINT_RESPONSE)
 RESPONSE = EARLIER_RESPONSE + tuple(name.format(j=j) for j in JOINTS for name in LATER_RESPONSE)
 # The columns of a state written before the joints were named (joint E alone), in their stored order, and
@@ -71,8 +72,13 @@ def scene_identity(scene: Scene) -> str:
                 keys.pop(at + name, None)
             if keys.get(at + "wear_coefficient", 0.0) is None:
                 keys[at + "wear_coefficient"] = REGIME_DEFAULTS["boundary_wear_coefficient"]
+    for name, value in DUTY_DEFAULTS.items():  # the steady prediction's duty keys, which a state before them lacks
+        if keys.get("duty." + name) == value:
+            keys.pop("duty." + name)
     return json.dumps(keys, sort_keys=True, default=str)
 
 
+DUTY_DEFAULTS = {"stops_per_hour": 0.0, "stop_minutes": 2.87, "hours_per_day": 24.0, "days_per_week": 7.0,
+                 "startup_revolutions": 1.0, "rundown_revolutions": 1.0}  # weftsim.input.params.Duty's
 REGIME_DEFAULTS = {"regime": "boundary", "dry_wear_coefficient": 5e-3, "boundary_wear_coefficient": 1e-7,
                    "mixed_wear_coefficient": 1e-7}  # weftsim.input.params.WearModel's defaults
