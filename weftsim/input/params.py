@@ -165,6 +165,8 @@ class WearModel:
     dry_wear_coefficient: float = 5e-3
     boundary_wear_coefficient: float = 1e-7
     mixed_wear_coefficient: float = 1e-7
+    run_in_roughness: float | None = None  # m: the lubricated joint's run-in roughness (weftsim.wear.extrapolate)
+    run_in_depth: float = 1e-6  # m: the worn depth over which the roughness runs in by 1/e
 
     @property
     def contact_wear_coefficient(self) -> float:

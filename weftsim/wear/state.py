@@ -81,4 +81,4 @@ def scene_identity(scene: Scene) -> str:
 DUTY_DEFAULTS = {"stops_per_hour": 0.0, "stop_minutes": 2.87, "hours_per_day": 24.0, "days_per_week": 7.0,
                  "startup_revolutions": 1.0, "rundown_revolutions": 1.0}  # weftsim.input.params.Duty's
 REGIME_DEFAULTS = {"regime": "boundary", "dry_wear_coefficient": 5e-3, "boundary_wear_coefficient": 1e-7,
-                   "mixed_wear_coefficient": 1e-7}  # weftsim.input.params.WearModel's defaults
+                   "mixed_wear_coefficient": 1e-7, "run_in_roughness_um": None, "run_in_depth_um": 1.0}  # weftsim.input.params.WearModel's defaults

@@ -21,7 +21,7 @@ import numpy as np
 from weftsim.post.output import write_atomic, write_csv
 from weftsim.wear.extrapolate import Update, effective_clearance, joint_of, limit_hours, wearing_joints
 # What a stored state is lives in weftsim.wear.state, read by weftsim.wear.resume too; re-exported here.
-from weftsim.wear.state import JOINTS, JOINT_RESPONSE, LEGACY_NAMES, LEGACY_RESPONSE, MECHANISM_RESPONSE, PARTS, RESPONSE, STATE, StateMismatch, scene_identity  # noqa: F401
+from weftsim.wear.state import JOINTS, JOINT_RESPONSE, LATER_RESPONSE, LEGACY_NAMES, LEGACY_RESPONSE, MECHANISM_RESPONSE, PARTS, RESPONSE, STATE, StateMismatch, scene_identity  # noqa: F401
 
 if TYPE_CHECKING:
     from weftsim.input.params import Scene
@@ -100,7 +100,7 @@ def table(scene: Scene, updates: list[Update]) -> dict[str, np.ndarray]:
 def response_keys(scene: Scene) -> tuple[str, ...]:
     """The :data:`RESPONSE` statistics of the mechanism and of the scene's wearing joints."""
     joints = wearing_joints(scene)
-    return MECHANISM_RESPONSE + tuple(name.format(j=j) for j in joints for name in JOINT_RESPONSE)
+    return MECHANISM_RESPONSE + tuple(name.format(j=j) for j in joints for name in (*JOINT_RESPONSE, *LATER_RESPONSE))
 
 
 def write_table(target: Path, scene: Scene, updates: list[Update]) -> Path:
