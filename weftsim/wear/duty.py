@@ -9,8 +9,8 @@ read):
    revolution), then the crank slows to rest over ``rundown_revolutions`` (theta_dot = omega (1 - s(tau)),
    s the smooth step) and stands a quarter of a period while the last impacts die out; counted from the start
    of the ramp;
-2. **start-up**: from rest with the journal lying on the bearing's wall below its centre (delta = 0: the film
-   squeezed out while the loom stood), the crank reaches full speed over ``startup_revolutions`` and turns one
+2. **start-up**: from rest with the journal lying on the bearing's wall below its centre (1e-3 c off it: the
+   film squeezed out while the loom stood), the crank reaches full speed over ``startup_revolutions`` and turns one
    revolution more at full speed while the film builds up again; counted from the start.
 
 Archard's law over both windows (the same rows and deposit as an update, :mod:`weftsim.wear.archard`) is the
