@@ -228,6 +228,14 @@ def run_ensemble(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     if reach["fraction"] < 1.0 and data.get("hours_of_those_reaching"):
         print("  of those reaching it: " + ", ".join(f"{name} {text_hours(q['hours'], horizon)}" for name, q in
                                                      data["hours_of_those_reaching"].items()))
+    days = data["calendar_days_to_limit"]
+    print(f"  calendar days to {args.limit_clearance_mm:g} mm ({data['duty_text']}): " + ", ".join(
+        f"{name} {text_hours(days[name]['hours'], data['horizon_calendar_days'])[:-2]} d" for name in ("p10", "p50", "p90")))
+    stops = data.get("stop_start_share")
+    if stops:
+        print(f"  wear from stop-starts: {100 * stops['median']:.3g} % of the worn volume at the median design point "
+              f"({100 * stops['min']:.3g} - {100 * stops['max']:.3g} % over the {len(stops['by_design_point'])} "
+              "simulated predictions)")
     print("  shares of the spread: " + ", ".join(f"{k} {100 * v['share']:.0f} %" for k, v in
                                                  sorted(data["shares"].items(), key=lambda kv: -kv[1]["share"])))
     for path in data["files"].values():

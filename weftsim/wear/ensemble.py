@@ -36,6 +36,7 @@ from weftsim.wear.censored import censored_quantile, fraction_interval, json_hou
 from weftsim.wear.ensemble_design import (DESIGN_QUANTILES, RESCALED, k_scale, _lagrange, centre_name,  # noqa: F401
                                           interpolate, plan)
 from weftsim.wear.jobs import hours_at, run_job
+from weftsim.wear.life import duty_text, horizon_days, life_figure, sample_days, stop_share_summary
 from weftsim.wear.uncertain import Uncertain, latin_hypercube, parse_uncertain, rank_shares
 
 if TYPE_CHECKING:
@@ -243,8 +244,11 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
     for p in QUANTILES:  # inf where the quantile falls among the censored samples
         band[f"hours_p{round(100 * p)}"] = np.array([censored_quantile(hours[:, i], p)[0] for i in range(lv.size)])
     band["fraction_reaching"] = np.mean(np.isfinite(hours), axis=0)
-    by_level = {f"{1e3 * lv[i]:.6g}": {**quantile_table(hours[:, i], horizon), "reaching": reaching(hours[:, i], horizon)}
-                for i in range(lv.size) if i == lv.size - 1 or any(abs(lv[i] - v) < 1e-12 for v in levels)}
+    level_index = {f"{1e3 * lv[i]:.6g}": i for i in range(lv.size)
+                   if i == lv.size - 1 or any(abs(lv[i] - v) < 1e-12 for v in levels)}
+    by_level = {key: {**quantile_table(hours[:, i], horizon), "reaching": reaching(hours[:, i], horizon)}
+                for key, i in level_index.items()}
+    days = sample_days(scene, ens["values"], hours)
     data = {
         "scene": scene.name,
         "joint": "E",  # wear at joint E (the wear prediction's joint so far)
@@ -275,6 +279,13 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
         "censored_design_points": ens["censored_nodes"],
         "unresolved_samples": ens["unresolved"],
         "hours_by_clearance_mm": by_level,
+        # calendar time (each sample's own duty, weftsim.wear.life) and the stop-starts' share of the wear
+        "duty_text": duty_text(scene, ens["values"]),
+        "horizon_calendar_days": horizon_days(scene, horizon),
+        "calendar_days_to_limit": quantile_table(days[:, -1], horizon_days(scene, horizon)),
+        "calendar_days_by_clearance_mm": {key: quantile_table(days[:, i], horizon_days(scene, horizon))
+                                          for key, i in level_index.items()},
+        "stop_start_share": stop_share_summary(results),
         "shares": {k: {"rank_correlation": r, "share": s} for k, (r, s) in ens["shares"].items()},
         "jobs": {n: {"wall_s": r.get("wall_s"), "cpu_s": r.get("cpu_s"), "updates": r.get("updates"),
                      "error": r.get("error"),
@@ -288,6 +299,7 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
     table["chaos_run"] = ens["chaos_draw"].astype(float)
     table["hours_to_limit_e"] = hours[:, -1]  # inf: does not reach the limit within the horizon
     table["reaches_limit_e"] = np.isfinite(hours[:, -1]).astype(float)
+    table["calendar_days_to_limit_e"] = days[:, -1]
     files = {
         "samples": ("ensemble.csv", lambda p: write_csv(p, table)),
         "band": ("ensemble_band.csv", lambda p: write_csv(p, band)),
@@ -300,6 +312,9 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
         files["cdf_figure"] = ("ensemble_cdf.png", lambda p: write_figure(p, cdf_figure(hours[:, -1], data, title)))
         files["band_figure"] = ("ensemble_band.png", lambda p: write_figure(p, band_figure(band, title)))
         files["shares_figure"] = ("ensemble_shares.png", lambda p: write_figure(p, shares_figure(data, title)))
+        shown = list(level_index.values())
+        files["life_figure"] = ("ensemble_life.png", lambda p: write_figure(p, life_figure(
+            days[:, shown], [1e3 * lv[i] for i in shown], data, title)))
     written = write_files(outdir, what, files)
     data["files"] = {k: str(v) for k, v in written.items()}
     return data
