@@ -14,7 +14,6 @@ import numpy as np
 import pytest
 
 from weftsim import reference
-from weftsim.errors import WearError
 from weftsim.input.scene import load_scene
 from weftsim.kernel import chain as kc
 from weftsim.reference.dynamics import pack_parameters
@@ -40,29 +39,6 @@ def test_reference_ends_at_the_limit_with_the_crossing_update_cut(tmp_path):
     assert 5.0 < data["hours_to_limit"] < 20.0  # 11.43 h measured (docs/wear.md section 2)
     table = np.genfromtxt(tmp_path / "wear.csv", delimiter=",", names=True)
     assert np.all(table["effective_clearance_e_mm"] < 0.3)
-
-
-def test_a_failed_update_says_how_far_the_prediction_got(tmp_path, monkeypatch):
-    """A prediction that leaves the model (here: an update made to fail) keeps every update and its message gives
-    the hours and the clearance reached."""
-    from weftsim.wear import extrapolate
-
-    real, calls = extrapolate.simulate_update, []
-
-    def failing_fourth(scene, bearing, journal):
-        calls.append(1)
-        if len(calls) == 4:
-            raise WearError("the energy balance misses (made to fail by the test)")
-        return real(scene, bearing, journal)
-
-    monkeypatch.setattr(extrapolate, "simulate_update", failing_fourth)
-    with pytest.raises(WearError) as error:
-        predict_to_directory(load_scene("reference"), 100.0, tmp_path, figures=False)
-    data = json.loads((tmp_path / "wear.json").read_text())
-    text = str(error.value)
-    assert f"after {data['hours_reached']:.6g} h at an effective clearance of " \
-           f"{data['final_effective_clearance_e_mm']:.4g} mm at E" in text, text
-    assert data["updates"] == 3 and data["final_effective_clearance_e_mm"] > 0.25
 
 
 @pytest.mark.slow
