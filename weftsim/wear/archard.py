@@ -36,7 +36,8 @@ if TYPE_CHECKING:
 @njit(cache=True, error_model="numpy")
 def contact_rows(prm: np.ndarray, time: np.ndarray, states: np.ndarray, contact: np.ndarray, impact: np.ndarray,
                  out: np.ndarray) -> None:
-    """Per step row into ``out`` (n, 6): F_N (N), v_T (m/s), psi_b, psi_j (rad), phi0 (rad), F_a (N).
+    """Per step row into ``out`` (n, 6) (or (n, 5) without F_a): F_N (N), v_T (m/s), psi_b, psi_j (rad), phi0
+    (rad), F_a (N).
 
     A lubricated joint: F_N is the load the solids carry, the asperity load F_a plus the dry law's beyond
     e = c, never the film's (no wear under a full film: F_a = 0 while h_min >= 4 sigma); phi0 then covers
@@ -96,7 +97,8 @@ def _row(jp: np.ndarray, f_n: float, c: float, ecc_y: float, ecc_z: float, v_y: 
         if f_a > 0.0:
             f_n += f_a
             half_angle = max(half_angle, asperity_half_angle(jp[ROUGHNESS], c, length))
-            out[5] = f_a
+            if out.size > 5:  # the rows of callers that take F_N alone have 5 columns
+                out[5] = f_a
     if f_n > 0.0 and length > 0.0:
         direction = math.atan2(ecc_z, ecc_y)
         out[0] = f_n
@@ -176,9 +178,8 @@ def wear_from_rows(joint: ClearanceJoint, time: np.ndarray, rows: np.ndarray) ->
     """
     wear = joint.wear
     weights = time_weights(time) if time.size > 1 else np.zeros(time.size)
-    sliding_weights = np.abs(rows[:, 1]) * weights
-    work = rows[:, 0] * sliding_weights
-    asperity = rows[:, 5] * sliding_weights if rows.shape[1] > 5 else np.zeros(time.size)
+    work = rows[:, 0] * np.abs(rows[:, 1]) * weights  # the order of the products as before the regimes: bit for bit
+    asperity = rows[:, 5] * np.abs(rows[:, 1]) * weights if rows.shape[1] > 5 else np.zeros(time.size)
     k_c, k_a = wear.contact_wear_coefficient, wear.asperity_wear_coefficient
     worn = work if k_a == k_c or not asperity.any() else work + (k_a / k_c - 1.0) * asperity
     n = wear.profile_points
@@ -191,7 +192,7 @@ def wear_from_rows(joint: ClearanceJoint, time: np.ndarray, rows: np.ndarray) ->
                  k_j / (joint.bearing_length * joint.journal_radius * cell), bearing, journal)  # fmt: skip
     total = float(work.sum())
     effective = total if worn is work else float(worn.sum())
-    sliding = float(np.sum(sliding_weights * (rows[:, 0] > 0.0)))
+    sliding = float(np.sum(np.abs(rows[:, 1]) * weights * (rows[:, 0] > 0.0)))
     return RunWear(bearing, journal, k_b * effective, k_j * effective, total, sliding,
                    asperity_work=float(asperity.sum()))
 

@@ -126,8 +126,9 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
         print(f"  wrote {path}")
     if data.get("ended"):
         asked = "" if until_limit else f" of the {hours:g} asked for"
-        print(f"  the prediction ends at {data['hours_reached']:.6g} h{asked}: {data['ended']}; nothing beyond "
-              "it is predicted")
+        at = ", ".join(f"{data[f'final_effective_clearance_{j}_mm']:.4g} mm at {j.upper()}" for j in joints)
+        print(f"  the prediction ends at {data['hours_reached']:.6g} h{asked} (effective clearance {at}): "
+              f"{data['ended']}; nothing beyond it is predicted")
     if limit is not None:  # the last lines: what a planner reads
         for line in limit_lines(data, joints):
             print(line)
