@@ -91,8 +91,11 @@ DIGEST_PLATFORM = ("2.", "0.6")  # numpy, numba version prefixes of the developm
 def test_dry_scene_is_bit_for_bit_the_former_joint():
     result = solve(load_scene("reference", {"drive.revolutions": 0.3}))
     assert not any(name in result.steps for name in LUBRICATION_CHANNELS)
+    # The joint's load (weftsim.joint.load, issue 30) came later: for this dry frictionless joint it is its contact
+    # force, bit for bit; the digest covers the channels of the former joint.
+    np.testing.assert_array_equal(result.steps["joint_force_N"], result.steps["contact_force_N"])
     digest = hashlib.sha256()
-    for name in sorted(result.steps):
+    for name in sorted(set(result.steps) - {"joint_force_N"}):
         digest.update(name.encode())
         digest.update(np.ascontiguousarray(result.steps[name]).tobytes())
     if not (np.__version__.startswith(DIGEST_PLATFORM[0]) and numba.__version__.startswith(DIGEST_PLATFORM[1])):
@@ -131,14 +134,14 @@ def test_asperity_load_is_continuous_and_its_potential_is_its_integral():
     # Continuous: no step between neighbours larger than the largest slope times the spacing, x 1.01.
     slope = np.max(np.abs(np.gradient(load, ecc)))
     assert np.max(np.abs(np.diff(load))) <= 1.01 * slope * (ecc[1] - ecc[0])
-    # Beyond c: continued with the slope at c (C1): the one-sided difference quotients agree there.
+    # Beyond c: held at its value at c (the dry law takes it over there: weftsim.kernel.lubricated.asperity_share,
+    # tests/test_asperity_contact.py).
     at = np.searchsorted(ecc, C)
-    inside = (load[at - 1] - load[at - 2]) / (ecc[1] - ecc[0])
-    beyond = (load[-1] - load[-2]) / (ecc[1] - ecc[0])
-    assert beyond == pytest.approx(inside, rel=1e-2)  # first differences lag by h/2 |F''|: ~1e-3 measured
-    # dU/d|e| = F_a: the trapezoid of F_a against U's change; trapezoid error (h^2/12) |F''| ~ 1e-7 relative.
+    assert np.all(load[at + 1:] == asperity_load(COEF, SIGMA, C, C, R, L)[0])
+    # dU/d|e| = F_a up to c: the trapezoid of F_a against U's change; trapezoid error (h^2/12) |F''| ~ 1e-7 relative.
     integral = np.concatenate([[0.0], np.cumsum(0.5 * (load[1:] + load[:-1]) * np.diff(ecc))])
-    np.testing.assert_allclose(energy - energy[0], integral, rtol=1e-5, atol=1e-6 * energy[-1])
+    inside = slice(0, at)
+    np.testing.assert_allclose((energy - energy[0])[inside], integral[inside], rtol=1e-5, atol=1e-6 * energy[at])
 
 
 def test_asperity_quadrature_is_converged():
@@ -155,7 +158,7 @@ def test_asperity_quadrature_is_converged():
 
 def test_asperity_gauss_jacobi_rule_matches_a_fine_legendre_rule():
     """The 8-point Gauss-Jacobi rule of asperity_load (weight (theta_max - theta)^5.804) against 400 Gauss-Legendre
-    points, load, potential and stiffness, over film ratios 0-4 at clearances 2 um-0.25 mm."""
+    points, load and potential, over film ratios 0-4 at clearances 2 um-0.25 mm."""
     from weftsim.kernel import asperity
 
     x, w = np.polynomial.legendre.leggauss(400)
@@ -173,12 +176,6 @@ def test_asperity_gauss_jacobi_rule_matches_a_fine_legendre_rule():
             energy = scale * SIGMA * np.sum(w * p * base) / (asperity.F52_EXPONENT + 1.0)
             got = asperity_load(COEF, SIGMA, c, e, R, L)
             worst = max(worst, abs(got[0] / force - 1.0), abs(got[1] / energy - 1.0))
-            # The stiffness enters beyond c (the C1 continuation): the slope of the load there.
-            stiff = scale / SIGMA * np.sum(w * asperity.F52_EXPONENT * p / np.where(base > 0, base, 1.0)
-                                           * np.cos(theta) ** 2)  # fmt: skip
-            beyond = asperity_load(COEF, SIGMA, c, c + 1e-9, R, L)[0] - asperity_load(COEF, SIGMA, c, c, R, L)[0]
-            if ratio == 0.0:
-                worst = max(worst, abs(beyond / 1e-9 / stiff - 1.0))
     # Measured 1.6e-11, the reference's own round-off (6 points: 1e-8; the former 24-point Gauss-Legendre
     # rule: 1.4e-11).
     assert worst < 1e-10

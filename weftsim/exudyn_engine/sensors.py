@@ -116,6 +116,7 @@ def step_channels(mbs: exu.MainSystem, model: MechanismModel, sensors: dict) -> 
         if joint == "f":  # joint F's channels carry its suffix; E's keep their names
             pairs = zip(LUBRICATION_CHANNELS_F, LUBRICATION_CHANNELS)
             lubricated = {f_name: contact[e_name] for f_name, e_name in pairs if e_name in contact}
+            lubricated["joint_force_f_N"] = contact["joint_force_N"]
             contact = {f_name: contact[e_name] for f_name, e_name in JOINT_E_NAME.items()} | lubricated
         ch.update(contact)
     return ch
@@ -131,6 +132,7 @@ def _joint_channels(cl, data: dict, joint: str, t: np.ndarray, n: int) -> dict[s
     rate = np.where(length > 0.0, np.sum(ecc * rate_vec, axis=1) / safe, 0.0)
     force = data[f"force_{joint}"]
     f_n = np.hypot(force[:n, 1], force[:n, 2])
+    load = f_n  # the connector's whole force: dry law, its friction, film and asperities (weftsim.joint.load)
     friction_power = np.zeros(n)
     f_el = np.where(delta > 0.0, cl.law.elastic_force(np.maximum(delta, 0.0)), 0.0)
     hist = cl.tracker.history()
@@ -153,6 +155,7 @@ def _joint_channels(cl, data: dict, joint: str, t: np.ndarray, n: int) -> dict[s
             h_min = np.maximum(cl.joint.clearance - length, 0.0)
             lubricated = dict(zip(LUBRICATION_CHANNELS, (h_min, h_min / sigma, lub[:, 3], lub[:, 4], lub[:, 5])))
     return lubricated | {
+        "joint_force_N": load,
         "contact_force_N": f_n,
         "penetration_m": delta,
         "eccentricity_y_m": ecc[:, 0],

@@ -246,14 +246,19 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
     row = np.clip(np.searchsorted(hist["time"], t * (1.0 + 1e-12), side="right") - 1, 0, len(hist["time"]) - 1)
     ratio = scene.geometry.rapier_ratio
     kin13 = 0.5 * j13 * omega**2
-    lubricated = {}
-    if scene.joint.is_lubricated:  # the film channels from the kernel at the tree's states (weftsim.joint.lubrication)
-        from weftsim.joint.lubrication import lubrication_table
-        from weftsim.reference.dynamics import pack_parameters
+    # The film channels and the joint's load from the kernel at the tree's states (weftsim.joint.lubrication,
+    # weftsim.joint.load).
+    from weftsim.joint.load import joint_force_table
+    from weftsim.reference.dynamics import pack_parameters
 
-        states = np.zeros((n, 6))
-        states[:, 0], states[:, 1], states[:, 2], states[:, 3] = a, psi, da, dpsi
-        lubricated = lubrication_table(scene, pack_parameters(scene), t, states)[0]
+    prm = pack_parameters(scene)
+    states = np.zeros((n, 6))
+    states[:, 0], states[:, 1], states[:, 2], states[:, 3] = a, psi, da, dpsi
+    lubricated = joint_force_table(scene, prm, t, states, {"contact_force_N": f_n})
+    if scene.joint.is_lubricated:
+        from weftsim.joint.lubrication import lubrication_table
+
+        lubricated |= lubrication_table(scene, prm, t, states)[0]
     return lubricated | {
         "time_s": t,
         "crank_angle_deg": np.degrees(theta),

@@ -26,6 +26,9 @@ if TYPE_CHECKING:
 
 # Table -> (joint letter, Scene attribute).
 JOINTS = {"joint_e": ("E", "joint"), "joint_f": ("F", "joint_f")}
+# The keys that name a joint's lubricant (a fixed viscosity, or an oil): F takes them from E together or not at all.
+LUBRICANT = ("lubrication.viscosity_mpa_s", "lubrication.oil", "lubrication.oil.nu40_mm2_s",
+             "lubrication.oil.nu100_mm2_s")
 CLEARANCE = "clearance_mm"
 
 
@@ -54,12 +57,10 @@ def inherit_joint_f(flat: dict[str, Any]) -> tuple[dict[str, Any], tuple[str, ..
     """
     out = dict(flat)
     taken = []
-    lubricant = ("lubrication.viscosity_mpa_s", "lubrication.oil", "lubrication.oil.nu40_mm2_s",
-                 "lubrication.oil.nu100_mm2_s")
-    own_lubricant = any("joint_f." + rest in out for rest in lubricant)
+    own_lubricant = any("joint_f." + rest in out for rest in LUBRICANT)
     for rest in _f_keys():
         mine, hers = "joint_f." + rest, "joint_e." + rest
-        if own_lubricant and rest in lubricant:
+        if own_lubricant and rest in LUBRICANT:
             continue  # F names its own lubricant (a viscosity or an oil): E's other one is not F's
         if mine not in out and hers in out:
             out[mine] = out[hers]
@@ -80,10 +81,24 @@ def resync_joint_f(scene: Scene, overridden: set[str] | dict) -> Scene:
     ``overridden``: the dotted keys just applied.  A key given for F stops being taken from E.
     """
     inherits = tuple(rest for rest in scene.joint_f_inherits if "joint_f." + rest not in overridden)
+    if any(rest in LUBRICANT for rest in inherits):  # F's lubricant is E's: all of it (a viscosity or an oil)
+        inherits = tuple(rest for rest in inherits if rest not in LUBRICANT) + LUBRICANT
     if any(str(key).startswith("joint_e.") for key in overridden):
         for rest in inherits:
-            scene = _set(scene, _BY_PATH["joint_f." + rest].target, _value(scene, _BY_PATH["joint_e." + rest].target))
+            if rest not in LUBRICANT:
+                scene = _set(scene, _BY_PATH["joint_f." + rest].target,
+                             _value(scene, _BY_PATH["joint_e." + rest].target))
+        if LUBRICANT[0] in inherits and scene.joint_f.lubrication is not None:
+            scene = _lubricant_of_e(scene)
     return replace(scene, joint_f_inherits=inherits)
+
+
+def _lubricant_of_e(scene: Scene) -> Scene:
+    """``scene`` with joint F's lubricant (fixed viscosity or oil) set to E's, in one step (no state naming both)."""
+    e, f = scene.joint.lubrication, scene.joint_f.lubrication
+    lub = replace(f, viscosity=e.viscosity if not e.has_oil else 0.0, oil=e.oil, oil_nu40=e.oil_nu40,
+                  oil_nu100=e.oil_nu100, film_temperature=None)
+    return replace(scene, joint_f=replace(scene.joint_f, lubrication=lub))
 
 
 def ideal_joint_keys(scene: Scene, keys) -> list[str]:

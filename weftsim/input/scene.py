@@ -302,8 +302,11 @@ def _set_checked(scene: params.Scene, target: str, value: Any, where: str) -> pa
 LUBRICATION_TABLES = (("joint_e", "joint"), ("joint_f", "joint_f"))
 
 
-# The keys that name the lubricant of a [<joint>.lubrication] table: a fixed viscosity, or an oil.
+# The keys that name the lubricant of a [<joint>.lubrication] table: a fixed viscosity, or an oil; and every key
+# that matters only with an oil (its properties and the heat balance's).
 VISCOSITY_KEY, OIL_KEYS = "viscosity_mpa_s", ("oil", "oil.nu40_mm2_s", "oil.nu100_mm2_s")
+HEAT_KEYS = OIL_KEYS + ("oil.density_kg_m3", "oil.heat_capacity_j_kg_k", "ambient_temperature_c",
+                        "housing_heat_transfer_w_k", "oil_supply")
 
 
 def _names_oil(flat: dict, prefix: str) -> bool:
@@ -318,7 +321,8 @@ def _check_lubrication_given(flat: dict, where: str, before: params.Scene | None
         oil, viscosity = _names_oil(flat, prefix), flat.get(prefix + VISCOSITY_KEY) not in (None, 0, 0.0)
         if oil and viscosity:
             raise SceneError(f"{where}: keys '{prefix}{VISCOSITY_KEY}' and '{prefix}oil' are both given: give the "
-                             "oil (its viscosity then follows from the film temperature) or a fixed viscosity, not both")
+                             "oil (its viscosity then follows from the film temperature) or a fixed viscosity, not "
+                             "both")
         if before is not None and getattr(before, attr).lubrication is not None:
             continue
         if any(k.startswith(prefix) for k in flat) and not (oil or prefix + VISCOSITY_KEY in flat):
@@ -414,8 +418,8 @@ def scene_from_keys(flat: dict[str, Any], where: str = "scene", origin: dict[str
 
 
 def _film_temperature(scene: params.Scene, where: str) -> params.Scene:
-    """``scene`` with each oiled joint's viscosity at its film temperature (:func:`weftsim.joint.bearing.resolve_scene`);
-    a heat balance without a solution is a SceneError naming ``where``."""
+    """``scene`` with each oiled joint's viscosity at its film temperature
+    (:func:`weftsim.joint.bearing.resolve_scene`); a heat balance without a solution is a SceneError naming ``where``."""
     from weftsim.joint.bearing import resolve_scene
 
     try:

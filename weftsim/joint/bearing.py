@@ -6,7 +6,7 @@ operating points, the **mean** load at the mean sliding speed and the **peak** l
 the journal is a steadily loaded bearing (:mod:`weftsim.joint.steady`), with the film at the mean point's
 effective temperature (:mod:`weftsim.joint.heat`, when the scene names an oil: the peak lasts a fraction of a
 cycle, too short to heat the film) or at the scene's fixed viscosity.  The
-relative sliding speed v = R_j |omega_rel| becomes a journal speed omega = v / R_j in a still bushing.
+relative sliding speed v = R_j abs(omega_rel) becomes a journal speed omega = v / R_j in a still bushing.
 ``load`` and ``journal_rpm`` evaluate any other operating point instead (the bearing alone).  The Stribeck
 curve is the friction coefficient of the same bearing against journal speed at the point's load, each speed
 at its own film temperature.
@@ -79,9 +79,16 @@ def operating_point(joint, load: float, omega: float, film: dict | None = None) 
 
 def stribeck(joint, load: float, omega: float, points: int = STRIBECK_POINTS) -> dict:
     """The friction coefficient against journal speed at ``load``: speeds (rad/s) log-spaced over
-    :data:`STRIBECK_SPAN` x ``omega``, each with its film temperature, film ratio and regime."""
+    :data:`STRIBECK_SPAN` x ``omega``, each with its film temperature, film ratio and regime (``"overheats"``, and
+    NaN, where no temperature balances the friction power)."""
     speeds = omega * np.geomspace(*STRIBECK_SPAN, points)
-    rows = [operating_point(joint, load, float(w)) for w in speeds]
+    rows = []
+    for w in speeds:
+        try:
+            rows.append(operating_point(joint, load, float(w)))
+        except SceneError:  # no heat balance at this speed: the bearing overheats there
+            rows.append({"friction_coefficient": math.nan, "film_ratio": math.nan, "regime": "overheats",
+                         "film_temperature_c": None})
     return {"journal_speed_rad_s": [float(w) for w in speeds],
             "friction_coefficient": [r["friction_coefficient"] for r in rows],
             "film_ratio": [r["film_ratio"] for r in rows], "regime": [r["regime"] for r in rows],
@@ -143,6 +150,10 @@ def resolve_scene(scene):
             raise SceneError(f"{_table(name)}.lubrication: viscosity_mpa_s and oil are both given: give the oil (its "
                              "viscosity then follows from the film temperature) or a fixed viscosity_mpa_s, not both")
         mean, _, omega = mean_operating_point(scene, name)
-        resolved, _ = with_film_temperature(part, mean, omega)
+        try:
+            resolved, _ = with_film_temperature(part, mean, omega)
+        except SceneError as exc:
+            raise SceneError(f"{_table(name)}.lubrication at the ideal mechanism's mean pin load {mean / 1e3:.4g} kN "
+                             f"and sliding speed {omega * part.journal_radius:.3g} m/s: {exc}") from None
         scene = replace(scene, **{"joint" if name == "e" else "joint_f": resolved})
     return scene

@@ -2,7 +2,7 @@
 
 The journal spins at omega in a still bearing fed at ambient pressure along its line of thickest film (the
 finite film's supply, :func:`weftsim.joint.reynolds.solve` with ``supply=True``; Booker's squeeze velocity of
-pure rotation, |V| = omega eps c / 2 at xi = -90 deg).  With p = eta (R/c)^2 (|V|/c) P, h = c H, z = R zeta:
+pure rotation, abs(V) = omega eps c / 2 at xi = -90 deg).  With p = eta (R/c)^2 (abs(V)/c) P, h = c H, z = R zeta:
 
 - **inlet flow** Q, carried into the converging film across the supply line (Couette minus Poiseuille):
   Q / (R c N L) = pi H - (pi eps / (12 B/D)) integral H^3 dP/dphi dzeta over the half film, at the first

@@ -19,7 +19,8 @@ eta(T) is the oil's (:mod:`weftsim.joint.oil`), P_f, Q and Qs follow from the st
 balance is one equation in T_eff: g(T) = P_f - heat out.  g(T_amb) = P_f > 0 and the oil thins as T rises; the
 first root above T_amb is the temperature a bearing warming from ambient settles at.  It is bracketed by steps
 from T_amb of 0.5 K, doubled each time (:data:`STEP_K`), up to the oil's limit (nu = 2 mm^2/s, or 200 C), and
-found by Brent's method to :data:`TEMPERATURE_TOL`; power in equals heat out there to ~1e-9 relative (tests/test_bearing.py checks 1e-6).
+found by Brent's method to :data:`TEMPERATURE_TOL`; power in equals heat out there to ~1e-14 relative
+(tests/test_bearing.py checks 1e-6).
 No root below the limit: the bearing overheats (a :class:`weftsim.errors.SceneError` saying so).
 """
 
@@ -121,8 +122,8 @@ def heat_balance(joint, load: float, omega: float, viscosity=None, oil=None, amb
             if high >= limit:
                 raise SceneError(f"the plain bearing's heat balance has no solution below {limit:.4g} C (where the "
                                  f"oil thins to 2 mm^2/s): the friction power {at(limit)[1].power_loss_w:.4g} W "
-                                 "outgrows what the oil flow and the housing carry off; a thicker oil, more "
-                                 "clearance or more cooling (housing_heat_transfer_w_k)")
+                                 "outgrows what the oil flow and the housing carry off; a thicker oil, a larger "
+                                 "pin or more cooling (housing_heat_transfer_w_k)")
             low, step = high, 2.0 * step
         temperature = brentq(lambda t: at(t)[0], low, high, xtol=TEMPERATURE_TOL)
     point = at(temperature)[1]

@@ -31,6 +31,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 
+from weftsim.kernel.flow_factors import contact_factor, pressure_flow_factor
+
 MAPPING_FRACTION = 0.8  # the grid clusters as Sommerfeld's angle of eps_m = 0.8 eps
 # Grid of the table: 120 x 16 nodes over the half film.  Against 240 x 32 the force differs by
 # 0.2-0.3 % at eps = 0.95-0.99 and < 0.1 % below (second order: the error quarters per doubling).
@@ -50,17 +52,29 @@ def _angles(eps: float, n_phi: int) -> tuple[np.ndarray, np.ndarray]:
     return phi[0:-1:2], phi[1::2]  # nodes from -pi, faces at i + 1/2
 
 
-def operator(eps: float, half_width: float, n_phi: int, n_zeta: int):
+def _conductance(eps: float, angles: np.ndarray, roughness: float) -> np.ndarray:
+    """H^3, times Patir and Cheng's pressure flow factor phi_x(c H / sigma) on rough surfaces.
+
+    ``roughness`` = sigma / c (0: smooth surfaces, phi_x = 1).
+    """
+    gap = 1.0 - eps * np.cos(angles)
+    if roughness <= 0.0:
+        return gap**3
+    return gap**3 * pressure_flow_factor(gap / roughness)
+
+
+def operator(eps: float, half_width: float, n_phi: int, n_zeta: int, roughness: float = 0.0):
     """K (sparse, SPD), the node angles and the cell volumes of the half film zeta in [0, B/D].
 
-    Unknown (i, j) = P at phi_i, zeta_j = j dz, j = 0..n_zeta-1 (P = 0 at j = n_zeta).
+    Unknown (i, j) = P at phi_i, zeta_j = j dz, j = 0..n_zeta-1 (P = 0 at j = n_zeta).  ``roughness``
+    = sigma / c: the average-flow conductance phi_x H^3 (:mod:`weftsim.kernel.flow_factors`).
     """
     nodes, faces = _angles(eps, n_phi)
     dz = half_width / n_zeta
     gap = np.diff(np.concatenate((nodes, [nodes[0] + 2.0 * math.pi])))  # phi_{i+1} - phi_i
-    face_h3 = (1.0 - eps * np.cos(faces)) ** 3
+    face_h3 = _conductance(eps, faces, roughness)
     width = 0.5 * (gap + np.roll(gap, 1))  # control-volume width in phi
-    node_h3 = (1.0 - eps * np.cos(nodes)) ** 3
+    node_h3 = _conductance(eps, nodes, roughness)
     dzeta = np.full(n_zeta, dz)
     dzeta[0] = 0.5 * dz  # the mid-plane cell is half a cell
     index = np.arange(n_phi * n_zeta).reshape(n_phi, n_zeta)
@@ -91,14 +105,19 @@ def operator(eps: float, half_width: float, n_phi: int, n_zeta: int):
 
 
 def solve(eps: float, xi: float, half_width: float, n_phi: int = N_PHI, n_zeta: int = N_ZETA,
-          cavitation: bool = True, supply: bool = False):
+          cavitation: bool = True, supply: bool = False, roughness: float = 0.0):
     """Dimensionless force (f_along_e, f_ahead) and the half-film pressure P[i, j].
 
     ``cavitation=False`` gives the full-Sommerfeld film (negative pressures kept); ``supply=True``
     holds P = 0 on the line of thickest film (phi = pi), Raimondi and Boyd's inlet condition.
+    ``roughness`` = sigma / c > 0 solves Patir and Cheng's average-flow equation
+    div(phi_x H^3 grad P) = -12 Phi(c H / sigma) cos(phi - xi) (:mod:`weftsim.kernel.flow_factors`).
     """
-    matrix, nodes, volume = operator(eps, half_width, n_phi, n_zeta)
-    rhs = (12.0 * np.cos(nodes - xi))[:, None] * volume
+    matrix, nodes, volume = operator(eps, half_width, n_phi, n_zeta, roughness)
+    source = 12.0 * np.cos(nodes - xi)
+    if roughness > 0.0:
+        source = source * contact_factor((1.0 - eps * np.cos(nodes)) / roughness)
+    rhs = source[:, None] * volume
     q = rhs.ravel()
     pressure = spsolve(matrix.tocsc(), q)
     if cavitation:
@@ -142,8 +161,9 @@ def supply_weight(xi: float) -> float:
     return 1.0 - s * s * (3.0 - 2.0 * s)
 
 
-def film(eps: float, xi: float, half_width: float, n_phi: int = N_PHI, n_zeta: int = N_ZETA):
-    """The finite bearing of the kernel (``MODEL_FINITE``): (f_along_e, f_ahead).
+def film(eps: float, xi: float, half_width: float, n_phi: int = N_PHI, n_zeta: int = N_ZETA, roughness: float = 0.0):
+    """The finite bearing of the kernel (``MODEL_FINITE``): (f_along_e, f_ahead); ``roughness`` = sigma / c
+    (0: smooth surfaces; > 0: Patir and Cheng's average flow, :func:`solve`).
 
     The film is fed at ambient pressure along the line of thickest film, as in Raimondi and Boyd's
     full bearing, while the journal's squeeze velocity V does not point there (any rotation, and
@@ -152,8 +172,8 @@ def film(eps: float, xi: float, half_width: float, n_phi: int = N_PHI, n_zeta: i
     :func:`supply_weight`, so the force is continuous in every argument.
     """
     weight = supply_weight(xi)
-    fed = solve(eps, xi, half_width, n_phi, n_zeta, supply=True)[:2] if weight > 0.0 else (0.0, 0.0)
-    free = solve(eps, xi, half_width, n_phi, n_zeta)[:2] if weight < 1.0 else (0.0, 0.0)
+    fed = solve(eps, xi, half_width, n_phi, n_zeta, supply=True, roughness=roughness)[:2] if weight > 0.0 else (0.0, 0.0)
+    free = solve(eps, xi, half_width, n_phi, n_zeta, roughness=roughness)[:2] if weight < 1.0 else (0.0, 0.0)
     return (weight * fed[0] + (1.0 - weight) * free[0], weight * fed[1] + (1.0 - weight) * free[1])
 
 

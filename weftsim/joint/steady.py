@@ -3,13 +3,13 @@
 A journal of radius R spinning at omega (N = omega / 2 pi rev/s) in a still bearing of length L and radial
 clearance c carries a steady load W where the force of the joint's kernel balances it
 (:func:`weftsim.kernel.steady.steady_force`: oil film, asperities and their boundary friction, the dry law
-beyond e = c; the same functions the transient engines integrate).  By symmetry that force depends on |e|
-alone (its direction turns with e), so |e| is the root of |f(|e|)| = W (Brent's method; |f| grows with |e|),
-and the attitude angle is the angle between the load and the line of centres.  Then (Raimondi and Boyd,
-ASLE Trans. 1, 1958; Shigley's Mechanical Engineering Design, ch. 12):
+beyond e = c; the same functions the transient engines integrate).  By symmetry that force depends on abs(e)
+alone (its direction turns with e), so abs(e) is the root of abs(f(abs(e))) = W (Brent's method; abs(f) grows
+with abs(e)), and the attitude angle is the angle between the load and the line of centres.  Then (Raimondi and
+Boyd, ASLE Trans. 1, 1958; Shigley's Mechanical Engineering Design, ch. 12):
 
 - Sommerfeld number S = (R/c)^2 eta N / P, P = W / (2 R L) the projected pressure;
-- eccentricity ratio eps = |e| / c, minimum film h_min = c - |e| (0 once the dry law carries), film ratio
+- eccentricity ratio eps = abs(e) / c, minimum film h_min = c - abs(e) (0 once the dry law carries), film ratio
   h_min / sigma;
 - friction torque T = -M_j on the journal, friction coefficient f = T / (W R), power loss P_f = T omega;
 - the regime by the film ratio, as the regime map (docs/lubricated-joint.md): hydrodynamic above 3, mixed

@@ -18,11 +18,12 @@ the film is thinnest, h_min = c - |e|).  The asperities push the journal back al
 
     F_a(|e|) = R_j L_b integral p_a(h(theta)) cos(theta) dtheta,
 
-over the arc where h < 4 sigma (nothing when h_min >= 4 sigma), continued linearly beyond |e| = c with its
-slope there (:func:`asperity_load`).  The force depends on |e| only: it has
+over the arc where h < 4 sigma (nothing when h_min >= 4 sigma), up to |e| = c where the mean planes
+touch (:func:`asperity_load`; beyond c the bulk contact of the dry law takes the load over,
+:mod:`weftsim.kernel.lubricated`).  The force depends on |e| only: it has
 a potential U_a(|e|) = R_j L_b integral Pi(h(theta)) dtheta with Pi(h) = integral_h^(4 sigma) p_a,
 in closed form K E* sigma 4.4086e-5 (4 - H)^7.804 / 7.804, so the energy balance books it as stored,
-not dissipated.  The integrand is symmetric and vanishes at theta_max as (theta_max - theta)^6.8 (the
+not dissipated (the asperities' hysteresis, :mod:`weftsim.kernel.lubricated`, is the dissipated part).  The integrand is symmetric and vanishes at theta_max as (theta_max - theta)^6.8 (the
 load's, the stiffness's as ^5.8): the integrals over [0, theta_max] are a Gauss-Jacobi rule of :data:`NODES`
 points for the weight (theta_max - theta)^5.804, exact for that factor times a polynomial, so 8 points
 reach the 1e-11 of 24 Gauss-Legendre points (which converge only algebraically at that endpoint zero) at a
@@ -100,9 +101,8 @@ def asperity_load(coef: float, sigma: float, clearance: float, ecc: float, radiu
     """(F_a, U_a): asperity load along -n on the journal (N) and its potential (J) at |e| = ``ecc``.
 
     ``coef`` = K E* (Pa), ``sigma`` the combined RMS roughness (m), ``clearance`` c (m), ``radius`` R_j
-    and ``length`` L_b (m).  Beyond |e| = c (there the dry contact law takes over) continued with the
-    asperities' stiffness at c, k_a = dF_a/d|e|: F_a(c) + k_a (|e| - c) and its potential, so that the
-    force stays continuous with a continuous slope, and conservative.
+    and ``length`` L_b (m).  Beyond |e| = c the values at c (the dry contact law takes the load over
+    there: :func:`weftsim.kernel.lubricated.asperity_share`).
     """
     if coef <= 0.0:
         return 0.0, 0.0
@@ -117,7 +117,6 @@ def asperity_load(coef: float, sigma: float, clearance: float, ecc: float, radiu
     theta_max = math.acos(cos_max)
     force = 0.0
     energy = 0.0
-    slope = 0.0
     for k in range(nodes.size):
         theta = theta_max * nodes[k]
         c_t = math.cos(theta)
@@ -127,17 +126,9 @@ def asperity_load(coef: float, sigma: float, clearance: float, ecc: float, radiu
             p = F52_SCALE * base**F52_EXPONENT
             force += weights[k] * p * c_t
             energy += weights[k] * p * base / (F52_EXPONENT + 1.0)
-            slope += weights[k] * F52_EXPONENT * p / base * c_t * c_t
     scale = 2.0 * theta_max * radius * length * coef  # both halves of the arc
     force *= scale
     energy *= scale * sigma
-    if ecc > clearance:
-        # Beyond c the asperities keep their stiffness at h_min = 0 (a C1 continuation: the integrators see no
-        # kink where the dry law starts): F_a(c) + k_a (|e| - c), k_a = dF_a/d|e| at c.
-        stiffness = slope * scale / sigma
-        d = ecc - clearance
-        energy += force * d + 0.5 * stiffness * d * d
-        force += stiffness * d
     return force, energy
 
 

@@ -86,6 +86,10 @@ N_U, U_MAX = 29, 0.9
 N_XI = 49
 N_WIDTH, WIDTH_MIN, WIDTH_MAX = 9, 0.25, 4.0
 LOG_WIDTH_STEP = math.log(WIDTH_MAX / WIDTH_MIN) / (N_WIDTH - 1)
+# Rough surfaces (Patir and Cheng's average flow, weftsim.kernel.flow_factors): the fourth axis is
+# r = sigma / (h_min + sigma) = 1 / (1 + h_min / sigma), uniform on [0, R_MAX]: r = 0 the smooth film,
+# R_MAX = 0.8 a minimum film of sigma / 4.
+N_R, R_MAX = 9, 0.8
 # First 16 hex digits of the SHA-256 of the stored table (scripts/make_film_table.py writes this
 # line).  numba freezes the table into the compiled code and keys its cache by this file, so a new
 # table must change this file; a table that does not match is not used (NaN forces).
@@ -106,6 +110,16 @@ def table_angles() -> np.ndarray:
 def table_widths() -> np.ndarray:
     """The table's B/D."""
     return WIDTH_MIN * np.exp(LOG_WIDTH_STEP * np.arange(N_WIDTH))
+
+
+def table_roughness_axis() -> np.ndarray:
+    """The table's r = sigma / (h_min + sigma) (0: smooth surfaces)."""
+    return np.linspace(0.0, R_MAX, N_R)
+
+
+def roughness_of(eps: float, r: float) -> float:
+    """sigma / c of the film of eccentricity ratio eps and r = sigma / (h_min + sigma), h_min = c (1 - eps)."""
+    return 0.0 if r <= 0.0 else r * (1.0 - eps) / (1.0 - r)
 
 
 @njit(cache=True, error_model="numpy")

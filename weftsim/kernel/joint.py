@@ -38,14 +38,15 @@ if TYPE_CHECKING:
 # weftsim.kernel.lubricated reads them).
 (KIND, COEF, CLEARANCE, XI, BEARING_RADIUS, MU, V0, V1, V_MIN, TRACK_MAX, DEAD_RATE) = range(11)  # fmt: skip
 (LUBRICATED, VISCOSITY, FILM_MODEL, ROUGHNESS, ASPERITY_COEF, BOUNDARY_MU, FILM_FLOOR, JOURNAL_RADIUS,
- BEARING_LENGTH) = range(11, 20)  # fmt: skip
-N_JOINT = 20
+ BEARING_LENGTH, ASPERITY_HYSTERESIS) = range(11, 21)  # fmt: skip
+N_JOINT = 21
 
 
 def joint_parameters(joint: ClearanceJoint, law: _Law) -> np.ndarray:
     """The joint block: the law's (kind, coef, c, xi), R_b, mu, friction ramp, v_min, rule flag, dead zone,
     then the lubrication (flag, viscosity, film model, roughness, Greenwood-Tripp K E*, boundary mu, film
-    floor, R_j, L_b; zeros for a dry joint).
+    floor, R_j, L_b, the asperities' hysteresis kappa = (1 - e^2) / (1 + e^2) from the joint's restitution e;
+    zeros for a dry joint).
 
     ``joint``: a :class:`weftsim.input.params.ClearanceJoint`; ``law``: a law of :mod:`weftsim.joint.contact`
     (its ``parameters``).  ``TRACK_MAX`` is 1.0 under the "max_approach" rule, 0.0 under "onset";
@@ -74,7 +75,14 @@ def joint_parameters(joint: ClearanceJoint, law: _Law) -> np.ndarray:
         out[FILM_FLOOR] = lub.film_floor_ratio
         out[JOURNAL_RADIUS] = joint.journal_radius
         out[BEARING_LENGTH] = joint.bearing_length
+        out[ASPERITY_HYSTERESIS] = asperity_hysteresis(joint.restitution)
     return out
+
+
+def asperity_hysteresis(restitution: float) -> float:
+    """kappa of the asperities' loading and unloading branches (1 +- kappa) F_a: their loop returns the share
+    (1 - kappa) / (1 + kappa) = e^2 of the work done on it (:mod:`weftsim.kernel.lubricated`)."""
+    return (1.0 - restitution**2) / (1.0 + restitution**2)
 
 
 @njit(cache=True, error_model="numpy", inline="always")

@@ -15,17 +15,20 @@ at every eccentricity, in contact or not::
   the squeeze and wedge terms see the true motion.  The film force then stays finite where the dry law
   starts (its squeeze term grows as (1 - eps^2)^-2.5 towards eps = 1).  The film's shear torques act on
   journal and bearing; its power -(f.e_dot + T_j omega_j + T_b omega_b) is dissipated.
-- **Asperities.** F_a(|e|) of :func:`weftsim.kernel.asperity.asperity_load`, zero while h_min >= 4 sigma,
-  continued beyond |e| = c with its slope at c (C1); it has a potential U_a (stored, not dissipated).  Boundary
+- **Asperities.** F_a(|e|) of :func:`weftsim.kernel.asperity.asperity_load`, zero while h_min >= 4 sigma, up to
+  |e| = c; beyond c the dry law takes it over (:func:`asperity_share`: the solids carry max(F_a(c), F_el)
+  elastically).  That elastic share has a potential U_a (stored); on it the asperities' hysteresis loop
+  (:func:`asperity_normal`: (1 +- kappa) on loading and unloading, kappa from the joint's restitution) dissipates
+  what an impact of that restitution loses.  Boundary
   friction F_Ta = -mu_b c_d(v_T) F_a sign(v_T) acts at the contact point Q = P_b + R_b n with the moments
   of the dry friction, M_j = (R_b - |e|) F_Ta, M_b = -R_b F_Ta (:func:`weftsim.kernel.joint.friction_force`
   with mu_b and the joint's friction ramp).
 - **Dry law.** Unchanged (:func:`weftsim.kernel.joint.clearance_force_at`): zero at |e| = c and growing
   from there, so the total radial force is continuous in |e| (the film term is continuous and held
-  constant in |e| beyond its floor, the asperity term is C1, the dry law starts from 0).
+  constant in |e| beyond its floor, the asperity share is continuous and falls as the dry law rises).
 
-Dissipated power of the film and the boundary friction, the part of the power the asperity potential does
-not store: D' = -(f_l.e_dot + M_lj omega_j + M_lb omega_b) - F_a d|e|/dt.
+Dissipated power of the film, the boundary friction and the asperities' hysteresis, the part of the power the
+asperity potential does not store: D' = -(f_l.e_dot + M_lj omega_j + M_lb omega_b) - F_s d|e|/dt.
 """
 
 from __future__ import annotations
@@ -37,10 +40,11 @@ from numba import njit
 from weftsim.kernel.asperity import asperity_load
 from weftsim.kernel.film import film_force
 from weftsim.kernel.joint import (
-    ASPERITY_COEF, BEARING_LENGTH, BEARING_RADIUS, BOUNDARY_MU, CLEARANCE, FILM_FLOOR, FILM_MODEL, JOURNAL_RADIUS,
-    LUBRICATED, ROUGHNESS, V0, V1, VISCOSITY, connector_friction_force_at, tangential_velocity,
+    ASPERITY_COEF, ASPERITY_HYSTERESIS, BEARING_LENGTH, BEARING_RADIUS, BOUNDARY_MU, CLEARANCE, COEF, FILM_FLOOR,
+    FILM_MODEL, JOURNAL_RADIUS, KIND, LUBRICATED, ROUGHNESS, V0, V1, V_MIN, VISCOSITY, connector_friction_force_at,
+    tangential_velocity,
 )  # fmt: skip
-from weftsim.kernel.laws import friction_factor
+from weftsim.kernel.laws import elastic_energy, elastic_force, friction_factor
 
 # Outputs of lubricated_force, in order (the channels of weftsim.joint.lubrication read them by these indices).
 (L_FX, L_FY, L_MJ, L_MB, L_FILM, L_ASPERITY, L_FILM_TORQUE, L_ASPERITY_ENERGY, L_DISSIPATED, L_FILM_POWER) = range(10)
@@ -73,6 +77,87 @@ def film_at_floor(prm, clearance: float, ex: float, ey: float, vx: float, vy: fl
                       int(prm[FILM_MODEL]))  # fmt: skip
 
 
+HANDOVER_TOL = 1e-13  # relative: the penetration at which the dry law's elastic force reaches F_a(c)
+
+
+@njit(cache=True, error_model="numpy")
+def handover_depth(prm, clearance: float, load: float, delta: float) -> float:
+    """delta* in (0, delta]: the penetration at which the dry law's elastic force F_el reaches ``load`` (N),
+    given F_el(delta) >= load.  Secant steps on log F_el against log delta (every law is close to a power
+    1.5-2 there), bracketed; exact for the constant-stiffness law in one step."""
+    kind, coef = prm[KIND], prm[COEF]
+    hi, f_hi = delta, elastic_force(kind, coef, clearance, delta)
+    if f_hi <= load:
+        return delta
+    lo = hi * (load / f_hi) ** (2.0 / 3.0)  # a power 1.5 from hi
+    f_lo = elastic_force(kind, coef, clearance, lo)
+    if f_lo >= load:  # the law is steeper than 1.5 below hi: bracket from below
+        while f_lo >= load:
+            hi, f_hi = lo, f_lo
+            lo *= 0.5
+            f_lo = elastic_force(kind, coef, clearance, lo)
+    target = math.log(load)
+    for _ in range(60):
+        x_lo, x_hi = math.log(lo), math.log(hi)
+        g_lo, g_hi = math.log(f_lo) - target, math.log(f_hi) - target
+        x = x_hi - g_hi * (x_hi - x_lo) / (g_hi - g_lo)
+        mid = math.exp(x)
+        f_mid = elastic_force(kind, coef, clearance, mid)
+        if abs(f_mid - load) <= HANDOVER_TOL * load or hi - lo <= HANDOVER_TOL * hi:
+            return mid
+        if f_mid > load:
+            hi, f_hi = mid, f_mid
+        else:
+            lo, f_lo = mid, f_mid
+    return 0.5 * (lo + hi)
+
+
+@njit(cache=True, error_model="numpy")
+def asperity_share(prm, clearance: float, ecc: float) -> tuple[float, float]:
+    """(F_s, U_s): the elastic load the asperities carry at |e| = ``ecc`` (N) and its potential (J).
+
+    Up to |e| = c (the mean planes touch) Greenwood and Tripp's F_a (:func:`weftsim.kernel.asperity.asperity_load`).
+    Beyond c the asperities are pressed into the bulk and the dry law's contact (elastic force F_el(delta),
+    delta = |e| - c) takes their load over: F_s = max(F_a(c) - F_el(delta), 0), so that the solids carry
+    max(F_a(c), F_el(delta)) elastically, never more than the dry law once it carries F_a(c), and exactly the
+    dry joint as the roughness vanishes (F_a(c) falls as sqrt(sigma)).  U_s = U_a(c) + F_a(c) d - W_el(d),
+    d = min(delta, delta*) with F_el(delta*) = F_a(c) (:func:`handover_depth`).
+    """
+    f_a, u_a = asperity_load(prm[ASPERITY_COEF], prm[ROUGHNESS], clearance, ecc, prm[JOURNAL_RADIUS],
+                             prm[BEARING_LENGTH])  # fmt: skip
+    delta = ecc - clearance
+    if delta <= 0.0 or f_a <= 0.0:
+        return f_a, u_a
+    kind, coef = prm[KIND], prm[COEF]
+    f_el = elastic_force(kind, coef, clearance, delta)
+    d = delta if f_el < f_a else handover_depth(prm, clearance, f_a, delta)
+    energy = u_a + f_a * d - elastic_energy(kind, coef, clearance, d)
+    return (f_a - f_el if f_el < f_a else 0.0), energy
+
+
+@njit(cache=True, error_model="numpy")
+def asperity_normal(prm, clearance: float, ex: float, ey: float, vx: float, vy: float) -> tuple[float, float, float]:
+    """(F_an, U_s, D'_h): the asperities' normal load on their loading or unloading branch (N), the potential of
+    their elastic share (J) and the power their hysteresis dissipates (W) at eccentricity e and its rate.
+
+    F_an = F_s (1 + kappa s), s = r' / max(abs(r'), v_min) the sign of the approach rate r' = d|e|/dt (a ramp
+    below the joint's v_min), kappa = ``prm[ASPERITY_HYSTERESIS]`` = (1 - e^2) / (1 + e^2): a rate-independent
+    loop (loading (1 + kappa) F_s, unloading (1 - kappa) F_s) that returns e^2 of the work done on it, the
+    energy ratio of an impact with the joint's restitution e at any depth (the partially latching
+    spring of Walton and Braun, J. Rheol. 30, 1986, with its two branches in proportion).  D'_h = kappa s F_s r'
+    >= 0.  Rows with |e| = 0 or no asperity contact: (0, 0, 0).
+    """
+    length = math.sqrt(ex * ex + ey * ey)
+    f_s, u_s = asperity_share(prm, clearance, length)
+    if f_s <= 0.0 or length <= 0.0:
+        return 0.0, u_s, 0.0
+    rate = (ex * vx + ey * vy) / length
+    v_min = prm[V_MIN]
+    side = rate / (abs(rate) if abs(rate) > v_min else v_min)
+    hysteresis = prm[ASPERITY_HYSTERESIS] * side * f_s
+    return f_s + hysteresis, u_s, hysteresis * rate
+
+
 @njit(cache=True, error_model="numpy")
 def lubricated_force(prm, clearance: float, ex: float, ey: float, vx: float, vy: float, w_j: float,
                      w_b: float) -> tuple[float, ...]:
@@ -93,10 +178,9 @@ def lubricated_force(prm, clearance: float, ex: float, ey: float, vx: float, vy:
     ffx, ffy, t_j, t_b = film_at_floor(prm, clearance, ex, ey, vx, vy, w_j, w_b)
     film_power = -(ffx * vx + ffy * vy + t_j * w_j + t_b * w_b)
     length = math.sqrt(ex * ex + ey * ey)
-    r_j, l_b = prm[JOURNAL_RADIUS], prm[BEARING_LENGTH]
-    f_a, u_a = asperity_load(prm[ASPERITY_COEF], prm[ROUGHNESS], clearance, length, r_j, l_b)
+    f_a, u_a, hysteresis_power = asperity_normal(prm, clearance, ex, ey, vx, vy)
     fx, fy, m_j, m_b = ffx, ffy, t_j, t_b
-    dissipated = film_power
+    dissipated = film_power + hysteresis_power
     if f_a > 0.0 and length > 0.0:
         nx, ny = ex / length, ey / length
         f_t = 0.0

@@ -1,11 +1,11 @@
 """The lubricated joint as a steadily loaded plain bearing: the kernel's forces at one eccentricity.
 
-A journal spinning at omega_j in a still bearing, its centre held at e = (|e|, 0) (along +y of the joint's
+A journal spinning at omega_j in a still bearing, its centre held at e = (abs(e), 0) (along +y of the joint's
 plane), e_dot = 0.  The force of the joint on the journal is the sum the transient engines integrate
 (:func:`weftsim.kernel.lubricated.lubricated_force`: the film with its floor, the asperities and their
-boundary friction) and, beyond |e| = c, the dry law with its friction
+boundary friction) and, beyond abs(e) = c, the dry law with its friction
 (:func:`weftsim.kernel.joint.clearance_force_at`, at zero penetration rate: its elastic part).  A steady load W
-on the journal is carried where that force balances it, |f| = W (:mod:`weftsim.joint.steady`).
+on the journal is carried where that force balances it, abs(f) = W (:mod:`weftsim.joint.steady`).
 
 In steady motion the power the drive puts into the journal, -M_j omega_j, is what the joint dissipates
 (film shear and the boundary and dry friction; the asperities' and the dry law's normal forces do no work at
@@ -23,7 +23,7 @@ from weftsim.kernel.lubricated import L_ASPERITY, L_FILM, L_FX, L_FY, L_MJ, lubr
 @njit(cache=True, error_model="numpy")
 def steady_force(prm, clearance: float, ecc: float, omega_j: float) -> tuple[float, float, float, float, float,
                                                                               float]:
-    """(f_y, f_z, M_j, |f_film|, F_a, F_N): the joint's force on the journal (N) and its moment about the journal
+    """(f_y, f_z, M_j, abs(f_film), F_a, F_N): the joint's force on the journal (N) and its moment about the journal
     centre (N m) at eccentricity (``ecc``, 0), journal spin ``omega_j`` (rad/s), still bearing; the film force's
     magnitude, the asperity load and the dry law's normal force (N).  ``prm``: the joint block
     (:func:`weftsim.kernel.joint.joint_parameters`), ``clearance`` the radial clearance (m)."""

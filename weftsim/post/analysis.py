@@ -19,12 +19,14 @@ from weftsim.post.results import (
 def peak_channels(result: RunResult) -> tuple[str, ...]:
     """The channels summarised by peaks and statistics: :data:`PEAK_CHANNELS`, joint F's when it has a
     clearance, and the film ratio and film, asperity and torque channels of each lubricated joint (the
-    film ratio's ``min`` is its summary: the thinnest film of the run)."""
+    film ratio's ``min`` is its summary: the thinnest film of the run), and each loose joint's load
+    (``joint_force_N``, ``joint_force_f_N``: film + asperities + dry law)."""
     names = PEAK_CHANNELS + (PEAK_CHANNELS_F if result.has_joint_f else ())
     if "film_ratio" in result.steps:
         names += ("film_ratio",) + PEAK_CHANNELS_LUBRICATION
     if "film_ratio_f" in result.steps:
         names += ("film_ratio_f",) + PEAK_CHANNELS_LUBRICATION_F
+    names += tuple(name for name in ("joint_force_N", "joint_force_f_N") if name in result.steps)
     return names
 
 

@@ -41,7 +41,8 @@ if TYPE_CHECKING:
 
     from weftsim.input.params import Scene
 
-FIRST_REVOLUTION_CHANNELS = ("contact_force_N", "rapier_acceleration_m_s2", "driving_torque_Nm")
+# joint_force_N: the load the joint carries (film + asperities + dry law, weftsim.joint.load).
+FIRST_REVOLUTION_CHANNELS = ("joint_force_N", "rapier_acceleration_m_s2", "driving_torque_Nm")
 IDEAL_CURVE_CHANNELS = ("rapier_acceleration_m_s2", "driving_torque_Nm")
 STATISTICS_MIN_REVOLUTIONS = 10
 
@@ -112,8 +113,8 @@ def agreement_checks(exudyn: RunResult, reference: RunResult) -> list[dict]:
     if n >= STATISTICS_MIN_REVOLUTIONS:
         se, sr = statistics(exudyn), statistics(reference)
         pairs = (("rapier_acceleration_m_s2", "rms"), ("driving_torque_Nm", "rms"))
-        pairs += (("contact_force_N", "mean"),) if not reference.scene.joint.is_ideal else ()
-        for name, stat in pairs + ((("contact_force_f_N", "mean"),) if loose_f else ()):
+        pairs += (("joint_force_N", "mean"),) if not reference.scene.joint.is_ideal else ()
+        for name, stat in pairs + ((("joint_force_f_N", "mean"),) if loose_f else ()):
             checks.append(_check(f"{name}: {stat} over revolutions 2..{n}", se[name][stat], sr[name][stat], tol.rms))
             # The 99th percentile of the magnitude: for two-sided channels the signed p99 sits in one
             # tail, decided by a handful of impacts, and moved by 14-39% under tolerance changes of
@@ -152,9 +153,9 @@ def not_compared(exudyn: RunResult, reference: RunResult) -> list[dict]:
 
 def _first_revolution_channels(scene: Scene) -> tuple[str, ...]:
     """The channels whose first-revolution maxima are compared."""
-    # A joint without clearance has no contact force to compare (E ideal: both engines write 0).
-    names = tuple(name for name in FIRST_REVOLUTION_CHANNELS if name != "contact_force_N" or not scene.joint.is_ideal)
-    names += ("contact_force_f_N",) if not scene.joint_f.is_ideal else ()
+    # A joint without clearance has no load channel to compare.
+    names = tuple(name for name in FIRST_REVOLUTION_CHANNELS if name != "joint_force_N" or not scene.joint.is_ideal)
+    names += ("joint_force_f_N",) if not scene.joint_f.is_ideal else ()
     # A lubricated joint: the film's first-revolution maxima, as the contact force's (same tolerance).
     names += ("film_force_N",) if not scene.joint.is_ideal and scene.joint.is_lubricated else ()
     return names + (("film_force_f_N",) if not scene.joint_f.is_ideal and scene.joint_f.is_lubricated else ())

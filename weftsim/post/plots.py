@@ -21,12 +21,12 @@ PANELS = (
     ("rapier_velocity_m_s", "rapier velocity [m/s]", 1.0),
     ("rapier_acceleration_m_s2", "rapier acceleration [m/s²]", 1.0),
     ("driving_torque_Nm", "driving torque [N·m]", 1.0),
-    ("contact_force_N", "contact force at E [N]", 1.0),
+    ("joint_force_N", "load of the joint at E [N]", 1.0),
     ("penetration_m", "penetration at E [mm]", 1e3),
 )
 # Added below PANELS when every curve has a clearance at F (weftsim.post.results.JOINT_F_CHANNELS).
 PANELS_F = (
-    ("contact_force_f_N", "contact force at F [N]", 1.0),
+    ("joint_force_f_N", "load of the joint at F [N]", 1.0),
     ("penetration_f_m", "penetration at F [mm]", 1e3),
 )
 
@@ -90,8 +90,10 @@ def channel_panels(curves: list[tuple], title: str, panels: tuple | None = None)
         panel's channel is left out of that panel.
     """
     if panels is None:
-        panels = PANELS + (PANELS_F if curves and all(PANELS_F[0][0] in data for _, data, _ in curves) else ())
+        panels = PANELS + (PANELS_F if curves and all("contact_force_f_N" in data for _, data, _ in curves) else ())
         panels += PANELS_LUBRICATION if curves and all("film_ratio" in data for _, data, _ in curves) else ()
+    from weftsim.post.results import LOAD_FALLBACK
+
     rows = len(panels) // 2
     fig = figure(figsize=(11, 3 * rows))
     axes = fig.subplots(rows, 2, sharex=True)
@@ -100,9 +102,10 @@ def channel_panels(curves: list[tuple], title: str, panels: tuple | None = None)
         for ax, (name, ylabel, scale) in zip(axes.flat, panels):
             ax.set_ylabel(ylabel)
             ax.grid(alpha=0.3)
-            if name not in data:
+            values = data.get(name, data.get(LOAD_FALLBACK.get(name, "")))  # a 0.2 result: its dry law's load
+            if values is None:
                 continue
-            ax.plot(angle, data[name] * scale, label=label, rasterized=len(angle) > 20000,
+            ax.plot(angle, values * scale, label=label, rasterized=len(angle) > 20000,
                     **({"lw": 0.8} | style))
     for ax in axes[-1]:
         ax.set_xlabel("crank angle [deg]")

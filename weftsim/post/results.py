@@ -81,6 +81,13 @@ LUBRICATION_CHANNELS_F: tuple[str, ...] = (
     "film_torque_f_Nm",
 )
 
+# The load a loose joint carries (film + asperities + dry law, weftsim.joint.load), present for every loose joint
+# E / F (results saved before it existed lack it: weftsim.joint.load.joint_load reads their contact force).
+JOINT_FORCE_CHANNELS: tuple[str, ...] = ("joint_force_N",)
+JOINT_FORCE_CHANNELS_F: tuple[str, ...] = ("joint_force_f_N",)
+# What a result saved before the load channels existed gives in their place: its dry law's contact force.
+LOAD_FALLBACK = {"joint_force_N": "contact_force_N", "joint_force_f_N": "contact_force_f_N"}
+
 # Joint E's channel of each joint-F channel (same quantity at the other joint).
 JOINT_E_NAME = dict(zip(JOINT_F_CHANNELS, ("contact_force_N", "penetration_m", "eccentricity_y_m",
                                            "eccentricity_z_m", "impact_velocity_m_s", "in_contact",
@@ -115,11 +122,15 @@ PEAK_CHANNELS_LUBRICATION: tuple[str, ...] = ("film_force_N", "asperity_force_N"
 PEAK_CHANNELS_LUBRICATION_F: tuple[str, ...] = ("film_force_f_N", "asperity_force_f_N", "film_torque_f_Nm")
 
 
+OPTIONAL_GROUPS = (JOINT_F_CHANNELS, LUBRICATION_CHANNELS, LUBRICATION_CHANNELS_F, JOINT_FORCE_CHANNELS,
+                   JOINT_FORCE_CHANNELS_F)
+
+
 def optional_channels(names) -> tuple[str, ...]:
     """The optional channel groups (joint F's, the lubricated joints') present among ``names``, in order."""
     present = set(names)
     out: tuple[str, ...] = ()
-    for group in (JOINT_F_CHANNELS, LUBRICATION_CHANNELS, LUBRICATION_CHANNELS_F):
+    for group in OPTIONAL_GROUPS:
         if group[0] in present:
             out += group
     return out
@@ -134,7 +145,8 @@ def _as_channels(data: dict[str, np.ndarray], what: str) -> dict[str, np.ndarray
         raise ValueError(f"{what} lacks channels {missing}; every engine must provide all of {list(CHANNELS)}")
     names = CHANNELS
     for group, label in ((JOINT_F_CHANNELS, "joint F"), (LUBRICATION_CHANNELS, "lubrication"),
-                         (LUBRICATION_CHANNELS_F, "joint F lubrication")):
+                         (LUBRICATION_CHANNELS_F, "joint F lubrication"), (JOINT_FORCE_CHANNELS, "joint E load"),
+                         (JOINT_FORCE_CHANNELS_F, "joint F load")):
         given = [name for name in group if name in data]
         if given:
             if len(given) != len(group):
@@ -278,8 +290,8 @@ def empty_channels(joint_f: bool = False, scene: Scene | None = None) -> dict[st
 
 
 def scene_channels(scene: Scene) -> tuple[str, ...]:
-    """The channels a run of ``scene`` has: :data:`CHANNELS`, joint F's with a clearance at F, and the
-    lubrication channels of each lubricated loose joint."""
+    """The channels a run of ``scene`` has: :data:`CHANNELS`, joint F's with a clearance at F, the
+    lubrication channels of each lubricated loose joint and the load of each loose joint."""
     names = CHANNELS
     if not scene.joint_f.is_ideal:
         names += JOINT_F_CHANNELS
@@ -287,6 +299,10 @@ def scene_channels(scene: Scene) -> tuple[str, ...]:
         names += LUBRICATION_CHANNELS
     if not scene.joint_f.is_ideal and scene.joint_f.is_lubricated:
         names += LUBRICATION_CHANNELS_F
+    if not scene.joint.is_ideal:
+        names += JOINT_FORCE_CHANNELS
+    if not scene.joint_f.is_ideal:
+        names += JOINT_FORCE_CHANNELS_F
     return names
 
 

@@ -213,10 +213,14 @@ def compiled_channels(scene: Scene, time: np.ndarray, states: np.ndarray, contac
         channels = dict(zip(names, np.ascontiguousarray(out.T)))
     if scene.joint.is_lubricated or scene.joint_f.is_lubricated:
         # The film and asperity channels; the asperities' potential joins the contact energy (the chain
-        # books only the film's and the boundary friction's work as dissipated, weftsim.kernel.lubricated).
+        # books the film's, the boundary friction's and the asperities' hysteresis work as dissipated,
+        # weftsim.kernel.lubricated).
         from weftsim.joint.lubrication import lubrication_table
 
         lubricated, asperity_energy = lubrication_table(scene, prm, time, states)
         channels["contact_energy_J"] = channels["contact_energy_J"] + asperity_energy
         channels.update(lubricated)
+    from weftsim.joint.load import joint_force_table
+
+    channels.update(joint_force_table(scene, prm, time, states, channels))
     return channels

@@ -13,7 +13,7 @@ check                    value                                        limit (sce
 ``hertz_pressure``       Hertz line-contact pressure at peak force    1.67 x the smaller ``yield_strength_mpa``
 ``penetration``          largest delta / c (after the run only)       the law's range (:mod:`weftsim.joint.contact`)
 ``rapier_acceleration``  peak of abs(rapier acceleration)             ``limits.max_rapier_acceleration_m_s2``
-``film_temperature``     effective film temperature of an oiled joint none: reported (:mod:`weftsim.joint.heat`)
+``film_temperature``     film temperature of an oiled joint           none: reported (:mod:`weftsim.joint.heat`)
 =======================  ===========================================  ============================================
 
 *Before the run* (:func:`before_run`) the loads come from the ideal mechanism at the scene's speed
@@ -255,6 +255,7 @@ def after_run(result: RunResult) -> list[Check]:
     :func:`weftsim.run.plausibility.validity_warnings` judges and words it.
     """
     from weftsim.joint.contact import make_law
+    from weftsim.joint.load import joint_load
 
     full = result
     result = running(full)
@@ -271,8 +272,10 @@ def after_run(result: RunResult) -> list[Check]:
         _, samples = joint_view(replace_steps(result), name)
         _, whole = joint_view(full, name)
         area = 2.0 * joint.journal_radius * joint.bearing_length
-        force_steps = np.asarray(steps["contact_force_N"])
-        force_samples = np.asarray(samples["contact_force_N"]) if samples["time_s"].size else force_steps
+        # The load the joint carries (film + asperities + dry law, weftsim.joint.load); Hertz's pressure is the
+        # dry law's contact alone.
+        force_steps = np.asarray(joint_load(steps))
+        force_samples = np.asarray(joint_load(samples)) if samples["time_s"].size else force_steps
         theta_steps = np.radians(np.asarray(steps["crank_angle_deg"]))
         theta_samples = np.radians(np.asarray(samples["crank_angle_deg"])) if samples["time_s"].size else theta_steps
         v_steps = sliding_speed(theta_steps, scene, name, joint.journal_radius)

@@ -276,6 +276,9 @@ def joint_view(result: RunResult, joint: str) -> tuple[Scene, dict[str, np.ndarr
         return result.scene, result.steps
     steps = dict(result.steps)
     steps.update({e_name: result.steps[f_name] for f_name, e_name in JOINT_E_NAME.items()})
+    steps.pop("joint_force_N", None)
+    if "joint_force_f_N" in result.steps:  # the joint's load (weftsim.joint.load)
+        steps["joint_force_N"] = result.steps["joint_force_f_N"]
     return dataclasses.replace(result.scene, joint=result.scene.joint_f), steps
 
 

@@ -38,11 +38,17 @@ SUMMARY_FILE = "summary.json"
 CELL_FORMAT = "weftsim-sweep-cell/1"
 MAX_RECORD_BYTES = 16 * 2**20  # a cell.json is a few kB (its scene's keys, its metrics)
 
-# Channels summarised per cell: contact_force_N is joint E's, contact_force_f_N joint F's.  A joint that is
-# ideal in a cell has no contact force: its columns are empty there (not 0, which would read as a force
-# the joint never carried; the ideal joint's reaction is not a contact force).
-METRIC_CHANNELS = ("driving_torque_Nm", "rapier_acceleration_m_s2", "contact_force_N", "contact_force_f_N")
-JOINT_OF_CHANNEL = {"contact_force_N": "joint", "contact_force_f_N": "joint_f"}
+# Channels summarised per cell: contact_force_N is joint E's dry law, contact_force_f_N joint F's; joint_force_N
+# / joint_force_f_N the load each joint carries (film + asperities + dry law, weftsim.joint.load), and the film's
+# and the asperities' shares of a lubricated joint.  A joint that is ideal in a cell has no contact force: its
+# columns are empty there (not 0, which would read as a force the joint never carried; the ideal joint's reaction
+# is not a contact force); a dry joint's film and asperity columns are empty too.
+METRIC_CHANNELS = ("driving_torque_Nm", "rapier_acceleration_m_s2", "contact_force_N", "contact_force_f_N",
+                   "joint_force_N", "joint_force_f_N", "film_force_N", "film_force_f_N", "asperity_force_N",
+                   "asperity_force_f_N")
+JOINT_OF_CHANNEL = {"contact_force_N": "joint", "contact_force_f_N": "joint_f", "joint_force_N": "joint",
+                    "joint_force_f_N": "joint_f", "film_force_N": "joint", "film_force_f_N": "joint_f",
+                    "asperity_force_N": "joint", "asperity_force_f_N": "joint_f"}
 
 
 def normalise(data: Any) -> Any:

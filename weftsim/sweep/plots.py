@@ -21,8 +21,13 @@ PANEL_LABELS = {
     "rapier_acceleration_m_s2": "peak |rapier acceleration| [m/s²]",
     "contact_force_N": "peak contact force at E [kN]",
     "contact_force_f_N": "peak contact force at F [kN]",
+    "joint_force_N": "peak load of the joint at E [kN]",
+    "joint_force_f_N": "peak load of the joint at F [kN]",
 }
-SCALES = {"contact_force_N": 1e-3, "contact_force_f_N": 1e-3}  # contact forces reach 1e5 N: shown in kN
+# Forces reach 1e5 N: shown in kN.
+SCALES = {"contact_force_N": 1e-3, "contact_force_f_N": 1e-3, "joint_force_N": 1e-3, "joint_force_f_N": 1e-3}
+# The panels: torque, acceleration and the load of each joint (the film and asperity columns stay in the table).
+PLOTTED_CHANNELS = ("driving_torque_Nm", "rapier_acceleration_m_s2", "joint_force_N", "joint_force_f_N")
 
 
 UNITS = {"mm": "mm", "rpm": "rpm", "deg": "deg", "gpa": "GPa", "kg": "kg", "s": "s", "kg_m2": "kg m²"}
@@ -61,12 +66,15 @@ def _value(row: dict, channel: str, which: str) -> float:
 
 
 def shown_channels(rows: list[dict]) -> tuple[str, ...]:
-    """The panels to draw: torque and acceleration always, the contact force of each joint with a clearance
+    """The panels to draw: torque and acceleration always, the load of each joint with a clearance
     in some successful cell (a joint ideal in every cell has no contact force to show)."""
     def present(channel: str) -> bool:
         return any(math.isfinite(_value(row, channel, "rev1")) for row in rows)
 
-    return tuple(c for c in METRIC_CHANNELS if c not in ("contact_force_N", "contact_force_f_N") or present(c))
+    loads = ("joint_force_N", "joint_force_f_N")
+    if not any(present(c) for c in loads):  # a table written before the load columns existed
+        return tuple(c for c in METRIC_CHANNELS[:4] if c not in ("contact_force_N", "contact_force_f_N") or present(c))
+    return tuple(c for c in PLOTTED_CHANNELS if c not in loads or present(c))
 
 
 def _edges(centres: np.ndarray, numeric: bool = False) -> np.ndarray:

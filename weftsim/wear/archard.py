@@ -22,11 +22,9 @@ from numba import njit
 from weftsim.post.analysis import time_weights
 from weftsim.kernel import chain_f as kf
 from weftsim.kernel.chain import BEARING_RADIUS, chain, crank_rate, eccentricity, local_clearance, rocker_angle
-from weftsim.kernel.asperity import asperity_half_angle, asperity_load
-from weftsim.kernel.joint import (
-    ASPERITY_COEF, BEARING_LENGTH, JOURNAL_RADIUS, N_JOINT, ROUGHNESS, tangential_velocity,
-)  # fmt: skip
-from weftsim.kernel.lubricated import is_lubricated
+from weftsim.kernel.asperity import asperity_half_angle
+from weftsim.kernel.joint import N_JOINT, ROUGHNESS, tangential_velocity
+from weftsim.kernel.lubricated import asperity_normal, is_lubricated
 from weftsim.kernel.wear import contact_half_angle, deposit
 
 if TYPE_CHECKING:
@@ -92,8 +90,7 @@ def _row(jp: np.ndarray, f_n: float, c: float, ecc_y: float, ecc_z: float, v_y: 
     if is_lubricated(jp) and length > 0.0:
         # Mixed lubrication: the solids touch only through the asperities (and the dry law beyond e = c);
         # the film's load wears nothing.  The arc is where the asperities touch, h < 4 sigma.
-        f_a = asperity_load(jp[ASPERITY_COEF], jp[ROUGHNESS], c, length, jp[JOURNAL_RADIUS],
-                            jp[BEARING_LENGTH])[0]  # fmt: skip
+        f_a = asperity_normal(jp, c, ecc_y, ecc_z, v_y, v_z)[0]  # beyond c only what the dry law has not taken
         if f_a > 0.0:
             f_n += f_a
             half_angle = max(half_angle, asperity_half_angle(jp[ROUGHNESS], c, length))

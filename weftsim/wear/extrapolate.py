@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from weftsim.joint.load import joint_load
 from weftsim.post.analysis import channel_statistics, time_weights
 from weftsim.errors import WearError
 from weftsim.wear.archard import run_wear
@@ -224,8 +225,8 @@ def worn_scene(scene: Scene, bearing: np.ndarray, journal: np.ndarray, revolutio
 
 
 def _response(steps: dict, t0: float, joints: Sequence[str] = ("e",)) -> dict:
-    """Statistics of the steady cycle: the mechanism's (rapier, torque) and each wearing joint's contact force
-    and film (keys with the joint's letter, :data:`weftsim.wear.store.RESPONSE`)."""
+    """Statistics of the steady cycle: the mechanism's (rapier, torque) and each wearing joint's load
+    (``joint_force_N``) and film (keys with the joint's letter, :data:`weftsim.wear.store.RESPONSE`)."""
     keep = steps["time_s"] >= t0
     t = steps["time_s"][keep]
     acc = channel_statistics(t, steps["rapier_acceleration_m_s2"][keep])
@@ -234,7 +235,9 @@ def _response(steps: dict, t0: float, joints: Sequence[str] = ("e",)) -> dict:
            "driving_torque_rms_Nm": torque["rms"], "driving_torque_p99_Nm": torque["p99_abs"]}
     for joint in joints:
         tail = "" if joint == "e" else "_f"  # the channels' names (weftsim.post.results)
-        force = channel_statistics(t, steps[f"contact_force{tail}_N"][keep])
+        # The joint's load (film + asperities + dry law, weftsim.joint.load): the contact_force_* keys keep their
+        # names (stored wear states read them) and hold what the joint carries, oiled or dry.
+        force = channel_statistics(t, joint_load(steps, f"joint_force{tail}_N")[keep])
         film = {"film_ratio_min": math.nan, "film_ratio_mean": math.nan, "mixed_fraction": math.nan}
         if f"film_ratio{tail}" in steps:  # a lubricated joint: the film ratio over the steady cycle
             ratio = steps[f"film_ratio{tail}"][keep]

@@ -80,13 +80,13 @@ def statistic_label(name: str) -> str:
 
 
 def growth_figure(columns: dict, title: str = "", joints: Sequence[str] = ("e",)) -> Figure:
-    """Effective clearance, contact force and rapier acceleration against operating hours (``wear.csv`` columns),
+    """Effective clearance, the joint's load (film + asperities + dry law) and rapier acceleration against operating hours (``wear.csv`` columns),
     the clearance and contact force of each wearing joint."""
     fig = figure(figsize=(7, 8))
     hours = columns["hours"]
     at = " and ".join(j.upper() for j in joints)
     panels = ((tuple(f"effective_clearance_{j}_mm" for j in joints), f"effective clearance at {at} [mm]"),
-              (tuple(f"contact_force_{j}_{s}_N" for j in joints for s in ("mean", "p99")), f"contact force at {at} [N]"),
+              (tuple(f"contact_force_{j}_{s}_N" for j in joints for s in ("mean", "p99")), f"load of the joint at {at} [N]"),
               (("rapier_acceleration_rms_m_s2", "rapier_acceleration_p99_m_s2"), "rapier acceleration [m/s²]"),
               (("driving_torque_rms_Nm", "driving_torque_p99_Nm"), "driving torque [N·m]"))
     for k, (names, label) in enumerate(panels):

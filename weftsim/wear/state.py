@@ -56,9 +56,12 @@ def scene_identity(scene: Scene) -> str:
     """The scene's file keys as canonical JSON: what a stored state must match to be resumed.
 
     An ideal joint F's ``[joint_f.wear]`` keys are left out: they change nothing, and a state written before F
-    could wear (which did not know them) stays the same scene's.
+    could wear (which did not know them) stays the same scene's; so are the oil's and its heat balance's keys of a
+    joint that names no oil (a fixed viscosity or a dry joint), for a state written before they existed.
     """
     from weftsim.input.scene import to_file_keys
+
+    from weftsim.input.scene import HEAT_KEYS
 
     keys = to_file_keys(scene)
     if scene.joint_f.is_ideal:
@@ -75,6 +78,9 @@ def scene_identity(scene: Scene) -> str:
     for name, value in DUTY_DEFAULTS.items():  # the steady prediction's duty keys, which a state before them lacks
         if keys.get("duty." + name) == value:
             keys.pop("duty." + name)
+    for table, joint in (("joint_e", scene.joint), ("joint_f", scene.joint_f)):
+        if joint.lubrication is None or not joint.lubrication.has_oil:  # the oil's keys change nothing without one
+            keys = {k: v for k, v in keys.items() if k not in {f"{table}.lubrication.{name}" for name in HEAT_KEYS}}
     return json.dumps(keys, sort_keys=True, default=str)
 
 
