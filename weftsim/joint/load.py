@@ -60,7 +60,7 @@ def joint_force_rows(prm: np.ndarray, time: np.ndarray, states: np.ndarray, f_n_
         if e_only:
             e_y, e_z, v_y, v_z, _, _, dphi = kc.eccentricity(prm, t, y)[:7]
             c = kc.local_clearance(prm, t, e_y, e_z, v_y, v_z, y)[0]
-            out_e[i] = _force(prm, c, e_y, e_z, v_y, v_z, y[3], prm[kc.OMEGA] * dphi, f_n_e[i])
+            out_e[i] = _force(prm, c, e_y, e_z, v_y, v_z, y[3], kc.crank_rate(prm, t) * dphi, f_n_e[i])
             continue
         q = kf.eccentricities(prm, t, y)
         e_y, e_z, ve_y, ve_z, f_y, f_z, vf_y, vf_z, w_rocker, dpsi, da = q
