@@ -237,6 +237,12 @@ def run_ensemble(args: argparse.Namespace, scene: Scene, outdir: str | Path,
         print(f"  wear from stop-starts: {100 * stops['median']:.3g} % of the worn volume at the median design point "
               f"({100 * stops['min']:.3g} - {100 * stops['max']:.3g} % over the {len(stops['by_design_point'])} "
               "simulated predictions)")
+    if reach["fraction"] == 0.0:
+        print(f"  shares of the spread: none (no sample reaches {args.limit_clearance_mm:g} mm within {horizon:g} h: "
+              "the ranks are all tied)")
+        for path in data["files"].values():
+            print(f"  wrote {path}")
+        return 0
     print("  shares of the spread: " + ", ".join(f"{k} {100 * v['share']:.0f} %" for k, v in
                                                  sorted(data["shares"].items(), key=lambda kv: -kv[1]["share"])))
     for path in data["files"].values():
