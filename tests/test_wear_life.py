@@ -263,3 +263,32 @@ def test_an_oiled_update_runs_at_its_heat_balance_and_its_run_in_roughness():
     expected, balance = with_film_temperature(joint, mean, omega)
     assert lub.viscosity == expected.lubrication.viscosity and lub.film_temperature == balance.temperature_c
     assert lub.film_temperature != scene.joint.lubrication.film_temperature  # the clearance changed the balance
+
+
+def test_the_life_report_turns_each_sample_s_hours_into_its_own_calendar_days():
+    """Each sample's calendar days are its hours x (1 + stops x stop time / 60) / hours a day x 7 / days a week with
+    its own drawn duty keys (the scene's otherwise); censored hours stay censored; the stop-starts' share of a
+    prediction is the N-weighted share of its updates."""
+    from types import SimpleNamespace
+
+    from weftsim.wear.life import prediction_stop_share, sample_days
+
+    scene = load_scene("loom_oiled")
+    hours = np.array([[10.0, 20.0], [100.0, np.inf], [1.0, 2.0]])
+    stops = np.array([5.0, 15.0, 25.0])
+    days = sample_days(scene, {"duty.stops_per_hour": stops}, hours)
+    d = scene.duty
+    for i, s in enumerate(stops):
+        expected = hours[i] * (1.0 + s * d.stop_minutes / 60.0) / d.hours_per_day * 7.0 / d.days_per_week
+        np.testing.assert_allclose(days[i], expected, rtol=1e-15)
+        assert dc.replace(d, stops_per_hour=s).calendar_days(10.0) == pytest.approx(
+            10.0 * (1.0 + s * d.stop_minutes / 60.0) / d.hours_per_day * 7.0 / d.days_per_week, rel=1e-15)
+    assert np.isinf(days[1, 1])
+
+    def update(n, volume, share):
+        return SimpleNamespace(step_revolutions=n, part=lambda j: SimpleNamespace(volume_rate=volume),
+                               response={"stop_start_share_e": share})
+
+    assert prediction_stop_share([update(10.0, 1.0, 0.5), update(30.0, 1.0, 0.1), update(0.0, 5.0, 0.9)]) == \
+        pytest.approx((10 * 0.5 + 30 * 0.1) / 40)
+    assert prediction_stop_share([update(10.0, 0.0, 0.5)]) is None
