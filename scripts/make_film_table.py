@@ -1,11 +1,11 @@
-"""Build the finite-bearing table that weftsim.kernel.film interpolates (weftsim/kernel/film_table.npz).
+"""Build the finite-bearing table that weftsim.physics.film interpolates (weftsim/physics/film_table.npz).
 
 Usage::
 
     python scripts/make_film_table.py [--check] [--jobs 2]
 
 Solves Reynolds' equation with cavitation (:func:`weftsim.joint.reynolds.film`) on every node of the
-grid of :mod:`weftsim.kernel.film` (roughness axis r = sigma / (h_min + sigma) x B/D x eccentricity ratio
+grid of :mod:`weftsim.physics.film` (roughness axis r = sigma / (h_min + sigma) x B/D x eccentricity ratio
 x squeeze-velocity angle; r = 0 the smooth film, r > 0 Patir and Cheng's average-flow equation) and
 stores the scaled dimensionless force.  Deterministic: the same code gives the same table.  About
 115 000 solves, some 40 CPU minutes (``--jobs`` processes share them).  ``--check`` instead compares the
@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from weftsim.joint import reynolds
-from weftsim.kernel import film
+from weftsim.physics import film
 
 TABLE = Path(film.__file__).with_name("film_table.npz")
 

@@ -17,10 +17,10 @@ from scipy.integrate import solve_ivp
 
 from weftsim.input.params import ClearanceJoint, Lubrication
 from weftsim.joint.contact import make_law
-from weftsim.kernel.asperity import H_CUTOFF, asperity_load
-from weftsim.kernel.joint import ASPERITY_COEF, CLEARANCE, COEF, KIND, clearance_force_at, joint_parameters
-from weftsim.kernel.laws import elastic_energy, elastic_force
-from weftsim.kernel.lubricated import L_DISSIPATED, L_FX, asperity_share, lubricated_force
+from weftsim.physics.asperity import H_CUTOFF, asperity_load
+from weftsim.physics.joint import ASPERITY_COEF, CLEARANCE, COEF, KIND, clearance_force_at, joint_parameters
+from weftsim.physics.laws import elastic_energy, elastic_force
+from weftsim.physics.lubricated import L_DISSIPATED, L_FX, asperity_share, lubricated_force
 
 C, SIGMA = 0.1e-3, 0.4e-6
 

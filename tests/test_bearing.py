@@ -240,8 +240,8 @@ def test_a_run_takes_the_oils_viscosity_at_the_film_temperature():
     """A scene built in Python with an oil (no film temperature yet) runs at the viscosity of its heat balance, as a
     loaded scene does; the design checks report the temperature (summary.json's plausibility block)."""
     import weftsim
-    from weftsim.kernel.joint import VISCOSITY
-    from weftsim.reference.dynamics import pack_parameters
+    from weftsim.physics.joint import VISCOSITY
+    from weftsim.model.dynamics import pack_parameters
 
     oil = {"joint_e.lubrication.oil": "ISO_VG_220", "joint_e.lubrication.ambient_temperature_c": 40.0,
            "drive.revolutions": 0.02}

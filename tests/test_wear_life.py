@@ -13,15 +13,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from weftsim import reference
+from conftest import door
 from weftsim.input.scene import load_scene
-from weftsim.kernel import chain as kc
-from weftsim.reference.dynamics import pack_parameters
+from weftsim.physics import chain as kc
+from weftsim.model.dynamics import pack_parameters
 from weftsim.wear import predict_to_directory
 from weftsim.wear.archard import run_wear
 from weftsim.wear.extrapolate import predict
 
 ROOT = Path(__file__).resolve().parents[1]
+solve = door("reference")
 
 
 def _wear(scene, **changes):
@@ -95,7 +96,7 @@ def mixed_run():
     scene = load_scene("loom", {"joint_e.lubrication.viscosity_mpa_s": 10.0, "joint_e.clearance_mm": 0.03,
                                 "drive.revolutions": 2.0})
     rows = {}
-    result = reference.solve(scene, step_states=lambda *a: rows.update(steps=a))
+    result = solve(scene, observe=lambda *a: rows.update(steps=a))
     assert result.ok, result.message
     return scene, pack_parameters(scene), rows["steps"]
 
@@ -120,7 +121,7 @@ def test_mixed_regime_wears_the_asperity_load_with_its_own_k(mixed_run):
                          asperity_density_radius_roughness=s * scene.joint.lubrication.asperity_density_radius_roughness)
         sc = dc.replace(scene, joint=dc.replace(scene.joint, lubrication=lub))
         rows = {}
-        assert reference.solve(sc, step_states=lambda *a: rows.update(steps=a)).ok
+        assert solve(sc, observe=lambda *a: rows.update(steps=a)).ok
         run = run_wear(sc, pack_parameters(sc), *rows["steps"])
         works.append(run.asperity_work * w.asperity_wear_coefficient / w.bearing_hardness)  # the mixed regime's
     # The mixed regime's worn volume falls with the asperity coefficient at least linearly (measured: as its
@@ -153,7 +154,7 @@ def test_the_drive_laws_integrate_to_their_angles_and_keep_constant_speed():
         else:
             assert end[1] == omega
     late = dc.replace(scene, drive=dc.replace(scene.drive, law="run_down", ramp_start=10.0, ramp=0.1))
-    a, b = reference.solve(scene), reference.solve(late)
+    a, b = solve(scene), solve(late)
     for name in ("contact_force_N", "driving_torque_Nm", "rapier_acceleration_m_s2", "eccentricity_y_m"):
         np.testing.assert_array_equal(a.steps[name], b.steps[name])
 
@@ -169,7 +170,7 @@ def test_a_stop_start_s_wear_is_archard_s_integral_over_its_transients():
     w = scene.joint.wear
     for wear, (sc, t0, t1) in zip((down, up), transient_scenes(scene)):
         rows = {}
-        result = reference.solve(sc, step_states=lambda *a: rows.update(steps=a))
+        result = solve(sc, observe=lambda *a: rows.update(steps=a))
         assert result.ok, result.message
         t, y, contact, impact = rows["steps"]
         keep = (t >= t0) & (t <= t1)

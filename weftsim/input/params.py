@@ -181,7 +181,7 @@ class WearModel:
         return self.mixed_wear_coefficient if self.wear_coefficient is None else self.wear_coefficient
 
 
-# Film models of Lubrication.model (the codes of weftsim.kernel.film: MODEL_FINITE, MODEL_SHORT, MODEL_LONG,
+# Film models of Lubrication.model (the codes of weftsim.physics.film: MODEL_FINITE, MODEL_SHORT, MODEL_LONG,
 # MODEL_SHORT_HALF, in this order).
 FILM_MODELS = ("finite", "short", "long", "short_half")
 
@@ -194,7 +194,7 @@ class Lubrication:
     one, the film's pressure carries the journal for every eccentricity (no contact needed), the
     asperities of both surfaces carry load where the minimum film thickness ``h_min = c - |e|`` is below
     4 sigma (Greenwood and Tripp, Proc. Instn Mech. Engrs 185, 1970), and the dry contact law of the
-    joint takes over beyond e = c, continuously (:mod:`weftsim.kernel.lubricated`).
+    joint takes over beyond e = c, continuously (:mod:`weftsim.physics.lubricated`).
 
     Attributes
     ----------
@@ -280,7 +280,7 @@ class Lubrication:
 
     @property
     def model_code(self) -> int:
-        """The film kernel's model code (weftsim.kernel.film: finite 0, short 1, long 2)."""
+        """The film kernel's model code (weftsim.physics.film: finite 0, short 1, long 2)."""
         return FILM_MODELS.index(self.model)
 
 
@@ -508,7 +508,7 @@ LOOM_JOINT_E = ClearanceJoint(clearance=0.25e-3, law="variable_kd")
 
 @dataclass(frozen=True)
 class Drive:
-    """Crank speed and run length; the drive law of a stop-start's transient (:func:`weftsim.kernel.chain.crank_motion`).
+    """Crank speed and run length; the drive law of a stop-start's transient (:func:`weftsim.physics.chain.crank_motion`).
 
     ``law``: ``"constant"`` (theta = omega t: every run of a scene file), ``"run_down"`` (omega until
     ``ramp_start``, then to rest over ``ramp`` s) or ``"start_up"`` (at rest until ``ramp_start``, then to omega
@@ -634,7 +634,7 @@ class CompareTolerance:
 
 @dataclass(frozen=True)
 class Limits:
-    """Run-time failure criteria and budgets, checked by both engines (:mod:`weftsim.run.guards`).
+    """Run-time failure criteria and budgets, checked by both engines (:mod:`weftsim.checks.guards`).
 
     A run that crosses one ends with ``status = "failed"``, a message saying what, when
     (time and crank angle) and what to try, and keeps what it computed up to then.
@@ -672,7 +672,7 @@ class Limits:
         were derived for, stays within 1, and the default impact velocity rule
         ``max_approach`` keeps every step within 1: a step beyond it fails the run.  Under the
         ``onset`` rule a driven lasting contact exceeds it as a property of that model: a
-        warning (:mod:`weftsim.run.plausibility`).
+        warning (:mod:`weftsim.checks.plausibility`).
     """
 
     max_wall_time: float = 0.0

@@ -25,7 +25,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from weftsim.kernel.film import N_U, U_MAX
+from weftsim.physics.film import N_U, U_MAX
 
 # Dimensionless flows are tabulated on u = 1 - sqrt(1 - eps), as the film force.
 U_NODES = np.linspace(0.0, U_MAX, N_U)

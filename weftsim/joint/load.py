@@ -2,13 +2,13 @@
 
 ``joint_force_N`` (``joint_force_f_N`` at F) is the magnitude of the whole force of the joint on the journal:
 the dry law's normal force F_N (the engine's ``contact_force_N``, along -n) with its friction F_T t
-(:func:`weftsim.kernel.joint.friction_force` at the contact points' sliding velocity), plus, for a lubricated
+(:func:`weftsim.physics.joint.friction_force` at the contact points' sliding velocity), plus, for a lubricated
 joint, the film's and the asperities' force with their boundary friction
-(:func:`weftsim.kernel.lubricated.lubricated_force`).  For a dry frictionless joint it is ``contact_force_N``.
+(:func:`weftsim.physics.lubricated.lubricated_force`).  For a dry frictionless joint it is ``contact_force_N``.
 The design checks, ``compare``, the plots, the wear report and sweeps read it (:func:`joint_load`), so an
 oiled joint is judged by the load its film carries as a dry one by its contact's.
 
-Rows are reference-engine states (:func:`weftsim.reference.dynamics.initial_state` layout), as in
+Rows are reference-engine states (:func:`weftsim.model.dynamics.initial_state` layout), as in
 :mod:`weftsim.joint.lubrication`; the Exudyn rigid-body model measures the connector's force directly
 (:mod:`weftsim.exudyn_engine.sensors`).
 """
@@ -21,10 +21,10 @@ import numpy as np
 from numba import njit
 
 from weftsim.input.params import Scene
-from weftsim.kernel import chain as kc
-from weftsim.kernel import chain_f as kf
-from weftsim.kernel.joint import BEARING_RADIUS, friction_force, tangential_velocity
-from weftsim.kernel.lubricated import L_FX, L_FY, is_lubricated, lubricated_force
+from weftsim.physics import chain as kc
+from weftsim.physics import chain_f as kf
+from weftsim.physics.joint import BEARING_RADIUS, friction_force, tangential_velocity
+from weftsim.physics.lubricated import L_FX, L_FY, is_lubricated, lubricated_force
 from weftsim.post.results import JOINT_FORCE_CHANNELS, JOINT_FORCE_CHANNELS_F, LOAD_FALLBACK
 
 JOINT_FORCE, JOINT_FORCE_F = JOINT_FORCE_CHANNELS + JOINT_FORCE_CHANNELS_F

@@ -1,6 +1,6 @@
 """Finite-difference solution of Reynolds' equation of the finite journal bearing, with cavitation.
 
-Solves the dimensionless squeeze-velocity problem of :mod:`weftsim.kernel.film`,
+Solves the dimensionless squeeze-velocity problem of :mod:`weftsim.physics.film`,
 
     div(H^3 grad P) = -12 cos(phi - xi),   H = 1 - eps cos phi,   phi in [0, 2 pi), zeta in [-B/D, B/D],
 
@@ -31,7 +31,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 
-from weftsim.kernel.flow_factors import contact_factor, pressure_flow_factor
+from weftsim.physics.flow_factors import contact_factor, pressure_flow_factor
 
 MAPPING_FRACTION = 0.8  # the grid clusters as Sommerfeld's angle of eps_m = 0.8 eps
 # Grid of the table: 120 x 16 nodes over the half film.  Against 240 x 32 the force differs by
@@ -67,7 +67,7 @@ def operator(eps: float, half_width: float, n_phi: int, n_zeta: int, roughness: 
     """K (sparse, SPD), the node angles and the cell volumes of the half film zeta in [0, B/D].
 
     Unknown (i, j) = P at phi_i, zeta_j = j dz, j = 0..n_zeta-1 (P = 0 at j = n_zeta).  ``roughness``
-    = sigma / c: the average-flow conductance phi_x H^3 (:mod:`weftsim.kernel.flow_factors`).
+    = sigma / c: the average-flow conductance phi_x H^3 (:mod:`weftsim.physics.flow_factors`).
     """
     nodes, faces = _angles(eps, n_phi)
     dz = half_width / n_zeta
@@ -111,7 +111,7 @@ def solve(eps: float, xi: float, half_width: float, n_phi: int = N_PHI, n_zeta: 
     ``cavitation=False`` gives the full-Sommerfeld film (negative pressures kept); ``supply=True``
     holds P = 0 on the line of thickest film (phi = pi), Raimondi and Boyd's inlet condition.
     ``roughness`` = sigma / c > 0 solves Patir and Cheng's average-flow equation
-    div(phi_x H^3 grad P) = -12 Phi(c H / sigma) cos(phi - xi) (:mod:`weftsim.kernel.flow_factors`).
+    div(phi_x H^3 grad P) = -12 Phi(c H / sigma) cos(phi - xi) (:mod:`weftsim.physics.flow_factors`).
     """
     matrix, nodes, volume = operator(eps, half_width, n_phi, n_zeta, roughness)
     source = 12.0 * np.cos(nodes - xi)
@@ -192,11 +192,11 @@ RAIMONDI_BOYD = {
 
 def steady_load(eps: float, width: float, model: int) -> tuple[float, float]:
     """Sommerfeld number and attitude angle (deg) of a journal spinning at eccentricity ratio eps in a
-    still bearing of B/D = ``width``, from the kernel's film force (:func:`weftsim.kernel.film.film_force`).
+    still bearing of B/D = ``width``, from the kernel's film force (:func:`weftsim.physics.film.film_force`).
 
     Dimensionless: S = (R/c)^2 eta N / P does not depend on the numbers chosen here.
     """
-    from weftsim.kernel.film import film_force
+    from weftsim.physics.film import film_force
 
     radius, clearance, viscosity, omega = 0.01, 2e-5, 0.05, 100.0
     length = 2.0 * width * radius

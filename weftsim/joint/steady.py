@@ -2,7 +2,7 @@
 
 A journal of radius R spinning at omega (N = omega / 2 pi rev/s) in a still bearing of length L and radial
 clearance c carries a steady load W where the force of the joint's kernel balances it
-(:func:`weftsim.kernel.steady.steady_force`: oil film, asperities and their boundary friction, the dry law
+(:func:`weftsim.physics.steady.steady_force`: oil film, asperities and their boundary friction, the dry law
 beyond e = c; the same functions the transient engines integrate).  By symmetry that force depends on abs(e)
 alone (its direction turns with e), so abs(e) is the root of abs(f(abs(e))) = W (Brent's method; abs(f) grows
 with abs(e)), and the attitude angle is the angle between the load and the line of centres.  Then (Raimondi and
@@ -66,7 +66,7 @@ def regime_of(ratio: float) -> str:
 def joint_block(joint) -> np.ndarray:
     """The kernel's parameter block of a lubricated :class:`weftsim.input.params.ClearanceJoint`."""
     from weftsim.joint.contact import make_law
-    from weftsim.kernel.joint import joint_parameters
+    from weftsim.physics.joint import joint_parameters
 
     return joint_parameters(joint, make_law(joint))
 
@@ -77,8 +77,8 @@ def steady_point(joint, load: float, omega: float, viscosity: float, prm: np.nda
     from scipy.optimize import brentq
 
     from weftsim.joint.film_flow import flow_variables
-    from weftsim.kernel.joint import VISCOSITY
-    from weftsim.kernel.steady import steady_force
+    from weftsim.physics.joint import VISCOSITY
+    from weftsim.physics.steady import steady_force
 
     prm = (joint_block(joint) if prm is None else prm).copy()
     prm[VISCOSITY] = viscosity

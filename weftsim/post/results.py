@@ -136,7 +136,7 @@ def optional_channels(names) -> tuple[str, ...]:
     return out
 
 STATUSES = ("success", "failed")
-ENGINES = ("reference", "exudyn")
+ENGINES = ("reference", "exudyn")  # the built-in engines, what a result file records (weftsim.engines names them)
 
 
 def _as_channels(data: dict[str, np.ndarray], what: str) -> dict[str, np.ndarray]:
@@ -188,9 +188,9 @@ class RunResult:
         E.g. ``first_contact_time_s`` (true onset, located within the step) or None.
     plausibility : dict
         Counts of a broken contact history and the law-range warnings
-        (:meth:`weftsim.run.plausibility.Plausibility.as_dict`; not for the ideal mechanism), the design
-        checks before and after the run (``checks``, :mod:`weftsim.run.design_checks`) and every after-run
-        ``warnings``, filled by :func:`weftsim.run.guards.vet_result`; empty for a result no engine vetted.
+        (:meth:`weftsim.checks.plausibility.Plausibility.as_dict`; not for the ideal mechanism), the design
+        checks before and after the run (``checks``, :mod:`weftsim.checks.design_checks`) and every after-run
+        ``warnings``, filled by :func:`weftsim.checks.guards.vet_result`; empty for a result no engine vetted.
     path : dict
         The model and method that ran and why (``{"model": ..., "method": ..., "reason": ...}``):
         what the engine's automatic selection chose for this scene, or what the scene forced.
@@ -208,8 +208,9 @@ class RunResult:
     path: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        if self.engine not in ENGINES:
-            raise ValueError(f"engine must be one of {ENGINES}, got {self.engine!r}")
+        if self.engine not in ENGINES and not (isinstance(self.engine, str) and self.engine.isidentifier()):
+            raise ValueError(f"engine must be one of {ENGINES} or a plug-in engine's name (an identifier), "
+                             f"got {self.engine!r}")
         if self.status not in STATUSES:
             raise ValueError(f"status must be one of {STATUSES}, got {self.status!r}")
         object.__setattr__(self, "samples", _as_channels(self.samples, "samples"))

@@ -2,7 +2,7 @@
 
 A loom stops several times an hour (warp and weft breaks, ``[duty] stops_per_hour``) and starts again from
 rest.  Each stop is simulated on the current worn geometry, on the engine of the prediction, as two transients
-of the crank's prescribed motion (:func:`weftsim.kernel.chain.crank_motion`, the one drive law both engines
+of the crank's prescribed motion (:func:`weftsim.physics.chain.crank_motion`, the one drive law both engines
 read):
 
 1. **run-down**: one revolution at full speed from the centred journal (not counted, as an update's settling
@@ -66,14 +66,15 @@ def transient_scenes(scene: Scene) -> tuple[tuple[Scene, float, float], tuple[Sc
 
 def _window(run_scene: Scene, t_from: float, t_to: float, engine: str) -> RunWear:
     """Archard wear of ``run_scene``'s run on ``engine`` over [t_from, t_to] (joint E)."""
-    from weftsim.reference.dynamics import pack_parameters
+    from weftsim.model.dynamics import pack_parameters
     from weftsim.wear.archard import rows_from_contact, run_wear, wear_from_rows
 
     if engine == "reference":
-        from weftsim import reference
+        from weftsim.engines import simulate
+        from weftsim.wear.extrapolate import _quiet
 
         rows = {}
-        result = reference.solve(run_scene, step_states=lambda *a: rows.update(steps=a))
+        result = simulate(run_scene, "reference", observe=lambda *a: rows.update(steps=a), on_warning=_quiet)
         if not result.ok:
             raise WearError(f"the stop-start transient ({run_scene.drive.law.replace('_', '-')}) failed on the "
                             f"reference engine: {result.message}")

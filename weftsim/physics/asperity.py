@@ -20,10 +20,10 @@ the film is thinnest, h_min = c - |e|).  The asperities push the journal back al
 
 over the arc where h < 4 sigma (nothing when h_min >= 4 sigma), up to |e| = c where the mean planes
 touch (:func:`asperity_load`; beyond c the bulk contact of the dry law takes the load over,
-:mod:`weftsim.kernel.lubricated`).  The force depends on |e| only: it has
+:mod:`weftsim.physics.lubricated`).  The force depends on |e| only: it has
 a potential U_a(|e|) = R_j L_b integral Pi(h(theta)) dtheta with Pi(h) = integral_h^(4 sigma) p_a,
 in closed form K E* sigma 4.4086e-5 (4 - H)^7.804 / 7.804, so the energy balance books it as stored,
-not dissipated (the asperities' hysteresis, :mod:`weftsim.kernel.lubricated`, is the dissipated part).  The integrand is symmetric and vanishes at theta_max as (theta_max - theta)^6.8 (the
+not dissipated (the asperities' hysteresis, :mod:`weftsim.physics.lubricated`, is the dissipated part).  The integrand is symmetric and vanishes at theta_max as (theta_max - theta)^6.8 (the
 load's, the stiffness's as ^5.8): the integrals over [0, theta_max] are a Gauss-Jacobi rule of :data:`NODES`
 points for the weight (theta_max - theta)^5.804, exact for that factor times a polynomial, so 8 points
 reach the 1e-11 of 24 Gauss-Legendre points (which converge only algebraically at that endpoint zero) at a
@@ -102,7 +102,7 @@ def asperity_load(coef: float, sigma: float, clearance: float, ecc: float, radiu
 
     ``coef`` = K E* (Pa), ``sigma`` the combined RMS roughness (m), ``clearance`` c (m), ``radius`` R_j
     and ``length`` L_b (m).  Beyond |e| = c the values at c (the dry contact law takes the load over
-    there: :func:`weftsim.kernel.lubricated.asperity_share`).
+    there: :func:`weftsim.physics.lubricated.asperity_share`).
     """
     if coef <= 0.0:
         return 0.0, 0.0

@@ -14,7 +14,7 @@ their flow simulations.  For isotropic roughness (Peklenik number gamma = 1), H 
                                                                of Wu and Zheng, J. Tribol. 111, 1989)
 
 so that dh_T/dx = Phi(H) dh/dx and dh_T/dt = Phi(H) dh/dt: the right-hand side keeps Booker's form
-(the squeeze velocity V alone, :mod:`weftsim.kernel.film`), scaled by Phi(H) at each point.
+(the squeeze velocity V alone, :mod:`weftsim.physics.film`), scaled by Phi(H) at each point.
 weftsim knows one combined roughness of the joint and takes the two surfaces as alike (equal RMS and
 structure): then the shear-flow factor phi_s = (sigma_1/sigma)^2 Phi_s - (sigma_2/sigma)^2 Phi_s cancels, and so does
 the shear-stress factor phi_fs of the friction (Patir and Cheng 1979, eq. 16 and 30).

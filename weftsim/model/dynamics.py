@@ -1,7 +1,7 @@
 """Constants of the clearance-mode equations, their parameter array, and the initial state.
 
 The equations themselves (members 1-3 prescribed by theta = omega t, members 4-8 a 2-DOF chain
-q = (a, psi) forced through the contact at E) are written once, in :mod:`weftsim.kernel.chain`;
+q = (a, psi) forced through the contact at E) are written once, in :mod:`weftsim.physics.chain`;
 both paths of the reference engine integrate that compiled right-hand side (the scipy path is
 the independent integrator check over the same physics) and its output channels come from it.
 This module turns a scene into the kernel's numbers (:class:`ChainConstants`,
@@ -22,12 +22,12 @@ from numba import njit
 
 from weftsim.mechanism import kinematics as kin
 from weftsim.joint.contact import make_law
-from weftsim.kernel import chain as kc
-from weftsim.kernel import chain_f as kf
-from weftsim.kernel.joint import N_JOINT, joint_parameters
-from weftsim.kernel.wear import wear_block
+from weftsim.physics import chain as kc
+from weftsim.physics import chain_f as kf
+from weftsim.physics.joint import N_JOINT, joint_parameters
+from weftsim.physics.wear import wear_block
 from weftsim.input.params import Scene
-from weftsim.reference.ideal import sector_chain_inertia
+from weftsim.model.ideal import sector_chain_inertia
 
 if TYPE_CHECKING:
     from types import ModuleType
@@ -87,7 +87,7 @@ class ChainConstants:
 
 
 def _chain_block(p: ChainConstants) -> np.ndarray:
-    """The chain's constants of the kernel's parameter array (indices of :mod:`weftsim.kernel.chain`)."""
+    """The chain's constants of the kernel's parameter array (indices of :mod:`weftsim.physics.chain`)."""
     out = np.zeros(kc.N_PARAMETERS)
     out[kc.OMEGA], out[kc.TAN_BETA] = p.omega, p.tan_beta
     out[kc.COS_OE0], out[kc.SIN_OE0] = math.cos(p.rocker_arm_angle), math.sin(p.rocker_arm_angle)
@@ -104,7 +104,7 @@ DRIVE_LAWS = {"constant": kc.CONSTANT_SPEED, "run_down": kc.RUN_DOWN, "start_up"
 
 def drive_entries(scene: Scene) -> tuple[float, float, float, float]:
     """The drive law's entries of the kernel's parameter array (law, t0, ramp, theta0;
-    :func:`weftsim.kernel.chain.crank_motion`): zeros at constant speed."""
+    :func:`weftsim.physics.chain.crank_motion`): zeros at constant speed."""
     drive = scene.drive
     if drive.law == "constant":
         return 0.0, 0.0, 0.0, 0.0
@@ -118,7 +118,7 @@ def drive_entries(scene: Scene) -> tuple[float, float, float, float]:
 
 
 def topology(scene: Scene) -> int:
-    """The kernel's topology (:mod:`weftsim.kernel.chain_f`): E_ONLY (also the ideal mechanism), F_ONLY, E_AND_F."""
+    """The kernel's topology (:mod:`weftsim.physics.chain_f`): E_ONLY (also the ideal mechanism), F_ONLY, E_AND_F."""
     if scene.joint_f.is_ideal:
         return kf.E_ONLY
     return kf.F_ONLY if scene.joint.is_ideal else kf.E_AND_F
@@ -127,8 +127,8 @@ def topology(scene: Scene) -> int:
 def pack_parameters(scene: Scene) -> np.ndarray:
     """Every number the kernel needs for this scene: the joint block at E, the chain's constants,
     the joint block at F (zeros while F is ideal), the topology, J_FG and J4; then the wear tables
-    of the worn joints (:mod:`weftsim.kernel.wear`): E's at ``kc.WEAR_E``, then F's (E's block is the
-    empty ``[0, 0]`` when only F is worn; :func:`weftsim.kernel.chain_f.wear_start_f`)."""
+    of the worn joints (:mod:`weftsim.physics.wear`): E's at ``kc.WEAR_E``, then F's (E's block is the
+    empty ``[0, 0]`` when only F is worn; :func:`weftsim.physics.chain_f.wear_start_f`)."""
     out = np.zeros(kf.N_PARAMETERS)
     out[:kc.N_PARAMETERS] = _chain_block(ChainConstants.from_scene(scene))
     if not scene.joint.is_ideal or scene.joint_f.is_ideal:
@@ -168,7 +168,7 @@ def eccentricity(xp: ModuleType | None, p: ChainConstants, t: ArrayLike, a: Arra
                  dpsi: ArrayLike) -> tuple[np.ndarray | float, ...]:
     """Eccentricity e = P_j - P_b, its rate and the bearing's motion, over arrays (broadcast).
 
-    :func:`weftsim.kernel.chain.eccentricity` at every element (``xp`` is ignored: kept for callers
+    :func:`weftsim.physics.chain.eccentricity` at every element (``xp`` is ignored: kept for callers
     that passed the numpy namespace).
 
     Returns
@@ -184,7 +184,7 @@ def eccentricity(xp: ModuleType | None, p: ChainConstants, t: ArrayLike, a: Arra
 
 
 def penetration(p: ChainConstants, t: float, y: np.ndarray) -> tuple[float, float]:
-    """delta = |e| - c (m) and delta_dot = e_dot . n (m/s) of a state y (:func:`weftsim.kernel.chain.penetration`)."""
+    """delta = |e| - c (m) and delta_dot = e_dot . n (m/s) of a state y (:func:`weftsim.physics.chain.penetration`)."""
     return kc.penetration(_geometry_parameters(p), float(t), np.asarray(y[:4], dtype=float))
 
 
@@ -239,7 +239,7 @@ def initial_state(scene: Scene) -> np.ndarray:
     and the two integrated energy terms 0 (the same with clearance at F alone: psi is then the
     rod's angle about E of the rocker).
     With clearance at E and F (4 coordinates) the state is [a, Y, Z, psi, a', Y', Z', psi', W3, D],
-    (Y, Z) the rod's centre of mass (:mod:`weftsim.kernel.chain_f`).
+    (Y, Z) the rod's centre of mass (:mod:`weftsim.physics.chain_f`).
     """
     omega = scene.drive.speed
     if scene.drive.law != "constant":

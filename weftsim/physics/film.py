@@ -86,7 +86,7 @@ N_U, U_MAX = 29, 0.9
 N_XI = 49
 N_WIDTH, WIDTH_MIN, WIDTH_MAX = 9, 0.25, 4.0
 LOG_WIDTH_STEP = math.log(WIDTH_MAX / WIDTH_MIN) / (N_WIDTH - 1)
-# Rough surfaces (Patir and Cheng's average flow, weftsim.kernel.flow_factors): the fourth axis is
+# Rough surfaces (Patir and Cheng's average flow, weftsim.physics.flow_factors): the fourth axis is
 # r = sigma / (h_min + sigma) = 1 / (1 + h_min / sigma), uniform on [0, R_MAX]: r = 0 the smooth film,
 # R_MAX = 0.8 a minimum film of sigma / 4.
 N_R, R_MAX = 9, 0.8
