@@ -64,6 +64,10 @@ def transient_scenes(scene: Scene) -> tuple[tuple[Scene, float, float], tuple[Sc
     return (run_down, t0, end_down), (start_up, 0.0, end_up)
 
 
+def _quiet(text: str) -> None:
+    """A transient's before-run warnings: the wear command reports the scene's design checks once."""
+
+
 def _window(run_scene: Scene, t_from: float, t_to: float, engine: str) -> RunWear:
     """Archard wear of ``run_scene``'s run on ``engine`` over [t_from, t_to] (joint E)."""
     from weftsim.model.dynamics import pack_parameters
@@ -71,7 +75,6 @@ def _window(run_scene: Scene, t_from: float, t_to: float, engine: str) -> RunWea
 
     if engine == "reference":
         from weftsim.engines import simulate
-        from weftsim.wear.extrapolate import _quiet
 
         rows = {}
         result = simulate(run_scene, "reference", observe=lambda *a: rows.update(steps=a), on_warning=_quiet)
@@ -118,7 +121,7 @@ def with_stops(scene: Scene, wear: RunWear, revolutions: int, engine: str) -> tu
     duty = scene.duty
     if not duty.stops_per_hour > 0.0:
         return wear, {}
-    from weftsim.wear.extrapolate import SECONDS_PER_HOUR
+    from weftsim.wear.updates import SECONDS_PER_HOUR
 
     down, up = stop_start_wear(scene, engine)
     revs_per_hour = scene.drive.speed / (2.0 * math.pi) * SECONDS_PER_HOUR
