@@ -60,6 +60,7 @@ SECTIONS: tuple[tuple[str, str, str], ...] = (
     ("joint_*.restitution", "physics.md#3-contact-force-laws", "physics §3"),
     ("joint_*.", "physics.md#2-clearance-joint-at-e-flores-ambrósio-formulation", "physics §2"),
     ("drive.", "physics.md#4-dynamics", "physics §4"),
+    ("duty.", "wear.md#12-the-looms-duty-cycle-and-its-life", "wear §12"),
     ("solver.reference.", "reference-solver.md#3-integration", "reference solver §3"),
     ("solver.exudyn.", "clearance-joint.md#the-loom-in-exudyn-mechanism-py", "Exudyn engine"),
     ("output.", "physics.md#4-dynamics", "physics §4"),
@@ -89,6 +90,9 @@ TABLES: dict[str, str] = {
     "joint_f.wear": "Archard wear at F (`weftsim wear`), all optional; with a clearance at F alone, F takes "
                     "the keys `[joint_e.wear]` gives that it does not give itself.",
     "drive": "The crank's constant speed and the length of a run. Required.",
+    "duty": "How the loom runs (`weftsim wear`): stops for warp and weft breaks, each a simulated run-down and "
+            "start-up whose wear is added per running hour, and the scheduled hours that turn running hours into "
+            "calendar time. All optional.",
     "solver.reference": "The reference engine's integrator; the defaults are the fast path "
                         "([Performance](performance.md)).",
     "solver.exudyn": "The Exudyn engine's model and solver; the defaults are the fast path.",

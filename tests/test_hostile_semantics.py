@@ -313,6 +313,9 @@ def test_a_wear_update_failing_mid_way_keeps_every_update_before_it(tmp_path, mo
     table = np.genfromtxt(tmp_path / "wear.csv", delimiter=",", names=True)
     assert table["hours"].size == 2 and table["hours"][1] > 0.0
     data = json.loads((tmp_path / "wear.json").read_text())
+    # how far it got, in hours and clearance (issue 31)
+    assert f"after {data['hours_reached']:.6g} h at an effective clearance of " \
+           f"{data['final_effective_clearance_e_mm']:.4g} mm at E" in str(error.value), str(error.value)
     assert data["updates"] == 2 and "made to fail" in data["failure"] and not data["complete"]
 
 

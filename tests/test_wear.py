@@ -50,7 +50,7 @@ def test_closed_form_constant_load_and_sliding():
                                               wear.bearing_volume),
                                              (wear.journal, joint.journal_radius, k.journal_hardness,
                                               wear.journal_volume)):
-        exact = k.wear_coefficient * load * speed * duration / hardness
+        exact = k.contact_wear_coefficient * load * speed * duration / hardness
         # Sums of ~2000 positive terms: round-off ~1e-13 relative.
         assert volume == pytest.approx(exact, rel=1e-12)
         assert profile.sum() * w * radius * cell == pytest.approx(exact, rel=1e-12)
@@ -105,8 +105,8 @@ def test_conservation_over_a_run(reference_run):
     cell = 2.0 * math.pi / k.profile_points
     assert integral > 0.0
     # ~5e4 terms summed in two orders: round-off ~1e-13 relative.
-    assert wear.bearing_volume == pytest.approx(k.wear_coefficient / k.bearing_hardness * integral, rel=1e-12)
-    assert wear.journal_volume == pytest.approx(k.wear_coefficient / k.journal_hardness * integral, rel=1e-12)
+    assert wear.bearing_volume == pytest.approx(k.contact_wear_coefficient / k.bearing_hardness * integral, rel=1e-12)
+    assert wear.journal_volume == pytest.approx(k.contact_wear_coefficient / k.journal_hardness * integral, rel=1e-12)
     assert wear.bearing.sum() * j.bearing_length * j.bearing_radius * cell == pytest.approx(wear.bearing_volume,
                                                                                           rel=1e-12)
     assert wear.journal.sum() * j.bearing_length * j.journal_radius * cell == pytest.approx(wear.journal_volume,
@@ -170,7 +170,7 @@ def test_hours_scale_exactly_as_hardness_over_k(short_prediction):
     only within that scatter.
     """
     scene, updates = short_prediction
-    wear = dc.replace(scene.joint.wear, wear_coefficient=2.0 * scene.joint.wear.wear_coefficient)
+    wear = dc.replace(scene.joint.wear, wear_coefficient=2.0 * scene.joint.wear.contact_wear_coefficient)
     doubled = predict(dc.replace(scene, joint=dc.replace(scene.joint, wear=wear)), 3.0)
     for a, b in zip(updates, doubled):
         assert b.hours == pytest.approx(0.5 * a.hours, rel=1e-12)  # round-off of the sums of N / (rev/h)
@@ -186,7 +186,8 @@ def test_cli_wear_resumes_and_refuses_bad_input(tmp_path):
     first = run_cli("wear", REFERENCE, "--hours", 2, "-o", out, "--no-plot")
     assert first.returncode == 0, first.stderr
     n1 = json.loads((out / "wear.json").read_text())["updates"]
-    second = run_cli("wear", REFERENCE, "--hours", 4, "--limit-clearance-mm", 0.26, "-o", out, "--no-plot")
+    second = run_cli("wear", REFERENCE, "--hours", 4, "--limit-clearance-mm", 0.26, "--past-limit", "-o", out,
+                     "--no-plot")
     assert second.returncode == 0, second.stderr
     assert "resuming" not in first.stderr
     assert f"resuming the prediction stored in {out}: {n1} updates kept, up to 2 h" in second.stderr  # says so
@@ -208,6 +209,34 @@ def test_cli_wear_resumes_and_refuses_bad_input(tmp_path):
         bad = run_cli("wear", REFERENCE, "--hours", 1, "-o", tmp_path / "x", *args)
         assert bad.returncode == 2 and words in bad.stderr and "Traceback" not in bad.stderr
         assert len(bad.stderr.strip().splitlines()) == 1
+
+
+def test_cli_wear_ends_at_the_limit_unless_past_limit(tmp_path):
+    """With --limit-clearance-mm the prediction ends where the effective clearance reaches the limit (the
+    crossing update cut at it, to the bisection's round-off) and its last line gives the hours to it;
+    --past-limit goes on to --hours; --past-limit without both is refused with one line."""
+    out = tmp_path / "w"
+    ended = run_cli("wear", REFERENCE, "--hours", 4, "--limit-clearance-mm", 0.26, "-o", out, "--no-plot")
+    assert ended.returncode == 0, ended.stderr
+    data = json.loads((out / "wear.json").read_text())
+    assert 0.0 < data["hours_to_limit"] < 4.0
+    assert data["hours_reached"] == pytest.approx(data["hours_to_limit"], rel=1e-9)
+    # the crossing update is cut by bisection to 1e-18 of its N: the clearance is the limit to round-off
+    assert data["final_effective_clearance_e_mm"] == pytest.approx(0.26, rel=1e-9)
+    assert "reaches the limit 0.26 mm" in data["ended"]
+    last = ended.stdout.strip().splitlines()[-1]
+    days = data["calendar_days_to_limit_e"]  # 24 h a day, 7 days a week, no stops: hours / 24
+    assert days == pytest.approx(data["hours_to_limit"] / 24.0, rel=1e-12)
+    assert last.startswith(f"  at E: {data['hours_to_limit']:.6g} h of running = {days:.4g} calendar days"), last
+    table = np.genfromtxt(out / "wear.csv", delimiter=",", names=True)
+    assert np.all(table["effective_clearance_e_mm"] < 0.26)  # no update beyond it is simulated
+    past = run_cli("wear", REFERENCE, "--hours", 4, "--limit-clearance-mm", 0.26, "--past-limit", "-o",
+                   tmp_path / "p", "--no-plot")
+    assert past.returncode == 0, past.stderr
+    data = json.loads((tmp_path / "p" / "wear.json").read_text())
+    assert data["hours_reached"] == pytest.approx(4.0) and data["final_effective_clearance_e_mm"] > 0.26
+    bad = run_cli("wear", REFERENCE, "--hours", 4, "--past-limit", "-o", tmp_path / "x")
+    assert bad.returncode == 2 and "--past-limit" in bad.stderr and len(bad.stderr.strip().splitlines()) == 1
 
 
 def _hours_to(clearance: float, fraction: float, revolutions: int) -> float:

@@ -93,7 +93,7 @@ def test_rescaled_hours_equal_a_rerun(reference_scene, tmp_path):
     A factor of 4 is exact in floating point, so the rerun takes the same geometries bit for bit; other
     factors change the last bits of the worn depths, which the chaotic impact sequence turns into another
     draw (the ensemble's chaos runs sample exactly that)."""
-    k0 = reference_scene.joint.wear.wear_coefficient
+    k0 = reference_scene.joint.wear.contact_wear_coefficient
     centre = run_job(reference_scene, LIMIT, str(tmp_path / "a"))
     rerun = run_job(_with_k(reference_scene, 4.0 * k0), LIMIT, str(tmp_path / "b"))
     assert centre["error"] is None and rerun["error"] is None
@@ -113,7 +113,7 @@ def test_ensemble_combines_rescaling_chaos_and_design(reference_scene, tmp_path)
     ens = combine(reference_scene, parsed, dynamic, nodes, results, 500, LIMIT, seed=2)
     k = ens["values"]["joint_e.wear.wear_coefficient"]
     chaos = np.array([hours_at(results[n], ens["levels"][-1:])[0] for n in ("centre", "chaos_1", "chaos_2")])
-    expected = chaos.mean() * reference_scene.joint.wear.wear_coefficient / k
+    expected = chaos.mean() * reference_scene.joint.wear.contact_wear_coefficient / k
     ratio = ens["hours"][:, -1] / expected
     # exp(log(h)) and the products: round-off ~1e-15 relative
     assert np.all(np.min(np.abs(ratio[:, None] - chaos / chaos.mean()), axis=1) < 1e-12)

@@ -118,7 +118,7 @@ def test_the_exudyn_update_integrates_archard_over_its_own_contact_channels():
     w = scene.joint.wear
     ex, response = exudyn_update(scene, bearing, journal)
     ref = engine_update(scene, bearing, journal, "reference")[0]
-    cell_b = w.bearing_hardness ** -1 * w.wear_coefficient
+    cell_b = w.bearing_hardness ** -1 * w.contact_wear_coefficient
     # the profiles' volume: sum(h) L R dpsi = (k / H) W to round-off (the deposit conserves it)
     dpsi = 2 * math.pi / w.profile_points
     volume_b = ex.bearing.sum() * scene.joint.bearing_length * scene.joint.bearing_radius * dpsi

@@ -159,7 +159,7 @@ def test_the_rows_at_f_carry_f_s_contact_force():
                                                                                             rel=1e-12)
     assert wear.journal.sum() * j.bearing_length * j.journal_radius * cell == pytest.approx(wear.journal_volume,
                                                                                             rel=1e-12)
-    assert wear.bearing_volume == pytest.approx(j.wear.wear_coefficient / j.wear.bearing_hardness
+    assert wear.bearing_volume == pytest.approx(j.wear.contact_wear_coefficient / j.wear.bearing_hardness
                                                 * wear.sliding_work, rel=1e-15)
 
 
@@ -168,9 +168,9 @@ def both(tmp_path_factory):
     """A prediction of E and F together over 1 h, F's wear coefficient twice E's, with a clearance limit."""
     scene = _scene("ef")
     scene = dc.replace(scene, joint_f=dc.replace(scene.joint_f, wear=dc.replace(
-        scene.joint_f.wear, wear_coefficient=2.0 * scene.joint.wear.wear_coefficient)))
+        scene.joint_f.wear, wear_coefficient=2.0 * scene.joint.wear.contact_wear_coefficient)))
     outdir = tmp_path_factory.mktemp("wear") / "ef"
-    data = predict_to_directory(scene, 1.0, outdir, limit=0.253e-3)
+    data = predict_to_directory(scene, 1.0, outdir, limit=0.253e-3, past_limit=True)
     return scene, outdir, data
 
 

@@ -260,6 +260,11 @@ def simulate(scene: Scene | str | os.PathLike, engine: str = "auto", *,
         raise ArgumentError(f"simulate: progress must be None or a function called with the completed fraction "
                             f"(e.g. lambda f: print(f)), got {type(progress).__name__} {progress!r:.40}")
     scene = _as_scene(scene)
+    if any(getattr(scene, attr).lubrication is not None and getattr(scene, attr).lubrication.has_oil
+           for attr in ("joint", "joint_f")):
+        from weftsim.joint.bearing import resolve_scene
+
+        scene = resolve_scene(scene)  # the oil's viscosity at the film temperature of this scene's operating point
     for text in warnings_of(before_run(scene)):
         if on_warning is None:
             warnings.warn(text, PlausibilityWarning, stacklevel=2)

@@ -48,7 +48,10 @@ def add_flags(p: argparse.ArgumentParser, positive: Callable[[Callable[[str], fl
                    "or exudyn (its kinematic tree; default output out/<scene name>/wear-exudyn; docs/wear.md)")
     p.add_argument("--limit-clearance-mm", type=positive(float),
                    help="clearance limit for every wearing joint: wear.json gives the hours at which each joint's "
-                        "effective clearance reaches it and the first of them (the joint to service first)")
+                        "effective clearance reaches it and the first of them (the joint to service first); the "
+                        "prediction ends there (the update that crosses it is cut at it) unless --past-limit")
+    p.add_argument("--past-limit", action="store_true",
+                   help="with --limit-clearance-mm and --hours: go on wearing past the limit up to --hours")
     p.add_argument("--no-plot", action="store_true", help="skip the figures")
     from weftsim.wear.uncertain import ALLOWED
 
@@ -99,6 +102,9 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
         raise CliError("--hours or --limit-clearance-mm is required (or --uncertain KEY=DISTRIBUTION with "
                        "--limit-clearance-mm for an ensemble)")
     until_limit = args.hours is None  # predict until the clearance limit
+    past_limit = bool(getattr(args, "past_limit", False))
+    if past_limit and (limit is None or until_limit):
+        raise CliError("--past-limit goes on wearing past --limit-clearance-mm up to --hours: give both")
     hours = MAX_HOURS if until_limit else args.hours
     check_request(scene, hours, args.engine, limit)  # a WearError is one line, exit 2
     outdir = prepare_directory(outdir, args.force, scene, kind="wear")
@@ -112,7 +118,9 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     joints = wearing_joints(scene)
     first = joint_of(scene, joints[0]).wear
     at = " and ".join(j.upper() for j in joints)
-    span = f"until the clearance reaches {args.limit_clearance_mm:g} mm" if until_limit else f"over {hours:g} h"
+    span = (f"until the clearance reaches {args.limit_clearance_mm:g} mm" if until_limit else f"over {hours:g} h"
+            if limit is None or past_limit else f"over {hours:g} h or until the clearance reaches "
+            f"{args.limit_clearance_mm:g} mm")
     print(f"scene {scene.name}, wear at {at} {span} on the {args.engine} engine; each update simulates "
           f"{first.settle_revolutions} + {first.revolutions_per_update} revolutions "
           f"(~{_duration(update_time(scene, args.engine))}), the update interval grows each clearance by at most "
@@ -126,7 +134,7 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
         try:
             data = predict_to_directory(scene, hours, outdir, args.engine, limit, progress,
                                         stop=lambda: state["signal"] is not None, figures=not args.no_plot,
-                                        force=args.force, until_limit=until_limit)
+                                        force=args.force, until_limit=until_limit, past_limit=past_limit)
         except StateMismatch as exc:
             raise CliError(str(exc)) from None
         except WearError as exc:  # the updates before it are written (the message says where)
@@ -147,24 +155,44 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
                   f"sliding-weighted mean load {data[f'sliding_weighted_mean_load_{j}_N']:.4g} N (the time mean is "
                   f"{data[f'time_mean_load_{j}_N']:.4g} N) gives {data[f'archard_volume_{j}_mm3']:.4g} mm^3; the "
                   f"profiles hold {data[f'profile_volume_{j}_mm3']:.4g} mm^3")
-    if limit is not None:
-        reached = data.get("hours_to_limit")
-        each = ", ".join(f"{j.upper()} " + (f"{data[f'hours_to_limit_{j}']:.6g} h"
-                                           if data.get(f"hours_to_limit_{j}") is not None else "not reached")
-                         for j in joints)
-        print(f"  clearance limit {args.limit_clearance_mm:g} mm: reached first at {data['limit_joint'].upper()} "
-              f"after {reached:.6g} h ({each})" if reached is not None else f"  {data['note']}")
     for path in data["files"].values():
         print(f"  wrote {path}")
     if data.get("ended"):
         asked = "" if until_limit else f" of the {hours:g} asked for"
-        print(f"  the prediction ends at {data['hours_reached']:.6g} h{asked}: {data['ended']}; nothing beyond "
-              "it is predicted")
+        at = ", ".join(f"{data[f'final_effective_clearance_{j}_mm']:.4g} mm at {j.upper()}" for j in joints)
+        print(f"  the prediction ends at {data['hours_reached']:.6g} h{asked} (effective clearance {at}): "
+              f"{data['ended']}; nothing beyond it is predicted")
+    if limit is not None:  # the last lines: what a planner reads
+        for line in limit_lines(data, joints):
+            print(line)
+    if data.get("ended"):
         return 0
     if not data["complete"]:
         raise CliError(f"interrupted: stopped after {data['hours_reached']:.6g} h; the state is in {outdir}: run the "
                         "same command again to resume", 130)
     return 0
+
+
+def limit_lines(data: dict, joints: list[str]) -> list[str]:
+    """The terminal's last lines of a prediction with a clearance limit: the hours to it at each joint (and the
+    calendar days where ``wear.json`` has them), or why it was not reached."""
+    limit = data["limit_clearance_mm"]
+    lines = []
+    for j in joints:
+        hours = data.get(f"hours_to_limit_{j}")
+        if hours is None:
+            lines.append(f"  at {j.upper()}: the limit {limit:g} mm is not reached (effective clearance "
+                         f"{data[f'final_effective_clearance_{j}_mm']:.4g} mm after {data['hours_reached']:.6g} h)")
+            continue
+        days = data.get(f"calendar_days_to_limit_{j}")
+        when = "" if days is None else f" of running = {days:.4g} calendar days ({data['duty_text']})"
+        first = " (first)" if len(joints) > 1 and data.get("limit_joint") == j else ""
+        share = data.get(f"stop_start_share_{j}") or 0.0
+        stops = f"; {100 * share:.3g} % of the wear from stop-starts" if data.get("stops_per_hour") else ""
+        lines.append(f"  at {j.upper()}{first}: {hours:.6g} h{when} to the limit {limit:g} mm{stops}")
+    if data.get("hours_to_limit") is None and data.get("note"):
+        lines.append(f"  {data['note']}")
+    return lines
 
 
 def _stored_updates(outdir: Path, scene: Scene, force: bool) -> list:
@@ -242,6 +270,20 @@ def run_ensemble(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     if reach["fraction"] < 1.0 and data.get("hours_of_those_reaching"):
         print("  of those reaching it: " + ", ".join(f"{name} {text_hours(q['hours'], horizon)}" for name, q in
                                                      data["hours_of_those_reaching"].items()))
+    days = data["calendar_days_to_limit"]
+    print(f"  calendar days to {args.limit_clearance_mm:g} mm ({data['duty_text']}): " + ", ".join(
+        f"{name} {text_hours(days[name]['hours'], data['horizon_calendar_days'])[:-2]} d" for name in ("p10", "p50", "p90")))
+    stops = data.get("stop_start_share")
+    if stops:
+        print(f"  wear from stop-starts: {100 * stops['median']:.3g} % of the worn volume at the median design point "
+              f"({100 * stops['min']:.3g} - {100 * stops['max']:.3g} % over the {len(stops['by_design_point'])} "
+              "simulated predictions)")
+    if reach["fraction"] == 0.0:
+        print(f"  shares of the spread: none (no sample reaches {args.limit_clearance_mm:g} mm within {horizon:g} h: "
+              "the ranks are all tied)")
+        for path in data["files"].values():
+            print(f"  wrote {path}")
+        return 0
     if any(v["share"] > 0.0 for v in data["shares"].values()):
         print("  shares of the spread: " + ", ".join(f"{k} {100 * v['share']:.0f} %" for k, v in
                                                      sorted(data["shares"].items(), key=lambda kv: -kv[1]["share"])))

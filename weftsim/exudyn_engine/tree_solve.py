@@ -185,6 +185,21 @@ def tree_states(data: dict, n: int) -> tuple[np.ndarray, ...]:
     return np.zeros(0), states, np.zeros(0), np.zeros(0)
 
 
+def crank_motions(scene: Scene, t: np.ndarray) -> tuple:
+    """(theta, theta_dot, theta_ddot) at the times ``t`` and (theta, theta_dot) at 0 of the scene's drive law
+    (:func:`weftsim.physics.chain.crank_motion`, the one definition): omega t, omega, 0 at constant speed."""
+    omega = scene.drive.speed
+    if scene.drive.law == "constant":
+        return omega * t, omega, 0.0, 0.0, omega
+    from weftsim.physics.chain import crank_motion
+    from weftsim.model.dynamics import pack_parameters
+
+    prm = pack_parameters(scene)
+    motion = np.array([crank_motion(prm, float(x)) for x in t]).reshape(-1, 3)
+    start = crank_motion(prm, 0.0)
+    return motion[:, 0], motion[:, 1], motion[:, 2], start[0], start[1]
+
+
 def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
     """All channels at the stored steps from the sensors' data (rows cut to a common length)."""
     scene = model.scene
@@ -204,11 +219,11 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
     f_b = force[:, 1:3]  # F_N n - F_T t, the force on the bearing
     f_n, m_b, friction_power = force[:, 3], force[:, 4], force[:, 5]
     q3 = f_b[:, 0] * db_y + f_b[:, 1] * db_z + m_b * dphi
-    theta = omega * t
+    theta, omega, acceleration, theta0, omega0 = crank_motions(scene, t)  # omega t, omega, 0 at constant speed
     j13, dj13 = crank_side_inertia(theta, scene)
     u13, du13 = crank_side_potential(theta, scene)
-    j13_0, _ = crank_side_inertia(0.0, scene)
-    u13_0, _ = crank_side_potential(0.0, scene)
+    j13_0, _ = crank_side_inertia(theta0, scene)
+    u13_0, _ = crank_side_potential(theta0, scene)
     kin48, pot48 = chain_energy(p, a, psi, da, dpsi)
     law = make_law(scene.joint)
     inside = delta > 0.0
@@ -255,7 +270,8 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
         "rapier_displacement_m": ratio * (a - initial_state(scene)[0]),
         "rapier_velocity_m_s": ratio * da,
         "rapier_acceleration_m_s2": ratio * q_tt[:, 1],
-        "driving_torque_Nm": 0.5 * dj13 * omega**2 + du13 - q3,
+        "driving_torque_Nm": 0.5 * dj13 * omega**2 + du13 - q3 + (j13 * acceleration if scene.drive.law != "constant"
+                                                                  else 0.0),
         "contact_force_N": f_n,
         "penetration_m": delta,
         "eccentricity_y_m": ecc_y,
@@ -265,7 +281,7 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
         "kinetic_energy_J": kin13 + kin48,
         "potential_energy_J": u13 + pot48,
         "contact_energy_J": energy,
-        "driving_work_J": kin13 + u13 - (0.5 * float(j13_0) * omega**2 + float(u13_0)) + drawn,
+        "driving_work_J": kin13 + u13 - (0.5 * float(j13_0) * omega0**2 + float(u13_0)) + drawn,
         "dissipated_energy_J": dissipated,
         "penetration_rate_m_s": rate,
     }

@@ -113,20 +113,35 @@ class Material:
         return (1.0 - self.poisson_ratio**2) / self.youngs_modulus
 
 
+WEAR_REGIMES = ("boundary", "dry")  # of the solid contact (the dry law's load): weftsim.wear.regimes
+
+
 @dataclass(frozen=True)
 class WearModel:
     """Archard wear of a clearance joint and the cycle extrapolation that integrates it (docs/wear.md).
 
     Archard's law: the volume a surface of hardness H loses is V = k F_N s / H (Archard, J. Appl.
-    Phys. 24, 1953), with the dimensionless wear coefficient k of the pair and the sliding distance s.
+    Phys. 24, 1953), with the dimensionless wear coefficient k of the pair and the sliding distance s;
+    k / H is the specific wear rate (mm^3/(N m) with H in N/mm^2 and s in m, times 1e3).  k depends on the
+    regime of the contact (docs/wear.md section 5, :mod:`weftsim.wear.regimes`, with the tables it comes from):
+
+    - the **solid contact** (the dry law's load beyond e = c, the only load of a joint without an oil film)
+      wears with ``dry_wear_coefficient`` (unlubricated metal on metal) or ``boundary_wear_coefficient``
+      (a grease or oil layer on the surfaces, no hydrodynamic film), as ``regime`` says;
+    - the **asperity load** of an oil-lubricated joint in the mixed regime (Greenwood-Tripp, the load the
+      film does not carry) wears with ``mixed_wear_coefficient``; the film's load wears nothing.
 
     Attributes
     ----------
-    wear_coefficient : float
-        k, dimensionless.  Default 1e-7: mild, boundary-lubricated wear of a steel pair; k spans
-        1e-2 (severe, dry) to below 1e-6 (mild, lubricated) (Archard 1953; Rabinowicz, Friction and
-        Wear of Materials, 2nd ed. 1995), dry mild steel on mild steel 7e-3 (Archard and Hirst,
-        Proc. R. Soc. A 236, 1956).  Predicted hours scale exactly as H / k (docs/wear.md).
+    regime : str
+        ``"boundary"`` (default) or ``"dry"``: which of the two coefficients the solid contact takes.
+    dry_wear_coefficient, boundary_wear_coefficient, mixed_wear_coefficient : float
+        k of each regime, dimensionless.  Defaults: steel on steel, 5e-3 clean (Rabinowicz's table of
+        adhesive wear coefficients, like metals), 1e-7 boundary and mixed (the lower end of his "excellent
+        lubrication", 2e-6 to 1e-7).
+    wear_coefficient : float or None
+        One k for every load of the joint, overriding the three above (the key of scenes written before the
+        regimes; None: the regime keys apply).
     bearing_hardness, journal_hardness : float
         H of each surface, Pa (default 2.0e9: through-hardened steel, ~200 HB).
     max_clearance_change : float
@@ -140,13 +155,31 @@ class WearModel:
         Points of the tabulated wear profiles h_b(psi), h_j(psi) over 360 deg.
     """
 
-    wear_coefficient: float = 1e-7
+    wear_coefficient: float | None = None
     bearing_hardness: float = 2.0e9
     journal_hardness: float = 2.0e9
     max_clearance_change: float = 0.02
     revolutions_per_update: int = 4
     settle_revolutions: int = 1
     profile_points: int = 360
+    regime: str = "boundary"
+    dry_wear_coefficient: float = 5e-3
+    boundary_wear_coefficient: float = 1e-7
+    mixed_wear_coefficient: float = 1e-7
+    run_in_roughness: float | None = None  # m: the lubricated joint's run-in roughness (weftsim.wear.extrapolate)
+    run_in_depth: float = 1e-6  # m: the worn depth over which the roughness runs in by 1/e
+
+    @property
+    def contact_wear_coefficient(self) -> float:
+        """k of the solid contact's load (the dry law's): ``wear_coefficient`` if given, else the regime's."""
+        if self.wear_coefficient is not None:
+            return self.wear_coefficient
+        return self.dry_wear_coefficient if self.regime == "dry" else self.boundary_wear_coefficient
+
+    @property
+    def asperity_wear_coefficient(self) -> float:
+        """k of the asperity load of a lubricated joint (mixed regime): ``wear_coefficient`` if given."""
+        return self.mixed_wear_coefficient if self.wear_coefficient is None else self.wear_coefficient
 
 
 # Film models of Lubrication.model (the codes of weftsim.physics.film: MODEL_FINITE, MODEL_SHORT, MODEL_LONG,
@@ -485,10 +518,20 @@ LOOM_JOINT_E = ClearanceJoint(clearance=0.25e-3, law="variable_kd")
 
 @dataclass(frozen=True)
 class Drive:
-    """Constant crank speed and run length."""
+    """Crank speed and run length; the drive law of a stop-start's transient (:func:`weftsim.physics.chain.crank_motion`).
+
+    ``law``: ``"constant"`` (theta = omega t: every run of a scene file), ``"run_down"`` (omega until
+    ``ramp_start``, then to rest over ``ramp`` s) or ``"start_up"`` (at rest until ``ramp_start``, then to omega
+    over ``ramp`` s, the journal resting on the bearing's wall at t = 0: no film).  The transients are set by
+    the duty cycle (:mod:`weftsim.wear.duty`), not by scene keys; ``start_angle`` is the crank angle at t = 0.
+    """
 
     speed: float = 400.0 * (2.0 * math.pi / 60.0)  # omega, rad/s (same rounding as a scene file's 400 rpm)
     revolutions: float = 2.0
+    law: str = "constant"
+    ramp_start: float = 0.0  # s
+    ramp: float = 0.0  # s
+    start_angle: float = 0.0  # rad
 
     @property
     def period(self) -> float:
@@ -498,6 +541,38 @@ class Drive:
     @property
     def end_time(self) -> float:
         return self.revolutions * self.period
+
+
+@dataclass(frozen=True)
+class Duty:
+    """How a loom runs in a day (``[duty]``; :mod:`weftsim.wear.duty`, docs/wear.md section 12).
+
+    Attributes
+    ----------
+    stops_per_hour : float
+        Stops per hour of running (warp and weft breaks, other stops); each is a run-down to rest and a start-up
+        from rest with the film built up again from zero, whose simulated wear is added per hour of running.
+        0 (default): the steady prediction alone.
+    stop_minutes : float
+        Mean time the loom stands per stop, min (repair of the break): the calendar time, not the wear.
+    hours_per_day, days_per_week : float
+        The loom's scheduled hours (24 = three shifts) and working days.
+    startup_revolutions, rundown_revolutions : float
+        Crank revolutions of the start-up ramp from rest to full speed and of the run-down to rest.
+    """
+
+    stops_per_hour: float = 0.0
+    stop_minutes: float = 2.87
+    hours_per_day: float = 24.0
+    days_per_week: float = 7.0
+    startup_revolutions: float = 1.0
+    rundown_revolutions: float = 1.0
+
+    def calendar_days(self, running_hours: float) -> float:
+        """Calendar days for ``running_hours`` of running: each running hour costs 1 + stops x stop time of the
+        scheduled hours, hours_per_day of them a working day, days_per_week working days a week."""
+        scheduled = running_hours * (1.0 + self.stops_per_hour * self.stop_minutes / 60.0)
+        return scheduled / self.hours_per_day * 7.0 / self.days_per_week
 
 
 @dataclass(frozen=True)
@@ -630,6 +705,7 @@ class Scene:
     # Joint F (rod 4 - sector 5): ideal unless a scene gives it a clearance (docs/clearance-f.md).
     joint_f: ClearanceJoint = field(default_factory=lambda: replace(LOOM_JOINT_E, clearance=0.0))
     drive: Drive = field(default_factory=Drive)
+    duty: Duty = field(default_factory=Duty)
     reference_solver: ReferenceSolver = field(default_factory=ReferenceSolver)
     exudyn_solver: ExudynSolver = field(default_factory=ExudynSolver)
     output: Output = field(default_factory=Output)

@@ -74,8 +74,21 @@ def WEAR_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 - a cons
         # k spans 1e-2 (severe, dry) to below 1e-6 (Archard 1953; Rabinowicz 1995); hardness from soft
         # polymer bushings (~10 MPa) to ceramics and diamond (~1e5 MPa).  Beyond these the wear per update
         # dwarfs the clearance and the cycle extrapolation cannot follow it (issue 24).
+        Key(f"{table}.wear.regime", f"{joint}.wear.regime", "str", choices=params.WEAR_REGIMES,
+            doc="regime of the solid contact: \"boundary\" (default: grease or oil on the surfaces, no film) or "
+                "\"dry\" (unlubricated); an oil film's asperities take mixed_wear_coefficient"),
+        Key(f"{table}.wear.dry_wear_coefficient", f"{joint}.wear.dry_wear_coefficient", "float", 1, 0, 1e-2, True,
+            False, doc="Archard's k of unlubricated contact (default 5e-3, steel on steel; docs/wear.md section 5)"),
+        Key(f"{table}.wear.boundary_wear_coefficient", f"{joint}.wear.boundary_wear_coefficient", "float", 1, 0,
+            1e-2, True, False, doc="Archard's k of boundary-lubricated contact (default 1e-7)"),
+        Key(f"{table}.wear.mixed_wear_coefficient", f"{joint}.wear.mixed_wear_coefficient", "float", 1, 0, 1e-2,
+            True, False, doc="Archard's k of the asperity load of an oil-lubricated joint (default 1e-7)"),
+        Key(f"{table}.wear.run_in_roughness_um", f"{joint}.wear.run_in_roughness", "float", 1e-6, 0, None, False,
+            doc="running-in: the combined RMS roughness an oiled joint's surfaces wear down to (default: none)"),
+        Key(f"{table}.wear.run_in_depth_um", f"{joint}.wear.run_in_depth", "float", 1e-6, 0, None,
+            doc="running-in: the worn depth over which the roughness falls by 1/e towards it (default 1 um)"),
         Key(f"{table}.wear.wear_coefficient", f"{joint}.wear.wear_coefficient", "float", 1, 0, 1e-2, True, False,
-            doc="Archard's dimensionless wear coefficient k (default 1e-7, mild lubricated steel; 1e-2 severe dry wear)"),
+            doc="one Archard k for every load of the joint, overriding the regime keys (optional)"),
         Key(f"{table}.wear.bearing_hardness_mpa", f"{joint}.wear.bearing_hardness", "float", MPA, 1, 1e5, False,
             doc="hardness H of the bearing surface (default 2000 MPa, hardened steel)"),
         Key(f"{table}.wear.journal_hardness_mpa", f"{joint}.wear.journal_hardness", "float", MPA, 1, 1e5, False,
@@ -205,6 +218,17 @@ SCHEMA: tuple[Key, ...] = (
     Key("drive.speed_rpm", "drive.speed", "float", RPM, 1, 5000, False,
         doc="constant crank speed (1 rpm or more: a jog is 10-60 rpm)"),
     Key("drive.revolutions", "drive.revolutions", "float", 1, 0, 1000, doc="crank revolutions to simulate"),
+    # The duty cycle (weftsim wear; docs/wear.md section 12), all optional.
+    Key("duty.stops_per_hour", "duty.stops_per_hour", "float", 1, 0, 120, False,
+        doc="loom stops per running hour (warp and weft breaks); each adds a simulated run-down and start-up's wear"),
+    Key("duty.stop_minutes", "duty.stop_minutes", "float", 1, 0, 600, False,
+        doc="mean standstill per stop, min (default 2.87: a warp break's repair, Haque et al. 2019)"),
+    Key("duty.hours_per_day", "duty.hours_per_day", "float", 1, 0, 24, doc="scheduled hours a day (24: three shifts)"),
+    Key("duty.days_per_week", "duty.days_per_week", "float", 1, 0, 7, doc="working days a week"),
+    Key("duty.startup_revolutions", "duty.startup_revolutions", "float", 1, 0, 20,
+        doc="crank revolutions of the start-up ramp from rest (default 1: full speed within the first pick)"),
+    Key("duty.rundown_revolutions", "duty.rundown_revolutions", "float", 1, 0, 20,
+        doc="crank revolutions of the run-down to rest (default 1)"),
     Key("solver.reference.method", "reference_solver.method", "str", choices=INTEGRATORS,
         doc="method of the reference engine: scipy's, or numba_* (compiled, docs/performance.md; numba_RODAS4 "
             "linearly implicit, numba_DOP853_RODAS4 implicit in contact); auto = numba_DOP853, or with friction "

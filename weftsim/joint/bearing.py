@@ -132,6 +132,15 @@ def bearing(scene, joint: str = "e", load: float | None = None, journal_rpm: flo
     return out
 
 
+def _balanced(part):
+    """The joint whose heat balance sets the film temperature: a worn joint (``weftsim wear``'s update) at its
+    effective clearance c0 + max h_b + max h_j, the round joint of that clearance (docs/wear.md section 12)."""
+    if not part.is_worn:
+        return part
+    worn = max(part.bearing_wear, default=0.0) + max(part.journal_wear, default=0.0)
+    return replace(part, clearance=part.clearance + worn, bearing_wear=(), journal_wear=())
+
+
 def resolve_scene(scene):
     """``scene`` with each oiled joint's viscosity at its effective film temperature (the heat balance at the
     ideal mechanism's mean load and sliding speed, :func:`weftsim.joint.heat.with_film_temperature`); scenes
@@ -151,9 +160,10 @@ def resolve_scene(scene):
                              "viscosity then follows from the film temperature) or a fixed viscosity_mpa_s, not both")
         mean, _, omega = mean_operating_point(scene, name)
         try:
-            resolved, _ = with_film_temperature(part, mean, omega)
+            resolved, _ = with_film_temperature(_balanced(part), mean, omega)
         except SceneError as exc:
             raise SceneError(f"{_table(name)}.lubrication at the ideal mechanism's mean pin load {mean / 1e3:.4g} kN "
                              f"and sliding speed {omega * part.journal_radius:.3g} m/s: {exc}") from None
-        scene = replace(scene, **{"joint" if name == "e" else "joint_f": resolved})
+        # the joint as it was (a worn one keeps its profiles), its lubrication at the film temperature found
+        scene = replace(scene, **{"joint" if name == "e" else "joint_f": replace(part, lubrication=resolved.lubrication)})
     return scene

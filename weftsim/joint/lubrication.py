@@ -52,7 +52,7 @@ def joint_states(prm: np.ndarray, t: float, y: np.ndarray):
     if prm[kf.TOPOLOGY] == kf.E_ONLY:
         e_y, e_z, v_y, v_z, _, _, dphi = kc.eccentricity(prm, t, y)[:7]
         c = kc.local_clearance(prm, t, e_y, e_z, v_y, v_z, y)[0]
-        return (c, e_y, e_z, v_y, v_z, y[3], prm[kc.OMEGA] * dphi), none
+        return (c, e_y, e_z, v_y, v_z, y[3], kc.crank_rate(prm, t) * dphi), none
     q = kf.eccentricities(prm, t, y)
     e_y, e_z, ve_y, ve_z, f_y, f_z, vf_y, vf_z, w_rocker, dpsi, da = q
     c_e, _, c_f, _ = kf.local_clearances(prm, t, y, q)

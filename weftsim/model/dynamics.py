@@ -60,6 +60,7 @@ class ChainConstants:
     friction_coefficient: float  # mu
     friction_v0: float
     friction_v1: float  # m/s
+    drive: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)  # the drive law's (law, t0, ramp, theta0)
 
     @classmethod
     def from_scene(cls, scene: Scene) -> "ChainConstants":
@@ -81,6 +82,7 @@ class ChainConstants:
             friction_coefficient=joint.friction_coefficient,
             friction_v0=joint.friction_velocities[0],
             friction_v1=joint.friction_velocities[1],
+            drive=drive_entries(scene),
         )  # fmt: skip
 
 
@@ -93,7 +95,26 @@ def _chain_block(p: ChainConstants) -> np.ndarray:
     out[kc.ROD_MASS], out[kc.GRAVITY] = p.rod_mass, p.gravity
     out[kc.M11], out[kc.M22], out[kc.COUPLING] = p.m11, p.m22, p.coupling
     out[kc.CLEARANCE] = p.clearance
+    out[kc.DRIVE_LAW], out[kc.DRIVE_T0], out[kc.DRIVE_RAMP], out[kc.DRIVE_THETA0] = p.drive
     return out
+
+
+DRIVE_LAWS = {"constant": kc.CONSTANT_SPEED, "run_down": kc.RUN_DOWN, "start_up": kc.START_UP}
+
+
+def drive_entries(scene: Scene) -> tuple[float, float, float, float]:
+    """The drive law's entries of the kernel's parameter array (law, t0, ramp, theta0;
+    :func:`weftsim.physics.chain.crank_motion`): zeros at constant speed."""
+    drive = scene.drive
+    if drive.law == "constant":
+        return 0.0, 0.0, 0.0, 0.0
+    if drive.law not in DRIVE_LAWS or not drive.ramp > 0.0:
+        raise ValueError(f"drive law {drive.law!r} with a ramp of {drive.ramp:g} s: the laws are "
+                         f"{', '.join(DRIVE_LAWS)}, a transient's ramp > 0")
+    if not scene.joint_f.is_ideal:
+        raise ValueError("a stop-start transient (drive law run_down / start_up) covers the chain with joint E "
+                         "alone; the scene gives a clearance at F")
+    return DRIVE_LAWS[drive.law], drive.ramp_start, drive.ramp, drive.start_angle
 
 
 def topology(scene: Scene) -> int:
@@ -176,6 +197,40 @@ def chain_energy(p: ChainConstants, a: ArrayLike, psi: ArrayLike, da: ArrayLike,
     return kinetic, potential
 
 
+def _transient_state(scene: Scene) -> np.ndarray:
+    """The state at t = 0 of a stop-start transient (joint E alone): a run-down starts as a steady run (the
+    journal centred at the crank angle ``start_angle``, the ideal velocities); a start-up starts at rest with the
+    journal on the bearing's wall below its centre (e = 0.999 c (0, -1): the film squeezed out while the loom
+    stood), every rate 0.
+
+    The chain's coordinates (a, psi) of a journal centre P_j: F = G + L_FG u(a) lies on the circle of radius
+    L_EF about P_j (P_j = F - L_EF u(psi)), the intersection on the ideal mechanism's branch (nearest a).
+    """
+    drive = scene.drive
+    st = kin.linkage_state(drive.start_angle, scene.geometry, scene.inertia.rocker_com)
+    a0, psi0 = float(st.theta_fg), float(st.theta_ef)
+    if drive.law == "run_down":
+        w = scene.drive.speed  # at full speed until the ramp
+        return np.array([a0, psi0, w * float(st.d_theta_fg), w * float(st.d_theta_ef), 0.0, 0.0])
+    prm = pack_parameters(scene)
+    b_y, b_z = kc.crank_side(prm, 0.0)[:2]
+    geo = scene.geometry
+    # the journal centre on the wall below the bearing's, 1e-3 c off it (it settles onto the wall under its weight:
+    # a contact that starts at t = 0 with no approach rate has no onset the contact history could check)
+    p_y, p_z = b_y, b_z - (1.0 - 1e-3) * scene.joint.clearance
+    # |G + L_FG u(a) - P_j| = L_EF: with d = G - P_j, 2 L_FG (d . u(a)) = L_EF^2 - |d|^2 - L_FG^2
+    d_y, d_z = geo.l_og - p_y, -p_z
+    rho = math.hypot(d_y, d_z)
+    phase = math.atan2(d_z, d_y)
+    arc = math.acos((geo.l_ef**2 - rho * rho - geo.l_fg**2) / (2.0 * geo.l_fg * rho))
+    a = min((phase + arc, phase - arc), key=lambda x: abs(math.remainder(x - a0, 2.0 * math.pi)))
+    a = a0 + math.remainder(a - a0, 2.0 * math.pi)
+    f_y, f_z = geo.l_og + geo.l_fg * math.cos(a), geo.l_fg * math.sin(a)
+    psi = math.atan2(f_z - p_z, f_y - p_y)
+    psi = psi0 + math.remainder(psi - psi0, 2.0 * math.pi)
+    return np.array([a, psi, 0.0, 0.0, 0.0, 0.0])
+
+
 def initial_state(scene: Scene) -> np.ndarray:
     """State at t = 0: journal centred (e = 0), ideal-mechanism velocities (docs/physics.md section 2).
 
@@ -187,6 +242,8 @@ def initial_state(scene: Scene) -> np.ndarray:
     (Y, Z) the rod's centre of mass (:mod:`weftsim.physics.chain_f`).
     """
     omega = scene.drive.speed
+    if scene.drive.law != "constant":
+        return _transient_state(scene)
     st = kin.linkage_state(0.0, scene.geometry, scene.inertia.rocker_com)
     if topology(scene) == kf.E_AND_F:
         com, d_com = np.asarray(st.rod_com, dtype=float), np.asarray(st.d_rod_com, dtype=float)

@@ -46,13 +46,66 @@ from weftsim.physics.wear import clearance_along
 if TYPE_CHECKING:
     import numpy as np
 
-# Indices of the chain's constants, after the joint block.
+# Indices of the chain's constants, after the joint block; the drive law's four (:func:`crank_motion`) last.
 (OMEGA, TAN_BETA, COS_OE0, SIN_OE0, L_OE, L_EF, L_FG, L_OG, ROD_MASS, GRAVITY, M11, M22,
- COUPLING) = range(N_JOINT, N_JOINT + 13)  # fmt: skip
-N_PARAMETERS = N_JOINT + 13
+ COUPLING, DRIVE_LAW, DRIVE_T0, DRIVE_RAMP, DRIVE_THETA0) = range(N_JOINT, N_JOINT + 17)  # fmt: skip
+N_PARAMETERS = N_JOINT + 17
+# Drive laws of the crank (prm[DRIVE_LAW]): constant speed theta = omega t; a run-down from omega to rest; a
+# start-up from rest to omega (:func:`crank_motion`).
+CONSTANT_SPEED, RUN_DOWN, START_UP = 0.0, 1.0, 2.0
 # A worn joint E appends its wear block (weftsim.physics.wear.wear_block) here, after the blocks of
 # weftsim.physics.chain_f (joint F's parameters, the topology, J_FG, J4); a round one appends nothing.
 WEAR_E = N_PARAMETERS + N_JOINT + 3
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _ramp(tau: float) -> tuple[float, float, float]:
+    """(S, s, s') of the smooth step s(tau) = 3 tau^2 - 2 tau^3 on [0, 1]: S = integral of s = tau^3 - tau^4 / 2,
+    s' = 6 tau (1 - tau) (zero at both ends: the crank's acceleration is continuous)."""
+    t2 = tau * tau
+    return t2 * tau - 0.5 * t2 * t2, t2 * (3.0 - 2.0 * tau), 6.0 * tau * (1.0 - tau)
+
+
+@njit(cache=True, error_model="numpy")
+def crank_motion(prm: np.ndarray, t: float) -> tuple[float, float, float]:
+    """The crank's prescribed motion: (theta, theta_dot, theta_ddot) at time t (rad, rad/s, rad/s^2).
+
+    - ``CONSTANT_SPEED`` (every run but a stop-start's): theta = omega t, exactly as before the drive laws.
+    - ``RUN_DOWN``: omega until t0, then theta_dot = omega (1 - s(tau)) over the ramp T (tau = (t - t0) / T,
+      :func:`_ramp`), at rest after it: the crank turns omega T / 2 while it stops.
+    - ``START_UP``: at rest until t0, then theta_dot = omega s(tau) over T, omega after it (the drive's start-up
+      ramp; the crank turns omega T / 2 on the ramp).
+    Both from theta0 = prm[DRIVE_THETA0] (the crank angle at t = 0).  A loom drive reaches full speed within
+    the first pick or two (docs/wear.md section 12).
+    """
+    omega = prm[OMEGA]
+    law = prm[DRIVE_LAW]
+    if law == CONSTANT_SPEED:
+        return omega * t, omega, 0.0
+    t0, ramp, theta0 = prm[DRIVE_T0], prm[DRIVE_RAMP], prm[DRIVE_THETA0]
+    if law == RUN_DOWN:
+        if t <= t0:
+            return theta0 + omega * t, omega, 0.0
+        tau = (t - t0) / ramp
+        if tau >= 1.0:
+            return theta0 + omega * (t0 + 0.5 * ramp), 0.0, 0.0
+        big, small, slope = _ramp(tau)
+        return theta0 + omega * (t0 + ramp * (tau - big)), omega * (1.0 - small), -omega * slope / ramp
+    if t <= t0:
+        return theta0, 0.0, 0.0
+    tau = (t - t0) / ramp
+    if tau >= 1.0:
+        return theta0 + omega * (0.5 * ramp + (t - t0 - ramp)), omega, 0.0
+    big, small, slope = _ramp(tau)
+    return theta0 + omega * ramp * big, omega * small, omega * slope / ramp
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def crank_rate(prm: np.ndarray, t: float) -> float:
+    """theta_dot at time t (rad/s): prm[OMEGA] itself at constant speed (:func:`crank_motion`)."""
+    if prm[DRIVE_LAW] == CONSTANT_SPEED:
+        return prm[OMEGA]
+    return crank_motion(prm, t)[1]
 
 
 @njit(cache=True, error_model="numpy")
@@ -60,9 +113,9 @@ def crank_side(prm: np.ndarray, t: float) -> tuple[float, ...]:
     """Bearing centre P_b = E of the rocker: (P_b, dP_b/dtheta, phi') at time t.
 
     phi = -atan(u), u = tan(beta) cos(theta); theta_OE = theta_OE0 + phi; sin and cos of
-    atan(u) from u directly (1/sqrt(1 + u^2), u/sqrt(1 + u^2)).
+    atan(u) from u directly (1/sqrt(1 + u^2), u/sqrt(1 + u^2)); theta of :func:`crank_motion`.
     """
-    theta = prm[OMEGA] * t
+    theta = crank_motion(prm, t)[0]
     st, ct = math.sin(theta), math.cos(theta)
     u = prm[TAN_BETA] * ct
     w = 1.0 + u * u
@@ -79,7 +132,7 @@ def eccentricity(prm: np.ndarray, t: float, y: np.ndarray) -> tuple[float, ...]:
     """e = P_j - P_b, its rate, and sin/cos of a, psi (m, m/s) of state y at time t."""
     b_y, b_z, db_y, db_z, dphi = crank_side(prm, t)
     sa, ca, sp, cp = math.sin(y[0]), math.cos(y[0]), math.sin(y[1]), math.cos(y[1])
-    l_fg, l_ef, omega = prm[L_FG], prm[L_EF], prm[OMEGA]
+    l_fg, l_ef, omega = prm[L_FG], prm[L_EF], crank_rate(prm, t)
     ecc_y = prm[L_OG] + l_fg * ca - l_ef * cp - b_y
     ecc_z = l_fg * sa - l_ef * sp - b_z
     v_y = -l_fg * sa * y[2] + l_ef * sp * y[3] - omega * db_y
@@ -107,15 +160,16 @@ def rod_clearance(prm: np.ndarray, t: float, ecc_y: float, ecc_z: float, v_y: fl
     or a list on the Exudyn engine's plain-Python callback route (hence ``len``)."""
     if len(prm) <= WEAR_E:
         return prm[CLEARANCE], 0.0
-    theta = prm[OMEGA] * t
-    w_b = prm[OMEGA] * prm[TAN_BETA] * math.sin(theta) / (1.0 + (prm[TAN_BETA] * math.cos(theta)) ** 2)
+    theta, omega, _ = crank_motion(prm, t)
+    w_b = omega * prm[TAN_BETA] * math.sin(theta) / (1.0 + (prm[TAN_BETA] * math.cos(theta)) ** 2)
     return clearance_along(prm, WEAR_E, prm[CLEARANCE], ecc_y, ecc_z, v_y, v_z, rocker_angle(prm, t), w_b, psi, dpsi)
 
 
 @njit(cache=True, error_model="numpy")
 def rocker_angle(prm: np.ndarray, t: float) -> float:
-    """theta_OE = theta_OE0 + phi, phi = -atan(tan(beta) cos(omega t)): the bearing's frame angle, rad."""
-    return math.atan2(prm[SIN_OE0], prm[COS_OE0]) - math.atan(prm[TAN_BETA] * math.cos(prm[OMEGA] * t))
+    """theta_OE = theta_OE0 + phi, phi = -atan(tan(beta) cos(theta)): the bearing's frame angle, rad (theta of
+    :func:`crank_motion`)."""
+    return math.atan2(prm[SIN_OE0], prm[COS_OE0]) - math.atan(prm[TAN_BETA] * math.cos(crank_motion(prm, t)[0]))
 
 
 @njit(cache=True, error_model="numpy")
@@ -142,7 +196,7 @@ def chain(prm: np.ndarray, t: float, y: np.ndarray, contact: bool, impact_veloci
     sin a, cos a, sin psi, cos psi, force on the journal f_Y, f_Z (N), friction moments M_j, M_b (N m).
     """
     ecc_y, ecc_z, v_y, v_z, db_y, db_z, dphi, sa, ca, sp, cp = eccentricity(prm, t, y)
-    da, dpsi, omega = y[2], y[3], prm[OMEGA]
+    da, dpsi, omega = y[2], y[3], crank_rate(prm, t)
     f_y = f_z = m_j = m_b = dissipated = f_n = 0.0
     length = math.sqrt(ecc_y * ecc_y + ecc_z * ecc_z)
     c, c_rate = local_clearance(prm, t, ecc_y, ecc_z, v_y, v_z, y)
@@ -236,7 +290,7 @@ def tree_joint_force(prm: np.ndarray, t: float, a: float, q1: float, da: float, 
     vx = -l_fg * sa * da - l_ef * sb * db
     vy = l_fg * ca * da + l_ef * cb * db
     b_y, b_z, db_y, db_z, dphi = crank_side(prm, t)
-    omega = prm[OMEGA]
+    omega = crank_rate(prm, t)
     # F_N = hypot of the normal force, as the channels computed it before friction: bit-identical at mu = 0.
     lub_power = asperity_energy = 0.0
     ex, ey, evx, evy = px - b_y, py - b_z, vx - omega * db_y, vy - omega * db_z

@@ -23,7 +23,7 @@ from numba import njit
 
 from weftsim.input.params import Geometry, Inertia, Scene
 from weftsim.physics.chain import (
-    COEF, COUPLING, GRAVITY, KIND, L_EF, L_FG, M11, M22, OMEGA, ROD_MASS, chain, local_clearance, penetration,
+    COEF, COUPLING, GRAVITY, KIND, L_EF, L_FG, M11, M22, OMEGA, ROD_MASS, chain, crank_motion, local_clearance, penetration,
 )  # fmt: skip
 from weftsim.physics import chain_f as kf
 from weftsim.physics.laws import elastic_energy
@@ -91,28 +91,32 @@ def crank_side_eval(table: np.ndarray, theta: float, out: np.ndarray) -> None:
 @njit(cache=True, error_model="numpy")
 def _fill(prm, table, a0, ratio, time, states, contact, impact, out):
     """Rows of :data:`CHANNELS` (in that order) into out (n, 18)."""
-    omega = prm[OMEGA]
     d = np.empty(6)
     start = np.empty(4)
     crank = np.empty(4)
-    crank_side_eval(table, 0.0, start)
-    work0 = 0.5 * start[0] * omega * omega + start[2]
+    theta0, omega0, _ = crank_motion(prm, 0.0)  # (0, omega, 0) at constant speed
+    crank_side_eval(table, theta0, start)
+    work0 = 0.5 * start[0] * omega0 * omega0 + start[2]
     for i in range(time.size):
         t = time[i]
         y = states[i]
         q3, f_n, delta, ecc_y, ecc_z, sa, ca, sp, cp = chain(prm, t, y, contact[i], impact[i], d)[:9]
-        crank_side_eval(table, omega * t, crank)
+        theta, omega, acceleration = crank_motion(prm, t)  # omega t, omega, 0 at constant speed
+        crank_side_eval(table, theta, crank)
         a, da, dpsi = y[0], y[2], y[3]
         m12 = -prm[COUPLING] * (cp * ca + sp * sa)  # -k cos(psi - a)
         kin48 = 0.5 * (prm[M11] * da * da + 2.0 * m12 * da * dpsi + prm[M22] * dpsi * dpsi)
         pot48 = prm[ROD_MASS] * prm[GRAVITY] * (prm[L_FG] * sa - 0.5 * prm[L_EF] * sp)
         kin13 = 0.5 * crank[0] * omega * omega
         out[i, 0] = t
-        out[i, 1] = omega * t * (180.0 / math.pi)
+        out[i, 1] = theta * (180.0 / math.pi)
         out[i, 2] = ratio * (a - a0)
         out[i, 3] = ratio * da
         out[i, 4] = ratio * d[2]
+        # T = J13 theta'' + 1/2 J13' theta'^2 + U13' - Q3 (the crank side's inertia term only off constant speed)
         out[i, 5] = 0.5 * crank[1] * omega * omega + crank[3] - q3
+        if acceleration != 0.0:
+            out[i, 5] += crank[0] * acceleration
         out[i, 6] = f_n
         out[i, 7] = delta
         out[i, 8] = ecc_y

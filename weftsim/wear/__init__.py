@@ -117,7 +117,7 @@ def check_engine(outdir: str | Path, engine: str, force: bool = False) -> None:
 def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine: str = "reference",
                          limit: float | None = None, progress: Callable[[float], None] | None = None,
                          stop: Callable[[], bool] | None = None, figures: bool = True, force: bool = False,
-                         until_limit: bool = False) -> dict:
+                         until_limit: bool = False, past_limit: bool = False) -> dict:
     """Predict the wear over ``hours`` of operation into ``outdir``, resuming a stored state.
 
     Parameters
@@ -140,7 +140,11 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
     stop : callable, optional
         Returns True to end after the current update (Ctrl-C): the state is kept for a resume.
     until_limit : bool
-        End where the effective clearance reaches ``limit`` (the update that crosses it extrapolates only up
+        ``hours`` is only a bound: the prediction is asked to run until the clearance limit (``limit`` is then
+        required, and the progress is the share of the clearance's way to it).
+    past_limit : bool
+        Go on wearing past ``limit`` up to ``hours``.  By default a prediction with a ``limit`` ends where the
+        first wearing joint's effective clearance reaches it (the update that crosses it extrapolates only up
         to it, as at a geometric limit; ``"ended"`` says so), even before ``hours``.
 
     Returns
@@ -166,6 +170,9 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
     check_request(scene, hours, engine, limit)
     if until_limit and limit is None:
         raise WearError("until_limit needs a clearance limit (--limit-clearance-mm)")
+    if until_limit and past_limit:
+        raise WearError("--past-limit needs --hours: without them the prediction runs until the clearance limit")
+    at_limit = limit is not None and not past_limit  # end where the first joint reaches the limit
     outdir = prepare_directory(outdir, force, scene, kind="wear")
     check_engine(outdir, engine, force)
     what = {"kind": "wear", "scene": scene.name, "engine": engine, **provenance(scene)}  # from the first update on
@@ -197,20 +204,22 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
         latest[:] = updates
         save(updates)
         if progress is not None and updates[-1].hours > 0.0:  # no time-left estimate from a zero fraction
-            if until_limit:  # the share of the clearance's way to the limit
-                progress(min(_grown(scene, updates[-1], share=limit), 1.0))
-            else:
-                progress(min(updates[-1].hours / hours, 1.0))
+            # the share of the hours, or of the clearance's way to the limit where the prediction ends there:
+            # whichever is nearer its end (the estimate of the time left then follows what ends the run)
+            done_share = 0.0 if until_limit else updates[-1].hours / hours
+            if at_limit:
+                done_share = max(done_share, _grown(scene, updates[-1], share=limit))
+            progress(min(done_share, 1.0))
 
     asked_stop = stop
-    if until_limit:
+    if at_limit:
 
         def stop() -> bool:
             return (asked_stop is not None and asked_stop()) or (bool(latest) and _beyond(scene, latest[-1], limit))
 
     try:
         updates = predict(scene, hours, done, on_update=on_update, stop=stop, simulate=simulator(engine))
-        if until_limit and updates and _beyond(scene, updates[-1], limit):
+        if at_limit and updates and _beyond(scene, updates[-1], limit):
             updates[-1] = _cut_at(scene, updates[-1], limit)
             save(updates)
         if not updates:  # stopped (Ctrl-C) before the first update was done: nothing to write
@@ -218,13 +227,52 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
     except WearError as exc:
         if not latest:
             raise
-        _write_results(scene, latest, hours, limit, time.perf_counter() - wall0, outdir, what, figures, str(exc),
-                       engine)
-        raise WearError(f"{exc}; the prediction stopped there: the {len(latest)} updates before it "
-                        f"(0 to {latest[-1].hours:.6g} h) are in {outdir}/wear.csv and wear.json") from None
-    reached = until_limit and _beyond(scene, updates[-1], limit * (1.0 - 1e-12))
+        data = _write_results(scene, latest, hours, limit, time.perf_counter() - wall0, outdir, what, figures,
+                              str(exc), engine)
+        raise WearError(f"{exc}; the prediction stopped there, {reached_text(scene, data)}: the {len(latest)} "
+                        f"updates before it are in {outdir}/wear.csv and wear.json") from None
+    reached = at_limit and _beyond(scene, updates[-1], limit * (1.0 - 1e-12))
     return _write_results(scene, updates, hours, limit, time.perf_counter() - wall0, outdir, what, figures,
                           engine=engine, reached_limit=reached)
+
+
+def duty_summary(scene: Scene, updates: list, data: dict) -> dict:
+    """``wear.json``'s duty-cycle fields: the duty (``duty_text``), the calendar days to the limit of each joint
+    (``calendar_days_to_limit_<j>``, :meth:`~weftsim.input.params.Duty.calendar_days`) and the stop-starts' share
+    of the worn volume over the prediction (``stop_start_share_<j>``, N-weighted over the updates)."""
+    import numpy as np
+
+    from weftsim.wear.extrapolate import wearing_joints
+
+    duty = scene.duty
+    out = {"duty_text": f"{duty.hours_per_day:g} h a day, {duty.days_per_week:g} days a week, {duty.stops_per_hour:g} "
+                        f"stops an hour of {duty.stop_minutes:g} min",
+           "stops_per_hour": duty.stops_per_hour}
+    for j in wearing_joints(scene):
+        hours = data.get(f"hours_to_limit_{j}")
+        out[f"calendar_days_to_limit_{j}"] = None if hours is None else duty.calendar_days(hours)
+        rows = [(u.step_revolutions * u.part(j).volume_rate, u.response.get(f"stop_start_share_{j}", 0.0))
+                for u in updates if u.step_revolutions > 0.0]
+        volume = np.array([r[0] for r in rows]) if rows else np.zeros(0)
+        share = np.nan_to_num(np.array([r[1] for r in rows], dtype=float)) if rows else np.zeros(0)
+        out[f"stop_start_share_{j}"] = float(np.dot(volume, share) / volume.sum()) if volume.sum() > 0.0 else 0.0
+    if data.get("hours_to_limit") is not None:
+        out["calendar_days_to_limit"] = duty.calendar_days(data["hours_to_limit"])
+    return out
+
+
+def reached_text(scene: Scene, data: dict) -> str:
+    """How far a prediction got: "after 460.2 h at an effective clearance of 1.04 mm at E" (``data``: the
+    summary of :func:`_write_results`), with the hours to the limit where it was reached before."""
+    from weftsim.wear.extrapolate import wearing_joints
+
+    joints = wearing_joints(scene)
+    text = f"after {data['hours_reached']:.6g} h at an effective clearance of " + ", ".join(
+        f"{data[f'final_effective_clearance_{j}_mm']:.4g} mm at {j.upper()}" for j in joints)
+    if data.get("hours_to_limit") is not None:
+        text += (f" (the limit {data['limit_clearance_mm']:g} mm was reached at {data['limit_joint'].upper()} after "
+                 f"{data['hours_to_limit']:.6g} h)")
+    return text
 
 
 def _beyond(scene: Scene, update, limit: float) -> bool:
@@ -304,6 +352,7 @@ def _write_results(scene: Scene, updates: list, hours: float, limit: float | Non
         from weftsim.wear.censored import limit_note
 
         data.update(limit_note(scene, updates, limit, data.get("hours_to_limit")))
+    data.update(duty_summary(scene, updates, data))
     columns = store.table(scene, updates)
     files = {
         "state": (store.STATE, lambda p: p),

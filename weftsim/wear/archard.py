@@ -21,11 +21,9 @@ from numba import njit
 
 from weftsim.post.analysis import time_weights
 from weftsim.physics import chain_f as kf
-from weftsim.physics.chain import BEARING_RADIUS, OMEGA, chain, eccentricity, local_clearance, rocker_angle
-from weftsim.physics.asperity import asperity_half_angle, asperity_load
-from weftsim.physics.joint import (
-    ASPERITY_COEF, BEARING_LENGTH, JOURNAL_RADIUS, N_JOINT, ROUGHNESS, tangential_velocity,
-)  # fmt: skip
+from weftsim.physics.chain import BEARING_RADIUS, chain, crank_rate, eccentricity, local_clearance, rocker_angle
+from weftsim.physics.asperity import asperity_half_angle
+from weftsim.physics.joint import N_JOINT, ROUGHNESS, tangential_velocity
 from weftsim.physics.lubricated import asperity_normal, is_lubricated
 from weftsim.physics.wear import contact_half_angle, deposit
 
@@ -36,11 +34,14 @@ if TYPE_CHECKING:
 @njit(cache=True, error_model="numpy")
 def contact_rows(prm: np.ndarray, time: np.ndarray, states: np.ndarray, contact: np.ndarray, impact: np.ndarray,
                  out: np.ndarray) -> None:
-    """Per step row into ``out`` (n, 5): F_N (N), v_T (m/s), psi_b, psi_j (rad), phi0 (rad).
+    """Per step row into ``out`` (n, 6) (or (n, 5) without F_a): F_N (N), v_T (m/s), psi_b, psi_j (rad), phi0
+    (rad), F_a (N).
 
     A lubricated joint: F_N is the load the solids carry, the asperity load F_a plus the dry law's beyond
     e = c, never the film's (no wear under a full film: F_a = 0 while h_min >= 4 sigma); phi0 then covers
-    the asperity arc too (:func:`weftsim.physics.asperity.asperity_half_angle`).
+    the asperity arc too (:func:`weftsim.physics.asperity.asperity_half_angle`).  F_a, the asperities' part of
+    F_N (0 for a dry joint), wears with the mixed regime's k, the rest with the solid contact's
+    (:func:`wear_from_rows`).
 
     ``psi_b``, ``psi_j``: the contact direction n in the bearing's (rocker) and the journal's (rod)
     frame; ``phi0``: half the contact arc (:func:`weftsim.physics.wear.contact_half_angle`).  Rows
@@ -53,7 +54,7 @@ def contact_rows(prm: np.ndarray, time: np.ndarray, states: np.ndarray, contact:
         f_n = chain(prm, t, y, contact[i], impact[i], d)[1]
         ecc_y, ecc_z, v_y, v_z, _, _, dphi = eccentricity(prm, t, y)[:7]
         c = local_clearance(prm, t, ecc_y, ecc_z, v_y, v_z, y)[0]
-        _row(prm, f_n, c, ecc_y, ecc_z, v_y, v_z, rocker_angle(prm, t), prm[OMEGA] * dphi, y[1], y[3], out[i])
+        _row(prm, f_n, c, ecc_y, ecc_z, v_y, v_z, rocker_angle(prm, t), crank_rate(prm, t) * dphi, y[1], y[3], out[i])
 
 
 @njit(cache=True, error_model="numpy")
@@ -73,7 +74,7 @@ def rows_from_contact(prm: np.ndarray, time: np.ndarray, states: np.ndarray, f_d
         y = states[i]
         ecc_y, ecc_z, v_y, v_z, _, _, dphi = eccentricity(prm, t, y)[:7]
         c = local_clearance(prm, t, ecc_y, ecc_z, v_y, v_z, y)[0]
-        _row(prm, f_dry[i], c, ecc_y, ecc_z, v_y, v_z, rocker_angle(prm, t), prm[OMEGA] * dphi, y[1], y[3], out[i])
+        _row(prm, f_dry[i], c, ecc_y, ecc_z, v_y, v_z, rocker_angle(prm, t), crank_rate(prm, t) * dphi, y[1], y[3], out[i])
         if out[i, 0] > 0.0 and v_t[i] == v_t[i]:
             out[i, 1] = v_t[i]
 
@@ -81,7 +82,7 @@ def rows_from_contact(prm: np.ndarray, time: np.ndarray, states: np.ndarray, f_d
 @njit(cache=True, error_model="numpy")
 def _row(jp: np.ndarray, f_n: float, c: float, ecc_y: float, ecc_z: float, v_y: float, v_z: float, frame_b: float,
          w_b: float, frame_j: float, w_j: float, out: np.ndarray) -> None:
-    """One row of :func:`contact_rows` into ``out`` (5,) for a joint (block ``jp``) with the contact force F_N
+    """One row of :func:`contact_rows` into ``out`` (6,) for a joint (block ``jp``) with the contact force F_N
     of its law, the clearance c along e, and its bearing's and journal's frame angles and rates."""
     length = math.sqrt(ecc_y * ecc_y + ecc_z * ecc_z)
     out[:] = 0.0
@@ -93,6 +94,8 @@ def _row(jp: np.ndarray, f_n: float, c: float, ecc_y: float, ecc_z: float, v_y: 
         if f_a > 0.0:
             f_n += f_a
             half_angle = max(half_angle, asperity_half_angle(jp[ROUGHNESS], c, length))
+            if out.size > 5:  # the rows of callers that take F_N alone have 5 columns
+                out[5] = f_a
     if f_n > 0.0 and length > 0.0:
         direction = math.atan2(ecc_z, ecc_y)
         out[0] = f_n
@@ -132,7 +135,8 @@ def contact_rows_f(prm: np.ndarray, time: np.ndarray, states: np.ndarray, contac
 @njit(cache=True, error_model="numpy")
 def deposit_rows(rows: np.ndarray, work: np.ndarray, depth_b: float, depth_j: float, bearing: np.ndarray,
                  journal: np.ndarray) -> None:
-    """Add each row's worn depth (``work`` (n,) times ``depth_b`` or ``depth_j``, m/J) to the profiles."""
+    """Add each row's worn depth (``work`` (n,) times ``depth_b`` or ``depth_j``, m/J) to the profiles; ``work``
+    is the sliding work weighted by each load's k over the joint's contact k (:func:`wear_from_rows`)."""
     for i in range(work.size):
         if work[i] > 0.0:
             deposit(bearing, rows[i, 2], rows[i, 4], work[i] * depth_b)
@@ -143,9 +147,11 @@ def deposit_rows(rows: np.ndarray, work: np.ndarray, depth_b: float, depth_j: fl
 class RunWear:
     """Wear of one run's window: depth profiles (m) and volumes (m^3) of bearing and journal.
 
-    ``sliding_work`` = int F_N |v_T| dt (J); ``bearing_volume`` = (k / H_b) sliding_work and
-    ``journal_volume`` = (k / H_j) sliding_work exactly; the profiles hold the same volumes
-    (sum(h) L_b R dpsi) to round-off.
+    ``sliding_work`` = int F_N |v_T| dt (J), of which the asperities of a lubricated joint carry
+    ``asperity_work`` = int F_a |v_T| dt; ``bearing_volume`` = (k_c (W - W_a) + k_a W_a) / H_b and
+    ``journal_volume`` likewise with H_j (k_c, k_a: the solid contact's and the asperities' k,
+    :attr:`~weftsim.input.params.WearModel.contact_wear_coefficient`), exactly (k_c W / H when k_a = k_c); the
+    profiles hold the same volumes (sum(h) L_b R dpsi) to round-off.
     """
 
     bearing: np.ndarray
@@ -156,27 +162,36 @@ class RunWear:
     sliding_distance: float  # int |v_T| dt in contact, m
     joint: str = "e"  # the joint worn ("e" or "f")
     second: RunWear | None = None  # joint F's wear when E and F wear in the same run
+    asperity_work: float = 0.0  # int F_a |v_T| dt, J: the mixed regime's part of sliding_work
 
 
 def wear_from_rows(joint: ClearanceJoint, time: np.ndarray, rows: np.ndarray) -> RunWear:
-    """Archard wear of contact rows (``rows`` (n, 5) as :func:`contact_rows` fills them) at times ``time`` (s).
+    """Archard wear of contact rows (``rows`` (n, 6) as :func:`contact_rows` fills them) at times ``time`` (s).
 
-    ``joint``: the :class:`~weftsim.input.params.ClearanceJoint` (radii, length, ``wear``).
+    ``joint``: the :class:`~weftsim.input.params.ClearanceJoint` (radii, length, ``wear``).  The solid contact's
+    load F_N - F_a wears with the regime's k_c, the asperity load F_a with the mixed regime's k_a
+    (:class:`~weftsim.input.params.WearModel`); with k_a = k_c (or no asperity load) the wear is k_c F_N ds / H,
+    computed as it was before the regimes, bit for bit.
     """
     wear = joint.wear
     weights = time_weights(time) if time.size > 1 else np.zeros(time.size)
-    work = rows[:, 0] * np.abs(rows[:, 1]) * weights
+    work = rows[:, 0] * np.abs(rows[:, 1]) * weights  # the order of the products as before the regimes: bit for bit
+    asperity = rows[:, 5] * np.abs(rows[:, 1]) * weights if rows.shape[1] > 5 else np.zeros(time.size)
+    k_c, k_a = wear.contact_wear_coefficient, wear.asperity_wear_coefficient
+    worn = work if k_a == k_c or not asperity.any() else work + (k_a / k_c - 1.0) * asperity
     n = wear.profile_points
     cell = 2.0 * math.pi / n
-    k_b = wear.wear_coefficient / wear.bearing_hardness
-    k_j = wear.wear_coefficient / wear.journal_hardness
+    k_b = k_c / wear.bearing_hardness
+    k_j = k_c / wear.journal_hardness
     bearing, journal = np.zeros(n), np.zeros(n)
-    deposit_rows(np.ascontiguousarray(rows, dtype=float), work,
+    deposit_rows(np.ascontiguousarray(rows, dtype=float), worn,
                  k_b / (joint.bearing_length * joint.bearing_radius * cell),
                  k_j / (joint.bearing_length * joint.journal_radius * cell), bearing, journal)  # fmt: skip
     total = float(work.sum())
+    effective = total if worn is work else float(worn.sum())
     sliding = float(np.sum(np.abs(rows[:, 1]) * weights * (rows[:, 0] > 0.0)))
-    return RunWear(bearing, journal, k_b * total, k_j * total, total, sliding)
+    return RunWear(bearing, journal, k_b * effective, k_j * effective, total, sliding,
+                   asperity_work=float(asperity.sum()))
 
 
 def run_wear(scene: Scene, prm: np.ndarray, time: np.ndarray, states: np.ndarray, contact: np.ndarray,
@@ -189,7 +204,7 @@ def run_wear(scene: Scene, prm: np.ndarray, time: np.ndarray, states: np.ndarray
     :func:`contact_rows_f` for the joint asked for.
     """
     time = np.ascontiguousarray(time, dtype=float)
-    rows = np.zeros((time.size, 5))
+    rows = np.zeros((time.size, 6))
     if scene.joint_f.is_ideal:
         if joint != "e":
             raise ValueError(f"joint {joint!r} has no clearance in this scene")

@@ -95,7 +95,7 @@ def exudyn_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray) -> tup
         raise UpdateFailed(f"the Exudyn simulation on the worn geometry failed (also at relative tolerance "
                            f"{ATTEMPTS[1][1]:g} and on the implicit tree): {result.message}")
     keep = t >= w.settle_revolutions * scene.drive.period
-    rows = np.zeros((int(keep.sum()), 5))
+    rows = np.zeros((int(keep.sum()), 6))
     # The callback's v_T where it applied a dry contact; elsewhere (a lubricated joint's asperities alone) the
     # sliding velocity at the state, as on the reference engine
     sliding = np.ascontiguousarray(np.where(f_n[keep] > 0.0, v_t[keep], np.nan))

@@ -33,9 +33,10 @@ import numpy as np
 
 from weftsim.errors import WearError
 from weftsim.wear.censored import censored_quantile, fraction_interval, json_hours
-from weftsim.wear.ensemble_design import (DESIGN_QUANTILES, RESCALED, _lagrange, centre_name,  # noqa: F401
+from weftsim.wear.ensemble_design import (DESIGN_QUANTILES, RESCALED, k_scale, _lagrange, centre_name,  # noqa: F401
                                           interpolate, plan)
 from weftsim.wear.jobs import hours_at, run_job
+from weftsim.wear.life import duty_text, horizon_days, life_figure, sample_days, stop_share_summary
 from weftsim.wear.uncertain import Uncertain, latin_hypercube, parse_uncertain, rank_shares
 
 if TYPE_CHECKING:
@@ -131,9 +132,7 @@ def combine(scene: Scene, uncertain: list[Uncertain], dynamic: list[Uncertain], 
     values = {v.key: v.ppf(u[:, i]) for i, v in enumerate(uncertain)}
     base = to_file_keys(scene)
     share_b = results[centre]["bearing_share"]
-    scale = np.ones(samples)
-    if "joint_e.wear.wear_coefficient" in values:
-        scale *= base["joint_e.wear.wear_coefficient"] / values["joint_e.wear.wear_coefficient"]
+    scale = k_scale(scene, values, samples)
     hb = values.get("joint_e.wear.bearing_hardness_mpa", base["joint_e.wear.bearing_hardness_mpa"])
     hj = values.get("joint_e.wear.journal_hardness_mpa", base["joint_e.wear.journal_hardness_mpa"])
     scale /= share_b * base["joint_e.wear.bearing_hardness_mpa"] / hb \
@@ -271,8 +270,11 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
     for p in QUANTILES:  # inf where the quantile falls among the censored samples
         band[f"hours_p{round(100 * p)}"] = np.array([censored_quantile(hours[:, i], p)[0] for i in range(lv.size)])
     band["fraction_reaching"] = np.mean(np.isfinite(hours), axis=0)
-    by_level = {f"{1e3 * lv[i]:.6g}": {**quantile_table(hours[:, i], horizon), "reaching": reaching(hours[:, i], horizon)}
-                for i in range(lv.size) if i == lv.size - 1 or any(abs(lv[i] - v) < 1e-12 for v in levels)}
+    level_index = {f"{1e3 * lv[i]:.6g}": i for i in range(lv.size)
+                   if i == lv.size - 1 or any(abs(lv[i] - v) < 1e-12 for v in levels)}
+    by_level = {key: {**quantile_table(hours[:, i], horizon), "reaching": reaching(hours[:, i], horizon)}
+                for key, i in level_index.items()}
+    days = sample_days(scene, ens["values"], hours)
     data = {
         "scene": scene.name,
         "joint": "E",  # wear at joint E (the wear prediction's joint so far)
@@ -303,6 +305,13 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
         "censored_design_points": ens["censored_nodes"],
         "unresolved_samples": ens["unresolved"],
         "hours_by_clearance_mm": by_level,
+        # calendar time (each sample's own duty, weftsim.wear.life) and the stop-starts' share of the wear
+        "duty_text": duty_text(scene, ens["values"]),
+        "horizon_calendar_days": horizon_days(scene, horizon),
+        "calendar_days_to_limit": quantile_table(days[:, -1], horizon_days(scene, horizon)),
+        "calendar_days_by_clearance_mm": {key: quantile_table(days[:, i], horizon_days(scene, horizon))
+                                          for key, i in level_index.items()},
+        "stop_start_share": stop_share_summary(results),
         "shares": {k: {"rank_correlation": r, "share": s} for k, (r, s) in ens["shares"].items()},
         "jobs": {n: {"wall_s": r.get("wall_s"), "cpu_s": r.get("cpu_s"), "updates": r.get("updates"),
                      "error": r.get("error"),
@@ -316,6 +325,7 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
     table["chaos_run"] = ens["chaos_draw"].astype(float)
     table["hours_to_limit_e"] = hours[:, -1]  # inf: does not reach the limit within the horizon
     table["reaches_limit_e"] = np.isfinite(hours[:, -1]).astype(float)
+    table["calendar_days_to_limit_e"] = days[:, -1]
     files = {
         "samples": ("ensemble.csv", lambda p: write_csv(p, table)),
         "band": ("ensemble_band.csv", lambda p: write_csv(p, band)),
@@ -332,6 +342,9 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
         files["band_figure"] = ("ensemble_band.png",
                                 lambda p: write_figure(p, band_figure(band, title, 1e3 * limit)))
         files["shares_figure"] = ("ensemble_shares.png", lambda p: write_figure(p, shares_figure(data, title)))
+        shown = list(level_index.values())
+        files["life_figure"] = ("ensemble_life.png", lambda p: write_figure(p, life_figure(
+            days[:, shown], [1e3 * lv[i] for i in shown], data, title)))
     written = write_files(outdir, what, files, scene=scene)  # scene.toml: the nominal scene
     data["files"] = {k: str(v) for k, v in written.items()}
     return data

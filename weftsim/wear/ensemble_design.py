@@ -33,7 +33,10 @@ if TYPE_CHECKING:
     from weftsim.input.params import Scene
     from weftsim.wear.uncertain import Uncertain
 
-RESCALED = ("joint_e.wear.wear_coefficient", "joint_e.wear.bearing_hardness_mpa", "joint_e.wear.journal_hardness_mpa")
+# The wear coefficients (the regimes' and the one-for-all override) and the hardnesses never enter the dynamics.
+K_KEYS = ("joint_e.wear.wear_coefficient", "joint_e.wear.dry_wear_coefficient", "joint_e.wear.boundary_wear_coefficient",
+          "joint_e.wear.mixed_wear_coefficient")
+RESCALED = (*K_KEYS, "joint_e.wear.bearing_hardness_mpa", "joint_e.wear.journal_hardness_mpa")
 DESIGN_QUANTILES = (0.05, 0.5, 0.95)
 MAX_DESIGN_POINTS = 9  # per key: the job names carry one digit per key
 
@@ -46,11 +49,44 @@ def design_quantiles(points: int) -> tuple[float, ...]:
 
 
 def last_bits(scene: Scene, j: int) -> Scene:
-    """``scene`` with its wear coefficient j units in the last place larger (the same physics to 1e-15)."""
-    k = scene.joint.wear.wear_coefficient
-    for _ in range(j):
-        k = math.nextafter(k, math.inf)
-    return replace(scene, joint=replace(scene.joint, wear=replace(scene.joint.wear, wear_coefficient=k)))
+    """``scene`` with its wear coefficients j units in the last place larger (the same physics to 1e-15): the
+    one-for-all ``wear_coefficient`` where the scene gives it, else every regime's."""
+    w = scene.joint.wear
+
+    def up(k: float) -> float:
+        for _ in range(j):
+            k = math.nextafter(k, math.inf)
+        return k
+
+    if w.wear_coefficient is not None:
+        w = replace(w, wear_coefficient=up(w.wear_coefficient))
+    else:
+        w = replace(w, dry_wear_coefficient=up(w.dry_wear_coefficient),
+                    boundary_wear_coefficient=up(w.boundary_wear_coefficient),
+                    mixed_wear_coefficient=up(w.mixed_wear_coefficient))
+    return replace(scene, joint=replace(scene.joint, wear=w))
+
+
+def k_scale(scene: Scene, values: dict[str, np.ndarray], samples: int) -> np.ndarray:
+    """The factor k0 / k on the hours of each sample from its uncertain wear coefficients (:data:`K_KEYS`).
+
+    Hours scale exactly as 1 / k where one k carries the wear: the solid contact's k (the regime's, dry or
+    boundary) of a joint without an oil film, the mixed regime's of an oiled one (the asperities carry its
+    load; where the dry law carries some too, the factor is the asperities' to first order).  A regime's key
+    that the joint does not wear in (``dry_wear_coefficient`` of a boundary-lubricated joint) changes nothing.
+    """
+    w = scene.joint.wear
+    oiled = scene.joint.is_lubricated
+    active = {"joint_e.wear.wear_coefficient": w.asperity_wear_coefficient if oiled else w.contact_wear_coefficient}
+    if w.wear_coefficient is None:
+        key = "mixed" if oiled else w.regime
+        active = {f"joint_e.wear.{key}_wear_coefficient": getattr(w, f"{key}_wear_coefficient"),
+                  **active}
+    scale = np.ones(samples)
+    for key in K_KEYS:
+        if key in values and key in active:
+            scale *= active[key] / values[key]
+    return scale
 
 
 def _lagrange(nodes: np.ndarray, x: np.ndarray) -> np.ndarray:

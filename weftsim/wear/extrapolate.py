@@ -142,10 +142,58 @@ def _cut_to_limit(update: Update, scene: Scene) -> Update:
     return replace(update, step_revolutions=outside)
 
 
-def _worn_joint(joint, bearing: np.ndarray, journal: np.ndarray):
+def _worn_joint(joint, bearing: np.ndarray, journal: np.ndarray, film: tuple[float, float] | None = None):
     worn = bool(np.any(bearing) or np.any(journal))
-    return replace(joint, bearing_wear=tuple(map(float, bearing)) if worn else (),
-                   journal_wear=tuple(map(float, journal)) if worn else ())
+    joint = replace(joint, bearing_wear=tuple(map(float, bearing)) if worn else (),
+                    journal_wear=tuple(map(float, journal)) if worn else ())
+    if worn and joint.lubrication is not None:
+        joint = replace(joint, lubrication=worn_film(joint, effective_clearance(joint.clearance, bearing, journal),
+                                                     film))
+    return joint
+
+
+def run_in_roughness(wear, sigma0: float, depth: float) -> float:
+    """The combined RMS roughness (m) after the surfaces have worn ``depth`` (m) where they touch (running-in).
+
+    sigma(h) = sigma_ss + (sigma0 - sigma_ss) exp(-h / h_r): the asperities' peaks are worn off first and the
+    roughness falls towards its run-in value sigma_ss (``run_in_roughness_um``) over a worn depth of a few h_r
+    (``run_in_depth_um``), the exponential transient of running-in models (Queener, Smith and Mitchell, Wear 8,
+    1965; Hu, Li and Tonder, J. Tribol. 113, 1991; reviewed by Khonsari, Ghatrehsamani and Akbarzadeh, Wear
+    474, 2021).  Without ``run_in_roughness_um`` the roughness stays sigma0.
+    """
+    if wear.run_in_roughness is None:
+        return sigma0
+    return wear.run_in_roughness + (sigma0 - wear.run_in_roughness) * math.exp(-depth / wear.run_in_depth)
+
+
+def worn_film(joint, clearance: float, film: tuple[float, float] | None = None):
+    """The lubrication of a worn ``joint`` whose effective clearance is ``clearance`` (m): the roughness run in
+    by the worn depth c_eff - c0 (:func:`run_in_roughness`) and, for a joint given an oil (the viscosity from
+    the bearing's heat balance, ``film_temperature`` set), the viscosity at the film temperature of the heat
+    balance at that clearance (:func:`weftsim.joint.heat.with_film_temperature`; ``film``: its (mean load N,
+    journal speed rad/s), the ideal mechanism's operating point)."""
+    lub = joint.lubrication
+    lub = replace(lub, roughness=run_in_roughness(joint.wear, lub.roughness, clearance - joint.clearance))
+    if film is not None and lub.has_oil and lub.film_temperature is not None:
+        from weftsim.joint.heat import with_film_temperature
+
+        resolved, _ = with_film_temperature(replace(joint, clearance=clearance, lubrication=lub, bearing_wear=(),
+                                                    journal_wear=()), *film)
+        lub = resolved.lubrication
+    return lub
+
+
+def film_operating_point(scene: Scene, name: str) -> tuple[float, float] | None:
+    """(mean load N, journal speed rad/s) of the ideal mechanism at joint ``name`` for the heat balance of a joint
+    given an oil; None for a fixed viscosity or a dry joint."""
+    joint = joint_of(scene, name)
+    lub = joint.lubrication
+    if lub is None or not lub.has_oil or lub.film_temperature is None:
+        return None
+    from weftsim.joint.bearing import mean_operating_point
+
+    mean, _, omega = mean_operating_point(scene, name)
+    return mean, omega
 
 
 def worn_scene(scene: Scene, bearing: np.ndarray, journal: np.ndarray, revolutions: float,
@@ -161,7 +209,8 @@ def worn_scene(scene: Scene, bearing: np.ndarray, journal: np.ndarray, revolutio
     if second is not None:
         profiles["f"] = second
     worn = any(bool(np.any(b) or np.any(j)) for b, j in profiles.values())
-    changes = {"joint" if name == "e" else "joint_f": _worn_joint(joint_of(scene, name), *pair)
+    changes = {"joint" if name == "e" else "joint_f": _worn_joint(joint_of(scene, name), *pair,
+                                                                  film_operating_point(scene, name))
                for name, pair in profiles.items()}
     scene = replace(scene, **changes)
     solver = scene.reference_solver
@@ -205,6 +254,7 @@ def _response(steps: dict, t0: float, joints: Sequence[str] = ("e",)) -> dict:
 def _sliding(wear: RunWear, per_rev: float, joint: str) -> dict:
     return {f"sliding_distance_per_rev_{joint}_m": wear.sliding_distance * per_rev,
             f"sliding_work_per_rev_{joint}_J": wear.sliding_work * per_rev,
+            f"asperity_work_per_rev_{joint}_J": wear.asperity_work * per_rev,
             # Archard's load: the mean of F_N weighted by the sliding ds = |v_T| dt (not by dt)
             f"contact_force_sliding_mean_{joint}_N": wear.sliding_work / wear.sliding_distance
             if wear.sliding_distance > 0.0 else math.nan}
@@ -290,6 +340,22 @@ def next_update(scene: Scene, hours_done: float, revolutions_done: float, bearin
         wear, response = run(scene, bearing, journal)
     else:
         wear, response = run(scene, bearing, journal, second)
+    for joint, (b, j) in zip(joints, [(bearing, journal)] + ([second] if second is not None else [])):
+        lub = joint_of(scene, joint).lubrication
+        if lub is not None:  # the film's temperature and the run-in roughness the update ran with
+            worn = _worn_joint(joint_of(scene, joint), b, j, film_operating_point(scene, joint)).lubrication
+            response = {**response, f"film_temperature_{joint}_C": math.nan if worn.film_temperature is None
+                        else worn.film_temperature, f"roughness_{joint}_um": 1e6 * worn.roughness}
+    if scene.duty.stops_per_hour > 0.0:  # the stop-starts' wear on this geometry, per revolution of running
+        from weftsim.wear.duty import with_stops
+
+        engine = "reference" if simulate is None or simulate is simulate_update else "exudyn"
+        worn = worn_scene(scene, bearing, journal, w.settle_revolutions + w.revolutions_per_update)
+        try:
+            wear, stops = with_stops(worn, wear, w.revolutions_per_update, engine)
+        except WearError as exc:
+            raise UpdateFailed(str(exc)) from None
+        response = {**response, **stops}
     per_rev = 1.0 / w.revolutions_per_update
     profiles = [(bearing, journal)] + ([second] if second is not None else [])
     runs = [wear] + ([wear.second] if second is not None else [])
@@ -303,8 +369,8 @@ def next_update(scene: Scene, hours_done: float, revolutions_done: float, bearin
             raise WearError(
                 f"the wear is too fast to extrapolate: the {w.revolutions_per_update} revolutions of an update alone "
                 f"grow the clearance at {joint.upper()} by {100 * grown:.3g} %, more than "
-                f"joint_{joint}.wear.max_clearance_change = {100 * jw.max_clearance_change:g} % (wear_coefficient "
-                f"{jw.wear_coefficient:g}, hardness {jw.bearing_hardness / 1e6:g} / {jw.journal_hardness / 1e6:g} MPa: "
+                f"joint_{joint}.wear.max_clearance_change = {100 * jw.max_clearance_change:g} % (wear coefficient "
+                f"{jw.contact_wear_coefficient:g}, hardness {jw.bearing_hardness / 1e6:g} / {jw.journal_hardness / 1e6:g} MPa: "
                 f"check [joint_{joint}.wear])")
         parts.append(part)
         n = min(n, allowed)

@@ -65,6 +65,7 @@ def run_job(scene: Scene, limit: float, directory: str, horizon: float | None = 
     from weftsim.wear import store
     from weftsim.wear.censored import no_wear_reason
     from weftsim.wear.extrapolate import MAX_HOURS, advance, effective_clearance, predict
+    from weftsim.wear.life import prediction_stop_share
 
     horizon = MAX_HOURS if horizon is None else min(float(horizon), MAX_HOURS)
     directory = Path(directory)
@@ -115,7 +116,8 @@ def run_job(scene: Scene, limit: float, directory: str, horizon: float | None = 
         result.update(hours=[v if math.isfinite(v) else None for v in two_ended_hours(hours, clearance)],
                       hours_one_ended=hours, clearance_m=clearance,
                       updates=len(updates),
-                      bearing_share=depth_b / (depth_b + depth_j) if depth_b + depth_j > 0.0 else 0.5)
+                      bearing_share=depth_b / (depth_b + depth_j) if depth_b + depth_j > 0.0 else 0.5,
+                      stop_start_share=prediction_stop_share(updates))
         if result["error"] is None and clearance[-1] < limit:  # censored: beyond the horizon, or never
             result["censored"] = True
             result["never"] = no_wear_reason(scene, updates[-1])

@@ -93,7 +93,7 @@ def read_state(path: Path, scene: Scene) -> list[Update]:
     """
     from weftsim.post.npz_guard import DAMAGE, array_headers, open_archive, read_array
     from weftsim.wear.extrapolate import joint_of, wearing_joints
-    from weftsim.wear.state import LEGACY_RESPONSE, RESPONSE, StateMismatch, scene_identity
+    from weftsim.wear.state import EARLIER_RESPONSE, LEGACY_RESPONSE, RESPONSE, StateMismatch, scene_identity
 
     joints = wearing_joints(scene)
     allowed = {"scene", "response", "digest", *SERIES, *LEGACY,
@@ -118,6 +118,8 @@ def read_state(path: Path, scene: Scene) -> list[Update]:
             names = _names(joints, legacy)
             points = {j: joint_of(scene, j).wear.profile_points for j in joints}
             columns = len(LEGACY_RESPONSE) if legacy else len(RESPONSE)
+            if not legacy and headers.get("response", ((0, 0),))[0][1:] == (len(EARLIER_RESPONSE),):
+                columns = len(EARLIER_RESPONSE)  # written before the later columns (state.LATER_RESPONSE)
             problem = _shape_problem(headers, names, points, columns)
             if problem:
                 raise StateMismatch(f"{path}: damaged wear state: {problem}{_advice(path)}")
@@ -134,6 +136,8 @@ def read_state(path: Path, scene: Scene) -> list[Update]:
     written_response = response
     if legacy:
         response = _legacy_response(response)
+    elif response.shape[1] < len(RESPONSE):
+        response = np.hstack([response, np.full((response.shape[0], len(RESPONSE) - response.shape[1]), math.nan)])
     if stored is None and not legacy:  # every state naming its joints was written with its checksum
         raise StateMismatch(f"{path}: its checksum ('digest') is missing: weftsim has written one with every state "
                             "that names its joints (bearing_e, ...), so it was removed or the file damaged, and a "

@@ -24,7 +24,12 @@ JOINT_RESPONSE = ("contact_force_{j}_mean_N", "contact_force_{j}_p99_N", "contac
                   "film_ratio_min_{j}", "film_ratio_mean_{j}", "mixed_fraction_{j}", "sliding_distance_per_rev_{j}_m",
                   "sliding_work_per_rev_{j}_J", "contact_force_sliding_mean_{j}_N")
 JOINTS = ("e", "f")
-RESPONSE = MECHANISM_RESPONSE + tuple(name.format(j=j) for j in JOINTS for name in JOINT_RESPONSE)
+# Columns added after the layout above was first stored, appended so that a state written before them loads
+# (their values NaN, weftsim.wear.resume): the asperities' share of the sliding work (the mixed regime's k).
+LATER_RESPONSE = ("asperity_work_per_rev_{j}_J", "stop_start_volume_{j}_mm3", "stop_start_share_{j}",
+                  "stop_start_start_up_share_{j}", "film_temperature_{j}_C", "roughness_{j}_um")
+EARLIER_RESPONSE = MECHANISM_RESPONSE + tuple(name.format(j=j) for j in JOINTS for name in JOINT_RESPONSE)
+RESPONSE = EARLIER_RESPONSE + tuple(name.format(j=j) for j in JOINTS for name in LATER_RESPONSE)
 # The columns of a state written before the joints were named (joint E alone), in their stored order, and
 # their names now: such a state still loads (weftsim.wear.resume).
 LEGACY_RESPONSE = ("rapier_acceleration_rms_m_s2", "rapier_acceleration_p99_m_s2", "driving_torque_rms_Nm",
@@ -61,7 +66,25 @@ def scene_identity(scene: Scene) -> str:
     keys = to_file_keys(scene)
     if scene.joint_f.is_ideal:
         keys = {k: v for k, v in keys.items() if not k.startswith("joint_f.wear.")}
+    # The wear regimes' keys at their defaults are the single k = 1e-7 a state written before them knew:
+    # the same scene (its identity written as then).
+    for table in ("joint_e", "joint_f"):
+        at = f"{table}.wear."
+        if all(keys.get(at + name, value) == value for name, value in REGIME_DEFAULTS.items()):
+            for name in REGIME_DEFAULTS:
+                keys.pop(at + name, None)
+            if keys.get(at + "wear_coefficient", 0.0) is None:
+                keys[at + "wear_coefficient"] = REGIME_DEFAULTS["boundary_wear_coefficient"]
+    for name, value in DUTY_DEFAULTS.items():  # the steady prediction's duty keys, which a state before them lacks
+        if keys.get("duty." + name) == value:
+            keys.pop("duty." + name)
     for table, joint in (("joint_e", scene.joint), ("joint_f", scene.joint_f)):
         if joint.lubrication is None or not joint.lubrication.has_oil:  # the oil's keys change nothing without one
             keys = {k: v for k, v in keys.items() if k not in {f"{table}.lubrication.{name}" for name in HEAT_KEYS}}
     return json.dumps(keys, sort_keys=True, default=str)
+
+
+DUTY_DEFAULTS = {"stops_per_hour": 0.0, "stop_minutes": 2.87, "hours_per_day": 24.0, "days_per_week": 7.0,
+                 "startup_revolutions": 1.0, "rundown_revolutions": 1.0}  # weftsim.input.params.Duty's
+REGIME_DEFAULTS = {"regime": "boundary", "dry_wear_coefficient": 5e-3, "boundary_wear_coefficient": 1e-7,
+                   "mixed_wear_coefficient": 1e-7, "run_in_roughness_um": None, "run_in_depth_um": 1.0}  # weftsim.input.params.WearModel's defaults

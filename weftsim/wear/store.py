@@ -21,7 +21,7 @@ import numpy as np
 from weftsim.post.output import write_atomic, write_csv
 from weftsim.wear.extrapolate import Update, effective_clearance, joint_of, limit_hours, wearing_joints
 # What a stored state is lives in weftsim.wear.state, read by weftsim.wear.resume too; re-exported here.
-from weftsim.wear.state import JOINTS, JOINT_RESPONSE, LEGACY_NAMES, LEGACY_RESPONSE, MECHANISM_RESPONSE, PARTS, RESPONSE, STATE, StateMismatch, scene_identity  # noqa: F401
+from weftsim.wear.state import JOINTS, JOINT_RESPONSE, LATER_RESPONSE, LEGACY_NAMES, LEGACY_RESPONSE, MECHANISM_RESPONSE, PARTS, RESPONSE, STATE, StateMismatch, scene_identity  # noqa: F401
 
 if TYPE_CHECKING:
     from weftsim.input.params import Scene
@@ -100,7 +100,7 @@ def table(scene: Scene, updates: list[Update]) -> dict[str, np.ndarray]:
 def response_keys(scene: Scene) -> tuple[str, ...]:
     """The :data:`RESPONSE` statistics of the mechanism and of the scene's wearing joints."""
     joints = wearing_joints(scene)
-    return MECHANISM_RESPONSE + tuple(name.format(j=j) for j in joints for name in JOINT_RESPONSE)
+    return MECHANISM_RESPONSE + tuple(name.format(j=j) for j in joints for name in (*JOINT_RESPONSE, *LATER_RESPONSE))
 
 
 def write_table(target: Path, scene: Scene, updates: list[Update]) -> Path:
@@ -197,14 +197,20 @@ def archard_check(scene: Scene, updates: list[Update]) -> dict:
         n = np.array([u.step_revolutions for u in updates[:-1]])
         rows = [(u.response.get(f"sliding_distance_per_rev_{joint}_m", math.nan),
                  u.response.get(f"sliding_work_per_rev_{joint}_J", math.nan),
-                 u.response.get(f"contact_force_{joint}_mean_N", math.nan)) for u in updates[:-1]]
-        s_rev, w_rev, f_mean = (np.array(c, dtype=float) for c in zip(*rows)) if rows else (np.zeros(0),) * 3
+                 u.response.get(f"contact_force_{joint}_mean_N", math.nan),
+                 u.response.get(f"asperity_work_per_rev_{joint}_J", math.nan)) for u in updates[:-1]]
+        s_rev, w_rev, f_mean, a_rev = (np.array(c, dtype=float) for c in zip(*rows)) if rows else (np.zeros(0),) * 4
         distance = float(np.dot(n, s_rev))
         work = float(np.dot(n, w_rev))
-        specific = w.wear_coefficient * (1.0 / w.bearing_hardness + 1.0 / w.journal_hardness)
+        k_c, k_a = w.contact_wear_coefficient, w.asperity_wear_coefficient
+        specific = k_c * (1.0 / w.bearing_hardness + 1.0 / w.journal_hardness)
         load = work / distance if distance > 0.0 else math.nan
+        # Archard's volume: k_c on the solid contact's sliding work, k_a on the asperities' (the mixed regime)
+        extra = 0.0 if k_a == k_c else (k_a / k_c - 1.0) * float(np.dot(n, a_rev))
         out.update({f"profile_volume_{joint}_mm3": 1e9 * profile,
-                    f"archard_volume_{joint}_mm3": 1e9 * specific * load * distance if distance > 0.0 else 0.0,
+                    f"archard_volume_{joint}_mm3": 1e9 * specific * (load * distance + extra) if distance > 0.0
+                    else 0.0,
+                    f"asperity_work_share_{joint}": float(np.dot(n, a_rev)) / work if work > 0.0 else math.nan,
                     f"sliding_distance_{joint}_m": distance,
                     f"sliding_weighted_mean_load_{joint}_N": load,
                     f"time_mean_load_{joint}_N": float(np.dot(n, f_mean) / n.sum()) if n.size and n.sum() > 0.0

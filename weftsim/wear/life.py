@@ -1,0 +1,113 @@
+"""The life report of a wear ensemble: calendar time to the limit and the stop-starts' share of the wear
+(docs/wear.md section 12).
+
+The ensemble (:mod:`weftsim.wear.ensemble`) gives each sample's running hours to every clearance level.  A
+planner reads calendar time: each sample's hours are turned into calendar days by its own duty cycle
+(:meth:`weftsim.input.params.Duty.calendar_days`, the ``[duty]`` keys the sample draws or the scene's), and the
+days are summarised as the hours are (p10 / p50 / p90 with their order-statistic intervals, censored samples
+beyond the horizon's days).  The stop-starts' share of the worn volume is each design prediction's
+(:func:`prediction_stop_share`): it is a property of the simulated design points, reported per point.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+    from weftsim.input.params import Scene
+
+DUTY_KEYS = ("stops_per_hour", "stop_minutes", "hours_per_day", "days_per_week")
+
+
+def sample_days(scene: Scene, values: dict[str, np.ndarray], hours: np.ndarray) -> np.ndarray:
+    """Calendar days of each sample's ``hours`` (samples, levels), inf where the hours are: the duty of each
+    sample (its drawn ``duty.*`` values, the scene's otherwise)."""
+    duty = scene.duty
+    n = hours.shape[0]
+    keys = {name: np.asarray(values.get(f"duty.{name}", np.full(n, getattr(duty, name))), dtype=float)
+            for name in DUTY_KEYS}
+    scheduled = 1.0 + keys["stops_per_hour"] * keys["stop_minutes"] / 60.0
+    factor = scheduled / keys["hours_per_day"] * 7.0 / keys["days_per_week"]
+    return hours * factor[:, None]
+
+
+def horizon_days(scene: Scene, horizon: float) -> float:
+    """The horizon in calendar days at the scene's duty (what a censored calendar quantile lies beyond)."""
+    return scene.duty.calendar_days(horizon)
+
+
+def prediction_stop_share(updates: list, joint: str = "e") -> float | None:
+    """The stop-starts' share of the volume a prediction's ``updates`` wear (N-weighted over the updates; None
+    when nothing wears or the duty has no stops)."""
+    volume = share = 0.0
+    for u in updates:
+        v = u.step_revolutions * u.part(joint).volume_rate
+        s = u.response.get(f"stop_start_share_{joint}", math.nan)
+        if v > 0.0 and math.isfinite(s):
+            volume += v
+            share += v * s
+    return share / volume if volume > 0.0 else None
+
+
+def stop_share_summary(results: dict) -> dict | None:
+    """{"centre", "min", "median", "max"} of the design predictions' stop-start shares (None without stops)."""
+    shares = {n: r.get("stop_start_share") for n, r in results.items() if r.get("stop_start_share") is not None}
+    if not shares:
+        return None
+    values = np.array(list(shares.values()), dtype=float)
+    return {"centre": shares.get("centre"), "min": float(values.min()), "median": float(np.median(values)),
+            "max": float(values.max()), "by_design_point": dict(sorted(shares.items()))}
+
+
+def life_figure(days: np.ndarray, levels_mm: list[float], data: dict, title: str = "") -> Figure:
+    """Left: the distribution of the calendar days to each clearance level (its curve ends at the fraction of
+    the samples reaching it within the horizon); right: the stop-starts' share of the wear at each design point."""
+    from weftsim.post.plots import figure
+
+    fig = figure(figsize=(11, 4.2))
+    ax = fig.add_subplot(1, 2, 1)
+    for i, level in enumerate(levels_mm):
+        d = np.sort(days[:, i])
+        finite = np.isfinite(d)
+        if finite.any():
+            ax.step(d[finite], np.arange(1, finite.sum() + 1) / d.size, where="post", label=f"{level:g} mm")
+    ax.set_xscale("log")
+    ax.set_xlabel(f"calendar days to the clearance ({data.get('duty_text', '')})")
+    ax.set_ylabel("fraction of the samples")
+    ax.set_ylim(0.0, 1.0)
+    ax.grid(True, alpha=0.3)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=8)
+    else:
+        ax.text(0.5, 0.5, "no sample reaches a level\nwithin the horizon", transform=ax.transAxes, ha="center")
+    ax = fig.add_subplot(1, 2, 2)
+    stops = data.get("stop_start_share")
+    if stops:
+        names = list(stops["by_design_point"])
+        ax.barh(names, [100.0 * stops["by_design_point"][n] for n in names], color="C1")
+        ax.set_xlabel("share of the worn volume from stop-starts, %")
+        ax.tick_params(axis="y", labelsize=7)
+    else:
+        ax.text(0.5, 0.5, "no stops ([duty] stops_per_hour = 0)", transform=ax.transAxes, ha="center")
+        ax.set_axis_off()
+    fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def duty_text(scene: Scene, values: dict) -> str:
+    """The duty of the report's calendar time, the drawn keys named as drawn."""
+    duty = scene.duty
+    parts = []
+    for name, unit in (("hours_per_day", "h a day"), ("days_per_week", "days a week"), ("stops_per_hour", "stops an h")):
+        parts.append(f"{'drawn' if f'duty.{name}' in values else f'{getattr(duty, name):g}'} {unit}")
+    return ", ".join(parts)
+
+
+__all__ = ["DUTY_KEYS", "duty_text", "horizon_days", "life_figure", "prediction_stop_share", "sample_days",
+           "stop_share_summary"]
