@@ -61,6 +61,8 @@ MAX_SCENE_BYTES = 1 << 20
 # Longest `extends` chain: the deepest in models/ is 2 files; 64 leaves room for any layering
 # a user builds and stops a runaway chain with one line instead of a RecursionError.
 MAX_EXTENDS_DEPTH = 64
+# The optional table of the flexible rapier tape (docs/rapier-tape.md): given even empty, the scene has a tape.
+TAPE_TABLE = "rapier_tape"
 
 
 def _spelling(table: tuple[str, ...], name: str) -> str:
@@ -78,6 +80,8 @@ def _flatten(table: dict, where: str, prefix: tuple[str, ...] = (),
     for name, value in table.items():
         path = ".".join(prefix + (name,))
         if isinstance(value, dict):
+            if not value and path == TAPE_TABLE:  # an empty [rapier_tape]: the tape with its defaults
+                flat[path] = {}
             flat.update(_flatten(value, where, prefix + (name,), seen))
             continue
         if path in seen:
@@ -332,6 +336,12 @@ def _check_scene(scene: params.Scene, where: str, origin: dict[str, Path]) -> No
                 f"{at(clearance)}: key '{clearance}' must be smaller than the journal radius "
                 f"{joint.journal_radius / MM:g} mm, got {joint.clearance / MM:g}"
             )
+    if scene.rapier_tape is not None:
+        from weftsim.tape.model import tape_problem
+
+        problem = tape_problem(scene)
+        if problem is not None:
+            raise SceneError(f"{where}: {problem}")
     if scene.output.sample_angle / scene.drive.speed > scene.drive.end_time:
         raise SceneError(f"{at('drive.revolutions')}: key 'drive.revolutions' is shorter than one output sample")
     from weftsim.mechanism.kinematics import assembly_failure_angle
@@ -375,6 +385,9 @@ def scene_from_keys(flat: dict[str, Any], where: str = "scene", origin: dict[str
     scene = params.Scene(name=name, source=where)
     for path, value in flat.items():
         if path in TOP_LEVEL:
+            continue
+        if path == TAPE_TABLE:  # an empty [rapier_tape] table (_flatten)
+            scene = replace(scene, rapier_tape=scene.rapier_tape or params.RapierTape())
             continue
         src = str(origin.get(path, where))
         key = _known(path, src)

@@ -245,10 +245,10 @@ def check_scene(path: Path, scene: params.Scene) -> None:
 def read_npz(path: str | os.PathLike):
     """The :class:`weftsim.post.results.RunResult` in ``path``, checked as the module docstring says."""
     from weftsim.post.results import (CHANNELS, JOINT_F_CHANNELS, LUBRICATION_CHANNELS, LUBRICATION_CHANNELS_F,
-                                      RunResult, optional_channels)
+                                      TAPE_CHANNELS, RunResult, optional_channels)
 
     path = Path(path)
-    all_names = CHANNELS + JOINT_F_CHANNELS + LUBRICATION_CHANNELS + LUBRICATION_CHANNELS_F
+    all_names = CHANNELS + JOINT_F_CHANNELS + LUBRICATION_CHANNELS + LUBRICATION_CHANNELS_F + TAPE_CHANNELS
     expected = {"meta"} | {f"{t}/{n}" for t in TABLES for n in all_names}
     archive = open_archive(path, WHAT, "give the result.npz file in it")
     try:

@@ -81,6 +81,22 @@ LUBRICATION_CHANNELS_F: tuple[str, ...] = (
     "film_torque_f_Nm",
 )
 
+# Channels of the flexible rapier tape (docs/rapier-tape.md), present exactly when the run models the tape as
+# flexible (weftsim.tape.selection.tape_model): the head's motion (s of the head's rigid position plus the tape's
+# axial displacement there), the tape's axial force where it leaves the wheel and at the head (tension
+# positive), the free length, its first axial natural frequency (the closed form at that length) and the
+# tape's strain energy.  rapier_* stay the wheel's pitch-circle motion (the rigid rapier's).
+TAPE_CHANNELS: tuple[str, ...] = (
+    "head_displacement_m",
+    "head_velocity_m_s",
+    "head_acceleration_m_s2",
+    "tape_force_wheel_N",
+    "tape_force_head_N",
+    "tape_free_length_m",
+    "tape_frequency_hz",
+    "tape_strain_energy_J",
+)
+
 # Joint E's channel of each joint-F channel (same quantity at the other joint).
 JOINT_E_NAME = dict(zip(JOINT_F_CHANNELS, ("contact_force_N", "penetration_m", "eccentricity_y_m",
                                            "eccentricity_z_m", "impact_velocity_m_s", "in_contact",
@@ -119,7 +135,7 @@ def optional_channels(names) -> tuple[str, ...]:
     """The optional channel groups (joint F's, the lubricated joints') present among ``names``, in order."""
     present = set(names)
     out: tuple[str, ...] = ()
-    for group in (JOINT_F_CHANNELS, LUBRICATION_CHANNELS, LUBRICATION_CHANNELS_F):
+    for group in (JOINT_F_CHANNELS, LUBRICATION_CHANNELS, LUBRICATION_CHANNELS_F, TAPE_CHANNELS):
         if group[0] in present:
             out += group
     return out
@@ -134,7 +150,7 @@ def _as_channels(data: dict[str, np.ndarray], what: str) -> dict[str, np.ndarray
         raise ValueError(f"{what} lacks channels {missing}; every engine must provide all of {list(CHANNELS)}")
     names = CHANNELS
     for group, label in ((JOINT_F_CHANNELS, "joint F"), (LUBRICATION_CHANNELS, "lubrication"),
-                         (LUBRICATION_CHANNELS_F, "joint F lubrication")):
+                         (LUBRICATION_CHANNELS_F, "joint F lubrication"), (TAPE_CHANNELS, "rapier tape")):
         given = [name for name in group if name in data]
         if given:
             if len(given) != len(group):
@@ -287,6 +303,11 @@ def scene_channels(scene: Scene) -> tuple[str, ...]:
         names += LUBRICATION_CHANNELS
     if not scene.joint_f.is_ideal and scene.joint_f.is_lubricated:
         names += LUBRICATION_CHANNELS_F
+    if scene.rapier_tape is not None:
+        from weftsim.tape.selection import tape_model
+
+        if tape_model(scene) == "flexible":
+            names += TAPE_CHANNELS
     return names
 
 

@@ -119,6 +119,10 @@ def compiled_method(scene: Scene) -> str | None:
     """
     method = scene.reference_solver.method
     if method == AUTO:
+        if _flexible_tape(scene):
+            # The tape's Ritz modes reach 10^5-10^6 rad/s, overdamped by the Kelvin-Voigt damping: a stiff
+            # system for an explicit method (docs/rapier-tape.md); RODAS4's step follows the accuracy alone.
+            return "numba_RODAS4"
         if any(j.is_lubricated for j in (scene.joint, scene.joint_f) if not j.is_ideal):
             # The film loads the joint at every step, not in contact segments alone: RODAS4 throughout
             # (loom, 600 rpm, c = 0.02 mm, 80 mPa s, one revolution: 20 897 steps against 363 870 of
@@ -126,6 +130,15 @@ def compiled_method(scene: Scene) -> str | None:
             return "numba_RODAS4"
         return "numba_DOP853_RODAS4" if stiff_joints(scene) else "numba_DOP853"
     return method if method in COMPILED_METHODS else None
+
+
+def _flexible_tape(scene: Scene) -> bool:
+    """True when the scene's rapier tape runs flexible (:func:`weftsim.tape.selection.tape_model`)."""
+    if scene.rapier_tape is None:
+        return False
+    from weftsim.tape.selection import tape_model
+
+    return tape_model(scene) == "flexible"
 
 
 def effective_rtol(scene: Scene) -> float:
@@ -143,7 +156,22 @@ def effective_rtol(scene: Scene) -> float:
 
 
 def select_path(scene: Scene) -> dict:
-    """``{"model", "method", "reason"}`` of the run :func:`solve` makes of ``scene``."""
+    """``{"model", "method", "reason"}`` of the run :func:`solve` makes of ``scene`` (and ``"rapier"``: the
+    tape's verdict, :func:`weftsim.tape.selection.tape_check`, when the scene has a ``[rapier_tape]``)."""
+    if scene.rapier_tape is not None:
+        from weftsim.tape.selection import rigid_scene, tape_check
+
+        check = tape_check(scene)
+        path = select_path(rigid_scene(scene)) if check["model"] == "rigid" else _select_path(scene)
+        if check["model"] == "flexible":
+            path["model"] += f" with the flexible rapier tape ({scene.rapier_tape.modes} Ritz functions)"
+        else:
+            path["model"] += " with the tape and head as the rigid rapier"
+        return dict(path, rapier=check["reason"])
+    return _select_path(scene)
+
+
+def _select_path(scene: Scene) -> dict:
     if scene.is_ideal:
         return {"model": "ideal joint", "method": "closed form",
                 "reason": "clearance 0: no free coordinate, nothing to integrate"}
@@ -215,7 +243,15 @@ def solve(scene: Scene, progress: Callable[[float], None] | None = None,
         integration fails; what was computed up to then is kept.  Invalid solver settings
         also give a failed result naming the setting.
     """
-    problem = _check(scene)
+    original = scene
+    problem = None
+    if scene.rapier_tape is not None:
+        from weftsim.tape.selection import flexible_problem, rigid_scene
+
+        scene = rigid_scene(scene)
+        problem = flexible_problem(scene) if scene.rapier_tape is not None else None
+    if problem is None:
+        problem = _check(scene)
     if problem is not None:
         empty = empty_channels(not scene.joint_f.is_ideal)
         return RunResult(scene, "reference", "failed", problem, empty, empty,
@@ -224,6 +260,8 @@ def solve(scene: Scene, progress: Callable[[float], None] | None = None,
         result = _solve_ideal(scene, progress)
     else:
         result = _solve_clearance(scene, progress, step_states)
-    object.__setattr__(result, "path", select_path(scene))
+    object.__setattr__(result, "path", select_path(original))
     # Post-run criteria (energy balance, ...) that no single step shows; see weftsim.run.guards.
-    return vet_result(result)
+    result = vet_result(result)
+    object.__setattr__(result, "scene", original)  # a tape run as the rigid rapier: the scene asked for
+    return result

@@ -196,6 +196,10 @@ def compiled_channels(scene: Scene, time: np.ndarray, states: np.ndarray, contac
     a0 = float(initial_state(scene)[0])
     size = initial_state(scene).size
     states = np.ascontiguousarray(states, dtype=float).reshape(time.size, size)
+    if prm[kf.TOPOLOGY] == kf.E_TAPE:  # the flexible rapier tape (weftsim.tape.channels)
+        from weftsim.tape.channels import tape_channels
+
+        return tape_channels(scene, prm, table, a0, time, states, contact, impact)
     if scene.joint_f.is_ideal:
         out = np.empty((time.size, len(CHANNELS)))
         _fill(prm, table, a0, scene.geometry.rapier_ratio, time, states, np.asarray(contact, dtype=np.bool_),

@@ -107,7 +107,17 @@ def pack_parameters(scene: Scene) -> np.ndarray:
     """Every number the kernel needs for this scene: the joint block at E, the chain's constants,
     the joint block at F (zeros while F is ideal), the topology, J_FG and J4; then the wear tables
     of the worn joints (:mod:`weftsim.kernel.wear`): E's at ``kc.WEAR_E``, then F's (E's block is the
-    empty ``[0, 0]`` when only F is worn; :func:`weftsim.kernel.chain_f.wear_start_f`)."""
+    empty ``[0, 0]`` when only F is worn; :func:`weftsim.kernel.chain_f.wear_start_f`).
+
+    A scene whose tape runs flexible (:func:`weftsim.tape.selection.tape_model`) gets topology E_TAPE and the
+    tape block (:func:`weftsim.tape.model.flexible_parameters`); one whose tape runs rigid, its rigid equivalent's."""
+    if scene.rapier_tape is not None:
+        from weftsim.tape import model as tape_model_
+        from weftsim.tape.selection import tape_model
+
+        if tape_model(scene) == "rigid":
+            return pack_parameters(tape_model_.rigid_equivalent(scene))
+        return tape_model_.flexible_parameters(scene, pack_parameters(tape_model_.massless_rapier(scene)))
     out = np.zeros(kf.N_PARAMETERS)
     out[:kc.N_PARAMETERS] = _chain_block(ChainConstants.from_scene(scene))
     if not scene.joint.is_ideal or scene.joint_f.is_ideal:
@@ -186,6 +196,12 @@ def initial_state(scene: Scene) -> np.ndarray:
     With clearance at E and F (4 coordinates) the state is [a, Y, Z, psi, a', Y', Z', psi', W3, D],
     (Y, Z) the rod's centre of mass (:mod:`weftsim.kernel.chain_f`).
     """
+    if scene.rapier_tape is not None:  # [a, psi, q, a', psi', q', W3, D] (weftsim.kernel.tape)
+        from weftsim.tape import model as tape_model_
+        from weftsim.tape.selection import tape_model
+
+        chain = initial_state(tape_model_.massless_rapier(scene))
+        return chain if tape_model(scene) == "rigid" else tape_model_.flexible_initial_state(scene, chain)
     omega = scene.drive.speed
     st = kin.linkage_state(0.0, scene.geometry, scene.inertia.rocker_com)
     if topology(scene) == kf.E_AND_F:
