@@ -440,7 +440,7 @@ def load_scene(path: str | os.PathLike, overrides: dict[str, Any] | None = None,
         flat[dotted] = value
         origin[dotted] = Path(overrides_from)
     for dotted in flat:  # a misspelt key is reported as such, not as the missing one it stands for
-        if dotted not in TOP_LEVEL:
+        if dotted not in TOP_LEVEL and dotted != TAPE_TABLE:
             _known(dotted, str(origin.get(dotted, path)))
     if "joint_f.clearance_mm" not in flat:  # a [joint_f] table without a clearance describes an ideal joint
         stray = [key for key in flat if key.startswith("joint_f.") and describes_joint(key)

@@ -129,6 +129,9 @@ PEAK_CHANNELS_F: tuple[str, ...] = ("contact_force_f_N", "penetration_f_m")
 # Peak channels of a lubricated joint (E's, F's); the film ratio's minimum is its summary (analysis).
 PEAK_CHANNELS_LUBRICATION: tuple[str, ...] = ("film_force_N", "asperity_force_N", "film_torque_Nm")
 PEAK_CHANNELS_LUBRICATION_F: tuple[str, ...] = ("film_force_f_N", "asperity_force_f_N", "film_torque_f_Nm")
+# Peak channels of the flexible rapier tape; the first frequency's min and max span the stroke.
+PEAK_CHANNELS_TAPE: tuple[str, ...] = ("head_displacement_m", "head_velocity_m_s", "head_acceleration_m_s2",
+                                       "tape_force_wheel_N", "tape_force_head_N", "tape_frequency_hz")
 
 
 def optional_channels(names) -> tuple[str, ...]:
