@@ -245,3 +245,40 @@ def test_exudyns_ancf_tape_meets_the_same_closed_form(free_length):
 
     assert axial_frequencies(TAPE, free_length, elements=4)[0] == pytest.approx(first_frequency(TAPE, free_length),
                                                                                 rel=5e-3)
+
+
+def _pulse(t: float, peak: float = 2000.0, duration: float = 5e-4) -> tuple[float, float, float]:
+    """The wheel's (s, s', s'') under a raised-cosine acceleration pulse of ``peak`` m/s^2 from rest."""
+    w = 2 * math.pi / duration
+    if t <= 0.0:
+        return 0.0, 0.0, 0.0
+    if t < duration:
+        return (0.5 * peak * (t * t / 2 + (math.cos(w * t) - 1) / w**2), 0.5 * peak * (t - math.sin(w * t) / w),
+                0.5 * peak * (1 - math.cos(w * t)))
+    return 0.5 * peak * duration * (duration / 2 + t - duration), 0.5 * peak * duration, 0.0
+
+
+def test_both_engines_agree_on_the_heads_acceleration_under_a_wheel_pulse():
+    """The wheel jerked by a 2000 m/s^2, 0.5 ms pulse (an impact's time scale; the tape's first mode at 0.87 m
+    rings at 1165 Hz), damping on: the head's acceleration peaks (+3229 / -3143 m/s^2, 1.6 x the wheel's) on the
+    kernel's Ritz tape and on Exudyn's ANCF cables (4 elements, h = 1 us; 8 elements at 0.5 us move them by
+    5e-6).  Measured 2.2e-4 and 0.9e-4 apart (the kernel's free length grows 0.2 % under the pulse, Exudyn's
+    is fixed); the issue asks 1 %.
+    """
+    from weftsim.exudyn_engine.tape import driven_head_acceleration
+
+    tape = replace(TAPE, free_length=0.87)
+    end = 4e-3
+    _, exudyn_head = driven_head_acceleration(tape, tape.free_length, lambda t: _pulse(t)[0], end, 1e-6)
+    prm = _kernel_parameters(tape)
+    n = tape.modes
+    sol = solve_ivp(_driven_rhs(prm, _pulse), (0.0, end), np.zeros(2 * n), method="DOP853", rtol=1e-9, atol=1e-14,
+                    dense_output=True, max_step=2.5e-5)
+    head = []
+    for t in np.linspace(0.0, end, 4001):
+        y = sol.sol(t)
+        head.append(kt.driven_tape(prm, *_pulse(t), y[:n].copy(), y[n:].copy(), np.empty(n))[3])
+    head = np.array(head)
+    assert head.max() > 1.5 * 2000.0  # the tape rings: the check is not the rigid rapier's
+    assert head.max() == pytest.approx(exudyn_head.max(), rel=1e-2)
+    assert head.min() == pytest.approx(exudyn_head.min(), rel=1e-2)

@@ -9,17 +9,23 @@ of that model (``mbs.ComputeODE2Eigenvalues`` on the unconstrained coordinates),
 against beta L tan(beta L) = M / m.  With the root's strain free, one element meets the closed form within 1.2e-6,
 two within 3.5e-8, four within 8e-10 (0.25-1.49 m, the default tape).
 
-Not built yet: the tape driven by the linkage's rapier wheel with a growing free length (an ALE cable or a
-sliding joint at the wheel), so the Exudyn engine runs a tape scene only as the rigid rapier.
+:func:`driven_head_acceleration` drives the root along the guide with a prescribed wheel motion s(t) (a coordinate
+constraint with an offset user function) at a fixed free length: the Exudyn side of the engines' agreement on the
+head's acceleration (tests/test_rapier_tape.py).  Not built yet: the tape driven by the linkage's rapier wheel
+with a growing free length (an ALE cable or a sliding joint at the wheel), so the Exudyn engine runs a tape
+scene only as the rigid rapier.
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
 
 import numpy as np
 
 import exudyn as exu
 from exudyn.beams import GenerateBeamElementsAlongLine
-from exudyn.itemInterface import ObjectANCFCable2D, ObjectMassPoint2D
+from exudyn.itemInterface import (MarkerNodeCoordinate, NodePointGround, ObjectANCFCable2D, ObjectConnectorCoordinate,
+                                  ObjectMassPoint2D, SensorNode)
 
 from weftsim.input.params import RapierTape
 
@@ -39,8 +45,10 @@ def add_guided_tape(mbs, tape: RapierTape, free_length: float, elements: int) ->
     Returns (cable node numbers from the root to the head, the coordinates the guide and the root fix as ODE2
     indices, after ``mbs.Assemble()``).
     """
+    # Kelvin-Voigt: the cable's axial damping multiplies the axial strain rate, EA tau (N s).
     template = ObjectANCFCable2D(massPerLength=tape.mass_per_length, bendingStiffness=bending_stiffness(tape),
-                                 axialStiffness=tape.axial_stiffness)
+                                 axialStiffness=tape.axial_stiffness,
+                                 axialDamping=tape.axial_stiffness * tape.damping_time)
     nodes = GenerateBeamElementsAlongLine(mbs, [0.0, 0.0, 0.0], [free_length, 0.0, 0.0], elements, template)["nodes"]
     mbs.AddObject(ObjectMassPoint2D(mass=tape.head_mass, nodeNumber=nodes[-1]))
     mbs.Assemble()
@@ -58,3 +66,42 @@ def axial_frequencies(tape: RapierTape, free_length: float, elements: int = 4) -
     _, fixed = add_guided_tape(mbs, tape, free_length, elements)
     frequencies, _ = mbs.ComputeODE2Eigenvalues(constrainedCoordinates=fixed, convert2Frequencies=True)
     return np.sort(np.asarray(frequencies))
+
+
+def driven_head_acceleration(tape: RapierTape, free_length: float, wheel: Callable[[float], float], end_time: float,
+                             step: float, elements: int = 4) -> tuple[np.ndarray, np.ndarray]:
+    """The head's acceleration (s, m/s^2) with the root driven along the guide by ``wheel(t)`` = s (m).
+
+    The guided free length of :func:`add_guided_tape`, its guide and root coordinates held by coordinate
+    constraints, the root's x by one with an offset user function; generalized-alpha (spectral radius 0.9) at
+    the fixed ``step``, modified Newton.
+    """
+    sc = exu.SystemContainer()
+    mbs = sc.AddSystem()
+    nodes, _ = add_guided_tape(mbs, tape, free_length, elements)
+    ground = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=mbs.AddNode(NodePointGround()), coordinate=0))
+
+    def offset(mbs_, t, item, value):  # the root's x follows the wheel
+        return wheel(t)
+
+    for i, node in enumerate(nodes):
+        for coordinate in ((_X, _Y, _SLOPE_Y) if i == 0 else (_Y, _SLOPE_Y)):
+            marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=coordinate))
+            driven = i == 0 and coordinate == _X
+            mbs.AddObject(ObjectConnectorCoordinate(markerNumbers=[ground, marker],
+                                                    offsetUserFunction=offset if driven else 0))
+    sensor = mbs.AddSensor(SensorNode(nodeNumber=nodes[-1], outputVariableType=exu.OutputVariableType.Acceleration,
+                                      storeInternal=True, writeToFile=False))
+    mbs.Assemble()
+    settings = exu.SimulationSettings()
+    settings.timeIntegration.numberOfSteps = int(round(end_time / step))
+    settings.timeIntegration.endTime = end_time
+    settings.timeIntegration.generalizedAlpha.spectralRadius = 0.9
+    settings.timeIntegration.newton.useModifiedNewton = True
+    settings.timeIntegration.verboseMode = 0
+    settings.solution.file.write = False
+    settings.solution.sensors.writePeriod = 0.0
+    settings.solution.solverInformationFileName = ""
+    mbs.SolveDynamic(settings)
+    data = mbs.GetSensorStoredData(sensor)
+    return data[:, 0], data[:, 1]
