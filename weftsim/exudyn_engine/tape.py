@@ -27,6 +27,7 @@ from exudyn.beams import GenerateBeamElementsAlongLine
 from exudyn.itemInterface import (MarkerNodeCoordinate, NodePointGround, ObjectANCFCable2D, ObjectConnectorCoordinate,
                                   ObjectMassPoint2D, SensorNode)
 
+from weftsim.exudyn_engine.sensors import silence
 from weftsim.input.params import RapierTape
 
 # NodePoint2DSlope1 coordinates: x, y, slope x, slope y.
@@ -98,10 +99,7 @@ def driven_head_acceleration(tape: RapierTape, free_length: float, wheel: Callab
     settings.timeIntegration.endTime = end_time
     settings.timeIntegration.generalizedAlpha.spectralRadius = 0.9
     settings.timeIntegration.newton.useModifiedNewton = True
-    settings.timeIntegration.verboseMode = 0
-    settings.solution.file.write = False
-    settings.solution.sensors.writePeriod = 0.0
-    settings.solution.solverInformationFileName = ""
+    silence(settings)
     mbs.SolveDynamic(settings)
     data = mbs.GetSensorStoredData(sensor)
     return data[:, 0], data[:, 1]

@@ -176,34 +176,6 @@ def tape_terms(prm: np.ndarray, lam: float, sd: float, q: np.ndarray, qd: np.nda
 
 
 @njit(cache=True, error_model="numpy")
-def solve_small(a: np.ndarray, b: np.ndarray) -> None:
-    """Solve a x = b in place (b <- x) by Gaussian elimination with partial pivoting (a is overwritten)."""
-    n = b.size
-    for k in range(n):
-        piv = k
-        big = abs(a[k, k])
-        for i in range(k + 1, n):
-            if abs(a[i, k]) > big:
-                big = abs(a[i, k])
-                piv = i
-        if piv != k:
-            for j in range(n):
-                a[k, j], a[piv, j] = a[piv, j], a[k, j]
-            b[k], b[piv] = b[piv], b[k]
-        for i in range(k + 1, n):
-            f = a[i, k] / a[k, k]
-            if f != 0.0:
-                for j in range(k, n):
-                    a[i, j] -= f * a[k, j]
-                b[i] -= f * b[k]
-    for k in range(n - 1, -1, -1):
-        s = b[k]
-        for j in range(k + 1, n):
-            s -= a[k, j] * b[j]
-        b[k] = s / a[k, k]
-
-
-@njit(cache=True, error_model="numpy")
 def chain_state(prm: np.ndarray, y: np.ndarray) -> np.ndarray:
     """The clearance chain's state [a, psi, a', psi', W3, D] inside the tape's state (module docstring)."""
     n = int(prm[TAPE + MODES])
@@ -263,7 +235,7 @@ def chain_tape(prm: np.ndarray, t: float, y: np.ndarray, contact: bool, impact_v
         for j in range(n):
             a[2 + i, 2 + j] = m_qq[i, j]
         acc[2 + i] = f_q[i]
-    solve_small(a, acc)
+    acc = np.linalg.solve(a, acc)
     h = _vec(prm, 1, n)
     hqdd = 0.0
     out[0], out[1] = y6[2], y6[3]
@@ -294,9 +266,10 @@ def driven_tape(prm: np.ndarray, s: float, sd: float, sdd: float, q: np.ndarray,
     m_qq = np.empty((n, n))
     f_q = np.empty(n)
     m_ss, f_s, dissipated, kinetic, strain, head_v, root = tape_terms(prm, lam, sd, q, qd, m_sq, m_qq, f_q)
+    rhs = np.empty(n)
     for i in range(n):
-        qdd[i] = f_q[i] - m_sq[i] * sdd
-    solve_small(m_qq, qdd)
+        rhs[i] = f_q[i] - m_sq[i] * sdd
+    qdd[:] = np.linalg.solve(m_qq, rhs)
     h = _vec(prm, 1, n)
     wheel = f_s - m_ss * sdd
     head_a = sdd
