@@ -2,7 +2,7 @@
 A journal settling in its oil film
 ==================================
 
-The oil film of :func:`weftsim.kernel.film.film_force` carries a journal that spins in a still
+The oil film of :func:`weftsim.physics.film.film_force` carries a journal that spins in a still
 bearing under a constant load. Started at the bearing centre, the journal sinks and swings
 sideways (the film pushes back across the load as well as against it) until it rests where the
 film's force balances the load: at an eccentricity ratio and an attitude angle (between the load
@@ -28,7 +28,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from scipy.integrate import solve_ivp
 
-from weftsim.kernel.film import MODEL_FINITE, MODEL_LONG, MODEL_SHORT, film_force
+from weftsim.physics.film import MODEL_FINITE, MODEL_LONG, MODEL_SHORT, film_force
 from weftsim.joint.reynolds import RAIMONDI_BOYD, equilibrium, steady_load
 
 RADIUS, LENGTH, CLEARANCE, VISCOSITY = 10e-3, 20e-3, 20e-6, 0.02  # m, m, m, Pa s

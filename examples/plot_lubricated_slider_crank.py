@@ -7,7 +7,7 @@ as Flores, Ambrosio, Claro and Lankarani (Mech. Mach. Theory 41, 2006) and Flore
 and Dynamics of Multibody Systems with Imperfect Joints", Springer 2008) study it: crank 0.05 m, rod
 0.12 m, crank at 5000 rpm, journal and bearing radii 9.5 and 10 mm (radial clearance 0.5 mm), bearing
 40 mm long, oil of 400 cP (0.4 Pa s).  The pin is weftsim's reusable Exudyn joint with a
-:class:`~weftsim.input.params.Lubrication`: the film force of :mod:`weftsim.kernel.film` acts at every
+:class:`~weftsim.input.params.Lubrication`: the film force of :mod:`weftsim.physics.film` acts at every
 eccentricity, the dry contact law only beyond the clearance.
 
 Two film models: ``"short_half"``, the short bearing as the paper writes it, and ``"finite"``,

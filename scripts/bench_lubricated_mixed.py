@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from weftsim import reference
+import weftsim
 from weftsim import load_scene
 
 LOOM = Path(__file__).resolve().parents[1] / "models" / "loom.toml"
@@ -51,12 +51,12 @@ def main() -> None:
     args = parser.parse_args()
     scenes = {name: load_scene(LOOM, keys, revolutions=args.revolutions) for name, (keys, _) in CASES.items()}
     for scene in scenes.values():
-        reference.solve(scene)  # warm-up: numba's cache
+        weftsim.simulate(scene, "reference", on_warning=lambda text: None)  # warm-up: numba's cache
     cpu: dict[str, list[float]] = {name: [] for name in scenes}
     stats = {}
     for _ in range(args.repeats):
         for name, scene in scenes.items():
-            seconds, result = cpu_of(lambda: reference.solve(scene))
+            seconds, result = cpu_of(lambda: weftsim.simulate(scene, "reference", on_warning=lambda text: None))
             cpu[name].append(seconds)
             stats[name] = result.solver_stats
     print(f"load average {os.getloadavg()}")

@@ -15,7 +15,7 @@ mechanism, one draw of its impact sequence: docs/physics.md section 6):
 - peak |rapier acceleration| and peak |driving torque|.
 
 The CSV also holds revolution 1's peaks, the largest penetration, the wall time of each run and the
-plausibility checks that warned (weftsim.run.design_checks; before = on the ideal mechanism, after = on the
+plausibility checks that warned (weftsim.checks.design_checks; before = on the ideal mechanism, after = on the
 run from revolution 2 on).
 """
 
@@ -33,7 +33,7 @@ import numpy as np
 
 import weftsim
 from weftsim.mechanism import kinematics as kin
-from weftsim.run.design_checks import after_run, before_run
+from weftsim.checks.design_checks import after_run, before_run
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ("loom", "reference")

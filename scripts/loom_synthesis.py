@@ -32,7 +32,7 @@ import numpy as np
 from weftsim.mechanism import kinematics as kin
 from weftsim.input.params import Geometry, Inertia
 from weftsim.mechanism.pin_loads import ideal_pin_loads
-from weftsim.reference.ideal import ideal_torque, sector_chain_inertia
+from weftsim.model.ideal import ideal_torque, sector_chain_inertia
 from weftsim.input.scene import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -1,11 +1,11 @@
-"""Build the finite-bearing table that weftsim.kernel.film interpolates (weftsim/kernel/film_table.npz).
+"""Build the finite-bearing table that weftsim.physics.film interpolates (weftsim/physics/film_table.npz).
 
 Usage::
 
     python scripts/make_film_table.py [--check]
 
 Solves Reynolds' equation with cavitation (:func:`weftsim.joint.reynolds.film`) on every node of the
-grid of :mod:`weftsim.kernel.film` (eccentricity ratio x squeeze-velocity angle x B/D) and stores
+grid of :mod:`weftsim.physics.film` (eccentricity ratio x squeeze-velocity angle x B/D) and stores
 the scaled dimensionless force.  Deterministic: the same code gives the same table.  About
 5000 solves, a few minutes on one core.  ``--check`` instead compares the kernel's interpolated
 force with fresh solves half-way between the nodes and prints the largest relative errors.
@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from weftsim.joint import reynolds
-from weftsim.kernel import film
+from weftsim.physics import film
 
 TABLE = Path(film.__file__).with_name("film_table.npz")
 

@@ -15,7 +15,8 @@ from PIL import Image
 from weftsim.post.animate import clearance_magnification, mechanism_frames, write_animation
 from weftsim.cli.commands import EXIT_USAGE
 from weftsim.mechanism.kinematics import linkage_state
-from weftsim.reference import solve
+from conftest import door
+solve = door("reference")
 from weftsim.input.scene import load_scene
 
 REFERENCE = Path(__file__).resolve().parents[1] / "models" / "reference.toml"
@@ -74,7 +75,8 @@ def test_drawn_points_close_the_linkage_on_the_exudyn_engine():
     """The Exudyn kinematic tree's steps (its output samples are interpolated between steps and
     would miss the closure by ~3e-7 L_EF)."""
     pytest.importorskip("exudyn")
-    from weftsim.exudyn_engine import solve as solve_exudyn
+    from conftest import door
+    solve_exudyn = door("exudyn")
 
     scene = load_scene(REFERENCE, {"drive.revolutions": 0.5})
     result = solve_exudyn(scene)

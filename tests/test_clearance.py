@@ -147,3 +147,33 @@ def test_tangential_velocity_of_the_contact_points():
         v_qb = vb + wb * np.array([-q_b[1], q_b[0]])
         v_qj = vj + wj * np.array([-q_j[1], q_j[0]])
         assert tangential_velocity(e, vb, wb, vj, wj, r_b) == pytest.approx((v_qj - v_qb) @ t, rel=1e-12)
+
+
+def test_the_kernel_clearance_geometry_is_what_every_form_evaluates():
+    """The clearance geometry is written once, in the kernel (issue 32): the compiled
+    :func:`weftsim.physics.joint.contact_geometry` gives delta = |e| - c and delta_dot = d|e|/dt (a central
+    difference of |e(t)| along a curved path with h = 1e-4 |e| / |e_dot|: truncation ~ 1e-9 and round-off
+    ~ 1e-12 relative, so 1e-6 is far above both), the array form
+    above is it element for element (bit for bit: generated from its source), and the force kernel reports
+    the same penetration and rate."""
+    from weftsim.physics import joint as kernel
+
+    rng = np.random.default_rng(7)
+    prm = kernel.joint_parameters(JOINT, make_law(JOINT))
+    for _ in range(20):
+        e0, v, a = rng.normal(0.0, 3e-4, 2), rng.normal(0.0, 0.5, 2), rng.normal(0.0, 50.0, 2)
+
+        def e(t):
+            return e0 + v * t + 0.5 * a * t * t
+
+        h = 1e-4 * np.hypot(*e0) / np.hypot(*v)
+        delta, rate, nx, ny = kernel.contact_geometry(*e0, *v, JOINT.clearance)
+        assert delta == pytest.approx(np.hypot(*e0) - JOINT.clearance, rel=1e-15, abs=1e-18)
+        fd = (np.hypot(*e(h)) - np.hypot(*e(-h))) / (2 * h)
+        assert rate == pytest.approx(fd, rel=1e-6, abs=1e-9)
+        assert (nx, ny) == pytest.approx(tuple(e0 / np.hypot(*e0)), rel=1e-15)
+        d_arr, r_arr, n_arr = contact_geometry(e0, v, JOINT.clearance)
+        assert (float(d_arr), float(r_arr), *map(float, n_arr)) == (delta, rate, nx, ny)
+        out = kernel.clearance_force(prm, *e0, *v, 0.0, 1.0)
+        assert (out[4], out[5]) == (delta, rate)
+    assert kernel.contact_geometry(0.0, 0.0, 1.0, 2.0, JOINT.clearance) == (-JOINT.clearance, 0.0, 0.0, 0.0)

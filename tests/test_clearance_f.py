@@ -18,8 +18,9 @@ import pytest
 from weftsim.post.analysis import time_weights
 from weftsim.mechanism import kinematics as kin
 from weftsim.input.params import ReferenceSolver, Scene
-from weftsim.reference import solve
-from weftsim.reference.ideal import ideal_torque
+from conftest import door
+solve = door("reference")
+from weftsim.model.ideal import ideal_torque
 from weftsim.post.results import CHANNELS, JOINT_F_CHANNELS
 from weftsim.input.scene import SceneError, load_scene
 
@@ -89,14 +90,14 @@ def test_paths_that_cannot_carry_f_say_so():
     from weftsim.exudyn_engine.selection import select_path
 
     scene = _scene(C, C, 0.05)
-    tree = exudyn_engine.solve(dataclasses.replace(
+    tree = door("exudyn")(dataclasses.replace(
         scene, exudyn_solver=dataclasses.replace(scene.exudyn_solver, model="kinematic_tree")))
     assert tree.status == "failed" and "carries the clearance at E only" in tree.message
     path = select_path(scene)
     assert path["model"] == "rigid_body" and "clearance at F" in path["reason"]
     friction = _scene(C, C, 0.05)
     friction = dataclasses.replace(friction, joint_f=dataclasses.replace(friction.joint_f, friction_coefficient=0.1))
-    assert "joint_f.friction_coefficient" in exudyn_engine.solve(friction).message
+    assert "joint_f.friction_coefficient" in door("exudyn")(friction).message
 
 
 # --- reference engine ------------------------------------------------------------------------
@@ -204,10 +205,10 @@ def test_small_clearance_tends_to_the_ideal_mechanism(case):
 
 def test_e_only_kernel_path_is_unchanged_by_the_joint_f_block():
     """A scene with clearance at E alone runs through the same chain as before joint F existed: the
-    kernel's topology E_ONLY calls weftsim.kernel.chain.chain unchanged (bit for bit)."""
-    from weftsim.kernel import chain as kc
-    from weftsim.kernel import chain_f as kf
-    from weftsim.reference.dynamics import initial_state, pack_parameters
+    kernel's topology E_ONLY calls weftsim.physics.chain.chain unchanged (bit for bit)."""
+    from weftsim.physics import chain as kc
+    from weftsim.physics import chain_f as kf
+    from weftsim.model.dynamics import initial_state, pack_parameters
 
     scene = _scene(C, 0.0)
     prm = pack_parameters(scene)
@@ -228,7 +229,7 @@ def _agreement(c_e, c_f, revolutions):
 
     scene = load_scene(MODELS / "clearance_ef.toml", {"joint_e.clearance_mm": c_e * 1e3,
                                                        "drive.revolutions": revolutions})
-    ref, exu = solve(scene), exudyn_engine.solve(scene)
+    ref, exu = solve(scene), door("exudyn")(scene)
     assert ref.ok and exu.ok, (ref.message, exu.message)
     assert exu.path["model"] == "rigid_body"
     return ref, exu, agreement_checks(exu, ref)

@@ -21,6 +21,7 @@ from weftsim import exudyn_engine, reference
 from weftsim.post.compare import agreement_checks
 from weftsim.exudyn_engine.solver import IDEAL_JOINT_STEP_ANGLE, step_plan
 from weftsim.input.scene import load_scene
+from conftest import door
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 
@@ -47,7 +48,7 @@ def test_clearance_zero_on_a_paper_scene_agrees_far_inside_the_tolerance(scene):
     step alone).  2e-5 sits 2x above it and 5x below the compare tolerance (1e-4), so the check fails
     if the step falls back to 2e-6 s (8.7e-5) or grows to 0.5 deg (6.3e-5)."""
     ideal = load_scene(MODELS / scene, {"joint_e.clearance_mm": 0})
-    ex, ref = exudyn_engine.solve(ideal), reference.solve(ideal)
+    ex, ref = door("exudyn")(ideal), door("reference")(ideal)
     assert ex.ok and ref.ok, (ex.message, ref.message)
     checks = agreement_checks(ex, ref)
     assert len(checks) == 2 and all(c["passed"] for c in checks)

@@ -20,8 +20,10 @@ from scipy.integrate import solve_ivp
 from weftsim.joint.clearance import make_clearance_kernel
 from weftsim.joint.contact import LAWS, make_law, restored_restitution
 from weftsim.input.params import ClearanceJoint
-from weftsim.reference import events, solve
-from weftsim.reference.dynamics import ChainConstants, penetration
+from weftsim.reference import events
+from conftest import door
+solve = door("reference")
+from weftsim.model.dynamics import ChainConstants, penetration
 from weftsim.input.scene import load_scene
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
@@ -150,7 +152,7 @@ def _raw_steps(scene, compiled):
         scene = dataclasses.replace(scene, reference_solver=dataclasses.replace(scene.reference_solver,
                                                                                  method="numba_DOP853"))
     rows = []
-    assert solve(scene, step_states=lambda *arrays: rows.extend(arrays)).ok
+    assert solve(scene, observe=lambda *arrays: rows.extend(arrays)).ok
     return rows
 
 
@@ -222,7 +224,7 @@ def test_very_slow_crank_engines_agree():
     from weftsim.post.compare import agreement_checks
 
     scene = load_scene(MODELS / "reference.toml", {"drive.speed_rpm": 5.0, "drive.revolutions": 0.01})
-    ref, exu = solve(scene), exudyn_engine.solve(scene)
+    ref, exu = solve(scene), door("exudyn")(scene)
     assert ref.ok and exu.ok, (ref.message, exu.message)
     checks = agreement_checks(exu, ref)
     assert checks and all(c["passed"] for c in checks), checks

@@ -1,4 +1,4 @@
-"""Plausibility checks of a scene before and after a run (issue 21; weftsim.mechanism.pin_loads, weftsim.run.design_checks).
+"""Plausibility checks of a scene before and after a run (issue 21; weftsim.mechanism.pin_loads, weftsim.checks.design_checks).
 
 The ideal pin loads are checked against closed forms: the reflected mass against finite differences of the
 kinematics (the rapier alone: m8 (ds/dv_E)^2), the pin forces against the power balance of the chain
@@ -19,11 +19,12 @@ import pytest
 
 import weftsim
 from weftsim import reference
-from weftsim.run.design_checks import after_run, before_run, before_run_lines
+from weftsim.checks.design_checks import after_run, before_run, before_run_lines
 from weftsim.errors import PlausibilityWarning
 from weftsim.mechanism.kinematics import linkage_state, rapier_motion
 from weftsim.mechanism.pin_loads import ideal_pin_loads, pin_forces, reflected_mass_e, reflected_mass_f, sliding_speed
 from weftsim.input.scene import load_scene
+from conftest import door
 
 REFERENCE = Path(__file__).resolve().parents[1] / "models" / "reference.toml"
 # Central differences of step H: truncation ~ H^2 x (third derivative) ~ 1e-10 relative, round-off ~ eps / H
@@ -220,7 +221,7 @@ def test_simulate_reports_the_before_run_warnings_before_it_starts():
 @pytest.fixture(scope="module")
 def run():
     """A tenth of a revolution of the reference scene: the start-up impact (132 kN at 6.6 deg)."""
-    return reference.solve(load_scene(REFERENCE, {"drive.revolutions": 0.1}))
+    return door("reference")(load_scene(REFERENCE, {"drive.revolutions": 0.1}))
 
 
 def with_scene(result, overrides):
@@ -262,7 +263,7 @@ def test_no_after_run_check_fires_in_range(run):
 def test_a_run_of_two_revolutions_is_judged_on_its_second_and_the_law_on_the_whole_run():
     """Revolution 1 holds the start-up impact of the centred journal (the reference scene: 239 kN at
     6.6 deg); the machine's loads are judged from revolution 2 on, the law's range over the whole run."""
-    run = reference.solve(load_scene(REFERENCE))
+    run = door("reference")(load_scene(REFERENCE))
     period = run.scene.drive.period
     later = run.steps["time_s"] >= period
     checks = checks_by_name(after_run(run), "after")

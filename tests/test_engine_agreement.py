@@ -35,6 +35,7 @@ import pytest
 
 from weftsim.post.compare import agreement_checks, compare_results
 from weftsim.input.scene import load_scene
+from conftest import door
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 REVOLUTIONS = 40
@@ -55,7 +56,7 @@ def both_engines(request):
         "compare.percentile_99": TOLERANCES["percentile_99"],
     }
     scene = load_scene(MODELS / "paper" / f"{request.param}.toml", overrides)
-    return reference.solve(scene), exudyn_engine.solve(scene)
+    return door("reference")(scene), door("exudyn")(scene)
 
 
 @pytest.mark.slow

@@ -11,7 +11,9 @@ import numpy as np
 import pytest
 
 from weftsim import reference
-from weftsim.exudyn_engine import build_mechanism, solve
+from weftsim.exudyn_engine import build_mechanism
+from conftest import door
+solve = door("exudyn")
 from weftsim.exudyn_engine import callbacks as cb
 from weftsim.mechanism.kinematics import rapier_motion
 from weftsim.input.params import ClearanceJoint, Drive, ExudynSolver, Scene
@@ -70,7 +72,7 @@ def test_ideal_rapier_motion_matches_kinematics_at_every_sample(ideal_400):
 @pytest.mark.parametrize("rpm", [400.0, 800.0])
 def test_ideal_driving_torque_matches_reference_engine(rpm, ideal_400):
     r = ideal_400 if rpm == 400.0 else solve(scene(0.0, rpm, 1.0, step_size=IDEAL_STEP))
-    ref = reference.solve(r.scene)
+    ref = door("reference")(r.scene)
     assert r.ok and ref.ok
     t_ref = np.interp(r.samples["time_s"], ref.samples["time_s"], ref.samples["driving_torque_Nm"])
     peak = np.max(np.abs(t_ref))
@@ -115,7 +117,7 @@ START = 30.0 / 360.0  # revolutions: covers the first contact (6.6 deg) and its 
 @pytest.fixture(scope="module")
 def startup():
     sc = scene(0.25e-3, 400.0, START)
-    return solve(sc), reference.solve(sc)
+    return solve(sc), door("reference")(sc)
 
 
 def test_startup_first_contact_and_peaks_match_reference(startup):
@@ -261,7 +263,7 @@ def test_no_files_written_and_nothing_printed(tmp_path, monkeypatch, capfd):
 @pytest.mark.parametrize("clearance", [0.25e-3, 0.50e-3])
 def test_first_revolution_matches_reference(clearance):
     sc = scene(clearance, 400.0, 1.0)
-    ex, ref = solve(sc), reference.solve(sc)
+    ex, ref = solve(sc), door("reference")(sc)
     assert ex.ok and ref.ok, (ex.message, ref.message)
     assert abs(ex.first_contact_angle_deg - ref.first_contact_angle_deg) < 0.1  # issue: 0.1 deg
     for name in ("contact_force_N", "rapier_acceleration_m_s2", "driving_torque_Nm"):

@@ -16,6 +16,7 @@ from weftsim.exudyn_engine.solver import IDEAL_JOINT_STEP_ANGLE  # noqa: E402
 from weftsim.input.params import Scene  # noqa: E402
 import weftsim  # noqa: E402
 from weftsim.input.scene import SceneError, load_scene  # noqa: E402
+from conftest import door
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 SHORT = {"drive.revolutions": 0.02}  # 7.2 deg: through the first contact at 6.6 deg
@@ -88,7 +89,7 @@ def test_explicit_models_stay_choices():
 ])  # fmt: skip
 def test_solve_runs_what_the_selection_names(overrides, model, method):
     scene = load_scene(MODELS / "reference.toml", {**SHORT, **overrides})
-    r = exudyn_engine.solve(scene)
+    r = door("exudyn")(scene)
     assert r.ok, r.message
     assert r.path == select_path(scene)
     assert r.path["model"] == model and r.solver_stats["method"] == method
@@ -101,7 +102,7 @@ def test_solve_runs_what_the_selection_names(overrides, model, method):
 
 def test_the_callback_override_is_part_of_the_selection():
     scene = load_scene(MODELS / "reference.toml", SHORT)
-    r = exudyn_engine.solve(scene, callback="python")
+    r = door("exudyn")(scene, callback="python")
     assert r.ok and r.path["model"] == "kinematic_tree" and r.solver_stats["callback"] == "python"
     assert r.path == select_path(_with(scene, callback="python"))
 
@@ -115,7 +116,7 @@ def test_the_default_path_meets_the_issue_targets_on_the_reference_scene():
     from weftsim.bench.measure import converged_solution, errors, quantities
 
     scene = load_scene(MODELS / "reference.toml", {"drive.revolutions": 10.0})
-    r = exudyn_engine.solve(scene)
+    r = door("exudyn")(scene)
     assert r.ok and r.path["model"] == "kinematic_tree", r.message
     ref = converged_solution("c0.25mm-400rpm", MODELS, 10.0, log=lambda *a: None)
     err = errors(quantities(r), ref)
@@ -137,7 +138,7 @@ def test_the_default_path_runs_a_slow_drive_that_the_other_paths_run():
     assert largest_step(scene) == pytest.approx(0.1 * (2 * scene.joint.clearance / scene.inertia.gravity) ** 0.5)
     fast = load_scene(MODELS / "reference.toml")  # 400 rpm: the half sample is the bound, steps unchanged
     assert largest_step(fast) == fast.output.sample_angle / fast.drive.speed / 2
-    exu, ref = exudyn_engine.solve(scene), reference.solve(scene)
+    exu, ref = door("exudyn")(scene), door("reference")(scene)
     assert exu.ok and ref.ok, (exu.message, ref.message)
     assert exu.path["model"] == "kinematic_tree" and exu.path["method"].startswith("DOPRI5")
     # At rest the journal carries its static load (3.136 N in both engines): the settled state of two
@@ -150,9 +151,14 @@ def test_the_run_time_estimate_follows_the_exudyn_trees_solver_with_friction():
     """The estimate prices friction by the path that integrates it: the implicit tree (the default with
     friction) at ~5x a dry run as measured in issue 23, the explicit tree at its stability-limited 1400x,
     and only the explicit one is announced as an explicit solver on a stiff joint."""
-    from weftsim.run.progress import (
-        EXUDYN_IMPLICIT_STIFF_FACTOR, EXUDYN_STIFF_FACTOR, estimate_run_time, stiff_explicit,
-    )  # fmt: skip
+    from weftsim.engines import get
+    from weftsim.exudyn_engine.engine import EXUDYN_IMPLICIT_STIFF_FACTOR, EXUDYN_STIFF_FACTOR
+
+    def estimate_run_time(scene, engine):
+        return get(engine).estimate(scene).run_time_s
+
+    def stiff_explicit(scene, engines):
+        return any(get(engine).estimate(scene).stiff_explicit for engine in engines)
 
     dry = weftsim.load_scene("reference", clearance_mm=0.5, revolutions=1)
     rough = weftsim.load_scene("reference", {"joint_e.friction_coefficient": 0.15}, clearance_mm=0.5, revolutions=1)

@@ -23,14 +23,15 @@ import pytest
 
 from weftsim import exudyn_engine, reference
 from weftsim.post.analysis import energy_balance
-from weftsim.run.guards import RunGuard, failure_message, vet_result, where
+from weftsim.checks.guards import RunGuard, failure_message, vet_result, where
 from weftsim.input.params import Drive, ExudynSolver, Limits, Material, ReferenceSolver, Scene
 from weftsim.post.results import CHANNELS
 from weftsim.input.scene import SCHEMA
+from conftest import door
 
 RPM = math.pi / 30.0
 MODELS = Path(__file__).resolve().parents[1] / "models"
-SOLVERS = {"reference": reference.solve, "exudyn": exudyn_engine.solve}
+SOLVERS = {"reference": door("reference"), "exudyn": door("exudyn")}
 FIRST_CONTACT_DEG = 6.637  # reference scene: onset of the start-up impact (docs/clearance-joint.md)
 
 
@@ -218,7 +219,7 @@ def test_reference_explicit_method_stops_at_an_impact_no_step_resolves(method):
     the right-hand side turned non-finite in steps shrunk to 2e-17 s, the compiled one that the step
     collapsed to 6e-17 s; either way the run fails at the first contact, says so and which limit it
     crossed, and keeps the free flight before."""
-    r = reference.solve(scene(youngs_modulus=1e40, reference_solver=ReferenceSolver(method=method)))
+    r = door("reference")(scene(youngs_modulus=1e40, reference_solver=ReferenceSolver(method=method)))
     assert_failed_at_an_unresolvable_impact(r, f"reference solver ({method})")
     assert "limits.min_step_s = 1e-12 s" in r.message or "spacing between numbers" in r.message, r.message
 
@@ -226,7 +227,7 @@ def test_reference_explicit_method_stops_at_an_impact_no_step_resolves(method):
 def test_reference_implicit_method_newton_failure_shows_as_step_collapse():
     """Radau on the same scene: its Newton iterations fail and it halves the step until scipy gives up;
     the message names the method, and when it is the step that collapsed, says why Radau shrinks it."""
-    r = reference.solve(scene(youngs_modulus=1e40, reference_solver=ReferenceSolver(method="Radau")))
+    r = door("reference")(scene(youngs_modulus=1e40, reference_solver=ReferenceSolver(method="Radau")))
     assert_failed_at_an_unresolvable_impact(r, "reference solver (Radau)")
     if r.solver_stats["failure"] == "step_size":  # measured: the step collapsed to 4e-18 s
         assert "Newton iterations" in r.message, r.message
@@ -250,7 +251,7 @@ def test_absurd_stiffness_fails_on_the_error_controlled_exudyn_paths(settings):
     output sample (0.5 deg), and the step into the impact cannot be completed (measured: the rigid-body
     model's matrix is not factorized, the tree's penetration guard), so the run fails naming the last
     accepted state, at most one such step before the first contact, and keeps the free flight."""
-    r = exudyn_engine.solve(scene(youngs_modulus=1e305, exudyn=settings))
+    r = door("exudyn")(scene(youngs_modulus=1e305, exudyn=settings))
     assert r.status == "failed" and "crank angle" in r.message and "Traceback" not in r.message
     assert FIRST_CONTACT_DEG - 0.5 <= failure_angle(r) <= FIRST_CONTACT_DEG + 0.01, r.message
     assert r.steps["penetration_m"][:-1].max() < 1e-12  # the free flight before it, kept
@@ -258,7 +259,7 @@ def test_absurd_stiffness_fails_on_the_error_controlled_exudyn_paths(settings):
 
 def test_reference_step_size_floor_from_limits():
     """limits.min_step_s above the steps the start-up impact takes (1.6e-6 s at the smallest)."""
-    r = reference.solve(scene(min_step=1e-5))
+    r = door("reference")(scene(min_step=1e-5))
     assert_failed(r, "step_size", "below limits.min_step_s = 1e-05 s")
     assert r.steps["time_s"][-1] > 0.0
 
@@ -267,7 +268,7 @@ def test_exudyn_newton_non_convergence():
     """Three modified-Newton iterations at a step of 1e-4 s: Newton fails, Exudyn halves the step down
     to limits.min_step_s and gives up; the message says both and what to try."""
     settings = ExudynSolver(model="rigid_body", step_size=2e-4, newton_max_iterations=3)
-    r = exudyn_engine.solve(scene(exudyn=settings))
+    r = door("exudyn")(scene(exudyn=settings))
     assert_failed(r, "newton", "Newton did not converge", "step-size collapse", "solver.exudyn.step_size_s",
                   "solver.exudyn.newton_max_iterations")  # fmt: skip
 
@@ -289,7 +290,7 @@ def test_reference_non_finite_right_hand_side(monkeypatch):
         return q3
 
     monkeypatch.setattr(integrate, "chain_rhs", poisoned)
-    r = reference.solve(scene())
+    r = door("reference")(scene())
     assert_failed(r, "non_finite", "right-hand side turned non-finite")
     assert r.steps["time_s"][-1] == pytest.approx(2e-3, abs=1e-4)
 
@@ -311,7 +312,7 @@ def test_exudyn_nan_contact_force(monkeypatch):
         return nan_in_contact
 
     monkeypatch.setattr(callbacks, "make_python_force", poisoned)
-    r = exudyn_engine.solve(scene(), callback="python")
+    r = door("exudyn")(scene(), callback="python")
     assert_failed(r, "non_finite", "Newton residual is nan", "solver.exudyn.step_size_s")
     assert failure_angle(r) == pytest.approx(FIRST_CONTACT_DEG, abs=0.1)
 
@@ -340,7 +341,7 @@ def test_unresolved_stiff_joint_fails_on_the_energy_balance():
     the python and numba callbacks, 940x with the symbolic one (numpy 2.4.6, exudyn 1.13.6), 2.7x in
     issue 11; the energy balance failed every time."""
     stiff = scene(youngs_modulus=1e20, exudyn=ExudynSolver(model="rigid_body", step_control="fixed"))
-    ref = reference.solve(stiff)
+    ref = door("reference")(stiff)
     assert ref.ok, ref.message
     # Why Exudyn cannot resolve it: the reference engine measures the first impact at 1.09e-6 s.
     h = stiff.exudyn_solver.step_size
@@ -349,10 +350,10 @@ def test_unresolved_stiff_joint_fails_on_the_energy_balance():
     # KE_max as in tests/test_hard_cases.py (measured 3.4e-10 KE_max, against the limit 1e-2 KE_max).
     assert abs(energy_balance(ref)["relative_residual"]) < 100 * stiff.reference_solver.rtol
 
-    r = exudyn_engine.solve(stiff)
+    r = door("exudyn")(stiff)
     assert_failed(r, "energy", "energy balance misses", "limits.max_energy_error", "smaller step")
     # The error-controlled step (the default) shortens its steps through the impact and resolves it.
-    adaptive = exudyn_engine.solve(dataclasses.replace(stiff, exudyn_solver=ExudynSolver(model="rigid_body")))
+    adaptive = door("exudyn")(dataclasses.replace(stiff, exudyn_solver=ExudynSolver(model="rigid_body")))
     assert adaptive.ok, adaptive.message
     assert adaptive.solver_stats["step_size_s"] < first_impact_duration(ref)
     # The balance is checked once the run is over, so the failed run keeps every step to the end for
@@ -363,7 +364,7 @@ def test_unresolved_stiff_joint_fails_on_the_energy_balance():
 
 
 def test_vet_result_passes_sound_runs_and_catches_a_doctored_one():
-    r = reference.solve(scene(degrees=12.0))
+    r = door("reference")(scene(degrees=12.0))
     again = vet_result(r)  # already vetted by the engine: vetting again changes nothing
     assert r.ok and again.ok and again.message == "" and again.plausibility == r.plausibility
     doctored = dict(r.steps)
@@ -381,10 +382,10 @@ def run_cli(*args, cwd=None):
 
 
 def _error_lines(stderr: str) -> list[str]:
-    """stderr without the progress lines, which any run longer than 2 s prints (weftsim.run.progress): a
+    """stderr without the progress lines, which any run longer than 2 s prints (weftsim.checks.progress): a
     loaded machine, or numba's start-up when the process first loads a compiled kernel, gets there; and
     without the design checks' numbers and the plausibility warnings (the reference scene's 0.25 mm
-    clearance on a 20 mm pin is outside a new bushed pin's design range, weftsim.run.design_checks)."""
+    clearance on a 20 mm pin is outside a new bushed pin's design range, weftsim.checks.design_checks)."""
     return [line for line in stderr.strip().splitlines()
             if not re.search(r"\d%\s+elapsed", line) and not line.startswith(("weftsim run: warning: ",
                                                                                 "weftsim run: design checks "))]
@@ -469,10 +470,10 @@ def test_cli_compare_with_a_failed_engine_exits_3(tmp_path):
 
 @pytest.mark.parametrize("engine", SOLVERS)
 def test_a_stop_request_ends_the_run_as_interrupted_and_keeps_what_was_computed(engine):
-    """weftsim.run.guards.request_stop (the CLI's SIGINT handler) is seen at the next guard check: the
+    """weftsim.checks.guards.request_stop (the CLI's SIGINT handler) is seen at the next guard check: the
     run ends as failed with kind "interrupted", the steps up to there kept.  The request is made
     from the progress callback once 30 % of the run is done."""
-    from weftsim.run.guards import clear_stop, request_stop
+    from weftsim.checks.guards import clear_stop, request_stop
 
     def progress(fraction):
         if fraction >= 0.3:
@@ -506,12 +507,12 @@ def test_a_stop_request_ends_the_run_as_interrupted_and_keeps_what_was_computed(
 def test_penetration_bound_at_joint_f_names_joint_f():
     """Joint F against its own journal radius: a soft bushing at F (E ideal) sinks past a tenth of the
     radius in the start-up impact, and both engines stop naming [joint_f] (the guard judges each joint
-    with its own bound, weftsim.run.guards.RunGuard)."""
+    with its own bound, weftsim.checks.guards.RunGuard)."""
     from weftsim import exudyn_engine, reference
     from weftsim.input.scene import load_scene
 
     soft = load_scene("clearance_f", {"drive.revolutions": 0.1, "joint_f.bearing_material.youngs_modulus_gpa": 0.05})
-    for r in (reference.solve(soft), exudyn_engine.solve(soft)):
+    for r in (door("reference")(soft), door("exudyn")(soft)):
         assert_failed(r, "penetration", "exceeds 0.1 of the journal radius (1.0000 mm", "[joint_f]")
         assert r.steps["penetration_f_m"].max() <= 1.0e-3 * 1.05  # stopped at the first step beyond it
         assert not np.any(r.steps["penetration_m"])  # E is ideal

@@ -14,10 +14,11 @@ pytest.importorskip("numba")
 from weftsim.post.analysis import peaks  # noqa: E402
 from weftsim.joint.contact import LAWS, make_law  # noqa: E402
 from weftsim.input.params import ReferenceSolver, Scene  # noqa: E402
-from weftsim.reference import solve  # noqa: E402
-from weftsim.kernel import laws  # noqa: E402
+from conftest import door
+solve = door("reference")
+from weftsim.physics import laws  # noqa: E402
 from weftsim.reference.compiled_channels import crank_side_eval, crank_side_table  # noqa: E402
-from weftsim.reference.ideal import crank_side_inertia, crank_side_potential  # noqa: E402
+from weftsim.model.ideal import crank_side_inertia, crank_side_potential  # noqa: E402
 
 # The tolerances below were set for rtol 1e-9, atol 1e-12 (the reference engine's default until
 # issue 12; now the automatic path runs at 1e-5): named here, so the comparisons keep their meaning.
@@ -186,7 +187,8 @@ def start_up_exudyn():
     against 6.4e-4 here; test_exudyn_engine.py compares the models under "max_approach").
     """
     pytest.importorskip("exudyn")
-    from weftsim.exudyn_engine import solve as exudyn_solve
+    from conftest import door
+    exudyn_solve = door("exudyn")
 
     tree = exudyn_solve(_exudyn_scene(revolutions=1.0, rule="onset", relative_tolerance=1e-8, absolute_tolerance=1e-11))
     # The rigid body at the fixed 2e-6 s step the tolerances below were measured with (its default
@@ -220,7 +222,8 @@ def test_tree_model_matches_the_reference_engine_under_max_approach():
     """The default rule in both engines: the first revolution (start-up impact and the lasting contact
     after it, where the held value is raised ~50 times) with both integrated tightly."""
     pytest.importorskip("exudyn")
-    from weftsim.exudyn_engine import solve as exudyn_solve
+    from conftest import door
+    exudyn_solve = door("exudyn")
 
     tree = exudyn_solve(_exudyn_scene(revolutions=1.0, rule="max_approach", relative_tolerance=1e-8,
                                       absolute_tolerance=1e-11))  # fmt: skip
@@ -254,7 +257,8 @@ def test_tree_model_matches_the_reference_engine(start_up_exudyn):
 
 def test_tree_callback_routes_agree():
     pytest.importorskip("exudyn")
-    from weftsim.exudyn_engine import solve as exudyn_solve
+    from conftest import door
+    exudyn_solve = door("exudyn")
 
     # rtol 1e-10: under "max_approach" the held rate has a kink (max) that DOPRI5's step control
     # feels, so at the default rtol round-off shifts the step sequence and the peak sampled at step
@@ -273,7 +277,8 @@ def test_tree_callback_routes_agree():
 
 def test_tree_model_settings_and_guards():
     pytest.importorskip("exudyn")
-    from weftsim.exudyn_engine import solve as exudyn_solve
+    from conftest import door
+    exudyn_solve = door("exudyn")
 
     ideal = dataclasses.replace(_exudyn_scene(), joint=dataclasses.replace(BASE.joint, clearance=0.0))
     r = exudyn_solve(ideal)

@@ -30,7 +30,7 @@ import pytest
 
 from weftsim.cli import commands as cli
 from weftsim.post import output
-from weftsim.cli.exitcodes import EXIT_DISAGREE, EXIT_FAILED
+from weftsim.errors import EXIT_DISAGREE, EXIT_FAILED
 from weftsim.post.output import MANIFEST
 from weftsim.post.results import CHANNELS
 
@@ -325,7 +325,7 @@ def test_compare_with_a_failed_engine_says_which_and_why(tmp_path):
 
 def test_progress_on_a_closed_stream_does_not_end_the_run():
     """stderr piped into a reader that exited (``2>&1 | head -1``): progress stops, the run goes on."""
-    from weftsim.run.progress import Progress
+    from weftsim.checks.progress import Progress
 
     read, write = os.pipe()
     os.close(read)

@@ -1,4 +1,4 @@
-"""The oil-film kernel (weftsim.kernel.film) against closed forms of the short and long bearing."""
+"""The oil-film kernel (weftsim.physics.film) against closed forms of the short and long bearing."""
 
 import math
 
@@ -7,7 +7,7 @@ import pytest
 from scipy.integrate import quad
 
 from weftsim.joint import reynolds
-from weftsim.kernel.film import (MODEL_FINITE, MODEL_LONG, MODEL_SHORT, MODEL_SHORT_HALF, _long_pressure, film_force,
+from weftsim.physics.film import (MODEL_FINITE, MODEL_LONG, MODEL_SHORT, MODEL_SHORT_HALF, _long_pressure, film_force,
                                  finite_force, long_force, short_force, sommerfeld_angle)
 from weftsim.joint.reynolds import RAIMONDI_BOYD, equilibrium, steady_load
 
@@ -238,7 +238,7 @@ def test_the_film_only_dissipates(model):
 @pytest.mark.parametrize(("k", "i", "j"), [(4, 10, 0), (4, 20, 24), (2, 27, 48), (7, 5, 30)])
 def test_stored_table_is_the_solver_of_this_code_at_its_nodes(k, i, j):
     """The shipped film_table.npz is what weftsim.joint.reynolds gives today (rebuild it after changing the solver)."""
-    from weftsim.kernel import film
+    from weftsim.physics import film
 
     eps, xi, width = film.table_eccentricities()[i], film.table_angles()[j], film.table_widths()[k]
     stored = film.FINITE_TABLE[k + 1, i + 1, j + 1] / film.table_scale(eps, width)

@@ -1,9 +1,9 @@
 """Friction in the Exudyn engine's kinematic tree against the reference engine (issue 13 section 1).
 
 The modified Coulomb friction of docs/physics.md section 2 at the journal-bearing contact: both engines
-evaluate one kernel (:func:`weftsim.kernel.joint.friction_force` at the tangential velocity of
-:func:`weftsim.kernel.joint.tangential_velocity`), the reference in its closed-form chain, the tree in its
-generalized force (:func:`weftsim.kernel.chain.tree_joint_force`), so what is compared is the two
+evaluate one kernel (:func:`weftsim.physics.joint.friction_force` at the tangential velocity of
+:func:`weftsim.physics.joint.tangential_velocity`), the reference in its closed-form chain, the tree in its
+generalized force (:func:`weftsim.physics.chain.tree_joint_force`), so what is compared is the two
 integrations of the same model.  Compared as without friction (tests/test_engine_agreement.py, the
 scene's ``[compare]`` table): first contact within 0.1 deg, first-revolution maxima of contact force,
 rapier acceleration and driving torque within 1 %, here over the first 0.1 revolution (the start-up
@@ -47,6 +47,7 @@ pytest.importorskip("exudyn")
 
 from weftsim.post.compare import agreement_checks  # noqa: E402
 from weftsim.input.scene import load_scene  # noqa: E402
+from conftest import door
 
 MODELS = Path(__file__).resolve().parents[1] / "models" / "paper"
 
@@ -88,7 +89,7 @@ def friction_runs():
     from weftsim import exudyn_engine, reference
 
     scene = _scene(0.15, "0p50", revolutions=SPAN_REVOLUTIONS)
-    return scene, reference.solve(scene), exudyn_engine.solve(scene)
+    return scene, door("reference")(scene), door("exudyn")(scene)
 
 
 def test_the_default_path_with_friction_is_the_implicit_tree_and_agrees_with_the_reference(friction_runs):
@@ -145,13 +146,13 @@ def test_friction_runs_agree_with_the_reference_engine(mu, clearance):
     from weftsim import exudyn_engine, reference
 
     scene = _scene(mu, clearance, revolutions=SPAN_REVOLUTIONS)
-    ref, exu = reference.solve(scene), exudyn_engine.solve(scene)
+    ref, exu = door("reference")(scene), door("exudyn")(scene)
     assert ref.ok and exu.ok, (ref.message, exu.message)
     assert exu.path["model"] == "kinematic_tree" and exu.path["reason"].startswith("auto")
     problems = _span_disagreements(exu, ref)
     assert not problems, problems
     # Friction did something: it dissipates more than the contact damping alone does in the same span.
-    free = reference.solve(_scene(0.0, clearance, revolutions=SPAN_REVOLUTIONS))
+    free = door("reference")(_scene(0.0, clearance, revolutions=SPAN_REVOLUTIONS))
     assert ref.steps["dissipated_energy_J"][-1] > free.steps["dissipated_energy_J"][-1] + 0.1
 
 
@@ -162,7 +163,7 @@ def test_friction_work_is_dissipated_and_the_energy_balance_closes():
     as it does without friction."""
     from weftsim import exudyn_engine, reference
 
-    runs = {mu: exudyn_engine.solve(_scene(mu, "0p25", revolutions=0.05)) for mu in (0.0, 0.15)}
+    runs = {mu: door("exudyn")(_scene(mu, "0p25", revolutions=0.05)) for mu in (0.0, 0.15)}
     for mu, r in runs.items():
         assert r.ok and r.path["model"] == "kinematic_tree", r.message
         st = r.steps
@@ -173,7 +174,7 @@ def test_friction_work_is_dissipated_and_the_energy_balance_closes():
         # measured 2.6e-3 J (mu = 0) and 1.2e-3 J (mu = 0.15).
         assert np.abs(residual).max() < 2e-3 * st["kinetic_energy_J"].max(), mu
     dissipated = {mu: r.steps["dissipated_energy_J"][-1] for mu, r in runs.items()}
-    ref = reference.solve(_scene(0.15, "0p25", revolutions=0.05)).steps["dissipated_energy_J"][-1]
+    ref = door("reference")(_scene(0.15, "0p25", revolutions=0.05)).steps["dissipated_energy_J"][-1]
     # Measured: tree 2.93853 J, reference 2.93881 J (1e-4); the start-up impact dissipates 2.79 J without
     # friction, so friction adds 0.15 J here (over a whole revolution 33.4 J against 13.0 J).
     assert dissipated[0.15] == pytest.approx(ref, rel=1e-3)
@@ -186,8 +187,8 @@ def test_the_trees_contact_with_friction_is_the_reference_chains():
     torques are the virtual work of the journal's force and moment."""
     import math
 
-    from weftsim.kernel import chain as kc
-    from weftsim.reference.dynamics import initial_state, pack_parameters
+    from weftsim.physics import chain as kc
+    from weftsim.model.dynamics import initial_state, pack_parameters
 
     scene = _scene(0.15, "0p25")
     prm = pack_parameters(scene)
@@ -253,7 +254,7 @@ def test_the_rigid_body_model_with_friction_agrees_with_the_reference_engine():
 
     scene = _scene(0.15, "0p25", revolutions=SPAN_REVOLUTIONS / 2)
     rigid = apply_overrides(scene, {"solver.exudyn.model": "rigid_body", "solver.exudyn.local_error_m": 3e-11})
-    ref, exu = reference.solve(scene), exudyn_engine.solve(rigid)
+    ref, exu = door("reference")(scene), door("exudyn")(rigid)
     assert ref.ok and exu.ok, (ref.message, exu.message)
     assert exu.path["model"] == "rigid_body"
     problems = _span_disagreements(exu, ref)
@@ -266,8 +267,8 @@ def test_each_frozen_friction_piece_is_the_law_on_its_own_speed_range():
     must equal the law (to round-off) at every sliding speed of that piece, and the piece of a speed must be
     the law's (its inequalities at v0 and v1)."""
     from weftsim.exudyn_engine.friction_segments import DEAD, RAMP, SLIDE, FrictionSegments
-    from weftsim.kernel.joint import friction_force
-    from weftsim.reference.dynamics import pack_parameters
+    from weftsim.physics.joint import friction_force
+    from weftsim.model.dynamics import pack_parameters
 
     scene = _scene(0.15, "0p50")
     law = pack_parameters(scene)
@@ -297,7 +298,7 @@ def test_the_implicit_tree_gives_the_same_run_on_both_callback_routes():
     from weftsim import exudyn_engine
 
     scene = _scene(0.15, "0p50", revolutions=0.05)
-    runs = [exudyn_engine.solve(scene, callback=route) for route in ("numba", "python")]
+    runs = [door("exudyn")(scene, callback=route) for route in ("numba", "python")]
     assert all(r.ok for r in runs), [r.message for r in runs]
     assert runs[0].solver_stats["steps"] == runs[1].solver_stats["steps"]
     for name in PEAK_CHANNELS:

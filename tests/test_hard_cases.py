@@ -5,7 +5,7 @@ the impact velocity are in tests/test_hard_cases_long.py.  docs/hard-cases.md ha
 Every case asserts physics, not stored numbers:
 
 - no NaN or inf in any channel, and the run ends as a success;
-- penetration below the run-time bound of weftsim.run.guards, a tenth of the journal radius (the
+- penetration below the run-time bound of weftsim.checks.guards, a tenth of the journal radius (the
   rigid-body model with a local contact compliance needs the deformed zone small against the
   bodies).  It is *not* small against the clearance: the start-up impact penetrates 0.69 c at
   c = 0.25 mm and 18.5 c at c = 0.01 mm (docs/hard-cases.md, "Penetration");
@@ -33,6 +33,7 @@ from weftsim.post.analysis import energy_balance, time_weights
 from weftsim.joint.contact import LAWS
 from weftsim.input.params import ClearanceJoint, Drive, ExudynSolver, Material, ReferenceSolver, Scene
 from weftsim.post.results import CHANNELS
+from conftest import door
 
 RPM = math.pi / 30.0
 STEEL = Scene()
@@ -137,7 +138,7 @@ def report(label: str, figures: dict) -> None:
 
 @pytest.fixture(scope="module")
 def reference_runs():
-    return {name: reference.solve(make_scene(case)) for name, case in CASES.items()}
+    return {name: door("reference")(make_scene(case)) for name, case in CASES.items()}
 
 
 @pytest.mark.slow
@@ -146,7 +147,7 @@ def test_reference_engine(name, reference_runs):
     r = reference_runs[name]
     figures = assert_sound(r)
     # Converged in tolerance: the start-up window again at rtol 1e-10 (atol 1e-13).
-    tight = reference.solve(make_scene(CASES[name], WINDOW_DEG, rtol=1e-10))
+    tight = door("reference")(make_scene(CASES[name], WINDOW_DEG, rtol=1e-10))
     assert tight.ok, tight.message
     for key, value in window(tight).items():
         # docs/physics.md section 6: the start-up impact is reproducible to 0.1 %; measured <= 2e-5 here.
@@ -195,9 +196,9 @@ def test_physics_across_the_cases(reference_runs):
 @pytest.mark.parametrize("name", CASES)
 def test_exudyn_engine(name, reference_runs):
     case = CASES[name]
-    r = exudyn_engine.solve(make_scene(case, WINDOW_DEG))
+    r = door("exudyn")(make_scene(case, WINDOW_DEG))
     figures = assert_sound(r)
-    half = exudyn_engine.solve(make_scene(case, WINDOW_DEG, step=case.exudyn_step / 2))
+    half = door("exudyn")(make_scene(case, WINDOW_DEG, step=case.exudyn_step / 2))
     assert half.ok, half.message
     for key, value in window(half).items():
         # Start-up impact O(h^2) (tests/test_exudyn_engine.py): measured <= 3.3e-4 (torque, flores);

@@ -21,6 +21,7 @@ from weftsim.post.analysis import channel_statistics, energy_balance, peaks
 from weftsim.joint.contact import make_law
 from weftsim.input.params import Drive, ExudynSolver, Material, Scene
 from weftsim.post.results import CHANNELS
+from conftest import door
 
 RPM = math.pi / 30.0
 STEEL = Scene()
@@ -52,7 +53,7 @@ def per_revolution(result, first: int = 1) -> dict[str, np.ndarray]:
 def assert_finite_and_bounded(result) -> None:
     assert result.ok, result.message
     assert all(np.all(np.isfinite(result.steps[name])) for name in CHANNELS)
-    bound = result.scene.limits.max_penetration * result.scene.joint.journal_radius  # weftsim.run.guards
+    bound = result.scene.limits.max_penetration * result.scene.joint.journal_radius  # weftsim.checks.guards
     assert result.steps["penetration_m"].max() < bound
 
 
@@ -61,7 +62,7 @@ def assert_finite_and_bounded(result) -> None:
 
 @pytest.fixture(scope="module")
 def long_reference():
-    return reference.solve(revolutions(STEEL, LONG_REVOLUTIONS))
+    return door("reference")(revolutions(STEEL, LONG_REVOLUTIONS))
 
 
 @pytest.mark.slow
@@ -107,7 +108,7 @@ def test_fifty_revolutions_without_drift(long_reference):
 @pytest.mark.slow
 def test_exudyn_steady_running_matches_the_long_reference_run(long_reference):
     rigid = dataclasses.replace(STEEL, exudyn_solver=ExudynSolver(model="rigid_body"))
-    r = exudyn_engine.solve(revolutions(rigid, EXUDYN_REVOLUTIONS))
+    r = door("exudyn")(revolutions(rigid, EXUDYN_REVOLUTIONS))
     assert_finite_and_bounded(r)
     balance = energy_balance(r)
     # Trapezoid sums and the integrator's damping at each impact (tests/test_exudyn_engine.py): 1e-3 of
@@ -192,7 +193,7 @@ def test_impact_velocity_floor_keeps_damping_finite_and_results_do_not_hinge_on_
     held-velocity rule (the engine of issue 7 found two real onsets at 5.7e-4 and 6.0e-4 m/s and 9
     tangencies below 1e-6 m/s; with the largest-approach rule and the corrected event location of issue
     11 every onset is above 1.5e-3 m/s), so the test reads them from the run instead of naming them."""
-    runs = {v: reference.solve(revolutions(CREEP, 0.1, min_impact_velocity=v)) for v in FLOORS}
+    runs = {v: door("reference")(revolutions(CREEP, 0.1, min_impact_velocity=v)) for v in FLOORS}
     for v, r in runs.items():
         assert_finite_and_bounded(r)
         st = r.steps
@@ -234,7 +235,7 @@ def test_floor_acts_only_from_the_first_onset_slower_than_it():
     with later versions of the reference engine), so the test finds it in the run instead of naming it.
     """
     stiff = revolutions(STEEL, 1.0, journal_material=Material(1000e9, 0.3), bearing_material=Material(1000e9, 0.3))
-    low = reference.solve(revolutions(stiff, 1.0, min_impact_velocity=1e-5))
+    low = door("reference")(revolutions(stiff, 1.0, min_impact_velocity=1e-5))
     assert_finite_and_bounded(low)
     slowest = float(low.steps["impact_velocity_m_s"][onsets(low)].min())
     # Floors a decade apart: one below the slowest onset and the first one above it.  The start-up impact
@@ -243,9 +244,9 @@ def test_floor_acts_only_from_the_first_onset_slower_than_it():
     assert 1e-5 < slowest < floors[-1], slowest
     below = max(v for v in floors if v < slowest)
     above = min(v for v in floors if v > slowest)
-    unchanged = reference.solve(revolutions(stiff, 1.0, min_impact_velocity=below))
+    unchanged = door("reference")(revolutions(stiff, 1.0, min_impact_velocity=below))
     assert figures(unchanged) == figures(low)
-    high = reference.solve(revolutions(stiff, 1.0, min_impact_velocity=above))
+    high = door("reference")(revolutions(stiff, 1.0, min_impact_velocity=above))
     assert_finite_and_bounded(high)
     floored = [i for i in onsets(high) if high.steps["impact_velocity_m_s"][i] == above]
     assert floored, f"expected the onset at {slowest:.3g} m/s to be held at the floor {above:g} m/s"
@@ -267,7 +268,7 @@ def test_exudyn_grazing_window_agrees_with_reference_and_ignores_the_floor():
     runs = {}
     for v in (1e-6, 1e-3):
         scene = revolutions(CREEP, 0.1, min_impact_velocity=v)
-        runs[v] = exudyn_engine.solve(dataclasses.replace(scene, exudyn_solver=ExudynSolver(
+        runs[v] = door("exudyn")(dataclasses.replace(scene, exudyn_solver=ExudynSolver(
             model="rigid_body", step_control="fixed", step_size=1e-5)))
         assert_finite_and_bounded(runs[v])
         inside = runs[v].steps["in_contact"] > 0
@@ -278,7 +279,7 @@ def test_exudyn_grazing_window_agrees_with_reference_and_ignores_the_floor():
         # Measured identical: every Exudyn onset in this window is faster than 1e-3 m/s (its fixed
         # step does not see the tangencies the event-driven reference engine locates).
         assert a[key] == pytest.approx(b[key], rel=1e-6), key
-    ref = figures(reference.solve(CREEP))
+    ref = figures(door("reference")(CREEP))
     for key in ("contact_force_N", "rapier_acceleration_m_s2", "driving_torque_Nm", "penetration_m"):
         # Gentle impacts, converged at both engines' settings: measured within 0.2 % (torque).
         assert a[key] == pytest.approx(ref[key], rel=0.01), key

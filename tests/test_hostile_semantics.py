@@ -16,6 +16,7 @@ import pytest
 from weftsim.cli.commands import main
 from weftsim.errors import SceneError, SweepError, WearError
 from weftsim.input.scene import load_scene
+from conftest import door
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = ROOT / "models"
@@ -196,7 +197,7 @@ def test_animation_of_a_clearance_at_f_draws_and_captions_f():
     from weftsim import reference
     from weftsim.post.animate import animation_figure, joint_caption, mechanism_frames
 
-    result = reference.solve(load_scene(CLEARANCE_F, {"drive.revolutions": 0.3}))
+    result = door("reference")(load_scene(CLEARANCE_F, {"drive.revolutions": 0.3}))
     frames = mechanism_frames(result, 12)
     assert frames.clearance == 0.0 and frames.clearance_f == pytest.approx(0.25e-3)
     assert np.hypot(*frames.eccentricity_f.T).max() > 0.5 * frames.clearance_f  # the pin moves in its eye
@@ -216,14 +217,14 @@ def test_orbit_figure_has_a_panel_per_clearance_joint(tmp_path):
     from weftsim.post.output import write_run
     from weftsim.post.plots import plot_orbit
 
-    only_f = reference.solve(load_scene(CLEARANCE_F, {"drive.revolutions": 0.3}))
+    only_f = door("reference")(load_scene(CLEARANCE_F, {"drive.revolutions": 0.3}))
     figure = plot_orbit(only_f)
     panels = [ax for ax in figure.axes if ax.get_title()]
     assert len(panels) == 1 and "orbit at F" in panels[0].get_title()
     orbit = panels[0].lines[1]  # the rod's pin in the sector's eye, every solver step, in mm
     assert np.array_equal(orbit.get_xdata(), only_f.steps["eccentricity_f_y_m"] * 1e3)
     assert "orbit" in write_run(only_f, tmp_path / "f")
-    both = reference.solve(load_scene(MODELS / "clearance_ef.toml", {"drive.revolutions": 0.3}))
+    both = door("reference")(load_scene(MODELS / "clearance_ef.toml", {"drive.revolutions": 0.3}))
     titles = [ax.get_title() for ax in plot_orbit(both).axes if ax.get_title()]
     assert ["orbit at E" in titles[0], "orbit at F" in titles[1]] == [True, True]
 
@@ -316,7 +317,7 @@ def test_a_wear_update_failing_mid_way_keeps_every_update_before_it(tmp_path, mo
 
 
 def test_a_stop_during_a_wear_update_is_an_interruption_not_a_failure(capsys, tmp_path, monkeypatch):
-    from weftsim.run.guards import clear_stop, request_stop
+    from weftsim.checks.guards import clear_stop, request_stop
     from weftsim.wear import extrapolate
 
     scene = load_scene(REFERENCE)

@@ -18,79 +18,24 @@ import pytest
 PACKAGE = Path(__file__).resolve().parent.parent / "weftsim"
 
 
-def _modules() -> dict[str, Path]:
-    out = {}
-    for path in PACKAGE.rglob("*.py"):
-        parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
-        name = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
-        out[name] = path
-    return out
+def _house():
+    """scripts/house.py, the one reader of the import graph (floors, circles, arrows back up, the walk)."""
+    import importlib.util
 
-
-def _resolve(name: str, modules: dict[str, Path]) -> str | None:
-    while name and name not in modules:
-        name = name.rpartition(".")[0]
-    return name or None
+    spec = importlib.util.spec_from_file_location("house", PACKAGE.parent / "scripts" / "house.py")
+    house = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(house)
+    return house
 
 
 def import_graph() -> dict[str, set[str]]:
     """module -> the weftsim modules it imports anywhere in its source (itself and its own packages left out)."""
-    modules = _modules()
-    graph = {}
-    for name, path in modules.items():
-        package = name if path.name == "__init__.py" else name.rpartition(".")[0]
-        targets = set()
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
-            if isinstance(node, ast.Import):
-                targets.update(alias.name for alias in node.names)
-            elif isinstance(node, ast.ImportFrom):
-                base = node.module or ""
-                if node.level:
-                    parts = package.split(".")[: len(package.split(".")) - node.level + 1]
-                    base = ".".join(parts + ([base] if base else []))
-                # `from weftsim.x import y`: the submodule weftsim.x.y where there is one, else weftsim.x
-                targets.update(f"{base}.{alias.name}" if f"{base}.{alias.name}" in modules else base
-                               for alias in node.names)
-        edges = {_resolve(t, modules) for t in targets if t == "weftsim" or t.startswith("weftsim.")}
-        # A package importing its own submodules (to export them) is not a dependency of theirs on it.
-        graph[name] = {e for e in edges if e and e != name and not (path.name == "__init__.py" and
-                                                                    e.startswith(name + "."))}
-    return graph
+    return _house().graph()
 
 
 def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
     """The strongly connected components of more than one module (Tarjan), each sorted."""
-    index: dict[str, int] = {}
-    low: dict[str, int] = {}
-    stack: list[str] = []
-    on_stack: set[str] = set()
-    found = []
-
-    def visit(v: str) -> None:
-        index[v] = low[v] = len(index)
-        stack.append(v)
-        on_stack.add(v)
-        for w in graph.get(v, ()):
-            if w not in index:
-                visit(w)
-                low[v] = min(low[v], low[w])
-            elif w in on_stack:
-                low[v] = min(low[v], index[w])
-        if low[v] == index[v]:
-            component = []
-            while True:
-                w = stack.pop()
-                on_stack.discard(w)
-                component.append(w)
-                if w == v:
-                    break
-            if len(component) > 1:
-                found.append(sorted(component))
-
-    for v in sorted(graph):
-        if v not in index:
-            visit(v)
-    return found
+    return _house().circles(graph)
 
 
 def test_the_cycle_finder_finds_a_circle_and_a_chain_has_none():
@@ -103,7 +48,7 @@ def test_the_graph_sees_deferred_and_type_checking_imports():
     kinds (checked on edges that exist today), so a circle of either kind would be found."""
     graph = import_graph()
     assert "weftsim.exudyn_engine.callbacks" in graph["weftsim.exudyn_engine.selection"]  # inside a function
-    assert "weftsim.post.results" in graph["weftsim.run.design_checks"]  # under TYPE_CHECKING
+    assert "weftsim.post.results" in graph["weftsim.checks.design_checks"]  # under TYPE_CHECKING
     assert "weftsim.errors" in graph["weftsim.post.results"]
 
 
@@ -118,17 +63,18 @@ def test_weftsim_imports_have_no_cycle():
 
 
 def test_errors_is_the_bottom_of_the_hierarchy_and_selection_needs_no_solver():
-    """``weftsim.errors`` names no weftsim module but the exit codes (every module raises its errors), and the
+    """``weftsim.errors`` names no weftsim module (every module raises its errors; the exit statuses live in it,
+    issue 32), and the
     Exudyn path's step plan (:mod:`weftsim.exudyn_engine.selection`) is plain arithmetic, no solver."""
     graph = import_graph()
-    assert graph["weftsim.errors"] == {"weftsim.cli.exitcodes"}
+    assert graph["weftsim.errors"] == set()
     assert "weftsim.exudyn_engine.solver" not in graph["weftsim.exudyn_engine.selection"]
-    assert "weftsim.run.design_checks" not in graph["weftsim.run.plausibility"]
+    assert "weftsim.checks.design_checks" not in graph["weftsim.checks.plausibility"]
 
 
 FORMER_CIRCLES = [
     "weftsim.post.results", "weftsim.errors", "weftsim.exudyn_engine.selection",
-    "weftsim.run.design_checks", "weftsim.sweep.store", "weftsim.input.joint_keys",
+    "weftsim.checks.design_checks", "weftsim.sweep.store", "weftsim.input.joint_keys",
     "weftsim.input.scene", "weftsim.post.result_file", "weftsim.post.npz_guard",
     "weftsim.post.output", "weftsim.post.plots", "weftsim.wear.resume", "weftsim.wear.store",
 ]
@@ -142,10 +88,11 @@ def test_a_module_of_a_former_circle_imports_first_in_a_fresh_interpreter(module
 
 def test_the_top_level_keeps_the_interface_and_each_concept_is_a_subpackage():
     """Issue 25: the modules are grouped by concept; the top level keeps the package's interface (weftsim.api),
-    the errors every module raises, the version and the entry point, so a new module goes into its concept's
+    the errors every module raises, the version, the engine registry (issue 32) and the entry point, so a new module goes into its concept's
     subpackage (a top-level one would also stop apply_regroup.py, the script that made this layout)."""
-    assert sorted(p.stem for p in PACKAGE.glob("*.py")) == ["__init__", "__main__", "api", "errors", "version"]
-    for concept in ("input", "mechanism", "joint", "run", "post", "cli"):
+    assert sorted(p.stem for p in PACKAGE.glob("*.py")) == ["__init__", "__main__", "api", "engines", "errors",
+                                                            "version"]
+    for concept in ("input", "mechanism", "joint", "checks", "post", "cli"):
         init = PACKAGE / concept / "__init__.py"
         assert init.is_file() and ast.get_docstring(ast.parse(init.read_text(encoding="utf-8")))
 
@@ -156,3 +103,55 @@ def test_python_m_weftsim_and_weftsim_cli_run_the_command():
         done = subprocess.run([sys.executable, "-m", module, "scenes"], cwd=PACKAGE.parent, capture_output=True,
                               text=True)
         assert done.returncode == 0 and "loom" in done.stdout, (module, done.stderr)
+
+
+ENGINE_PACKAGES = ("weftsim.reference", "weftsim.exudyn_engine")
+
+
+def test_no_module_of_one_engine_imports_the_other():
+    """Issue 32: the shared model (weftsim.model) sits below both engines; neither engine imports the other."""
+    graph = import_graph()
+    for engine in ENGINE_PACKAGES:
+        other = next(e for e in ENGINE_PACKAGES if e != engine)
+        for module, targets in graph.items():
+            if module == engine or module.startswith(engine + "."):
+                crossing = sorted(t for t in targets if t == other or t.startswith(other + "."))
+                assert not crossing, f"{module} imports {crossing}"
+
+
+def test_engines_are_chosen_by_name_in_one_module():
+    """Only weftsim.engines names the engines' modules (its registry); every other caller gets an engine from it
+    (weftsim.engines.get) or runs one through the door (simulate): no module outside the engines imports an
+    engine's solve."""
+    for name in import_graph():
+        if name.startswith(ENGINE_PACKAGES):
+            continue
+        path = PACKAGE.parent / (name.replace(".", "/") + ".py")
+        if not path.is_file():
+            path = PACKAGE.parent / name.replace(".", "/") / "__init__.py"
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and (node.module or "").startswith(ENGINE_PACKAGES):
+                names = {alias.name for alias in node.names}
+                assert not names & {"solve", "solve_tree", "solve_compiled", "engine", "ENGINE"}, (name, names)
+            if isinstance(node, ast.Constant) and isinstance(node.value, str) and name != "weftsim.engines":
+                assert not node.value.startswith(("weftsim.reference:", "weftsim.exudyn_engine:",
+                                                  "weftsim.reference.engine", "weftsim.exudyn_engine.engine")), name
+
+
+def test_at_most_four_imports_run_back_up_a_floor():
+    """Issue 32's check: at most 4 (importer, imported) pairs run from a lower floor to a higher one
+    (scripts/house.py defines the floors; 13 before issue 32); the four left are named here, so a new one fails."""
+    up = _house().arrows_up()
+    assert len(up) <= 4, up
+    assert set(up) <= {
+        ("weftsim.input.scene", "weftsim.joint.contact"),  # the scene reader validates the law's parameters
+        ("weftsim.input.scene", "weftsim.mechanism.kinematics"),  # ... and that the linkage assembles
+        ("weftsim.joint.lubrication", "weftsim.post.results"),  # the film's channel names
+        ("weftsim.checks.plausibility", "weftsim.post.results"),  # the checks read a result's channel table
+    }, up
+
+
+def test_house_floors_cover_every_subpackage():
+    house = _house()
+    for module in import_graph():
+        house.floor(module)  # raises SystemExit for a subpackage in no floor

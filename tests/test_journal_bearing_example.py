@@ -11,7 +11,7 @@ from pathlib import Path
 import matplotlib
 import pytest
 
-from weftsim.kernel.film import MODEL_FINITE
+from weftsim.physics.film import MODEL_FINITE
 from weftsim.joint.reynolds import equilibrium
 
 matplotlib.use("Agg")

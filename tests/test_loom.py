@@ -14,7 +14,7 @@ import pytest
 
 import weftsim
 from weftsim.mechanism import kinematics as kin
-from weftsim.run.design_checks import after_run, before_run, running
+from weftsim.checks.design_checks import after_run, before_run, running
 from weftsim.mechanism.pin_loads import ideal_pin_loads
 
 # Targets of the synthesis (docs/physics.md, "The loom mechanism").

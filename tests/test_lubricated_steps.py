@@ -17,7 +17,8 @@ import pytest
 import weftsim
 from weftsim.post.analysis import peaks
 from weftsim.reference.compiled_ros import rate_tolerance_factor
-from weftsim.reference.dynamics import pack_parameters
+from weftsim.model.dynamics import pack_parameters
+from conftest import door
 
 FILM = {"joint_e.lubrication.viscosity_mpa_s": 80.0}  # the loom at c = 0.02 mm, 600 rpm: no contact
 TIGHT = {"solver.reference.rtol": 1e-8, "solver.reference.atol": 1e-11}
@@ -92,14 +93,15 @@ def test_jacobian_of_the_mixed_film_is_accurate():
     """With a lubricated joint RODAS4's Jacobian is a central difference: against a Richardson-extrapolated
     difference (steps 10x and 20x larger), at the thinnest film of the first quarter revolution (on the
     asperities)."""
-    from weftsim.kernel.chain import penetration
-    from weftsim.kernel.chain_f import rhs_any
+    from weftsim.physics.chain import penetration
+    from weftsim.physics.chain_f import rhs_any
     from weftsim.reference import compiled_ros as ros
-    from weftsim.reference import solve
+    from conftest import door
+    solve = door("reference")
 
     scene = weftsim.load_scene("loom", MIXED, revolutions=0.25)
     rows = {}
-    solve(scene, step_states=lambda t, y, contact, impact: rows.update(t=t, y=y))
+    solve(scene, observe=lambda t, y, contact, impact: rows.update(t=t, y=y))
     prm = pack_parameters(scene)
     gaps = [penetration(prm, t, y)[0] for t, y in zip(rows["t"], rows["y"])]
     k = int(np.argmax(gaps))
@@ -145,7 +147,7 @@ def test_mixed_regime_converges_at_few_steps(mixed_runs):
 
 def _rodas_step(prm, t, y, h):
     """One RODAS4 step of the kernel from (t, y): (y_new, dense rows F) with F complete for both dense outputs."""
-    from weftsim.kernel.chain_f import rhs_any
+    from weftsim.physics.chain_f import rhs_any
     from weftsim.reference import compiled_ros as ros
 
     n, impact, ist = y.size, np.zeros(2), np.zeros(32, dtype=np.int64)
@@ -167,9 +169,9 @@ def test_stiff_dense_output_is_order_3_and_follows_the_clearance_rate():
     Hermite interpolant does not."""
     from scipy.integrate import solve_ivp
 
-    from weftsim.kernel.chain_f import rhs_any
+    from weftsim.physics.chain_f import rhs_any
     from weftsim.reference import compiled_ros as ros
-    from weftsim.reference.dynamics import initial_state
+    from weftsim.model.dynamics import initial_state
 
     def interpolants(prm, t, y, h, s):
         y_new, F = _rodas_step(prm, t, y, h)
@@ -196,7 +198,7 @@ def test_stiff_dense_output_is_order_3_and_follows_the_clearance_rate():
 
     mixed = weftsim.load_scene("loom", MIXED, revolutions=0.3)
     rows = {}
-    weftsim.reference.solve(mixed, step_states=lambda t, y, contact, impact: rows.update(t=t, y=y))
+    door("reference")(mixed, observe=lambda t, y, contact, impact: rows.update(t=t, y=y))
     prm = pack_parameters(mixed)
     for degrees in (60.0, 80.0):  # film ratio ~2.1 and ~1.6: on the asperities
         k = int(np.searchsorted(rows["t"], degrees / 360.0 * mixed.drive.period))

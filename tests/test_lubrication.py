@@ -18,12 +18,13 @@ import numpy as np
 import pytest
 
 import weftsim
-from weftsim.kernel.asperity import H_CUTOFF, asperity_load, f52, greenwood_tripp_coefficient
-from weftsim.kernel.joint import clearance_force_at, joint_parameters
-from weftsim.kernel.lubricated import L_ASPERITY, L_FILM, lubricated_force
+from weftsim.physics.asperity import H_CUTOFF, asperity_load, f52, greenwood_tripp_coefficient
+from weftsim.physics.joint import clearance_force_at, joint_parameters
+from weftsim.physics.lubricated import L_ASPERITY, L_FILM, lubricated_force
 from weftsim.joint.contact import make_law
 from weftsim.input.params import ClearanceJoint, Lubrication
-from weftsim.reference import solve
+from conftest import door
+solve = door("reference")
 from weftsim.post.results import LUBRICATION_CHANNELS
 from weftsim.input.scene import SceneError, load_scene
 
@@ -142,7 +143,7 @@ def test_asperity_load_is_continuous_and_its_potential_is_its_integral():
 
 
 def test_asperity_quadrature_is_converged():
-    from weftsim.kernel import asperity
+    from weftsim.physics import asperity
 
     e = C - 0.5 * SIGMA
     force = asperity_load(COEF, SIGMA, C, e, R, L)[0]
@@ -156,7 +157,7 @@ def test_asperity_quadrature_is_converged():
 def test_asperity_gauss_jacobi_rule_matches_a_fine_legendre_rule():
     """The 8-point Gauss-Jacobi rule of asperity_load (weight (theta_max - theta)^5.804) against 400 Gauss-Legendre
     points, load, potential and stiffness, over film ratios 0-4 at clearances 2 um-0.25 mm."""
-    from weftsim.kernel import asperity
+    from weftsim.physics import asperity
 
     x, w = np.polynomial.legendre.leggauss(400)
     x, w = 0.5 * (x + 1.0), 0.5 * w
@@ -250,7 +251,7 @@ def test_engines_agree_on_a_lubricated_run(runs):
     from weftsim import exudyn_engine
 
     ref = runs["oil"]
-    tree = exudyn_engine.solve(ref.scene)
+    tree = door("exudyn")(ref.scene)
     assert tree.ok, tree.message
     assert tree.path["model"] == "kinematic_tree"
     tolerance = ref.scene.compare.first_revolution_peaks  # the dry runs' first-revolution tolerance (1 %)
@@ -289,7 +290,7 @@ def test_reusable_exudyn_joint_carries_the_film(runs):
     # 13 023.2 N m at rtol 1e-5 with RODAS4, 13 024.0 with DOP853 at 1e-8).
     scene = dataclasses.replace(ref.scene, exudyn_solver=dataclasses.replace(ref.scene.exudyn_solver,
                                                                              model="rigid_body", local_error=3e-11))
-    rigid = exudyn_engine.solve(scene)
+    rigid = door("exudyn")(scene)
     assert rigid.ok, rigid.message
     tolerance = ref.scene.compare.first_revolution_peaks
     for name in ("driving_torque_Nm", "film_force_N"):
@@ -326,12 +327,12 @@ def test_regime_study_on_one_cell(tmp_path, monkeypatch):
 
 
 def test_wear_load_is_the_asperity_and_dry_load_never_the_film():
-    from weftsim.reference.dynamics import pack_parameters
+    from weftsim.model.dynamics import pack_parameters
     from weftsim.wear.archard import contact_rows
 
     scene = _oil_scene()
     kept = {}
-    result = solve(scene, step_states=lambda *rows: kept.update(rows=rows))
+    result = solve(scene, observe=lambda *rows: kept.update(rows=rows))
     time, states, contact, impact = kept["rows"]
     rows = np.zeros((time.size, 5))
     contact_rows(pack_parameters(scene), time, states, contact, impact, rows)

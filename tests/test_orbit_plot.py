@@ -8,7 +8,8 @@ import pytest
 
 from weftsim.post.output import write_run
 from weftsim.post.plots import contact_onsets, plot_orbit
-from weftsim.reference import solve
+from conftest import door
+solve = door("reference")
 from weftsim.input.scene import load_scene
 
 REFERENCE = Path(__file__).resolve().parents[1] / "models" / "reference.toml"

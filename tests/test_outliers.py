@@ -12,8 +12,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from weftsim.reference import solve
-from weftsim.reference.dynamics import ChainConstants, penetration
+from conftest import door
+solve = door("reference")
+from weftsim.model.dynamics import ChainConstants, penetration
 from weftsim.input.scene import load_scene
 from weftsim.studies.common import StudyError
 from weftsim.studies.outliers import (
@@ -89,7 +90,7 @@ def short_run():
     scene = load_scene(MODELS / "reference.toml", {"drive.revolutions": 0.3, "solver.reference.method": "DOP853",
                                                    "solver.reference.rtol": 1e-9, "solver.reference.atol": 1e-12})
     raw = {}
-    result = solve(scene, step_states=lambda t, y, c, i: raw.update(t=t, y=y, contact=c, impact=i))
+    result = solve(scene, observe=lambda t, y, c, i: raw.update(t=t, y=y, contact=c, impact=i))
     assert result.ok, result.message
     return scene, result, raw
 

@@ -25,5 +25,5 @@ def test_the_wheel_holds_every_scene_file_and_the_type_marker(tmp_path):
     scenes = {f"weftsim/scenes/{p.relative_to(ROOT / 'models').as_posix()}" for p in (ROOT / "models").rglob("*.toml")}
     assert scenes and scenes <= names, sorted(scenes - names)
     assert "weftsim/py.typed" in names and "weftsim/api.py" in names
-    assert "weftsim/kernel/film_table.npz" in names  # the finite journal bearing's table (kernel/film.py)
+    assert "weftsim/physics/film_table.npz" in names  # the finite journal bearing's table (physics/film.py)
     assert not any(name.startswith("models/") for name in names)  # inside the package, not a top-level folder

@@ -1,7 +1,7 @@
-"""The plausibility guard and the validity warnings (issue 11 section 4; weftsim.run.plausibility).
+"""The plausibility guard and the validity warnings (issue 11 section 4; weftsim.checks.plausibility).
 
 Sound runs pass with every defect count at zero; each defect, put into a sound run's per-step data
-by hand, fails the run through weftsim.run.guards.vet_result (the path every engine's result takes);
+by hand, fails the run through weftsim.checks.guards.vet_result (the path every engine's result takes);
 an "onset"-rule run whose damping outgrows the isolated-impact bound gets a warning (a property of
 that rule, not a defect); the warnings fire where the law is used outside its range, once each on stderr.
 """
@@ -21,13 +21,14 @@ import pytest
 from weftsim import reference
 from weftsim.post.analysis import summary
 from weftsim.joint.contact import make_law
-from weftsim.run.guards import vet_result, where
+from weftsim.checks.guards import vet_result, where
 from weftsim.input.params import Limits
-from weftsim.run.plausibility import (
+from weftsim.checks.plausibility import (
     PENETRATION_WARNING_RATIO, TRESCA_LINE_CONTACT_YIELD, contact_mode, damping_ratio, line_contact_pressure,
     onset_rows, roundoff_penetration, validity_warnings,
 )  # fmt: skip
 from weftsim.input.scene import load_scene
+from conftest import door
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 REFERENCE = MODELS / "reference.toml"
@@ -36,7 +37,7 @@ REFERENCE = MODELS / "reference.toml"
 @pytest.fixture(scope="module")
 def sound():
     """Half a revolution of the reference scene (the start-up impact and the contacts after it)."""
-    return reference.solve(load_scene(REFERENCE, {"drive.revolutions": 0.5}))
+    return door("reference")(load_scene(REFERENCE, {"drive.revolutions": 0.5}))
 
 
 def doctored(result, **channels):
@@ -68,7 +69,7 @@ def test_the_penetration_rate_channel_is_the_time_derivative_of_the_penetration(
     leaves room for other machines and steps without hiding a wrong channel (a sign or a missing term is O(1))."""
     overrides = {"drive.revolutions": 0.1, "solver.reference.max_step_deg": 0.02}
     for method in ("DOP853", "numba_DOP853"):
-        st = reference.solve(load_scene(REFERENCE, {**overrides, "solver.reference.method": method})).steps
+        st = door("reference")(load_scene(REFERENCE, {**overrides, "solver.reference.method": method})).steps
         t, delta, rate = st["time_s"], st["penetration_m"], st["penetration_rate_m_s"]
         free = ~contact_mode(st)
         inner = np.flatnonzero(free[1:-1] & free[:-2] & free[2:]) + 1
@@ -140,12 +141,12 @@ def test_the_onset_rule_in_a_lasting_contact_is_warned_about_and_max_approach_st
     overrides = {"solver.reference.method": "numba_DOP853", "solver.reference.rtol": 1e-5,
                  "solver.reference.atol": 1e-8, "drive.revolutions": 10}
     path = MODELS / "paper" / "speed_500rpm_c0p25mm.toml"
-    onset = reference.solve(load_scene(path, {**overrides, "joint_e.impact_velocity_rule": "onset"}))
+    onset = door("reference")(load_scene(path, {**overrides, "joint_e.impact_velocity_rule": "onset"}))
     assert onset.ok, onset.message
     p = onset.plausibility
     assert p["damping_steps"] > 0 and p["max_damping_ratio"] > 20.0 and p["defects"] == []
     assert sum("the \"onset\" rule in a lasting contact" in text for text in p["warnings"]) == 1
-    new = reference.solve(load_scene(path, {**overrides, "joint_e.impact_velocity_rule": "max_approach"}))
+    new = door("reference")(load_scene(path, {**overrides, "joint_e.impact_velocity_rule": "max_approach"}))
     assert new.ok, new.message
     assert new.plausibility["damping_steps"] == 0
     assert abs(new.plausibility["max_damping_ratio"] - 1.0) < 1e-12  # as in the sound run above
@@ -156,7 +157,7 @@ def test_the_ideal_joint_has_no_contact_counts_only_the_rapier_checks_which_agre
     before and after the run (issue 21); the ideal run's steps follow the ideal kinematics the before-run
     check reads, so the two peaks agree to the sampling of the two crank-angle grids (0.25 and 0.1 deg: 1e-3
     covers a peak between grid points; measured 0)."""
-    ideal = reference.solve(load_scene(REFERENCE, {"joint_e.clearance_mm": 0, "drive.revolutions": 1}))
+    ideal = door("reference")(load_scene(REFERENCE, {"joint_e.clearance_mm": 0, "drive.revolutions": 1}))
     assert ideal.ok and "onsets" not in ideal.plausibility
     before, after = ideal.plausibility["checks"]
     assert (before["stage"], before["name"], after["stage"], after["name"]) == (
@@ -267,7 +268,7 @@ def test_exudyn_penetration_rate_channel_is_the_time_derivative_of_the_penetrati
     below what a wrong channel gives (a sign or a missing term is O(1))."""
     exudyn_engine = pytest.importorskip("weftsim.exudyn_engine")
     scene = load_scene(REFERENCE, {"drive.revolutions": 0.015, "solver.exudyn.model": model})
-    result = exudyn_engine.solve(scene)
+    result = door("exudyn")(scene)
     st = result.steps
     t, delta, rate = st["time_s"], st["penetration_m"], st["penetration_rate_m_s"]
     free = ~contact_mode(st) & (delta < 0.0)

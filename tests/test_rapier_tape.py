@@ -1,6 +1,6 @@
 """The flexible rapier tape (docs/rapier-tape.md): closed forms, limits and energy of the kernel's model.
 
-The kernel's tape (weftsim.kernel.tape) is checked where the physics has an answer: the first axial
+The kernel's tape (weftsim.physics.tape) is checked where the physics has an answer: the first axial
 frequency of a fixed free length with the head at its end (beta L tan beta L = M / m), the quasi-static
 stretch under a constant wheel acceleration, the energy balance with the free length changing under the
 tape, the rigid rapier as the limit of a stiff tape, and the scene table's rules.
@@ -18,9 +18,9 @@ from scipy.integrate import solve_ivp
 from weftsim.api import load_scene, simulate
 from weftsim.errors import SceneError
 from weftsim.input.params import RapierTape
-from weftsim.kernel import tape as kt
-from weftsim.tape.model import first_frequency, quasi_static, rigid_equivalent, ritz_matrices, tape_block
-from weftsim.tape.selection import tape_check
+from weftsim.physics import tape as kt
+from weftsim.model.tape import first_frequency, quasi_static, rigid_equivalent, ritz_matrices, tape_block
+from weftsim.model.tape_selection import tape_check
 
 TAPE = RapierTape()
 # The loom_tape scene's free lengths: outermost (250 mm), mid stroke and innermost (250 + 1241 mm).

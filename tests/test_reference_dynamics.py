@@ -1,6 +1,6 @@
 """Clearance-mode equations of the reference solver: the 2-DOF chain against a Lagrangian
 built numerically from positions, the contact's generalized forces by virtual work, the
-link with the ideal-joint torque (the one kernel, weftsim.kernel.chain)."""
+link with the ideal-joint torque (the one kernel, weftsim.physics.chain)."""
 
 from __future__ import annotations
 
@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 from weftsim.mechanism import kinematics as kin
-from weftsim.kernel.chain import chain
+from weftsim.physics.chain import chain
 from weftsim.input.params import Scene
-from weftsim.reference.dynamics import ChainConstants, eccentricity, initial_state, pack_parameters, penetration
-from weftsim.reference.ideal import crank_side_inertia, crank_side_potential, ideal_torque
+from weftsim.model.dynamics import ChainConstants, eccentricity, initial_state, pack_parameters, penetration
+from weftsim.model.ideal import crank_side_inertia, crank_side_potential, ideal_torque
 
 SCENE = Scene()
 FRICTION = dataclasses.replace(SCENE, joint=dataclasses.replace(SCENE.joint, friction_coefficient=0.1))
@@ -124,7 +124,7 @@ def test_eccentricity_uses_the_kinematics_of_the_rocker():
     theta = np.linspace(0.0, 2 * np.pi, 37)
     st = kin.linkage_state(theta, SCENE.geometry, SCENE.inertia.rocker_com)
     q = (st.theta_fg, st.theta_ef)
-    from weftsim.reference.dynamics import NUMPY
+    from weftsim.model.dynamics import NUMPY
 
     ecc_y, ecc_z, v_y, v_z, dphi, db_y, db_z = eccentricity(
         NUMPY, p, theta / p.omega, q[0], q[1], p.omega * st.d_theta_fg, p.omega * st.d_theta_ef

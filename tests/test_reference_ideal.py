@@ -10,8 +10,9 @@ import numpy as np
 
 from weftsim.mechanism import kinematics as kin
 from weftsim.input.params import Scene
-from weftsim.reference import solve
-from weftsim.reference.ideal import equivalent_inertia, ideal_torque, potential_energy
+from conftest import door
+solve = door("reference")
+from weftsim.model.ideal import equivalent_inertia, ideal_torque, potential_energy
 from weftsim.post.results import CHANNELS, CONTACT_CHANNELS
 
 SCENE = dataclasses.replace(Scene(), joint=dataclasses.replace(Scene().joint, clearance=0.0))

@@ -12,8 +12,9 @@ import pytest
 from weftsim.mechanism import kinematics as kin
 from weftsim.post.analysis import peaks, time_weights
 from weftsim.input.params import ReferenceSolver, Scene
-from weftsim.reference import solve
-from weftsim.reference.ideal import ideal_torque
+from conftest import door
+solve = door("reference")
+from weftsim.model.ideal import ideal_torque
 from weftsim.post.results import CHANNELS
 
 # This file tests the scipy path (weftsim.reference.integrate), at the tolerances it was written for

@@ -12,10 +12,12 @@ import pytest
 pytest.importorskip("numba")
 
 from weftsim.post.analysis import energy_balance, peaks  # noqa: E402
-from weftsim.kernel.chain_f import rhs_any  # noqa: E402
+from weftsim.physics.chain_f import rhs_any  # noqa: E402
 from weftsim.reference import compiled_ros as ros  # noqa: E402
-from weftsim.reference import select_path, solve  # noqa: E402
-from weftsim.reference.dynamics import initial_state, pack_parameters  # noqa: E402
+from weftsim.reference import select_path  # noqa: E402
+from conftest import door
+solve = door("reference")
+from weftsim.model.dynamics import initial_state, pack_parameters  # noqa: E402
 from weftsim.input.scene import load_scene  # noqa: E402
 
 REFERENCE = Path(__file__).resolve().parents[1] / "models" / "reference.toml"
@@ -29,7 +31,7 @@ def _scene(mu=0.0, degrees=60.0, **solver):
 
 
 def pack_penetration(scene, t, y):
-    from weftsim.kernel.chain_f import penetration_at
+    from weftsim.physics.chain_f import penetration_at
 
     return penetration_at(pack_parameters(scene), t, y, 0)[0]
 
@@ -107,7 +109,7 @@ def test_jacobian_of_the_kernel_matches_a_richardson_extrapolated_difference_in_
     difference (steps 100x and 200x larger, which cancels the h^2 term), in contact with friction."""
     scene = _scene(mu=0.15, degrees=20.0)
     rows = {}
-    solve(scene, step_states=lambda t, y, contact, impact: rows.update(t=t, y=y, contact=contact, impact=impact))
+    solve(scene, observe=lambda t, y, contact, impact: rows.update(t=t, y=y, contact=contact, impact=impact))
     # The deepest contact row: near delta = 0 the law's delta^1.5 has no second derivative, and any
     # difference across it compares the kink, not the Jacobian (at the onset row: 40-100 % for h = 1e-7).
     k = int(np.argmax(np.where(rows["contact"], [pack_penetration(scene, t, y) for t, y in zip(rows["t"], rows["y"])],
@@ -186,7 +188,14 @@ def test_automatic_choice_names_the_stiff_joint_and_keeps_explicit_paths_selecta
 
 
 def test_run_time_and_record_estimates_know_friction():
-    from weftsim.run.progress import EXPLICIT_STIFF_FACTOR, estimate_run_time, estimate_step_bytes
+    from weftsim.engines import get
+    from weftsim.reference.engine import EXPLICIT_STIFF_FACTOR
+
+    def estimate_run_time(scene, engine):
+        return get(engine).estimate(scene).run_time_s
+
+    def estimate_step_bytes(scene, engine):
+        return get(engine).estimate(scene).step_bytes
 
     dry, rough = _scene(degrees=360.0), _scene(mu=0.15, degrees=360.0)
     explicit = _scene(mu=0.15, degrees=360.0, method="numba_DOP853")

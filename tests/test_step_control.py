@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 
 from weftsim import reference
-from weftsim.exudyn_engine import solve
+from conftest import door
+solve = door("exudyn")
 from weftsim.exudyn_engine.step_control import newmark_beta, to_sample_grid
 from weftsim.input.params import ClearanceJoint, Drive, ExudynSolver, ReferenceSolver, Scene
 from weftsim.input.scene import SceneError, load_scene
@@ -71,7 +72,7 @@ def test_samples_are_step_ends_and_the_step_varies(startup):
 
 
 def test_first_contact_and_startup_peaks_match_the_reference_engine(startup):
-    ex, ref = startup, reference.solve(startup.scene)
+    ex, ref = startup, door("reference")(startup.scene)
     assert ex.ok and ref.ok
     # The onset is located within its step: measured 7.4e-6 deg from the reference engine's event
     # location at 3e-9 m and below (7.1e-5 deg at 3e-8 m); the scene's compare tolerance is 0.1 deg.
@@ -94,7 +95,7 @@ def test_a_tighter_tolerance_takes_more_steps_and_converges(startup):
     # 2.4e-4 at 3e-8, 3e-9, 3e-10, 3e-11 m, so each 10x tighter tolerance cuts it 3-8x; asking for 2x
     # fails if the control stops converging.
     converged = dataclasses.replace(startup.scene, reference_solver=ReferenceSolver(rtol=1e-10, atol=1e-13))
-    done = reference.solve(converged).steps["dissipated_energy_J"][-1]  # compiled DOP853, 5 decades below
+    done = door("reference")(converged).steps["dissipated_energy_J"][-1]  # compiled DOP853, 5 decades below
     err = [abs(r.steps["dissipated_energy_J"][-1] / done - 1.0) for r in (startup, tight)]
     assert err[1] < 0.5 * err[0], err
 

@@ -118,7 +118,8 @@ def test_acceleration_spectrum_needs_a_revolution_after_the_first():
 
 def test_spectrum_of_the_ideal_run_holds_harmonics_only_and_satisfies_parseval():
     from weftsim.post.analysis import time_weights
-    from weftsim.reference import solve
+    from conftest import door
+    solve = door("reference")
     from weftsim.input.scene import load_scene
 
     result = solve(load_scene(MODELS / "ideal.toml", {"drive.revolutions": 3}))
@@ -180,7 +181,8 @@ def test_contact_law_study_writes_its_files_and_the_damping_is_the_law(reduced):
 
 
 def test_acceleration_deviation_of_the_ideal_run_is_round_off():
-    from weftsim.reference import solve
+    from conftest import door
+    solve = door("reference")
     from weftsim.input.scene import load_scene
     from weftsim.studies.clearance import acceleration_deviation, ideal_features
 

@@ -11,11 +11,12 @@ import pytest
 
 pytest.importorskip("exudyn")
 
-from weftsim.exudyn_engine import solve  # noqa: E402
+from conftest import door
+solve = door("exudyn")
 from weftsim.exudyn_engine.callbacks import make_tree_force  # noqa: E402
 from weftsim.exudyn_engine.tree_solve import contact_work  # noqa: E402
-from weftsim.reference.dynamics import ChainConstants, eccentricity, initial_state, pack_parameters  # noqa: E402
-from weftsim.reference.dynamics import NUMPY  # noqa: E402
+from weftsim.model.dynamics import ChainConstants, eccentricity, initial_state, pack_parameters  # noqa: E402
+from weftsim.model.dynamics import NUMPY  # noqa: E402
 from weftsim.input.scene import load_scene  # noqa: E402
 
 MODELS = Path(__file__).resolve().parents[1] / "models"

@@ -15,12 +15,13 @@ import numpy as np
 import pytest
 
 from weftsim import reference
-from weftsim.kernel.wear import deposit
+from weftsim.physics.wear import deposit
 from weftsim.input.params import LOOM_JOINT_E, WearModel
-from weftsim.reference.dynamics import pack_parameters
+from weftsim.model.dynamics import pack_parameters
 from weftsim.input.scene import load_scene
 from weftsim.wear.archard import contact_rows, run_wear, wear_from_rows
 from weftsim.wear.extrapolate import effective_clearance, predict
+from conftest import door
 
 REFERENCE = Path(__file__).resolve().parents[1] / "models" / "reference.toml"
 
@@ -84,7 +85,7 @@ def test_deposit_is_non_negative_and_conserves_the_depth():
 def reference_run():
     scene = load_scene(REFERENCE, {"drive.revolutions": 2.0})
     rows = {}
-    result = reference.solve(scene, step_states=lambda *a: rows.update(steps=a))
+    result = door("reference")(scene, observe=lambda *a: rows.update(steps=a))
     assert result.ok, result.message
     return scene, result, rows["steps"]
 
@@ -120,7 +121,7 @@ def test_worn_contact_with_zero_wear_is_the_round_contact(reference_run):
     """h = 0 through the worn-geometry path (tables present, all zero) gives the round run bit for bit."""
     scene, result, _ = reference_run
     n = scene.joint.wear.profile_points
-    worn = reference.solve(_worn(scene, np.zeros(n), np.zeros(n)))
+    worn = door("reference")(_worn(scene, np.zeros(n), np.zeros(n)))
     assert len(pack_parameters(_worn(scene, np.zeros(n), np.zeros(n)))) > len(pack_parameters(scene))
     for name, values in result.steps.items():
         np.testing.assert_array_equal(worn.steps[name], values, err_msg=name)
@@ -131,8 +132,8 @@ def test_uniform_wear_is_a_larger_round_clearance():
     base = load_scene(REFERENCE, {"drive.revolutions": 1.0})
     h = 0.05e-3
     n = base.joint.wear.profile_points
-    worn = reference.solve(_worn(base, np.full(n, h), ()))
-    wider = reference.solve(dc.replace(base, joint=dc.replace(base.joint, clearance=base.joint.clearance + h)))
+    worn = door("reference")(_worn(base, np.full(n, h), ()))
+    wider = door("reference")(dc.replace(base, joint=dc.replace(base.joint, clearance=base.joint.clearance + h)))
     assert worn.ok and wider.ok
     # c0 + h can differ between the two only by the round-off of the cubic weights (~1e-20 m);
     # measured: identical first contact and peaks over one revolution.  1e-9 allows that round-off

@@ -15,13 +15,14 @@ import numpy as np
 import pytest
 
 from weftsim import exudyn_engine, reference
-from weftsim.kernel import chain as kc
-from weftsim.kernel.wear import worn_clearance
-from weftsim.reference.dynamics import pack_parameters
+from weftsim.physics import chain as kc
+from weftsim.physics.wear import worn_clearance
+from weftsim.model.dynamics import initial_state, pack_parameters
 from weftsim.input.scene import load_scene
 from weftsim.wear import WearError, check_request
 from weftsim.wear.engines import engine_update, exudyn_update
 from weftsim.wear.extrapolate import worn_scene
+from conftest import door
 
 
 def _profiles(n: int, c0: float) -> tuple[np.ndarray, np.ndarray]:
@@ -48,7 +49,7 @@ def test_the_tree_contact_reads_the_same_worn_clearance_as_the_reference_chain()
     worn, bearing, journal = _worn(scene, 1.0)
     prm, round_prm = pack_parameters(worn), pack_parameters(scene)
     rng = np.random.default_rng(3)
-    a0, psi0 = reference.dynamics.initial_state(scene)[:2]
+    a0, psi0 = initial_state(scene)[:2]
     c0 = scene.joint.clearance
     depths = []
     for t in rng.uniform(0.0, 2e-4, 40):
@@ -91,8 +92,8 @@ def test_a_worn_scene_agrees_between_the_engines_to_the_compare_tolerances():
     out = {}
     for name, s in (("round", round_scene), ("worn", worn)):
         rigid = replace(s, exudyn_solver=replace(s.exudyn_solver, model="rigid_body"))
-        for engine, solve, run in (("reference", reference.solve, s), ("exudyn", exudyn_engine.solve, s),
-                                   ("rigid_body", exudyn_engine.solve, rigid)):
+        for engine, solve, run in (("reference", door("reference"), s), ("exudyn", door("exudyn"), s),
+                                   ("rigid_body", door("exudyn"), rigid)):
             result = solve(run)
             assert result.ok, result.message
             out[name, engine] = (result.events["first_contact_time_s"], result.steps["contact_force_N"].max())
@@ -208,7 +209,7 @@ def test_a_worn_lubricated_joint_agrees_between_the_engines():
     scene = apply_overrides(load_scene("loom"), {"joint_e.lubrication.viscosity_mpa_s": 20.0})
     worn = _worn(scene, 0.5)[0]
     out = {}
-    for engine, solve in (("reference", reference.solve), ("exudyn", exudyn_engine.solve)):
+    for engine, solve in (("reference", door("reference")), ("exudyn", door("exudyn"))):
         result = solve(worn)
         assert result.ok, result.message
         out[engine] = (result.steps["film_ratio"].min(), result.steps["film_force_N"].max())
@@ -216,7 +217,7 @@ def test_a_worn_lubricated_joint_agrees_between_the_engines():
     assert out["exudyn"][0] == pytest.approx(out["reference"][0], rel=1e-3)
     assert out["exudyn"][1] == pytest.approx(out["reference"][1], rel=1e-3)
     round_scene = replace(scene, drive=replace(scene.drive, revolutions=0.5))
-    assert reference.solve(round_scene).steps["film_ratio"].min() < 0.995 * out["reference"][0]
+    assert door("reference")(round_scene).steps["film_ratio"].min() < 0.995 * out["reference"][0]
 
 
 def test_cli_wear_to_the_limit_without_hours_ends_exactly_at_it(tmp_path):

@@ -16,14 +16,15 @@ import numpy as np
 import pytest
 
 from weftsim import reference
-from weftsim.kernel import chain_f as kf
-from weftsim.reference.dynamics import pack_parameters
+from weftsim.physics import chain_f as kf
+from weftsim.model.dynamics import pack_parameters
 from weftsim.input.scene import SceneError, load_scene
 from weftsim.wear import predict_to_directory
 from weftsim.wear.archard import contact_rows_f, run_wear
 from weftsim.wear.extrapolate import effective_clearance, predict
 from weftsim.wear.resume import read_state
 from weftsim.wear.store import STATE, StateMismatch
+from conftest import door
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = ROOT / "models"
@@ -50,7 +51,7 @@ def _lobe(amplitude: float, centre: float) -> tuple[np.ndarray, callable, callab
 def _states(scene, count: int = 40):
     """States along a short run of ``scene`` (every few accepted steps)."""
     rows = {}
-    result = reference.solve(scene, step_states=lambda *a: rows.update(steps=a))
+    result = door("reference")(scene, observe=lambda *a: rows.update(steps=a))
     assert result.ok, result.message
     t, y = rows["steps"][:2]
     pick = np.linspace(0, t.size - 1, count).astype(int)
@@ -99,7 +100,7 @@ def test_a_worn_e_beside_a_clearance_at_f_reads_its_own_tables():
     journal, h_j, _ = _lobe(5e-6, 2.5)
     worn = dc.replace(scene, joint=dc.replace(scene.joint, bearing_wear=tuple(bearing), journal_wear=tuple(journal)))
     round_prm, worn_prm = pack_parameters(scene), pack_parameters(worn)
-    from weftsim.kernel.chain import rocker_angle
+    from weftsim.physics.chain import rocker_angle
 
     for t, y in zip(*_states(scene, 20)):
         e_y, e_z = kf.eccentricities(round_prm, t, y)[:2]
@@ -116,7 +117,7 @@ def test_zero_wear_tables_at_f_are_the_round_joint_bit_for_bit(topology):
     scene = _scene(topology, revolutions=0.5)
     zeros = (0.0,) * N
     worn = dc.replace(scene, joint_f=dc.replace(scene.joint_f, bearing_wear=zeros, journal_wear=zeros))
-    a, b = reference.solve(scene), reference.solve(worn)
+    a, b = door("reference")(scene), door("reference")(worn)
     assert a.ok and b.ok
     for name in ("contact_force_f_N", "penetration_f_m", "rapier_acceleration_m_s2", "driving_torque_Nm"):
         np.testing.assert_array_equal(a.steps[name], b.steps[name])
@@ -129,7 +130,7 @@ def test_uniform_wear_at_f_is_a_larger_round_clearance():
     worn = dc.replace(scene, joint_f=dc.replace(scene.joint_f, bearing_wear=(0.5 * h,) * N,
                                                 journal_wear=(0.5 * h,) * N))
     wider = dc.replace(scene, joint_f=dc.replace(scene.joint_f, clearance=scene.joint_f.clearance + h))
-    a, b = reference.solve(worn), reference.solve(wider)
+    a, b = door("reference")(worn), door("reference")(wider)
     assert a.ok and b.ok
     # c0 + h_b + h_j and c0 + h differ by the round-off of the cubic weights (~1e-20 m); measured: the first
     # contact 3e-16 apart in relative terms.  1e-9 allows that round-off, far below any modelling difference.
@@ -140,7 +141,7 @@ def test_the_rows_at_f_carry_f_s_contact_force():
     """The Archard rows of joint F take F_N of F's contact (the channel contact_force_f_N at the same rows)."""
     scene = _scene("ef", revolutions=1.0)
     rows = {}
-    result = reference.solve(scene, step_states=lambda *a: rows.update(steps=a))
+    result = door("reference")(scene, observe=lambda *a: rows.update(steps=a))
     assert result.ok
     t, y, contact, impact = rows["steps"]
     prm = pack_parameters(scene)
@@ -313,7 +314,7 @@ def test_round_chains_with_clearance_at_f_are_unchanged_bit_for_bit(topology):
     """Half a revolution of clearance_ef (F alone, E and F) without wear: the channels main gave before F could
     wear, to the last bit (the worn-clearance reads return the round clearance unchanged)."""
     before = json.loads((REGRESSION / "clearance_f_round_before_joint_f_wear.json").read_text())
-    result = reference.solve(_scene(topology, revolutions=0.5))
+    result = door("reference")(_scene(topology, revolutions=0.5))
     assert result.ok
     for key, digest in before.items():
         name, _, channel = key.partition(":")
@@ -329,7 +330,7 @@ def test_a_worn_lubricated_f_has_its_film_on_the_worn_clearance():
     bearing, h_b, _ = _lobe(20e-6, 1.0)
     worn = dc.replace(scene, joint_f=dc.replace(scene.joint_f, bearing_wear=tuple(bearing), journal_wear=(0.0,) * N))
     rows = {}
-    result = reference.solve(worn, step_states=lambda *a: rows.update(steps=a))
+    result = door("reference")(worn, observe=lambda *a: rows.update(steps=a))
     assert result.ok, result.message
     t, y = rows["steps"][:2]
     prm = pack_parameters(scene)

@@ -11,7 +11,11 @@ Python interface
 load_scene(scene, overrides=None, **flags)
     A scene file or bundled scene name, with overrides in file units.
 simulate(scene, engine="auto")
-    Run one engine; returns a :class:`RunResult` (``to_pandas()``, ``samples``, ``steps``).
+    Run one engine; returns a :class:`RunResult` (``to_pandas()``, ``samples``, ``steps``).  The one door:
+    before-run checks, the engine's solve, the vetting of its result.
+estimate(scene, engine="auto"), select_path(scene, engine="auto")
+    What a run will cost, and which model and method it takes.  The engines and a plug-in's registration:
+    :mod:`weftsim.engines`.
 plausibility_checks(scene)
     The checks that need no simulation: reflected mass, pin pressure, p x v, clearance ratio,
     rapier acceleration against their limits (docs/plausibility.md).
@@ -19,6 +23,9 @@ save_result(result, path), load_result(path)
     Lossless NPZ (``weftsim run`` writes ``result.npz``).
 load_sweep(directory)
     A ``weftsim sweep`` directory as an xarray Dataset over its varied keys.
+kinematics(scene), compare(scene, outdir), sweep(scene, vary, outdir), wear(scene, hours, outdir)
+    The commands ``weftsim kinematics | compare | sweep | wear`` as functions (the commands are thin shells
+    over them).
 bundled_scenes()
     Names of the scenes installed with weftsim.
 WeftsimError
@@ -38,6 +45,9 @@ from weftsim.api import (
     DEFAULT_ENGINE,
     ENGINE_NAMES,
     bundled_scenes,
+    compare,
+    estimate,
+    kinematics,
     load_result,
     load_scene,
     load_sweep,
@@ -45,6 +55,8 @@ from weftsim.api import (
     save_result,
     select_path,
     simulate,
+    sweep,
+    wear,
 )
 from weftsim.errors import (  # noqa: E402
     ArgumentError,
@@ -80,6 +92,9 @@ __all__ = [
     "WeftsimError",
     "WriteFailed",
     "bundled_scenes",
+    "compare",
+    "estimate",
+    "kinematics",
     "load_result",
     "load_scene",
     "load_sweep",
@@ -87,4 +102,6 @@ __all__ = [
     "save_result",
     "select_path",
     "simulate",
+    "sweep",
+    "wear",
 ]

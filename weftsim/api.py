@@ -18,23 +18,23 @@ message is the line the command line prints.
 from __future__ import annotations
 
 import os
-import warnings
 from collections.abc import Mapping
 from pathlib import Path
-from types import ModuleType
 from typing import TYPE_CHECKING, Any, Callable
 
-from weftsim.errors import ArgumentError, EngineError, OutputError, PlausibilityWarning, RunFailed, SceneError, closest
+from weftsim import engines
+from weftsim.errors import ArgumentError, OutputError, SceneError, closest
 from weftsim.input.params import Scene
 from weftsim.post.results import RunResult
 
 if TYPE_CHECKING:
     import xarray
 
-# Engine names :func:`simulate` accepts.  "auto" is the default engine, the Exudyn multibody
+# Engine names :func:`simulate` accepts (the built-in ones; a plug-in registered with
+# :func:`weftsim.engines.register` is accepted too).  "auto" is the default engine, the Exudyn multibody
 # model (the project's primary engine; the reference engine is its independent cross-check).
-ENGINE_NAMES: tuple[str, ...] = ("auto", "exudyn", "reference")
-DEFAULT_ENGINE = "exudyn"
+ENGINE_NAMES: tuple[str, ...] = (engines.AUTO,) + tuple(engines.BUILT_IN)
+DEFAULT_ENGINE = engines.DEFAULT_ENGINE
 
 # The shorthands of the command line (--clearance-mm, --speed-rpm, --revolutions, --law) and of
 # load_scene's keyword flags, and the scene keys they set (file units).
@@ -116,97 +116,38 @@ def bundled_scenes() -> list[str]:
 
 
 def resolve_engine(engine: str) -> str:
-    """The engine ``engine`` names: ``"auto"`` is :data:`DEFAULT_ENGINE`; an unknown name is an EngineError."""
-    if engine == "auto":
-        return DEFAULT_ENGINE
-    if engine not in ENGINE_NAMES:
-        near = closest(engine, ENGINE_NAMES) if isinstance(engine, str) else None
-        raise EngineError(f"engine must be one of {', '.join(ENGINE_NAMES)}, got {engine!r}"
-                          + (f"; did you mean {near}?" if near else ""))
-    return engine
-
-
-def _engine_module(engine: str) -> ModuleType:
-    """The package of an engine, with ``solve(scene, progress=None)`` and ``select_path(scene)``."""
-    if resolve_engine(engine) == "reference":
-        import weftsim.reference as module
-    else:
-        import weftsim.exudyn_engine as module
-    return module
+    """The engine ``engine`` names: ``"auto"`` is :data:`DEFAULT_ENGINE`; an unknown name is an EngineError
+    (:func:`weftsim.engines.resolve`)."""
+    return engines.resolve(engine)
 
 
 def select_path(scene: Scene, engine: str = "auto") -> dict[str, str]:
-    """The model and method ``engine`` runs ``scene`` on, and why: ``{"model", "method", "reason"}``."""
-    return _engine_module(engine).select_path(scene)
+    """The model and method ``engine`` runs ``scene`` on, and why: ``{"model", "method", "reason"}``.
+
+    >>> import weftsim
+    >>> weftsim.select_path(weftsim.load_scene("ideal"), "reference")["model"]
+    'ideal joint'
+    """
+    return engines.get(engine).select_path(scene)
+
+
+def estimate(scene: Scene | str | os.PathLike, engine: str = "auto") -> engines.Estimate:
+    """What a run of ``scene`` on ``engine`` will cost before it starts (:class:`weftsim.engines.Estimate`:
+    wall-clock seconds and bytes of the step table, from measured rates, within ~3x).
+
+    >>> import weftsim
+    >>> weftsim.estimate("ideal", "reference").run_time_s   # the closed form: nothing to integrate
+    0.0
+    """
+    return engines.get(engine).estimate(_as_scene(scene))
 
 
 def _as_scene(scene: Scene | str | os.PathLike) -> Scene:
-    if isinstance(scene, Scene):
-        return scene
-    if isinstance(scene, (str, os.PathLike)):
-        return load_scene(scene)
-    raise SceneError(f"simulate: scene must be a Scene (weftsim.load_scene), a scene file or the name of a "
-                     f"bundled scene, got {type(scene).__name__}")
+    return engines._as_scene(scene)
 
 
-def simulate(scene: Scene | str | os.PathLike, engine: str = "auto", *,
-             progress: Callable[[float], None] | None = None, raise_on_failure: bool = False,
-             on_warning: Callable[[str], None] | None = None) -> RunResult:
-    """Simulate one scene with one engine.
-
-    Parameters
-    ----------
-    scene : Scene, str or path-like
-        A scene from :func:`load_scene`, or what :func:`load_scene` takes (a file or a bundled name).
-    engine : {"auto", "exudyn", "reference"}
-        ``"exudyn"``: the Exudyn multibody model (the kinematic tree, or the rigid-body model where
-        a scene needs it); ``"reference"``: the independent closed-form Lagrange engine (compiled
-        DOP853); ``"auto"``: the default engine, :data:`DEFAULT_ENGINE`.
-    progress : callable, optional
-        Called with the completed fraction in [0, 1] about 100 times per run.
-    raise_on_failure : bool
-        Raise :class:`weftsim.errors.RunFailed` (holding the partial result) when the run fails,
-        instead of returning it with ``status == "failed"``.
-    on_warning : callable, optional
-        Called with each before-run plausibility warning (:func:`plausibility_checks`), one sentence
-        naming the scene key to change, before the engine starts.  Default: issued as a
-        :class:`weftsim.errors.PlausibilityWarning` (Python's ``warnings``).  Every check, before and
-        after the run, is in ``result.plausibility["checks"]``.
-
-    Returns
-    -------
-    RunResult
-        The channels on the output grid (``samples``) and at every accepted step (``steps``), the
-        solver statistics, the status and message, the plausibility counts and the path taken.
-        A failed run keeps what it computed up to the failure (``result.ok`` is False).
-
-    Raises
-    ------
-    weftsim.errors.EngineError
-        ``engine`` is not one of :data:`ENGINE_NAMES`.
-    weftsim.errors.SceneError
-        ``scene`` is a file or name that does not load.
-    weftsim.errors.RunFailed
-        Only with ``raise_on_failure``: the run failed (``exc.result`` holds it).
-    weftsim.errors.ArgumentError
-        ``progress`` is neither None nor callable.
-    """
-    from weftsim.run.design_checks import before_run, warnings_of
-
-    module = _engine_module(engine)
-    if progress is not None and not callable(progress):
-        raise ArgumentError(f"simulate: progress must be None or a function called with the completed fraction "
-                            f"(e.g. lambda f: print(f)), got {type(progress).__name__} {progress!r:.40}")
-    scene = _as_scene(scene)
-    for text in warnings_of(before_run(scene)):
-        if on_warning is None:
-            warnings.warn(text, PlausibilityWarning, stacklevel=2)
-        else:
-            on_warning(text)
-    result = module.solve(scene, progress=progress)
-    if raise_on_failure and not result.ok:
-        raise RunFailed(f"simulation failed: {result.message}", result)
-    return result
+# The one door (defined beside the engine registry, below the commands that run many simulations).
+simulate = engines.simulate
 
 
 def plausibility_checks(scene: Scene | str | os.PathLike) -> list[dict]:
@@ -217,7 +158,7 @@ def plausibility_checks(scene: Scene | str | os.PathLike) -> list[dict]:
     "info"), further ``numbers`` and the warning ``message``.  A run adds the after-run checks in
     ``result.plausibility["checks"]``.
     """
-    from weftsim.run.design_checks import before_run
+    from weftsim.checks.design_checks import before_run
 
     return [check.as_dict() for check in before_run(_as_scene(scene))]
 
@@ -245,9 +186,18 @@ def save_result(result: RunResult, path: str | os.PathLike) -> Path:
     if not isinstance(path, (str, os.PathLike)):
         raise ArgumentError(f"save_result: path must be a file path, got {type(path).__name__}")
     from weftsim.post.output import write_atomic
+    from weftsim.post.results import ENGINES
+
+    if result.engine not in ENGINES:
+        raise OutputError(f"save_result: the result of the plug-in engine {result.engine!r} cannot be saved: the "
+                          f"result file records the built-in engines ({', '.join(ENGINES)}) only; keep its "
+                          "tables with result.to_pandas() or numpy")
 
     try:  # atomic: a run killed while saving leaves the previous file (or none), never a truncated one
-        write_atomic(Path(path), lambda tmp: save_npz(result, tmp))
+        def write(tmp: Path) -> None:
+            save_npz(result, tmp)
+
+        write_atomic(Path(path), write)
         return Path(path)
     except OSError as exc:
         raise OutputError(f"cannot write {path}: {exc.strerror or exc}") from None
@@ -299,3 +249,81 @@ def load_sweep(directory: str | os.PathLike) -> xarray.Dataset:
     if not isinstance(directory, (str, os.PathLike)):
         raise ArgumentError(f"load_sweep: directory must be a path, got {type(directory).__name__}")
     return load_grid(Path(directory))
+
+
+# The columns of weftsim.kinematics (and of `weftsim kinematics`'s kinematics.csv), in order.
+KINEMATICS_COLUMNS = ("crank_angle_deg", "rapier_displacement_m", "rapier_velocity_m_s", "rapier_acceleration_m_s2",
+                      "rocker_angle_deg", "rocker_arm_angle_deg", "sector_angle_deg", "rod_angle_deg",
+                      "transmission_angle_deg")
+
+
+def kinematics(scene: Scene | str | os.PathLike) -> dict[str, Any]:
+    """The ideal mechanism's motion over one crank revolution, on the scene's output grid (no simulation).
+
+    Returns the columns of :data:`KINEMATICS_COLUMNS` (``weftsim kinematics`` writes them to
+    ``kinematics.csv``) as arrays: the crank angle, deg; the rapier's displacement s, m, velocity
+    omega s', m/s, and acceleration omega^2 s'', m/s2, at the scene's constant crank speed omega; the
+    members' angles, deg, and the transmission angle at F, deg (docs/physics.md, the linkage's closure).
+
+    >>> import weftsim
+    >>> k = weftsim.kinematics("reference")
+    >>> round(float(k["rapier_displacement_m"].max() - k["rapier_displacement_m"].min()), 3)   # the stroke, m
+    1.052
+    """
+    import math
+
+    import numpy as np
+
+    from weftsim.mechanism.kinematics import linkage_state
+
+    scene = _as_scene(scene)
+    rows = int(round(2.0 * math.pi / scene.output.sample_angle)) + 1
+    theta = np.linspace(0.0, 2.0 * math.pi, rows)
+    state = linkage_state(theta, scene.geometry, scene.inertia.rocker_com)
+    w = scene.drive.speed
+    return {
+        "crank_angle_deg": np.degrees(theta),
+        "rapier_displacement_m": state.rapier_displacement,
+        "rapier_velocity_m_s": w * state.d_rapier_displacement,
+        "rapier_acceleration_m_s2": w * w * state.dd_rapier_displacement,
+        "rocker_angle_deg": np.degrees(state.phi),
+        "rocker_arm_angle_deg": np.degrees(state.theta_oe),
+        "sector_angle_deg": np.degrees(state.theta_fg),
+        "rod_angle_deg": np.degrees(state.theta_ef),
+        "transmission_angle_deg": np.degrees(state.transmission_angle),
+    }
+
+
+def compare(scene: Scene | str | os.PathLike, outdir: str | os.PathLike, *, force: bool = False,
+            solve: Callable[[Scene, str], RunResult] | None = None) -> dict:
+    """Run both engines on ``scene`` and compare them (``weftsim compare``): both runs' files, ``compare.json``
+    and the overlay figure ``compare.png`` in ``outdir``.
+
+    Returns the report (``compare.json``'s content: each channel's first-revolution peaks on both engines,
+    their difference against the scene's tolerance, ``agree``); :func:`weftsim.post.compare.verdict` gives the
+    command's exit status from it.  ``solve(scene, engine)`` runs one engine (default :func:`simulate`, its
+    before-run warnings left to the result's checks; the command passes one with progress on stderr).
+    """
+    from weftsim.post.compare import run_compare
+
+    def quiet(scene: Scene, engine: str) -> RunResult:
+        return simulate(scene, engine, on_warning=lambda text: None)
+
+    report, _, _ = run_compare(_as_scene(scene), Path(outdir), solve=solve or quiet, force=force)
+    return report
+
+
+def sweep(scene: str | os.PathLike, vary: list[str], outdir: str | os.PathLike, **options: Any) -> Any:
+    """A parameter sweep (``weftsim sweep``), each cell through :func:`simulate`: :func:`weftsim.sweep.sweep`
+    (``weftsim.sweep`` is that function too: the subpackage is callable)."""
+    from weftsim.sweep import sweep as run
+
+    return run(Path(scene) if not isinstance(scene, str) else scene, vary, Path(outdir), **options)
+
+
+def wear(scene: Scene | str | os.PathLike, hours: float, outdir: str | os.PathLike, **options: Any) -> dict:
+    """The wear of the scene's worn joint(s) over ``hours`` (``weftsim wear``): :func:`weftsim.wear.wear`
+    (``weftsim.wear`` is that function too: the subpackage is callable)."""
+    from weftsim.wear import wear as run
+
+    return run(_as_scene(scene), hours, Path(outdir), **options)

@@ -7,7 +7,8 @@ command line prints after ``weftsim COMMAND: error:``.  A script catches them al
 expect (``ValueError`` for bad input, ``OSError`` for files, ``ImportError`` for a missing
 package), so code written against those keeps working.
 
-``exit_status`` is the status the ``weftsim`` command ends with (:mod:`weftsim.cli.exitcodes`).
+``exit_status`` is the status the ``weftsim`` command ends with (the ``EXIT_*`` statuses below, which the
+command line, ``compare`` and the viewer share; :mod:`weftsim.cli.exitcodes` re-exports them).
 """
 
 from __future__ import annotations
@@ -15,7 +16,12 @@ from __future__ import annotations
 import difflib
 from typing import Any, Iterable
 
-from weftsim.cli.exitcodes import EXIT_FAILED, EXIT_USAGE
+# Exit statuses of the ``weftsim`` command.
+EXIT_OK = 0
+EXIT_USAGE = 2  # bad scene, flag or output directory
+EXIT_FAILED = 3  # the simulation itself failed (partial results written)
+EXIT_DISAGREE = 4  # compare: engines disagree beyond the scene's tolerance
+EXIT_PARTIAL = 5  # compare: what was compared agrees, but the core checks could not be compared (run too short)
 
 
 class WeftsimError(Exception):
@@ -116,4 +122,4 @@ def require(module: str, extra: str, purpose: str) -> Any:
 
 
 class PlausibilityWarning(UserWarning):
-    """A scene value outside what a real loom is built for (weftsim.run.design_checks); the run goes on."""
+    """A scene value outside what a real loom is built for (weftsim.checks.design_checks); the run goes on."""

@@ -131,10 +131,16 @@ def load_case(case: str, models: str | Path, revolutions: float, overrides: dict
 
 
 def _solver(engine: str):
-    if engine == "reference":
-        from weftsim.reference import solve
-    else:
-        from weftsim.exudyn_engine import solve
+    """``solve(scene)`` of ``engine`` through the one door (:func:`weftsim.api.simulate`: before-run checks,
+    the engine's solve from the registry, the vetting), the engine imported now."""
+    from weftsim.engines import simulate
+    from weftsim.engines import get
+
+    get(engine)
+
+    def solve(scene: Scene) -> RunResult:
+        return simulate(scene, engine, on_warning=lambda text: None)
+
     return solve
 
 

@@ -2,6 +2,6 @@
 
 :mod:`weftsim.cli.commands` holds the subcommands and ``main`` (the ``weftsim`` console script; also
 ``python -m weftsim.cli`` and ``python -m weftsim``), :mod:`weftsim.cli.grammar` the parser and the flags they
-share and :mod:`weftsim.cli.exitcodes` the exit statuses.  Thin: it parses, calls the Python interface
+share and :mod:`weftsim.errors` the exit statuses.  Thin: it parses, calls the Python interface
 (:mod:`weftsim.api`) and reports.
 """

@@ -44,7 +44,7 @@ from weftsim.cli.grammar import (  # noqa: F401 (CliError, add_scene_flags, scen
 )
 from weftsim.errors import WeftsimError
 from weftsim.post.record import set_command
-from weftsim.cli.exitcodes import EXIT_DISAGREE, EXIT_FAILED, EXIT_USAGE  # noqa: F401 (re-exported)
+from weftsim.errors import EXIT_DISAGREE, EXIT_FAILED, EXIT_USAGE  # noqa: F401 (re-exported)
 
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a command stopped by Ctrl-C
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE: the reader of stdout went away (`| head`), as for any Unix tool
@@ -159,7 +159,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _add_wear_flags(p: argparse.ArgumentParser) -> None:
-    from weftsim.wear.command import add_flags
+    from weftsim.cli.wear import add_flags
 
     add_scene_flags(p, shorthands=("speed_rpm", "clearance_mm", "law"))  # revolutions: set per update in [joint_e.wear]
     add_output_flags(p, "out/<scene name>/wear")
@@ -167,7 +167,7 @@ def _add_wear_flags(p: argparse.ArgumentParser) -> None:
 
 
 def cmd_wear(args: argparse.Namespace) -> int:
-    from weftsim.wear.command import run
+    from weftsim.cli.wear import run
 
     scene = scene_from_args(args)
     where = "wear" if args.engine == "reference" else f"wear-{args.engine}"  # engines' states apart
@@ -188,22 +188,21 @@ def _check_fits(scene, outdir: Path, runs: int = 1) -> None:
 def _announce_run_time(scene, engines: tuple[str, ...], command: str) -> None:
     """One line on stderr with the estimated run time of a long run (a warning above LONG_RUN_S), and for
     ``weftsim run`` one with the estimated size of the per-step record above LARGE_FILE_BYTES."""
+    from weftsim.engines import get as engine_named
     from weftsim.post.output import _size
-    from weftsim.run.progress import (
-        LARGE_FILE_BYTES, LONG_RUN_S, SHOW_ESTIMATE_S, estimate_run_time, estimate_step_bytes, format_duration,
-        stiff_explicit,
-    )  # fmt: skip
+    from weftsim.checks.progress import LARGE_FILE_BYTES, LONG_RUN_S, SHOW_ESTIMATE_S, format_duration
 
-    estimate = sum(estimate_run_time(scene, engine) for engine in engines)
+    costs = [engine_named(engine).estimate(scene) for engine in engines]
+    estimate = sum(cost.run_time_s for cost in costs)
     if estimate >= SHOW_ESTIMATE_S:
         prefix = "warning: " if estimate > LONG_RUN_S else ""
         print(f"weftsim {command}: {prefix}estimated run time ~{format_duration(estimate)} for "
               f"{scene.drive.revolutions:g} revolutions (within a factor of ~3); Ctrl-C stops it and keeps what was "
               "computed", file=sys.stderr, flush=True)
-    size = max(estimate_step_bytes(scene, engine) for engine in engines) if command == "run" else 0.0
+    size = max(cost.step_bytes for cost in costs) if command == "run" else 0.0
     if size > LARGE_FILE_BYTES:
         why = f"{scene.drive.revolutions:g} revolutions of solver steps"
-        if stiff_explicit(scene, engines):
+        if any(cost.stiff_explicit for cost in costs):
             why = ("an explicit solver steps at ~1e-9 s on the friction or film of the joint (the reference engine's "
                    "solver.reference.method = 'auto' integrates it implicitly)")
         print(f"weftsim {command}: warning: the per-step record will be ~{_size(size)} (held in memory, written "
@@ -220,11 +219,11 @@ STOP_SIGNALS = {signal.SIGINT: "Ctrl-C, SIGINT", signal.SIGTERM: "SIGTERM"}
 @contextlib.contextmanager
 def _stop_on_interrupt(command: str):
     """While the block runs, SIGINT (Ctrl-C) or SIGTERM asks the running engine to stop at its next
-    step and keep what it computed (weftsim.run.guards.request_stop); a second signal abandons at once.
+    step and keep what it computed (weftsim.checks.guards.request_stop); a second signal abandons at once.
 
     Yields a dict whose ``"signal"`` is the signal number once one came (else None).
     """
-    from weftsim.run.guards import clear_stop, request_stop
+    from weftsim.checks.guards import clear_stop, request_stop
 
     state = {"signal": None}
     previous = {signum: signal.getsignal(signum) for signum in STOP_SIGNALS}
@@ -272,15 +271,8 @@ def _stdout_to_stderr():
 
 
 # The columns of kinematics.csv, in order (their number sizes the output before it is computed).
-KINEMATICS_COLUMNS = ("crank_angle_deg", "rapier_displacement_m", "rapier_velocity_m_s", "rapier_acceleration_m_s2",
-                      "rocker_angle_deg", "rocker_arm_angle_deg", "sector_angle_deg", "rod_angle_deg",
-                      "transmission_angle_deg")
-
-
 def cmd_kinematics(args: argparse.Namespace) -> int:
-    import numpy as np
-
-    from weftsim.mechanism.kinematics import linkage_state
+    from weftsim.api import KINEMATICS_COLUMNS, kinematics
     from weftsim.post.output import check_output_fits, prepare_directory, write_csv, write_figure, write_files
     from weftsim.post.plots import plot_kinematics
 
@@ -292,20 +284,7 @@ def cmd_kinematics(args: argparse.Namespace) -> int:
                       f"output.sample_deg = {math.degrees(step):g} over one revolution",
                       fix="a coarser output.sample_deg (any value up to 0.5 deg)")
     outdir = prepare_directory(outdir, args.force, scene)
-    theta = np.linspace(0.0, 2.0 * math.pi, rows)
-    state = linkage_state(theta, scene.geometry, scene.inertia.rocker_com)
-    w = scene.drive.speed
-    columns = {
-        "crank_angle_deg": np.degrees(theta),
-        "rapier_displacement_m": state.rapier_displacement,
-        "rapier_velocity_m_s": w * state.d_rapier_displacement,
-        "rapier_acceleration_m_s2": w * w * state.dd_rapier_displacement,
-        "rocker_angle_deg": np.degrees(state.phi),
-        "rocker_arm_angle_deg": np.degrees(state.theta_oe),
-        "sector_angle_deg": np.degrees(state.theta_fg),
-        "rod_angle_deg": np.degrees(state.theta_ef),
-        "transmission_angle_deg": np.degrees(state.transmission_angle),
-    }
+    columns = kinematics(scene)
     rpm = scene.drive.speed * 30 / math.pi
     title = f"{scene.name}: ideal rapier motion at {rpm:g} rpm"
     written = write_files(outdir, {"kind": "kinematics", "scene": scene.name}, {
@@ -329,7 +308,7 @@ def cmd_kinematics(args: argparse.Namespace) -> int:
 def _solve(scene, engine: str, label: str | None = None, announce: bool = False):
     """:func:`weftsim.api.simulate` with progress on stderr; ``announce``: first the path it takes."""
     from weftsim.api import resolve_engine, select_path, simulate
-    from weftsim.run.progress import Progress
+    from weftsim.checks.progress import Progress
 
     engine = resolve_engine(engine)
     if announce:  # `run`: its first line is the model and method it takes, and why
@@ -349,8 +328,8 @@ def _quiet(text: str) -> None:
 
 
 def _announce_checks(scene, command: str) -> None:
-    """One ``warning:`` line on stderr per before-run plausibility check that fails (weftsim.run.design_checks)."""
-    from weftsim.run.design_checks import before_run_lines
+    """One ``warning:`` line on stderr per before-run plausibility check that fails (weftsim.checks.design_checks)."""
+    from weftsim.checks.design_checks import before_run_lines
 
     for line in before_run_lines(scene):
         print(f"weftsim {command}: {line}", file=sys.stderr, flush=True)
@@ -374,17 +353,17 @@ def _report_run(result, written) -> None:
 
 
 def _interrupted_line(result, outdir: Path, signum: int) -> str:
-    from weftsim.run.guards import where
+    from weftsim.checks.guards import where
 
     t = float(result.steps["time_s"][-1]) if result.steps["time_s"].size else 0.0
-    return (f"stopped by {STOP_SIGNALS[signum]} at {where(t, result.scene.drive.speed)}: the results up to "
+    return (f"stopped by {STOP_SIGNALS[signal.Signals(signum)]} at {where(t, result.scene.drive.speed)}: the results up to "
             f"there are in {outdir} (summary.json says complete: false); rerun to compute the whole run")
 
 
 def cmd_run(args: argparse.Namespace) -> int:
     from weftsim.api import resolve_engine
     from weftsim.post.output import prepare_directory, write_run
-    from weftsim.run.design_checks import report_lines
+    from weftsim.checks.design_checks import report_lines
 
     scene = scene_from_args(args)
     engine = resolve_engine(args.engine)
@@ -478,7 +457,8 @@ def _replay_in_viewer(args: argparse.Namespace, scene, engine: str) -> int:
 
 
 def cmd_compare(args: argparse.Namespace) -> int:
-    from weftsim.post.compare import format_report, run_compare
+    from weftsim.api import compare
+    from weftsim.post.compare import format_report, verdict
     from weftsim.post.output import prepare_directory, to_json
 
     scene = scene_from_args(args)
@@ -488,7 +468,8 @@ def cmd_compare(args: argparse.Namespace) -> int:
     with _stdout_to_stderr() if args.json else contextlib.nullcontext():  # the estimate imports Exudyn
         _announce_run_time(scene, ("reference", "exudyn"), "compare")
         _announce_checks(scene, "compare")
-        report, status, problem = run_compare(scene, outdir, solve=_solve, force=args.force)
+        report = compare(scene, outdir, solve=_solve, force=args.force)
+        status, problem = verdict(report, outdir)
     print(to_json(report) if args.json else format_report(report), end="" if args.json else "\n")
     if status:
         raise CliError(problem, status)
@@ -606,7 +587,7 @@ COMMANDS = {"scenes": cmd_scenes, "kinematics": cmd_kinematics, "run": cmd_run, 
             "sweep": cmd_sweep, "study": cmd_study, "bench": cmd_bench, "wear": cmd_wear}
 
 
-def _one_line(text: str) -> str:
+def _one_line(text: object) -> str:
     """A message as one terminal line: newlines and escape sequences from file names or values escaped."""
     from weftsim.input.scene import shown
 

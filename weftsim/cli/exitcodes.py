@@ -1,7 +1,6 @@
-"""Exit statuses of the ``weftsim`` command, shared by the CLI and the commands it calls."""
+"""Exit statuses of the ``weftsim`` command: defined in :mod:`weftsim.errors` (beside the errors that carry
+them, at the bottom of the house), re-exported here for the command line and older imports."""
 
-EXIT_OK = 0
-EXIT_USAGE = 2  # bad scene, flag or output directory
-EXIT_FAILED = 3  # the simulation itself failed (partial results written)
-EXIT_DISAGREE = 4  # compare: engines disagree beyond the scene's tolerance
-EXIT_PARTIAL = 5  # compare: what was compared agrees, but the core checks could not be compared (run too short)
+from weftsim.errors import EXIT_DISAGREE, EXIT_FAILED, EXIT_OK, EXIT_PARTIAL, EXIT_USAGE
+
+__all__ = ["EXIT_OK", "EXIT_USAGE", "EXIT_FAILED", "EXIT_DISAGREE", "EXIT_PARTIAL"]

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, NoReturn
 
 from weftsim.errors import WeftsimError, closest
-from weftsim.cli.exitcodes import EXIT_USAGE
+from weftsim.errors import EXIT_USAGE
 
 if TYPE_CHECKING:
     from weftsim.input.params import Scene

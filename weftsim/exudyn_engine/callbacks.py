@@ -21,14 +21,14 @@ f = F_N n with n = e/|e| pulls the journal back to the bearing centre::
                                       F_N = law(delta, delta_dot', max(v_imp, v_min))
                                       delta_dot' = delta_dot less a dead zone of +-1e-6 v_min
 
-All of it is :func:`weftsim.kernel.joint.connector_force` (and, for the kinematic tree, whose
-bearing moves with the crank, :func:`weftsim.kernel.chain.tree_joint_force`, through
-:func:`weftsim.kernel.joint.connector_friction_force`).  Routes:
+All of it is :func:`weftsim.physics.joint.connector_force` (and, for the kinematic tree, whose
+bearing moves with the crank, :func:`weftsim.physics.chain.tree_joint_force`, through
+:func:`weftsim.physics.joint.connector_friction_force`).  Routes:
 
 - ``"numba"``: the compiled kernel called from a thin Python callback (numba's cache: nothing
   to compile in a new process after the first run on a machine);
 - ``"python"``: the same kernel's plain-Python source
-  (:func:`weftsim.kernel.python.python_form`), for debugging and for machines where the compiled
+  (:func:`weftsim.physics.python.python_form`), for debugging and for machines where the compiled
   call is slower.
 
 Removed: ``"symbolic"`` (an Exudyn expression tree, a second copy of every law; it measured no
@@ -41,10 +41,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.kernel import chain as kernel_chain
-from weftsim.kernel import joint as kernel_joint
-from weftsim.kernel.hold import RESTING_RATE_FRACTION
-from weftsim.kernel.python import python_form
+from weftsim.physics import chain as kernel_chain
+from weftsim.physics import joint as kernel_joint
+from weftsim.physics.hold import RESTING_RATE_FRACTION
+from weftsim.physics.python import python_form
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -76,7 +76,7 @@ def route_error(callback: str) -> str | None:
 
 
 def connector_parameters(law: _Law, clearance: float, min_impact_velocity: float, max_approach: bool) -> np.ndarray:
-    """The joint block of :mod:`weftsim.kernel.joint` the connector force needs (no friction)."""
+    """The joint block of :mod:`weftsim.physics.joint` the connector force needs (no friction)."""
     prm = np.zeros(kernel_joint.N_JOINT)
     kind, coef, _, xi = law.parameters
     prm[kernel_joint.KIND], prm[kernel_joint.COEF], prm[kernel_joint.XI] = kind, coef, xi
@@ -146,8 +146,8 @@ def make_tree_force(prm: np.ndarray, memory: list, stash: list, route: str = "nu
     """``forceUserFunction(mbs, t, itemNumber, q, q_t)`` of the kinematic tree: its two joint torques.
 
     The contact of the moving bearing, projected on the joints by virtual work, is
-    :func:`weftsim.kernel.chain.tree_joint_force`.  ``prm``: the scene's kernel parameter array
-    (:func:`weftsim.reference.dynamics.pack_parameters`, friction included); ``memory`` =
+    :func:`weftsim.physics.chain.tree_joint_force`.  ``prm``: the scene's kernel parameter array
+    (:func:`weftsim.model.dynamics.pack_parameters`, friction included); ``memory`` =
     [v_held, delta0, rate0] of the last accepted step (written by the post-step bookkeeping); every
     call leaves [t, delta, delta_dot, F_b,x, F_b,y, F_N, M_b, F_T v_T, v_T, D'_lub, U_a] in ``stash`` (F_b =
     F_N n - F_T t, the force on the bearing, plus the film's and asperities' of a lubricated joint; M_b its

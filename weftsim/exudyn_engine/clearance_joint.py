@@ -32,16 +32,16 @@ reports it as a ``ModelError`` carrying this message):
   clearance (the contact only sees the in-plane part).
 
 Lubrication (``joint.lubrication``, :class:`weftsim.input.params.Lubrication`): the oil film, the asperity
-contact and the boundary friction of :mod:`weftsim.kernel.lubricated` act at every state, in contact or
+contact and the boundary friction of :mod:`weftsim.physics.lubricated` act at every state, in contact or
 not, through the same connector and torque loads as friction (:mod:`.joint_friction`, with the kernel's
-:func:`~weftsim.kernel.lubricated.connector_lubricated_force`); ``model.friction.lubrication_history``
+:func:`~weftsim.physics.lubricated.connector_lubricated_force`); ``model.friction.lubrication_history``
 records (t, D'_lub, U_a, |f_film|, F_a, T_j) at every accepted state.  Build the joint with
 ``ClearanceJoint(..., lubrication=Lubrication(viscosity=...))``.
 
 A worn joint (``ClearanceJoint(..., bearing_wear=..., journal_wear=...)``: worn depth tables, m, at equally
 spaced angles over one turn of each body's frame, i.e. from the body's own x axis about Z): the contact
 sees the local clearance c0 + h_b(psi_b) + h_j(psi_j) along the eccentricity
-(:mod:`weftsim.kernel.worn_joint`, the same worn clearance as weftsim's own engines), through the same
+(:mod:`weftsim.physics.worn_joint`, the same worn clearance as weftsim's own engines), through the same
 connector and loads as friction (the bodies' angles are read at every trial state).
 
 A restitution outside the law's valid range (``law.valid_restitution``) is a warning.
@@ -61,8 +61,8 @@ from weftsim.joint.contact import make_law
 from weftsim.exudyn_engine import callbacks
 from weftsim.exudyn_engine.joint_friction import JointFriction
 from weftsim.exudyn_engine.onset import OnsetTracker, penetration_state
-from weftsim.kernel.joint import joint_parameters
-from weftsim.kernel.wear import wear_block
+from weftsim.physics.joint import joint_parameters
+from weftsim.physics.wear import wear_block
 from weftsim.input.params import ClearanceJoint
 
 if TYPE_CHECKING:
@@ -232,7 +232,7 @@ def add_clearance_joint(mbs: exu.MainSystem, marker_bearing: exu.MarkerIndex, ma
     friction = None
     if joint.friction_coefficient > 0.0 or joint.is_lubricated or joint.is_worn:
         prm = joint_parameters(joint, law)
-        if joint.is_worn:  # the wear block after the joint block (weftsim.kernel.worn_joint)
+        if joint.is_worn:  # the wear block after the joint block (weftsim.physics.worn_joint)
             prm = np.concatenate([prm, wear_block(joint.bearing_wear, joint.journal_wear)])
         friction = JointFriction(mbs, marker_bearing, marker_journal, prm, route,
                                  lambda: model.tracker.callback_state)  # fmt: skip

@@ -1,6 +1,6 @@
 """Friction segments: Newton's iteration of the implicit kinematic tree on one smooth piece of the friction law.
 
-The modified Coulomb law (docs/physics.md section 2; :func:`weftsim.kernel.joint.friction_force`) is
+The modified Coulomb law (docs/physics.md section 2; :func:`weftsim.physics.joint.friction_force`) is
 piecewise linear in the sliding speed v_T::
 
     F_T / (mu F_N) = 0                          |v_T| <= v0        DEAD
@@ -26,7 +26,7 @@ iteration, which Exudyn runs through its post-Newton function) is used here:
 The pieces are made by setting the law's own parameters in the callback's copy (``prm``): DEAD
 mu = 0; SLIDE v0 = -1, v1 = 0 (c_d = 1 at every speed); RAMP v1 = :data:`FAR` with mu scaled by
 (FAR - v0) / (v1 - v0) (the same line, its saturation moved beyond any speed of the loom).  So the
-force is still the kernel's :func:`weftsim.kernel.chain.tree_joint_force` and nothing of the law is
+force is still the kernel's :func:`weftsim.physics.chain.tree_joint_force` and nothing of the law is
 written a second time.  Measured alternative: the RAMP's line continued below v0 down to v_T = 0 (a sum
 of three kernel evaluations; the line must then jump at v_T = 0 by 2 mu F_N, as any odd function of v_T
 not through the origin) took 2.3x the steps and 2.2x the Newton failures on the loom over a revolution.
@@ -34,7 +34,7 @@ not through the origin) took 2.3x the steps and 2.2x the Newton failures on the 
 
 from __future__ import annotations
 
-from weftsim.kernel.joint import MU, V0, V1
+from weftsim.physics.joint import MU, V0, V1
 
 DEAD, RAMP, SLIDE = 0, 1, 2
 # The frozen ramp's saturation speed, m/s.  The frozen RAMP equals the law on v0 < |v_T| < v1 for any FAR > v1;

@@ -15,7 +15,7 @@ with a user function on its own body.  The sliding speed needs the bodies' rotat
 
 which the Cartesian connector's callback does not receive: it reads them from the system
 (``GetObjectOutputBody``, the current trial state inside Newton).  Force, moments and v_T are
-:func:`weftsim.kernel.joint.connector_friction_force` (compiled or plain Python, the joint's route),
+:func:`weftsim.physics.joint.connector_friction_force` (compiled or plain Python, the joint's route),
 evaluated once per state and shared by the connector callback and the two loads.
 
 Newton: the connector's numerical Jacobian contains the friction force's dependence on e and e_dot;
@@ -28,7 +28,7 @@ A body without rotation (ground, mass point) turns at 0 and takes no moment.
 
 A worn joint (``joint.bearing_wear``, ``joint.journal_wear``: the wear block after the joint block in
 ``prm``) also reads the bodies' angles about Z (``RotationMatrix``, reference rotation included): its
-profiles are in each body's frame, and the force is :func:`weftsim.kernel.worn_joint.connector_worn_force`
+profiles are in each body's frame, and the force is :func:`weftsim.physics.worn_joint.connector_worn_force`
 (or its lubricated form) at the local clearance.
 """
 
@@ -41,9 +41,9 @@ import exudyn as exu
 from exudyn.itemInterface import LoadTorqueVector, MarkerBodyRigid
 
 from weftsim.exudyn_engine import callbacks
-from weftsim.kernel import joint as kernel_joint
-from weftsim.kernel.lubricated import connector_lubricated_force
-from weftsim.kernel.worn_joint import connector_worn_force, connector_worn_lubricated_force
+from weftsim.physics import joint as kernel_joint
+from weftsim.physics.lubricated import connector_lubricated_force
+from weftsim.physics.worn_joint import connector_worn_force, connector_worn_lubricated_force
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -80,7 +80,7 @@ class JointFriction:
     marker_bearing, marker_journal : exudyn MarkerIndex
         The joint's position markers (bearing centre, journal centre).
     prm : numpy.ndarray
-        The joint block of :func:`weftsim.kernel.joint.joint_parameters` (friction included).
+        The joint block of :func:`weftsim.physics.joint.joint_parameters` (friction included).
     route : {"numba", "python"}
     memory : callable
         Returns the connector's memory [v_held, delta0, rate0] (the tracker's ``callback_state``).
@@ -96,7 +96,7 @@ class JointFriction:
         self.bearing, self.bearing_local, self.bearing_rotates = _body_of(mbs, marker_bearing)
         self.journal, self.journal_local, self.journal_rotates = _body_of(mbs, marker_journal)
         # A lubricated joint (the block's LUBRICATED flag): the same nine values with the film and the
-        # asperities added, then their power, potential and channels (weftsim.kernel.lubricated).
+        # asperities added, then their power, potential and channels (weftsim.physics.lubricated).
         self.lubricated = bool(prm[kernel_joint.LUBRICATED] != 0.0)
         self.worn = len(prm) > kernel_joint.N_JOINT  # a wear block follows the joint block
         if self.worn:

@@ -191,7 +191,7 @@ def build_mechanism(mbs: exu.MainSystem, scene: Scene, callback: str | None = No
     else:  # F with a clearance: the sector's eye is the bearing, the rod's pin the journal
         bearing_f = mbs.AddMarker(MarkerBodyPosition(bodyNumber=sector["bodyNumber"], localPosition=[g.l_fg, 0.0, 0.0]))
         journal_f = mbs.AddMarker(MarkerBodyPosition(bodyNumber=rod["bodyNumber"], localPosition=[half, 0.0, 0.0]))
-        with warnings.catch_warnings():  # the scene's own check names joint_f.restitution (weftsim.run.plausibility);
+        with warnings.catch_warnings():  # the scene's own check names joint_f.restitution (weftsim.checks.plausibility);
             warnings.simplefilter("ignore", UserWarning)  # the joint's warning names the Python field
             clearance_f = add_clearance_joint(mbs, bearing_f, journal_f, scene.joint_f, callback=route)
     _pin(mbs, ground, [g.l_og, 0.0, 0.0], sector["bodyNumber"], [0.0, 0.0, 0.0])  # G

@@ -15,7 +15,7 @@ O(h^2)::
 The same formula runs inside the force callback (trial states of the onset step, so
 the force is a smooth function of the unknowns and Newton sees it) and in the
 accepted-step bookkeeping (:class:`OnsetTracker`, which then holds the value until
-separation); both take it from :mod:`weftsim.kernel.hold`, the rules' one definition.
+separation); both take it from :mod:`weftsim.physics.hold`, the rules' one definition.
 
 Held impact velocity rules (``ClearanceJoint.impact_velocity_rule``):
 
@@ -41,7 +41,7 @@ import math
 
 import numpy as np
 
-from weftsim.kernel.hold import (  # noqa: F401 - the rules' one definition, re-exported here
+from weftsim.physics.hold import (  # noqa: F401 - the rules' one definition, re-exported here
     RESTING_RATE_FRACTION,
     callback_impact_velocity,
     damping_rate,
@@ -145,6 +145,11 @@ def penetration_state(ex: float, ey: float, vx: float, vy: float, clearance: flo
     """delta = |e| - c and delta_dot = e_dot . e/|e| of an in-plane eccentricity (m, m/s).
 
     delta_dot is 0 when the journal is exactly centred (e = 0: no normal defined).
+
+    The kernel's :func:`weftsim.physics.joint.contact_geometry` is the same geometry as e_dot . (e / |e|);
+    this form, (e_dot . e) / |e|, rounds differently in the last bits, and the tracker's onsets and held
+    impact velocities follow it, so moving to the kernel's form changes the Exudyn engine's results at
+    round-off: left for a change that documents that (issue 32 kept every result bit for bit).
     """
     length = math.sqrt(ex * ex + ey * ey)
     if length <= 0.0:

@@ -17,7 +17,7 @@
   0.25 deg of crank, :data:`IDEAL_JOINT_STEP_ANGLE`, and never a
   contact time scale).  Friction in the clearance joint does not: the tree's generalized force
   carries the friction force at the contact point and its moments on the rod and, through the
-  driving torque, on the rocker (:func:`weftsim.kernel.chain.tree_joint_force`).  A clearance or a
+  driving torque, on the rocker (:func:`weftsim.physics.chain.tree_joint_force`).  A clearance or a
   flexible body anywhere in members 1-3 would need the rigid-body model (members 1-3 no longer move
   in closed form); weftsim's scenes have neither yet.
 
@@ -99,7 +99,7 @@ def select_path(scene: Scene) -> dict:
     """``{"model", "method", "reason"}`` of the run :func:`weftsim.exudyn_engine.solve` makes of ``scene``
     (and ``"rapier"``, the tape's verdict, for a scene with a ``[rapier_tape]``)."""
     if scene.rapier_tape is not None:
-        from weftsim.tape.selection import rigid_scene, tape_check
+        from weftsim.model.tape_selection import rigid_scene, tape_check
 
         check = tape_check(scene)
         if check["model"] == "flexible":

@@ -144,7 +144,7 @@ def _joint_channels(cl, data: dict, joint: str, t: np.ndarray, n: int) -> dict[s
         record = np.array(cl.friction.history).reshape(-1, 3)  # t, F_N, F_T v_T: one row per tracker record after t = 0
         at = np.clip(np.searchsorted(record[:, 0], t * (1.0 + 1e-12), side="right") - 1, 0, len(record) - 1)
         f_n, friction_power = record[at, 1], record[at, 2]
-        if cl.friction.lubricated:  # film and asperities (weftsim.kernel.lubricated), one row per record too
+        if cl.friction.lubricated:  # film and asperities (weftsim.physics.lubricated), one row per record too
             lub = np.array(cl.friction.lubrication_history).reshape(-1, 6)  # t, D', U_a, |f_film|, F_a, T_j
             lub = lub[at] if len(lub) else np.zeros((n, 6))
             lub_power = lub[:, 1]

@@ -34,7 +34,7 @@ from weftsim.exudyn_engine.selection import (  # noqa: F401 (IDEAL_JOINT_STEP_AN
 )
 from weftsim.exudyn_engine.step_control import StepController, failure_reason
 from weftsim.exudyn_engine.sensors import add_sensors, first_nonfinite_row, sample_channels, silence, step_channels
-from weftsim.run.guards import RunGuard, failure_message, non_finite_breach, vet_result
+from weftsim.checks.guards import RunGuard, failure_message, non_finite_breach
 from weftsim.input.params import Scene
 from weftsim.input.scene import IMPACT_VELOCITY_RULES, STEP_CONTROLS
 from weftsim.post.results import RunResult, angle_grid, empty_channels
@@ -150,8 +150,11 @@ def _what_to_try(scene: Scene, h: float) -> str:
 
 
 def solve(scene: Scene, progress: Callable[[float], None] | None = None, callback: str | None = None,
-          step_states: Callable[..., None] | None = None) -> RunResult:
-    """Simulate a scene with Exudyn.
+          observe: Callable[..., None] | None = None) -> RunResult:
+    """Simulate a scene with Exudyn: the engine's pure solve (the engine contract, :mod:`weftsim.engines`).
+
+    The result is not vetted here: :func:`weftsim.simulate` runs the before-run checks, this solve, then
+    :func:`weftsim.checks.guards.vet_result` once, for every engine.
 
     Parameters
     ----------
@@ -160,11 +163,11 @@ def solve(scene: Scene, progress: Callable[[float], None] | None = None, callbac
         Called with the completed fraction in [0, 1] about 100 times per run.
     callback : str, optional
         Override of ``scene.exudyn_solver.callback`` (clearance force route).
-    step_states : callable, optional
+    observe : callable, optional
         Kinematic tree only (a failed result on another model): called once after the run as
-        ``step_states(t, states, f_n, v_t)`` with the rows behind ``result.steps``
+        ``observe(t, states, f_n, v_t)`` with the rows behind ``result.steps``
         (:func:`weftsim.exudyn_engine.tree_solve.solve_tree`), as the reference engine's
-        ``solve(step_states=...)``; the wear prediction's Archard integral reads them.
+        ``solve(observe=...)``; the wear prediction's Archard integral reads them.
 
     Returns
     -------
@@ -174,7 +177,7 @@ def solve(scene: Scene, progress: Callable[[float], None] | None = None, callbac
         time; ``events["first_contact_time_s"]`` located within its step.
     """
     if scene.rapier_tape is not None:
-        return _solve_tape_scene(scene, progress, callback, step_states)
+        return _solve_tape_scene(scene, progress, callback, observe)
     wall0 = _time.perf_counter()
     if callback is not None:  # the route is part of the scene the selection sees (selection.py)
         scene = dataclasses.replace(scene, exudyn_solver=dataclasses.replace(scene.exudyn_solver, callback=callback))
@@ -182,35 +185,35 @@ def solve(scene: Scene, progress: Callable[[float], None] | None = None, callbac
     if problem is not None:
         return _failed(scene, problem, 0.0)
     path = select_path(scene)
-    if step_states is not None and path["model"] != "kinematic_tree":
-        return _failed(scene, "step_states: the Exudyn engine gives the step rows of the kinematic tree only, and "
+    if observe is not None and path["model"] != "kinematic_tree":
+        return _failed(scene, "observe: the Exudyn engine gives the step rows of the kinematic tree only, and "
                               f"this scene runs on the {path['model']} model", 0.0)
-    result = _solve_model(scene, path["model"], progress, None, wall0, step_states)
+    result = _solve_model(scene, path["model"], progress, None, wall0, observe)
     object.__setattr__(result, "path", path)
     return result
 
 
-def _solve_tape_scene(scene: Scene, progress, callback, step_states) -> RunResult:
+def _solve_tape_scene(scene: Scene, progress, callback, observe) -> RunResult:
     """A scene with a ``[rapier_tape]``: its rigid equivalent when the tape runs as the rigid rapier
-    (:func:`weftsim.tape.selection.tape_model`), else a failed result (this engine has no flexible tape yet)."""
-    from weftsim.tape.selection import rigid_scene, tape_check
+    (:func:`weftsim.model.tape_selection.tape_model`), else a failed result (this engine has no flexible tape yet)."""
+    from weftsim.model.tape_selection import rigid_scene, tape_check
 
     check = tape_check(scene)
     if check["model"] == "flexible":
         return _failed(scene, "the Exudyn engine does not model the flexible rapier tape yet (docs/rapier-tape.md); "
                               "run it on engine 'reference', or set rapier_tape.model = 'rigid'", 0.0)
-    result = solve(rigid_scene(scene), progress, callback, step_states)
+    result = solve(rigid_scene(scene), progress, callback, observe)
     object.__setattr__(result, "path", dict(result.path, rapier=check["reason"]))
     object.__setattr__(result, "scene", scene)
     return result
 
 
 def _solve_model(scene: Scene, model: str, progress, callback: str | None, wall0: float,
-                 step_states: Callable[..., None] | None = None) -> RunResult:
+                 observe: Callable[..., None] | None = None) -> RunResult:
     if model == "kinematic_tree":
         from weftsim.exudyn_engine.tree_solve import solve_tree
 
-        return solve_tree(scene, progress, callback, step_states)
+        return solve_tree(scene, progress, callback, observe)
     h, n_steps = step_plan(scene)
     omega = scene.drive.speed
     sc = exu.SystemContainer()
@@ -312,8 +315,8 @@ def _solve_model(scene: Scene, model: str, progress, callback: str | None, wall0
         events.update({f"first_contact_time_{name}_s": first.get(name) for name in ("e", "f")})
     if progress is not None:
         progress(1.0)
-    # Post-run criteria (energy balance, ...) that no single step shows; see weftsim.run.guards.
-    return vet_result(RunResult(scene, "exudyn", status, message, samples, steps, stats, events))
+    # vetted once, outside the engines, by weftsim.api.simulate (weftsim.checks.guards.vet_result)
+    return RunResult(scene, "exudyn", status, message, samples, steps, stats, events)
 
 
 def _contact_counters(model) -> dict:

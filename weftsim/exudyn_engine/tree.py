@@ -13,10 +13,10 @@ two revolute joints about Exudyn Z (the four-bar plane is Exudyn's XY plane, as 
                          q1 = psi + pi - a    link 1: rod 4, x axis from F to the journal,
                                               centre of mass at L_EF/2, journal at L_EF
 
-(psi = theta_EF of :mod:`weftsim.reference.dynamics`: P_j = F - L_EF u(psi)).  The bearing
+(psi = theta_EF of :mod:`weftsim.model.dynamics`: P_j = F - L_EF u(psi)).  The bearing
 centre P_b(t) = E of the prescribed rocker is not a body.  The contact enters as the tree's
 generalized force (``forceUserFunction``, :func:`weftsim.exudyn_engine.callbacks.make_tree_force`
-over the kernel's :func:`weftsim.kernel.chain.tree_joint_force`): the callback computes the
+over the kernel's :func:`weftsim.physics.chain.tree_joint_force`): the callback computes the
 journal centre and its velocity from the joint coordinates, subtracts P_b(t) and its velocity
 (closed form),
 
@@ -32,7 +32,7 @@ Newton iteration.  With friction the friction ramp makes it stiff, and generaliz
 error-controlled step integrates it instead (:mod:`.tree_implicit`).
 
 The driving torque comes from the contact force in closed form, with the crank-side
-terms of :mod:`weftsim.reference.ideal` (docs/physics.md section 4, docs/reference-solver.md):
+terms of :mod:`weftsim.model.ideal` (docs/physics.md section 4, docs/reference-solver.md):
 
     T = 1/2 J13'(theta) omega^2 + U13'(theta) - Q3,   Q3 = F_b . dP_b/dtheta + M_b phi'(theta)
 
@@ -54,8 +54,8 @@ from exudyn.itemInterface import NodeGenericODE2, ObjectKinematicTree
 from weftsim.exudyn_engine import callbacks
 from weftsim.exudyn_engine.onset import OnsetTracker
 from weftsim.input.params import Scene
-from weftsim.reference.dynamics import initial_state, pack_parameters
-from weftsim.reference.ideal import sector_chain_inertia
+from weftsim.model.dynamics import initial_state, pack_parameters
+from weftsim.model.ideal import sector_chain_inertia
 
 UNSPECIFIED_MASS = 1.0  # sector mass (balanced, on its fixed axis: no effect), kg
 
@@ -94,8 +94,8 @@ def build_tree(mbs: exu.MainSystem, scene: Scene, callback: str = "auto") -> Tre
     """Add the kinematic tree of members 4-8, gravity and the clearance contact to ``mbs``.
 
     Initial state: the ideal mechanism at theta = 0, journal centred
-    (:func:`weftsim.reference.dynamics.initial_state`).  ``callback``: "auto" (:func:`weftsim.exudyn_engine.callbacks.resolve_route`),
-    "python" or "numba"; both evaluate :func:`weftsim.kernel.chain.tree_joint_force`.  Needs ``scene.joint.clearance > 0``;
+    (:func:`weftsim.model.dynamics.initial_state`).  ``callback``: "auto" (:func:`weftsim.exudyn_engine.callbacks.resolve_route`),
+    "python" or "numba"; both evaluate :func:`weftsim.physics.chain.tree_joint_force`.  Needs ``scene.joint.clearance > 0``;
     friction (``joint.friction_coefficient`` > 0) acts at the contact point with its moments on rod and rocker.
     """
     g, m, joint = scene.geometry, scene.inertia, scene.joint

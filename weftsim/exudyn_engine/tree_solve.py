@@ -13,17 +13,17 @@ Channels, at every accepted step (docs/physics.md section 4 signs):
 
     a, psi           q0, q0 + q1 - pi;   rapier s, v, a = (d5 d7/d6) (a - a(0), a', a'')
     e, delta, F_N    from a, psi and the closed-form bearing motion
-                     (:func:`weftsim.reference.dynamics.eccentricity`); F_N = |connector Force|
-    torque           1/2 J13' omega^2 + U13' - Q3, Q3 = F_b . dP_b/dtheta + M_b phi' (:mod:`weftsim.reference.ideal`;
+                     (:func:`weftsim.model.dynamics.eccentricity`); F_N = |connector Force|
+    torque           1/2 J13' omega^2 + U13' - Q3, Q3 = F_b . dP_b/dtheta + M_b phi' (:mod:`weftsim.model.ideal`;
                      F_b, M_b: force and friction moment on the bearing)
-    energies         kinetic 1/2 J13 omega^2 + chain (:func:`~weftsim.reference.dynamics.chain_energy`),
+    energies         kinetic 1/2 J13 omega^2 + chain (:func:`~weftsim.model.dynamics.chain_energy`),
                      potential U13 + m4 g z4, contact law.elastic_energy(delta), driving work
                      [1/2 J13 omega^2 + U13]_0^t + integral -Q3 omega dt, dissipated
                      integral (F_N - F_el) delta_dot - F_T v_T dt (damping and friction work,
                      :func:`contact_work` over accepted steps)
 
-Failures as in :mod:`.solver`: the run guards of :mod:`weftsim.run.guards` after every step,
-Exudyn exceptions, non-finite values, a premature stop; :func:`weftsim.run.guards.vet_result`.
+Failures as in :mod:`.solver`: the run guards of :mod:`weftsim.checks.guards` after every step,
+Exudyn exceptions, non-finite values, a premature stop; :func:`weftsim.checks.guards.vet_result`.
 """
 
 from __future__ import annotations
@@ -53,10 +53,10 @@ from weftsim.exudyn_engine.selection import (  # noqa: F401 (re-exported: the tr
 )
 from weftsim.exudyn_engine.tree_implicit import ImplicitTree
 from weftsim.exudyn_engine.step_control import failure_reason as implicit_failure
-from weftsim.run.guards import RunGuard, failure_message, non_finite_breach, vet_result
+from weftsim.checks.guards import RunGuard, failure_message, non_finite_breach
 from weftsim.input.params import Scene
-from weftsim.reference.dynamics import NUMPY, ChainConstants, chain_energy, eccentricity, initial_state
-from weftsim.reference.ideal import crank_side_inertia, crank_side_potential
+from weftsim.model.dynamics import NUMPY, ChainConstants, chain_energy, eccentricity, initial_state
+from weftsim.model.ideal import crank_side_inertia, crank_side_potential
 from weftsim.post.results import RunResult, angle_grid, empty_channels
 
 if TYPE_CHECKING:
@@ -145,9 +145,9 @@ def contact_work(y: np.ndarray, t: np.ndarray, delta: np.ndarray) -> np.ndarray:
 def worn_channels(scene: Scene, t: np.ndarray, a: np.ndarray, psi: np.ndarray, da: np.ndarray,
                   dpsi: np.ndarray) -> tuple[np.ndarray, ...]:
     """(delta, delta_dot, F_el, U_el) of a worn joint E at the tree's steps: at the local clearance
-    c0 + h_b + h_j along e (:func:`weftsim.kernel.worn_rows.worn_contact_rows`), delta_dot = e_dot . n - dc/dt."""
-    from weftsim.kernel.worn_rows import worn_contact_rows
-    from weftsim.reference.dynamics import pack_parameters
+    c0 + h_b + h_j along e (:func:`weftsim.physics.worn_rows.worn_contact_rows`), delta_dot = e_dot . n - dc/dt."""
+    from weftsim.physics.worn_rows import worn_contact_rows
+    from weftsim.model.dynamics import pack_parameters
 
     states = np.ascontiguousarray(np.column_stack([a, psi, da, dpsi]), dtype=float)
     out = np.zeros((t.size, 5))
@@ -216,7 +216,7 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
     energy = np.zeros(n)
     f_el[inside] = law.elastic_force(delta[inside])
     energy[inside] = law.elastic_energy(delta[inside])
-    if scene.joint.is_worn:  # the local clearance the callback saw (weftsim.kernel.worn_rows), as the reference's
+    if scene.joint.is_worn:  # the local clearance the callback saw (weftsim.physics.worn_rows), as the reference's
         delta, rate, f_el, energy = worn_channels(scene, t, a, psi, da, dpsi)
     # A lubricated joint: the film and boundary friction dissipate at every step (the quadratic rule of
     # contact_work over all steps: the squeeze film's power peaks within a few steps, where trapezoids
@@ -234,7 +234,7 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
     lubricated = {}
     if scene.joint.is_lubricated:  # the film channels from the kernel at the tree's states (weftsim.joint.lubrication)
         from weftsim.joint.lubrication import lubrication_table
-        from weftsim.reference.dynamics import pack_parameters
+        from weftsim.model.dynamics import pack_parameters
 
         states = np.zeros((n, 6))
         states[:, 0], states[:, 1], states[:, 2], states[:, 3] = a, psi, da, dpsi
@@ -262,10 +262,10 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
 
 
 def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, callback: str | None = None,
-               step_states: Callable[..., None] | None = None) -> RunResult:
+               observe: Callable[..., None] | None = None) -> RunResult:
     """Simulate a scene with the kinematic-tree model (settings checked by the caller).
 
-    ``step_states``: called once after the run as ``step_states(t, states, f_n, v_t)`` with the rows behind
+    ``observe``: called once after the run as ``observe(t, states, f_n, v_t)`` with the rows behind
     ``result.steps`` (times (n,) s; states (n, 4) [a, psi, a', psi']; the callback's normal force F_N (n,) N
     and sliding velocity v_T (n,) m/s, 0 out of contact): the contact channels the wear's Archard integral
     reads (:mod:`weftsim.wear.engines`).
@@ -335,8 +335,8 @@ def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, ca
     data = {k: mbs.GetSensorStoredData(v) for k, v in sensors.items()}
     data["force"] = np.array(model.bearing_force).reshape(-1, RECORD_COLUMNS)
     steps = tree_channels(model, data) if min(len(v) for v in data.values()) else empty_channels()
-    if step_states is not None:
-        step_states(*tree_states(data, len(steps["time_s"])))
+    if observe is not None:
+        observe(*tree_states(data, len(steps["time_s"])))
     bad = first_nonfinite_row(steps)
     if bad is not None:
         steps = {k: v[:bad] for k, v in steps.items()}
@@ -383,6 +383,6 @@ def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, ca
     stats["time_per_step_us"] = 1e6 * wall_solve / max(n_done, 1)
     if progress is not None:
         progress(1.0)
-    return vet_result(RunResult(scene, "exudyn", status, message, samples, steps, stats,
-                                {"first_contact_time_s": model.tracker.first_contact_time,
-                                 **model.tracker.counters()}))  # fmt: skip
+    # vetted once, outside the engines, by weftsim.api.simulate (weftsim.checks.guards.vet_result)
+    return RunResult(scene, "exudyn", status, message, samples, steps, stats,
+                     {"first_contact_time_s": model.tracker.first_contact_time, **model.tracker.counters()})

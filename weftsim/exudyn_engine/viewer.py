@@ -30,7 +30,7 @@ import exudyn as exu
 import exudyn.graphics as graphics
 
 from weftsim.errors import RunFailed, WeftsimError
-from weftsim.cli.exitcodes import EXIT_USAGE
+from weftsim.errors import EXIT_USAGE
 from weftsim.exudyn_engine.mechanism import MechanismModel, build_mechanism
 from weftsim.exudyn_engine.solver import adaptive, check_settings, simulation_settings, step_plan
 from weftsim.exudyn_engine.step_control import StepController

@@ -1,9 +1,9 @@
 """A run of the kinematic tree on a worn joint E, with its step rows: what ``weftsim wear --engine exudyn`` simulates.
 
 The worn geometry reaches the tree's contact through the scene (``joint.bearing_wear``,
-``joint.journal_wear``): :func:`weftsim.reference.dynamics.pack_parameters` appends the wear block,
-and :func:`weftsim.kernel.chain.tree_joint_force` reads the local clearance c0 + h_b + h_j along e
-from it (:func:`weftsim.kernel.chain.clearance_along`), as the reference engine's chain does.
+``joint.journal_wear``): :func:`weftsim.model.dynamics.pack_parameters` appends the wear block,
+and :func:`weftsim.physics.chain.tree_joint_force` reads the local clearance c0 + h_b + h_j along e
+from it (:func:`weftsim.physics.chain.clearance_along`), as the reference engine's chain does.
 
 :data:`ATTEMPTS`: a run that fails (a hard cycle) is tried again at a tighter relative tolerance, then
 on the implicit tree (generalized-alpha with error control), as the reference engine's update is
@@ -16,11 +16,9 @@ from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from weftsim.exudyn_engine.selection import tree_relative_tolerance
-from weftsim.exudyn_engine.solver import solve
 
 if TYPE_CHECKING:
     from weftsim.input.params import Scene
-    from weftsim.post.results import RunResult
 
 # Relative tolerance of the explicit tree on a worn geometry, and of its retry.  The default 1e-6 is the
 # tree's own (the engines' compare meets its tolerances there); a failed update is run again at 1e-8.
@@ -37,19 +35,3 @@ def attempt_scene(scene: Scene, attempt: int) -> Scene:
     if rtol is not None:
         s = replace(s, relative_tolerance=min(s.relative_tolerance, rtol))
     return replace(scene, exudyn_solver=s)
-
-
-def solve_worn(scene: Scene, attempt: int = 0) -> tuple[RunResult, tuple, float]:
-    """(result, (t, states, F_N, v_T), relative tolerance) of one attempt (:data:`ATTEMPTS`) on ``scene``.
-
-    The rows are :func:`weftsim.exudyn_engine.tree_solve.solve_tree`'s ``step_states``: times (n,) s,
-    states (n, 4) [a, psi, a', psi'], the contact's F_N (N) and v_T (m/s) at every accepted step.
-    """
-    run_scene = attempt_scene(scene, attempt)
-    rows: dict = {}
-    result = solve(run_scene, step_states=lambda *a: rows.update(steps=a))
-    if "steps" not in rows:  # refused before the run (settings): no rows
-        import numpy as np
-
-        rows["steps"] = (np.zeros(0), np.zeros((0, 4)), np.zeros(0), np.zeros(0))
-    return result, rows["steps"], tree_relative_tolerance(run_scene)

@@ -148,7 +148,7 @@ class WearModel:
     profile_points: int = 360
 
 
-# Film models of Lubrication.model (the codes of weftsim.kernel.film: MODEL_FINITE, MODEL_SHORT, MODEL_LONG,
+# Film models of Lubrication.model (the codes of weftsim.physics.film: MODEL_FINITE, MODEL_SHORT, MODEL_LONG,
 # MODEL_SHORT_HALF, in this order).
 FILM_MODELS = ("finite", "short", "long", "short_half")
 
@@ -161,7 +161,7 @@ class Lubrication:
     one, the film's pressure carries the journal for every eccentricity (no contact needed), the
     asperities of both surfaces carry load where the minimum film thickness ``h_min = c - |e|`` is below
     4 sigma (Greenwood and Tripp, Proc. Instn Mech. Engrs 185, 1970), and the dry contact law of the
-    joint takes over beyond e = c, continuously (:mod:`weftsim.kernel.lubricated`).
+    joint takes over beyond e = c, continuously (:mod:`weftsim.physics.lubricated`).
 
     Attributes
     ----------
@@ -204,7 +204,7 @@ class Lubrication:
 
     @property
     def model_code(self) -> int:
-        """The film kernel's model code (weftsim.kernel.film: finite 0, short 1, long 2)."""
+        """The film kernel's model code (weftsim.physics.film: finite 0, short 1, long 2)."""
         return FILM_MODELS.index(self.model)
 
 
@@ -430,7 +430,7 @@ class RapierTape:
         Coulomb friction of the head and the free tape on the guide rail under their weight; 0 = off.
     model : str
         "auto" (the rigid rapier when the tape's first mode over the stroke is far above the drive's
-        harmonics, :func:`weftsim.tape.model.rigid_serves`), "flexible" or "rigid".
+        harmonics, :func:`weftsim.model.tape.rigid_serves`), "flexible" or "rigid".
     modes : int
         Ritz functions of the tape's axial displacement.
     """
@@ -549,7 +549,7 @@ class CompareTolerance:
 
 @dataclass(frozen=True)
 class Limits:
-    """Run-time failure criteria and budgets, checked by both engines (:mod:`weftsim.run.guards`).
+    """Run-time failure criteria and budgets, checked by both engines (:mod:`weftsim.checks.guards`).
 
     A run that crosses one ends with ``status = "failed"``, a message saying what, when
     (time and crank angle) and what to try, and keeps what it computed up to then.
@@ -587,7 +587,7 @@ class Limits:
         were derived for, stays within 1, and the default impact velocity rule
         ``max_approach`` keeps every step within 1: a step beyond it fails the run.  Under the
         ``onset`` rule a driven lasting contact exceeds it as a property of that model: a
-        warning (:mod:`weftsim.run.plausibility`).
+        warning (:mod:`weftsim.checks.plausibility`).
     """
 
     max_wall_time: float = 0.0

@@ -336,12 +336,6 @@ def _check_scene(scene: params.Scene, where: str, origin: dict[str, Path]) -> No
                 f"{at(clearance)}: key '{clearance}' must be smaller than the journal radius "
                 f"{joint.journal_radius / MM:g} mm, got {joint.clearance / MM:g}"
             )
-    if scene.rapier_tape is not None:
-        from weftsim.tape.model import tape_problem
-
-        problem = tape_problem(scene)
-        if problem is not None:
-            raise SceneError(f"{where}: {problem}")
     if scene.output.sample_angle / scene.drive.speed > scene.drive.end_time:
         raise SceneError(f"{at('drive.revolutions')}: key 'drive.revolutions' is shorter than one output sample")
     from weftsim.mechanism.kinematics import assembly_failure_angle
@@ -353,6 +347,15 @@ def _check_scene(scene: params.Scene, where: str, origin: dict[str, Path]) -> No
             "(the four-bar O-E-F-G does not close: check mechanism.l_oe_mm, l_ef_mm, l_fg_mm, l_og_mm "
             "and rocker_arm_angle_deg)"
         )
+    if scene.rapier_tape is not None:
+        from weftsim.mechanism.kinematics import rapier_stroke
+
+        tape = scene.rapier_tape
+        longest = tape.free_length + rapier_stroke(scene.geometry)
+        if tape.length < longest * (1.0 - 1e-12):  # the tape cannot run out of the wheel
+            raise SceneError(f"{at('rapier_tape.length_mm')}: key 'rapier_tape.length_mm' must be at least "
+                             f"free_length_mm + the stroke = {longest * 1e3:.1f} mm (the tape cannot run out of the "
+                             f"wheel), got {tape.length * 1e3:g}")
 
 
 def _known(path: str, where: str) -> Key:

@@ -4,5 +4,5 @@
 :mod:`weftsim.joint.contact` the continuous contact force laws, :mod:`weftsim.joint.lubrication` the
 channels of a lubricated joint and :mod:`weftsim.joint.reynolds` the finite-difference solution of
 Reynolds' equation behind the film table.  The compiled physics every engine calls is written once in
-:mod:`weftsim.kernel`; these modules are its Python face, its laws' names and its tables.
+:mod:`weftsim.physics`; these modules are its Python face, its laws' names and its tables.
 """

@@ -1,7 +1,7 @@
 """Planar revolute clearance joint: geometry, normal and friction force (docs/physics.md section 2).
 
 Array forms of the joint's force for analysis and tests (Flores-Ambrosio formulation; the
-one scalar definition is :mod:`weftsim.kernel.joint`, which the engines call)::
+one scalar definition is :mod:`weftsim.physics.joint`, which the engines call)::
 
              bearing (R_b), centre P_b
           .-----------.
@@ -41,10 +41,10 @@ from typing import TYPE_CHECKING, Callable, NamedTuple
 import numpy as np
 
 from weftsim.joint.contact import check_impact_velocity
-from weftsim.kernel import hold
-from weftsim.kernel import joint as kernel_joint
-from weftsim.kernel.joint import joint_parameters
-from weftsim.kernel.python import python_form
+from weftsim.physics import hold
+from weftsim.physics import joint as kernel_joint
+from weftsim.physics.joint import joint_parameters
+from weftsim.physics.python import python_form
 from weftsim.input.params import ClearanceJoint
 
 if TYPE_CHECKING:
@@ -54,6 +54,9 @@ if TYPE_CHECKING:
 
 # Array forms for analysis and tests, plain Python per element (the engines call the compiled kernel).
 _EFFECTIVE_IMPACT_VELOCITY = np.vectorize(python_form(hold.effective_impact_velocity), otypes=[float])
+# The clearance geometry, written once in the kernel (weftsim.physics.joint.contact_geometry).
+_CONTACT_GEOMETRY = np.vectorize(python_form(kernel_joint.contact_geometry), otypes=[float] * 4)
+_TANGENTIAL_VELOCITY = np.vectorize(python_form(kernel_joint.contact_tangential_velocity), otypes=[float])
 # The joint's parameter array is passed whole to every element (excluded from broadcasting).
 _CLEARANCE_FORCE = np.vectorize(python_form(kernel_joint.clearance_force), otypes=[float] * 8, excluded={0})
 
@@ -83,7 +86,8 @@ class ClearanceContact(NamedTuple):
 
 def contact_geometry(ecc: ArrayLike, ecc_rate: ArrayLike,
                      clearance: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Penetration, its rate and the normal from the eccentricity (docs/physics.md section 2).
+    """Penetration, its rate and the normal from the eccentricity (docs/physics.md section 2): the kernel's
+    :func:`weftsim.physics.joint.contact_geometry` at every element.
 
     Parameters
     ----------
@@ -100,11 +104,9 @@ def contact_geometry(ecc: ArrayLike, ecc_rate: ArrayLike,
     """
     e = np.asarray(ecc, dtype=float)
     e_dot = np.asarray(ecc_rate, dtype=float)
-    length = np.hypot(e[..., 0], e[..., 1])
-    safe = np.where(length > 0.0, length, 1.0)
-    normal = np.where((length > 0.0)[..., None], e / safe[..., None], 0.0)
-    rate = np.einsum("...i,...i->...", e_dot, normal)
-    return length - clearance, rate, normal
+    delta, rate, nx, ny = (np.asarray(v) for v in _CONTACT_GEOMETRY(e[..., 0], e[..., 1], e_dot[..., 0],
+                                                                    e_dot[..., 1], clearance))
+    return delta[()], rate[()], np.stack([nx, ny], axis=-1)
 
 
 def tangential_velocity(ecc: ArrayLike, bearing_velocity: ArrayLike, bearing_angular_velocity: ArrayLike,
@@ -124,17 +126,13 @@ def tangential_velocity(ecc: ArrayLike, bearing_velocity: ArrayLike, bearing_ang
     bearing_angular_velocity, journal_angular_velocity : (...,) rad/s about +z.
     bearing_radius : float, R_b, m.
 
-    Returns 0 where e = 0 (no normal, no contact).
+    Returns 0 where e = 0 (no normal, no contact).  The kernel's
+    :func:`weftsim.physics.joint.tangential_velocity` at every element.
     """
     e = np.asarray(ecc, dtype=float)
-    length = np.hypot(e[..., 0], e[..., 1])
-    _, _, n = contact_geometry(e, np.zeros_like(e), 0.0)
-    t = np.stack([-n[..., 1], n[..., 0]], axis=-1)
     dv = np.asarray(journal_velocity, dtype=float) - np.asarray(bearing_velocity, dtype=float)
-    v_t = (np.einsum("...i,...i->...", dv, t)
-           + np.asarray(journal_angular_velocity, dtype=float) * (bearing_radius - length)
-           - np.asarray(bearing_angular_velocity, dtype=float) * bearing_radius)
-    return np.where(length > 0.0, v_t, 0.0)
+    return _TANGENTIAL_VELOCITY(e[..., 0], e[..., 1], dv[..., 0], dv[..., 1], journal_angular_velocity,
+                                bearing_angular_velocity, bearing_radius)[()]
 
 
 def effective_impact_velocity(held: ArrayLike, penetration_rate: ArrayLike,
@@ -143,7 +141,7 @@ def effective_impact_velocity(held: ArrayLike, penetration_rate: ArrayLike,
 
     ``held``: the engine's held value (onset rate floored at v_min, raised at its updates);
     under ``"max_approach"`` the current approach rate raises it further, under ``"onset"`` not
-    (:func:`weftsim.kernel.hold.effective_impact_velocity`).
+    (:func:`weftsim.physics.hold.effective_impact_velocity`).
     """
     rule = joint.impact_velocity_rule == "max_approach"
     return _EFFECTIVE_IMPACT_VELOCITY(held, penetration_rate, rule)[()]
@@ -153,7 +151,7 @@ def clearance_contact(ecc: ArrayLike, ecc_rate: ArrayLike, rel_tangential_veloci
                       impact_velocity: ArrayLike, law: _Law, joint: ClearanceJoint) -> ClearanceContact:
     """Normal and friction force of the clearance joint, with moments (arrays, broadcast).
 
-    :func:`weftsim.kernel.joint.clearance_force` at every element.
+    :func:`weftsim.physics.joint.clearance_force` at every element.
 
     Parameters
     ----------
@@ -209,7 +207,7 @@ def make_clearance_kernel(law: _Law, joint: ClearanceJoint, jit: bool = False) -
 
     Returns ``kernel(ex, ey, ex_dot, ey_dot, v_t, v_imp) -> (fx, fy, F_N, delta, delta_dot,
     M_j, M_b)``: force on the journal (N), normal force, penetration (m) and its rate (m/s),
-    friction moments about P_j and P_b (N m), from :func:`weftsim.kernel.joint.clearance_force`
+    friction moments about P_j and P_b (N m), from :func:`weftsim.physics.joint.clearance_force`
     (plain Python, or compiled with ``jit=True``), with the joint's impact-velocity rule applied
     to the held v_imp.  No argument checks: v_imp must be > 0 in contact.
     """

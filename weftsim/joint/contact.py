@@ -82,8 +82,8 @@ import numpy as np
 
 from numba import njit
 
-from weftsim.kernel import laws as kernel
-from weftsim.kernel.python import python_form
+from weftsim.physics import laws as kernel
+from weftsim.physics.python import python_form
 from weftsim.input.params import ClearanceJoint
 
 if TYPE_CHECKING:
@@ -124,7 +124,7 @@ _COMPILED_FROM = 2_000
 
 
 def _law_array(fn, kind, coef, clearance, penetration):
-    """``fn`` of :mod:`weftsim.kernel.laws` at every element of ``penetration``."""
+    """``fn`` of :mod:`weftsim.physics.laws` at every element of ``penetration``."""
     delta = np.asarray(penetration, dtype=float)
     flat = np.ascontiguousarray(delta).ravel()
     if flat.size < _COMPILED_FROM:
@@ -178,8 +178,8 @@ CONFORMAL_BASIS = ("the elastic-foundation force (Liu, Zhang & Yang 2007) is wri
 class _Law:
     """Common part of all laws: F_N = max(0, K(delta) delta^n (1 + xi delta_dot / v_imp)), n = 1.5.
 
-    Subclasses define ``kind`` (a law id of :mod:`weftsim.kernel.laws`), ``coefficient``
-    (its ``coef``) and ``hysteresis_factor``; the arithmetic is that of :mod:`weftsim.kernel.laws`.
+    Subclasses define ``kind`` (a law id of :mod:`weftsim.physics.laws`), ``coefficient``
+    (its ``coef``) and ``hysteresis_factor``; the arithmetic is that of :mod:`weftsim.physics.laws`.
     """
 
     hysteresis: float  # xi, dimensionless
@@ -210,7 +210,7 @@ class _Law:
 
     @property
     def parameters(self) -> tuple[int, float, float, float]:
-        """(kind, coef, clearance, xi): the law's numbers for :mod:`weftsim.kernel.laws`."""
+        """(kind, coef, clearance, xi): the law's numbers for :mod:`weftsim.physics.laws`."""
         return self.kind, self.coefficient, getattr(self, "clearance", 0.0), self.hysteresis
 
     def stiffness(self, penetration: ArrayLike) -> np.ndarray | float:
@@ -224,7 +224,7 @@ class _Law:
         return _law_array(kernel.elastic_force, kind, coef, c, penetration)
 
     def elastic_energy(self, penetration: ArrayLike) -> np.ndarray | float:
-        """W = integral_0^delta F_el, J (0 for delta <= 0); closed forms in :func:`weftsim.kernel.laws.elastic_energy`."""
+        """W = integral_0^delta F_el, J (0 for delta <= 0); closed forms in :func:`weftsim.physics.laws.elastic_energy`."""
         kind, coef, c, _ = self.parameters
         return _law_array(kernel.elastic_energy, kind, coef, c, penetration)
 

@@ -1,10 +1,10 @@
 """Channels of the lubricated joints, from the states of a run (both engines; docs/lubricated-joint.md).
 
 The film and the asperities are evaluated by the kernel the engines integrated
-(:func:`weftsim.kernel.lubricated.lubricated_force`) at each row's eccentricity, its rate and the
+(:func:`weftsim.physics.lubricated.lubricated_force`) at each row's eccentricity, its rate and the
 bodies' rotation rates, so the channels are the forces the solver saw.  Rows are reference-engine
-states (:func:`weftsim.reference.dynamics.initial_state` layout: [a, psi, a', psi', W3, D] with E alone,
-the 4-DOF or F-only layouts of :mod:`weftsim.kernel.chain_f` otherwise); the Exudyn kinematic tree
+states (:func:`weftsim.model.dynamics.initial_state` layout: [a, psi, a', psi', W3, D] with E alone,
+the 4-DOF or F-only layouts of :mod:`weftsim.physics.chain_f` otherwise); the Exudyn kinematic tree
 converts its joint coordinates to that layout first.
 
 Channels (:data:`weftsim.post.results.LUBRICATION_CHANNELS`, ``_F`` for joint F): minimum film thickness
@@ -19,10 +19,10 @@ import math
 import numpy as np
 from numba import njit
 
-from weftsim.kernel import chain as kc
-from weftsim.kernel import chain_f as kf
-from weftsim.kernel.joint import ROUGHNESS
-from weftsim.kernel.lubricated import L_ASPERITY, L_ASPERITY_ENERGY, L_FILM, L_FILM_TORQUE, lubricated_force
+from weftsim.physics import chain as kc
+from weftsim.physics import chain_f as kf
+from weftsim.physics.joint import ROUGHNESS
+from weftsim.physics.lubricated import L_ASPERITY, L_ASPERITY_ENERGY, L_FILM, L_FILM_TORQUE, lubricated_force
 from weftsim.input.params import Scene
 from weftsim.post.results import LUBRICATION_CHANNELS, LUBRICATION_CHANNELS_F
 

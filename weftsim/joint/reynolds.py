@@ -1,6 +1,6 @@
 """Finite-difference solution of Reynolds' equation of the finite journal bearing, with cavitation.
 
-Solves the dimensionless squeeze-velocity problem of :mod:`weftsim.kernel.film`,
+Solves the dimensionless squeeze-velocity problem of :mod:`weftsim.physics.film`,
 
     div(H^3 grad P) = -12 cos(phi - xi),   H = 1 - eps cos phi,   phi in [0, 2 pi), zeta in [-B/D, B/D],
 
@@ -172,11 +172,11 @@ RAIMONDI_BOYD = {
 
 def steady_load(eps: float, width: float, model: int) -> tuple[float, float]:
     """Sommerfeld number and attitude angle (deg) of a journal spinning at eccentricity ratio eps in a
-    still bearing of B/D = ``width``, from the kernel's film force (:func:`weftsim.kernel.film.film_force`).
+    still bearing of B/D = ``width``, from the kernel's film force (:func:`weftsim.physics.film.film_force`).
 
     Dimensionless: S = (R/c)^2 eta N / P does not depend on the numbers chosen here.
     """
-    from weftsim.kernel.film import film_force
+    from weftsim.physics.film import film_force
 
     radius, clearance, viscosity, omega = 0.01, 2e-5, 0.05, 100.0
     length = 2.0 * width * radius

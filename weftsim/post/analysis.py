@@ -161,8 +161,8 @@ def summary(result: RunResult) -> dict:
         "statistics": statistics(result),
         "first_contact_crank_angle_deg": result.first_contact_angle_deg,
         "energy_balance": energy_balance(result) if result.steps["time_s"].size else None,
-        # Counts of a broken contact history and the law-range warnings (weftsim.run.plausibility; not for
-        # the ideal mechanism) and the design checks with their verdicts (weftsim.run.design_checks).
+        # Counts of a broken contact history and the law-range warnings (weftsim.checks.plausibility; not for
+        # the ideal mechanism) and the design checks with their verdicts (weftsim.checks.design_checks).
         "plausibility": dict(result.plausibility) or None,
         "solver": dict(result.solver_stats),
         "wall_time_s": result.wall_time_s,

@@ -20,7 +20,7 @@ ratio of each peak, as the paper reports 1.035 and 1.099 against ADAMS) is infor
 The report says what was compared and what was not (:func:`not_compared`).  With a clearance,
 the first-revolution maxima are the comparison's core: a run shorter than one revolution compares
 the first-contact angle alone, and that is never called an agreement: the status is ``"partial"``
-(exit status 5, :data:`weftsim.cli.exitcodes.EXIT_PARTIAL`) and the line says what to run instead.
+(exit status 5, :data:`weftsim.errors.EXIT_PARTIAL`) and the line says what to run instead.
 The statistics of revolutions 2..N are listed as not compared below 10 revolutions (the status may
 still be ``"agree"``: the first revolution is compared in full).
 """
@@ -310,7 +310,7 @@ def verdict(report: dict, outdir: str | Path) -> tuple[int, str]:
     but a check missed its tolerance (how many, the first one, and where the report is), 5 when
     what was compared agrees but the comparison is partial (what was not compared and why).
     """
-    from weftsim.cli.exitcodes import EXIT_DISAGREE, EXIT_FAILED, EXIT_PARTIAL
+    from weftsim.errors import EXIT_DISAGREE, EXIT_FAILED, EXIT_PARTIAL
 
     failed = [(name, info) for name, info in report["engines"].items() if info["status"] != "success"]
     if failed:
@@ -341,7 +341,7 @@ def run_compare(scene: Scene, outdir: str | Path, solve: Callable[[Scene, str], 
     Returns the report (:func:`compare_results`), the exit status and the line saying why it is
     not 0 (:func:`verdict`); the caller prints them.
     """
-    from weftsim.run.design_checks import report_lines
+    from weftsim.checks.design_checks import report_lines
     from weftsim.post.output import prepare_directory, write_files, write_json, write_run
 
     outdir = prepare_directory(outdir, force, scene)

@@ -154,9 +154,9 @@ def contact_onsets(steps: dict[str, np.ndarray]) -> np.ndarray:
     """Rows of the per-step channels that start a contact at E (an impact).
 
     A contact segment is where the engine holds an impact velocity (docs/physics.md section 2):
-    :func:`weftsim.run.plausibility.contact_mode`; an onset is its first row after free flight.
+    :func:`weftsim.checks.plausibility.contact_mode`; an onset is its first row after free flight.
     """
-    from weftsim.run.plausibility import contact_mode, onset_rows
+    from weftsim.checks.plausibility import contact_mode, onset_rows
 
     return onset_rows(contact_mode(steps))
 
@@ -207,7 +207,7 @@ def plot_orbit(result: RunResult, title: str | None = None) -> Figure:
 
 def _orbit_panel(fig, ax, steps: dict, channels: tuple[str, str, str], clearance: float) -> None:
     """One joint's orbit: its clearance circle, the journal centre at every step, and the impacts."""
-    from weftsim.run.plausibility import onset_rows
+    from weftsim.checks.plausibility import onset_rows
 
     ecc_y, ecc_z, impact = channels
     y_mm, z_mm = steps[ecc_y] * 1e3, steps[ecc_z] * 1e3

@@ -82,7 +82,7 @@ LUBRICATION_CHANNELS_F: tuple[str, ...] = (
 )
 
 # Channels of the flexible rapier tape (docs/rapier-tape.md), present exactly when the run models the tape as
-# flexible (weftsim.tape.selection.tape_model): the head's motion (s of the head's rigid position plus the tape's
+# flexible (weftsim.model.tape_selection.tape_model): the head's motion (s of the head's rigid position plus the tape's
 # axial displacement there), the tape's axial force where it leaves the wheel and at the head (tension
 # positive), the free length, its first axial natural frequency (the closed form at that length) and the
 # tape's strain energy.  rapier_* stay the wheel's pitch-circle motion (the rigid rapier's).
@@ -144,7 +144,7 @@ def optional_channels(names) -> tuple[str, ...]:
     return out
 
 STATUSES = ("success", "failed")
-ENGINES = ("reference", "exudyn")
+ENGINES = ("reference", "exudyn")  # the built-in engines, what a result file records (weftsim.engines names them)
 
 
 def _as_channels(data: dict[str, np.ndarray], what: str) -> dict[str, np.ndarray]:
@@ -195,9 +195,9 @@ class RunResult:
         E.g. ``first_contact_time_s`` (true onset, located within the step) or None.
     plausibility : dict
         Counts of a broken contact history and the law-range warnings
-        (:meth:`weftsim.run.plausibility.Plausibility.as_dict`; not for the ideal mechanism), the design
-        checks before and after the run (``checks``, :mod:`weftsim.run.design_checks`) and every after-run
-        ``warnings``, filled by :func:`weftsim.run.guards.vet_result`; empty for a result no engine vetted.
+        (:meth:`weftsim.checks.plausibility.Plausibility.as_dict`; not for the ideal mechanism), the design
+        checks before and after the run (``checks``, :mod:`weftsim.checks.design_checks`) and every after-run
+        ``warnings``, filled by :func:`weftsim.checks.guards.vet_result`; empty for a result no engine vetted.
     path : dict
         The model and method that ran and why (``{"model": ..., "method": ..., "reason": ...}``):
         what the engine's automatic selection chose for this scene, or what the scene forced.
@@ -215,8 +215,9 @@ class RunResult:
     path: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        if self.engine not in ENGINES:
-            raise ValueError(f"engine must be one of {ENGINES}, got {self.engine!r}")
+        if self.engine not in ENGINES and not (isinstance(self.engine, str) and self.engine.isidentifier()):
+            raise ValueError(f"engine must be one of {ENGINES} or a plug-in engine's name (an identifier), "
+                             f"got {self.engine!r}")
         if self.status not in STATUSES:
             raise ValueError(f"status must be one of {STATUSES}, got {self.status!r}")
         object.__setattr__(self, "samples", _as_channels(self.samples, "samples"))
@@ -307,7 +308,7 @@ def scene_channels(scene: Scene) -> tuple[str, ...]:
     if not scene.joint_f.is_ideal and scene.joint_f.is_lubricated:
         names += LUBRICATION_CHANNELS_F
     if scene.rapier_tape is not None:
-        from weftsim.tape.selection import tape_model
+        from weftsim.model.tape_selection import tape_model
 
         if tape_model(scene) == "flexible":
             names += TAPE_CHANNELS

@@ -2,7 +2,8 @@
 
 The cross-check engine that plays ADAMS's role for the Exudyn model.  Public entry:
 
-    solve(scene, progress=None) -> weftsim.post.results.RunResult
+    solve(scene, progress=None, observe=None) -> weftsim.post.results.RunResult   (pure: not vetted)
+    ENGINE: its object in the engine registry (:mod:`weftsim.engines`, :mod:`.engine`)
 
 - Ideal joint (``scene.joint.is_ideal``): one coordinate theta, the driving torque
   T = 1/2 J_eq'(theta) omega^2 + U'(theta) in closed form (:mod:`.ideal`); nothing is
@@ -12,7 +13,7 @@ The cross-check engine that plays ADAMS's role for the Exudyn model.  Public ent
   in segments between contact events (:mod:`.integrate`).
 - Clearance at F (``scene.joint_f``): alone, again 2 DOF (the rod turns about E of the rocker, the
   sector is driven through the contact at F); with E, the rod is free (4 DOF)
-  (:mod:`weftsim.kernel.chain_f`).  These run on the compiled path only.
+  (:mod:`weftsim.physics.chain_f`).  These run on the compiled path only.
 
 The derivation is in docs/reference-solver.md.
 """
@@ -25,8 +26,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.run.guards import vet_result
 from weftsim.input.params import Scene
+from weftsim.model.stiffness import stiff_joints
 from weftsim.reference.integrate import AUTO, METHODS
 from weftsim.post.results import RunResult, empty_channels
 
@@ -55,6 +56,9 @@ def _check(scene: Scene) -> str | None:
             import numba  # noqa: F401 - a dependency; checked for installs that lost it
         except ImportError:
             return f"`solver.reference.method` = {settings.method!r} needs numba installed; use 'DOP853' (scipy)"
+    if _flexible_tape(scene) and compiled_method(scene) is None:
+        return (f"`solver.reference.method` = {settings.method!r} cannot run the flexible rapier tape: the scipy path "
+                f"carries the rigid chain only; use 'auto' or one of {list(COMPILED_METHODS)}")
     if not scene.joint_f.is_ideal and compiled_method(scene) is None:
         return (f"`solver.reference.method` = {settings.method!r} cannot run a clearance at F (joint_f): the scipy "
                 f"path carries the clearance at E only; use 'auto' or one of {list(COMPILED_METHODS)}")
@@ -68,7 +72,7 @@ def _check(scene: Scene) -> str | None:
 
 
 def _solve_ideal(scene: Scene, progress) -> RunResult:
-    from weftsim.reference.ideal import ideal_channels
+    from weftsim.model.ideal import ideal_channels
     from weftsim.post.results import angle_grid
 
     wall0 = _time.perf_counter()
@@ -95,20 +99,6 @@ def _solve_ideal(scene: Scene, progress) -> RunResult:
 STIFF_RTOL = 1e-6
 
 
-def stiff_joints(scene: Scene) -> list[str]:
-    """Why the scene's contact is stiff for an explicit method: one phrase per loose joint with friction
-    (the modified Coulomb ramp) or a lubricating film (``lubrication`` of the joint, when the scene has one)."""
-    out = []
-    for name, joint in (("E", scene.joint), ("F", scene.joint_f)):
-        if joint.is_ideal:
-            continue
-        if joint.friction_coefficient > 0.0:
-            out.append(f"friction at {name} (mu = {joint.friction_coefficient:g})")
-        if getattr(joint, "lubrication", None) is not None:  # hook for the lubricated joint
-            out.append(f"oil film at {name}")
-    return out
-
-
 def compiled_method(scene: Scene) -> str | None:
     """The compiled method (:data:`COMPILED_METHODS`) a clearance scene runs on, or None for scipy.
 
@@ -133,10 +123,10 @@ def compiled_method(scene: Scene) -> str | None:
 
 
 def _flexible_tape(scene: Scene) -> bool:
-    """True when the scene's rapier tape runs flexible (:func:`weftsim.tape.selection.tape_model`)."""
+    """True when the scene's rapier tape runs flexible (:func:`weftsim.model.tape_selection.tape_model`)."""
     if scene.rapier_tape is None:
         return False
-    from weftsim.tape.selection import tape_model
+    from weftsim.model.tape_selection import tape_model
 
     return tape_model(scene) == "flexible"
 
@@ -157,9 +147,9 @@ def effective_rtol(scene: Scene) -> float:
 
 def select_path(scene: Scene) -> dict:
     """``{"model", "method", "reason"}`` of the run :func:`solve` makes of ``scene`` (and ``"rapier"``: the
-    tape's verdict, :func:`weftsim.tape.selection.tape_check`, when the scene has a ``[rapier_tape]``)."""
+    tape's verdict, :func:`weftsim.model.tape_selection.tape_check`, when the scene has a ``[rapier_tape]``)."""
     if scene.rapier_tape is not None:
-        from weftsim.tape.selection import rigid_scene, tape_check
+        from weftsim.model.tape_selection import rigid_scene, tape_check
 
         check = tape_check(scene)
         path = select_path(rigid_scene(scene)) if check["model"] == "rigid" else _select_path(scene)
@@ -188,19 +178,19 @@ def _select_path(scene: Scene) -> dict:
     return {"model": model, "method": f"{method} rtol {effective_rtol(scene):g} atol {s.atol:g}", "reason": why}
 
 
-def _solve_clearance(scene: Scene, progress, step_states) -> RunResult:
+def _solve_clearance(scene: Scene, progress, observe) -> RunResult:
     method = compiled_method(scene)
     if method is not None:
         from weftsim.reference.compiled_run import solve_compiled
 
-        return solve_compiled(scene, progress, method, step_states, rtol=effective_rtol(scene))
+        return solve_compiled(scene, progress, method, observe, rtol=effective_rtol(scene))
     from weftsim.reference.channels import clearance_channels
     from weftsim.reference.integrate import integrate
 
     traj = integrate(scene, progress)
-    if step_states is not None:
+    if observe is not None:
         states = np.array(traj.step_y).reshape(-1, 6)
-        step_states(np.array(traj.step_t), states, np.array(traj.step_contact, dtype=bool), np.array(traj.step_impact))
+        observe(np.array(traj.step_t), states, np.array(traj.step_contact, dtype=bool), np.array(traj.step_impact))
     wall0 = _time.perf_counter()
 
     def channels(t, y, contact, impact):
@@ -217,8 +207,11 @@ def _solve_clearance(scene: Scene, progress, step_states) -> RunResult:
 
 
 def solve(scene: Scene, progress: Callable[[float], None] | None = None,
-          step_states: Callable[..., None] | None = None) -> RunResult:
-    """Run the reference solver on a scene.
+          observe: Callable[..., None] | None = None) -> RunResult:
+    """Run the reference solver on a scene: the engine's pure solve (the engine contract, :mod:`weftsim.engines`).
+
+    The result is not vetted here: :func:`weftsim.simulate` runs the before-run checks, this solve, then
+    :func:`weftsim.checks.guards.vet_result` once, for every engine.
 
     Parameters
     ----------
@@ -229,9 +222,9 @@ def solve(scene: Scene, progress: Callable[[float], None] | None = None,
         rtol, atol, max_step as crank angle).  :func:`select_path` says which.
     progress : callable, optional
         Called with the completed fraction in [0, 1].
-    step_states : callable, optional
+    observe : callable, optional
         Clearance mode only: called once, after the integration, as
-        ``step_states(t, y, contact, impact)`` with the raw rows behind ``result.steps``
+        ``observe(t, y, contact, impact)`` with the raw rows behind ``result.steps``
         (times (N,) s; states (N, 6) [a, psi, a', psi', W3, D]; the segment's mode (N,) bool;
         the held impact velocity (N,) m/s), for analyses that need the state itself, e.g.
         the approach rate at each contact onset (:mod:`weftsim.studies.outliers`).
@@ -246,7 +239,7 @@ def solve(scene: Scene, progress: Callable[[float], None] | None = None,
     original = scene
     problem = None
     if scene.rapier_tape is not None:
-        from weftsim.tape.selection import flexible_problem, rigid_scene
+        from weftsim.model.tape_selection import flexible_problem, rigid_scene
 
         scene = rigid_scene(scene)
         problem = flexible_problem(scene) if scene.rapier_tape is not None else None
@@ -259,9 +252,7 @@ def solve(scene: Scene, progress: Callable[[float], None] | None = None,
     if scene.is_ideal:
         result = _solve_ideal(scene, progress)
     else:
-        result = _solve_clearance(scene, progress, step_states)
+        result = _solve_clearance(scene, progress, observe)
     object.__setattr__(result, "path", select_path(original))
-    # Post-run criteria (energy balance, ...) that no single step shows; see weftsim.run.guards.
-    result = vet_result(result)
     object.__setattr__(result, "scene", original)  # a tape run as the rigid rapier: the scene asked for
-    return result
+    return result  # vetted once, outside the engines, by weftsim.api.simulate (weftsim.checks.guards.vet_result)

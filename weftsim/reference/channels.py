@@ -1,7 +1,7 @@
 """Output channels of a clearance-mode run, evaluated from the integrated states.
 
 Everything is recomputed with the compiled right-hand side that was integrated
-(:func:`weftsim.kernel.chain.chain`, row by row in :mod:`.compiled_channels`), so the rapier
+(:func:`weftsim.physics.chain.chain`, row by row in :mod:`.compiled_channels`), so the rapier
 acceleration is the equation of motion's a'' (not a finite difference) and the contact force is
 the one the solver saw.
 

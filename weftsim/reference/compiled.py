@@ -3,11 +3,11 @@
 
 scipy's ``DOP853`` and ``RK45`` are re-implemented step for step in :mod:`.compiled_rk` (same
 tableaux, taken from scipy; same initial step, error norm, step-size control and dense output), with the
-right-hand side and the contact law of :mod:`weftsim.kernel.chain` (:mod:`weftsim.kernel.chain_f` with a
+right-hand side and the contact law of :mod:`weftsim.physics.chain` (:mod:`weftsim.physics.chain_f` with a
 clearance at F: one contact mode and held impact velocity per joint, events searched per joint).  What
 the scipy path pays per step in Python (stage combinations, error norm, dense-output
 objects, event location; ~50 us per step attempt, docs/reference-solver.md section 4)
-becomes a few microseconds.  The event search is that of :mod:`weftsim.kernel.roots` (compiled here,
+becomes a few microseconds.  The event search is that of :mod:`weftsim.physics.roots` (compiled here,
 in plain Python on the scipy path).  Events, impact velocity, recorded steps (accepted steps,
 events, ``_CONTACT_SUBSTEPS`` dense points inside contact steps) and output samples
 follow :mod:`weftsim.reference.integrate` and :mod:`weftsim.reference.events` exactly, so both
@@ -29,8 +29,8 @@ import math
 import numpy as np
 from numba import njit
 
-from weftsim.kernel.chain import TRACK_MAX, V_MIN
-from weftsim.kernel.chain_f import BLOCKS, N_JOINTS, joint_is_loose, penetration_at
+from weftsim.physics.chain import TRACK_MAX, V_MIN
+from weftsim.physics.chain_f import BLOCKS, N_JOINTS, joint_is_loose, penetration_at
 from weftsim.reference.compiled_rk import (
     _MAX_FACTOR, _MIN_FACTOR, _SAFETY, DOP853, RK45, _dense, _dense_coefficients, _error_norm, _f,
     _initial_step, _stages,
@@ -38,9 +38,9 @@ from weftsim.reference.compiled_rk import (
 from weftsim.reference.compiled_rk import DENSE as _RK_DENSE
 from weftsim.reference.compiled_rk import NFEV as _RK_NFEV
 from weftsim.reference import compiled_ros as ros
-from weftsim.kernel import roots
-from weftsim.kernel.python import specialize
-from weftsim.kernel.roots import SAMPLES
+from weftsim.physics import roots
+from weftsim.physics.python import specialize
+from weftsim.physics.roots import SAMPLES
 from weftsim.reference.integrate import _CONTACT_SUBSTEPS, _ROOT_XTOL
 
 # RODAS4 (linearly implicit, :mod:`.compiled_ros`) on every step, or only in contact segments with DOP853 in
@@ -58,7 +58,7 @@ _SUBSTEPS = np.arange(1, _CONTACT_SUBSTEPS + 1) / (_CONTACT_SUBSTEPS + 1.0)
 _GRID = np.linspace(0.0, 1.0, SAMPLES + 1)  # the event search grid of a step (integrate._GRID)
 
 # Float state: t, h_abs, held impact velocity at E, max penetration rate, first contact time (-1: none),
-# penetration at E of the last accepted step and its length (for the guards of weftsim.run.guards); then the
+# penetration at E of the last accepted step and its length (for the guards of weftsim.checks.guards); then the
 # held impact velocity, penetration and first contact time at F.  IMPACT + joint, LAST_PENETRATION + joint
 # and FIRST_CONTACT + joint are read through JOINT_SLOTS.
 T, H_ABS, IMPACT, MAX_RATE, FIRST_CONTACT, LAST_PENETRATION, LAST_STEP, IMPACT_F, LAST_PENETRATION_F, \
@@ -94,7 +94,7 @@ def _state(t, prm, method, F, t_old, h, y_old, tmp, joint):
     return penetration_at(prm, t, tmp, joint)
 
 
-# The event search of weftsim.kernel.roots on the dense output of the last step, compiled; its
+# The event search of weftsim.physics.roots on the dense output of the last step, compiled; its
 # ``args`` are (prm, method, F, t_old, h, y_old, tmp, joint).
 _first_crossing = specialize(roots.first_crossing, state=_state)
 _rate_peak = specialize(roots.rate_peak, state=_state)
@@ -347,7 +347,7 @@ def advance(prm: np.ndarray, method: int, rtol: float, atol: float, max_step: fl
                 ist[PEAKS] += 1
             else:
                 if not value > 0.0:
-                    ist[NONPOSITIVE] += 1  # no rising root found: counted, judged by weftsim.run.guards
+                    ist[NONPOSITIVE] += 1  # no rising root found: counted, judged by weftsim.checks.guards
                 fst[MAX_RATE] = max(fst[MAX_RATE], value)
                 ist[CONTACT] = contact | (1 << event_joint)
                 fst[held] = max(value, prm[BLOCKS[event_joint] + V_MIN])

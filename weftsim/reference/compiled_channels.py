@@ -4,8 +4,8 @@ The channels come from the equations that were integrated (see
 :func:`weftsim.reference.channels.clearance_channels` for the energy bookkeeping), at ~0.1 us per row:
 
 - the chain terms (a'', F_N, delta, e, Q3) from the compiled right-hand side
-  (:mod:`weftsim.kernel.chain`), the elastic energy from :func:`weftsim.kernel.laws.elastic_energy`;
-- the crank-side terms J13, J13', U13, U13' of :mod:`weftsim.reference.ideal`, which depend on
+  (:mod:`weftsim.physics.chain`), the elastic energy from :func:`weftsim.physics.laws.elastic_energy`;
+- the crank-side terms J13, J13', U13, U13' of :mod:`weftsim.model.ideal`, which depend on
   theta only and are periodic and analytic: they are sampled from those functions once per
   mechanism (:data:`TABLE_POINTS` per revolution) and read back through a periodic cubic
   spline, exact to ~1e-12 of their range (:func:`crank_side_table`; the closed forms are not
@@ -22,12 +22,12 @@ import numpy as np
 from numba import njit
 
 from weftsim.input.params import Geometry, Inertia, Scene
-from weftsim.kernel.chain import (
+from weftsim.physics.chain import (
     COEF, COUPLING, GRAVITY, KIND, L_EF, L_FG, M11, M22, OMEGA, ROD_MASS, chain, local_clearance, penetration,
 )  # fmt: skip
-from weftsim.kernel import chain_f as kf
-from weftsim.kernel.laws import elastic_energy
-from weftsim.reference.dynamics import initial_state, pack_parameters
+from weftsim.physics import chain_f as kf
+from weftsim.physics.laws import elastic_energy
+from weftsim.model.dynamics import initial_state, pack_parameters
 from weftsim.post.results import CHANNELS, JOINT_F_CHANNELS
 
 TABLE_POINTS = 4096  # spline knots per revolution: interpolation error ~ 5/384 h^4 |f''''| ~ 1e-12 relative
@@ -56,7 +56,7 @@ def periodic_spline(values: np.ndarray, h: float) -> np.ndarray:
 
 @functools.lru_cache(maxsize=16)
 def _table(geometry: Geometry, inertia: Inertia) -> np.ndarray:
-    from weftsim.reference.ideal import crank_side_inertia, crank_side_potential
+    from weftsim.model.ideal import crank_side_inertia, crank_side_potential
 
     scene = Scene(geometry=geometry, inertia=inertia)
     theta = np.linspace(0.0, 2.0 * math.pi, TABLE_POINTS, endpoint=False)
@@ -68,8 +68,8 @@ def _table(geometry: Geometry, inertia: Inertia) -> np.ndarray:
 def crank_side_table(scene: Scene) -> np.ndarray:
     """Spline coefficients (4, TABLE_POINTS, 4) of J13, J13', U13, U13' over one revolution.
 
-    Built from :func:`weftsim.reference.ideal.crank_side_inertia` and
-    :func:`~weftsim.reference.ideal.crank_side_potential` once per mechanism (cached).
+    Built from :func:`weftsim.model.ideal.crank_side_inertia` and
+    :func:`~weftsim.model.ideal.crank_side_potential` once per mechanism (cached).
     """
     return _table(scene.geometry, scene.inertia)
 
@@ -196,10 +196,6 @@ def compiled_channels(scene: Scene, time: np.ndarray, states: np.ndarray, contac
     a0 = float(initial_state(scene)[0])
     size = initial_state(scene).size
     states = np.ascontiguousarray(states, dtype=float).reshape(time.size, size)
-    if prm[kf.TOPOLOGY] == kf.E_TAPE:  # the flexible rapier tape (weftsim.tape.channels)
-        from weftsim.tape.channels import tape_channels
-
-        return tape_channels(scene, prm, table, a0, time, states, contact, impact)
     if scene.joint_f.is_ideal:
         out = np.empty((time.size, len(CHANNELS)))
         _fill(prm, table, a0, scene.geometry.rapier_ratio, time, states, np.asarray(contact, dtype=np.bool_),
@@ -213,7 +209,7 @@ def compiled_channels(scene: Scene, time: np.ndarray, states: np.ndarray, contac
         channels = dict(zip(names, np.ascontiguousarray(out.T)))
     if scene.joint.is_lubricated or scene.joint_f.is_lubricated:
         # The film and asperity channels; the asperities' potential joins the contact energy (the chain
-        # books only the film's and the boundary friction's work as dissipated, weftsim.kernel.lubricated).
+        # books only the film's and the boundary friction's work as dissipated, weftsim.physics.lubricated).
         from weftsim.joint.lubrication import lubrication_table
 
         lubricated, asperity_energy = lubrication_table(scene, prm, time, states)

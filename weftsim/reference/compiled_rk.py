@@ -2,7 +2,7 @@
 
 Re-implemented step for step from scipy (same tableaux, copied from scipy in :mod:`.rk_tableaux`; same initial step, error
 norm, step-size control and dense output), with the right-hand side of
-:mod:`weftsim.kernel.chain_f` (which is :mod:`weftsim.kernel.chain`'s with clearance at E alone); the
+:mod:`weftsim.physics.chain_f` (which is :mod:`weftsim.physics.chain`'s with clearance at E alone); the
 state has 6 entries (2 coordinates) or 10 (clearance at E and F).  :mod:`weftsim.reference.compiled` drives these in its
 event-driven loop.  Every function is module-level ``@njit(cache=True, error_model="numpy")``.
 """
@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 from numba import njit
-from weftsim.kernel.chain_f import rhs_any
+from weftsim.physics.chain_f import rhs_any
 from weftsim.reference import rk_tableaux as _T
 
 DOP853, RK45 = 0, 1
@@ -44,7 +44,7 @@ def _f(prm, t, y, contact, impact, out, ist):
     """y' into out; returns delta at (t, y) (the kernel computes it anyway).
 
     ``contact``: mask of the joints in a contact segment (bit 0 E, bit 1 F); ``impact`` (2,): their
-    held impact velocities (:func:`weftsim.kernel.chain_f.rhs_any`).
+    held impact velocities (:func:`weftsim.physics.chain_f.rhs_any`).
     """
     ist[NFEV] += 1
     return rhs_any(prm, t, y, contact, impact, out)

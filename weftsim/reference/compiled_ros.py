@@ -20,7 +20,7 @@ Each step solves 6 linear systems with one LU decomposition of E, so its step si
 accuracy, not by the stiffness of a lasting contact or of the friction ramp (the explicit DOP853
 steps at ~1e-9 s where the journal sticks: the ramp's slope mu F_N / (v1 - v0) ~ 1e7-1e8 N s/m).
 
-The Jacobian J = df/dy and df/dt come from the one kernel (:func:`weftsim.kernel.chain_f.rhs_any`) by forward
+The Jacobian J = df/dy and df/dt come from the one kernel (:func:`weftsim.physics.chain_f.rhs_any`) by forward
 differences with fixed, small perturbations (:data:`JAC_STEP_Q`, :data:`JAC_STEP_V`, :data:`JAC_STEP_T`) from
 f(t, y), which the step needs anyway: n - 1 evaluations (5 for the 2-DOF chain).  The quadrature states W3 and
 D are not read by the right-hand side, so their columns are zero and are not perturbed.  Accuracy, measured in
@@ -43,10 +43,10 @@ import math
 import numpy as np
 from numba import njit
 
-from weftsim.kernel.chain import OMEGA
-from weftsim.kernel.chain_f import JOINT_F
-from weftsim.kernel.joint import N_JOINT, VISCOSITY
-from weftsim.kernel.lubricated import is_lubricated
+from weftsim.physics.chain import OMEGA
+from weftsim.physics.chain_f import JOINT_F
+from weftsim.physics.joint import N_JOINT, VISCOSITY
+from weftsim.physics.lubricated import is_lubricated
 from weftsim.reference.compiled_rk import _f
 
 RODAS4 = 2  # method code next to compiled_rk.DOP853 (0) and RK45 (1)

@@ -1,5 +1,5 @@
 """Driver of the compiled reference path: runs :func:`weftsim.reference.compiled.advance` in
-chunks (progress, wall-time budget, buffers), applies the run guards of :mod:`weftsim.run.guards`
+chunks (progress, wall-time budget, buffers), applies the run guards of :mod:`weftsim.checks.guards`
 and builds the :class:`~weftsim.post.results.RunResult` with the compiled channels.
 
 Entry: :func:`solve_compiled` (``reference_solver.method`` = ``"numba_DOP853"``, ``"numba_RK45"``,
@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.run.guards import RunGuard, failure_message, non_finite_breach
+from weftsim.checks.guards import RunGuard, failure_message, non_finite_breach
 from weftsim.input.params import Scene
 from weftsim.reference.compiled import (
     DECOMPOSITIONS, DENSE, DONE, EVENTS, IMPLICIT_STEPS, JACOBIANS, FIRST_CONTACT, FIRST_CONTACT_F, GUARD, IMPACTS, LAST_PENETRATION, LAST_PENETRATION_F,
@@ -22,8 +22,8 @@ from weftsim.reference.compiled import (
     PEAKS, REJECTED, SEGMENTS, START, STEP_TOO_SMALL, STEPS, T, _STEP_BUFFER,
     advance,
 )  # fmt: skip
-from weftsim.kernel.chain_f import N_JOINTS
-from weftsim.reference.dynamics import initial_state, pack_parameters
+from weftsim.physics.chain_f import N_JOINTS
+from weftsim.model.dynamics import initial_state, pack_parameters
 from weftsim.reference.integrate import _PROGRESS_EVERY
 from weftsim.post.results import RunResult
 
@@ -162,11 +162,11 @@ def integrate_compiled(scene: Scene, progress: Callable[[float], None] | None = 
 
 
 def solve_compiled(scene: Scene, progress: Callable[[float], None] | None = None, method: str | None = None,
-                   step_states: Callable[..., None] | None = None, rtol: float | None = None) -> RunResult:
+                   observe: Callable[..., None] | None = None, rtol: float | None = None) -> RunResult:
     """The reference engine's clearance mode through the compiled integrator.
 
     ``method``: one of :data:`METHODS`; default ``scene.reference_solver.method``.
-    ``step_states``: optional callable given the raw step rows (t, y, contact, impact), as
+    ``observe``: optional callable given the raw step rows (t, y, contact, impact), as
     in :func:`weftsim.reference.solve`.
     """
     from weftsim.reference.compiled_channels import compiled_channels
@@ -174,12 +174,16 @@ def solve_compiled(scene: Scene, progress: Callable[[float], None] | None = None
 
     steps, samples, stats, events, status, message = integrate_compiled(
         scene, progress, method or scene.reference_solver.method, rtol)
-    if step_states is not None:
-        step_states(*steps)
+    if observe is not None:
+        observe(*steps)
     wall0 = _time.perf_counter()
 
+    fill = compiled_channels
+    if scene.rapier_tape is not None:  # the flexible tape (a rigid one arrives as its rigid equivalent)
+        from weftsim.reference.tape_channels import tape_channels as fill
+
     def channels(arrays):
-        return compiled_channels(scene, *arrays) if arrays[0].size else empty_channels(not scene.joint_f.is_ideal)
+        return fill(scene, *arrays) if arrays[0].size else empty_channels(not scene.joint_f.is_ideal)
 
     step_channels, sample_channels = channels(steps), channels(samples)
     stats["postprocess_time_s"] = _time.perf_counter() - wall0

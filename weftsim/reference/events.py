@@ -19,7 +19,7 @@ sign at both ends.  So the step is sampled at :data:`SAMPLES` + 1 points, a root
 only where the crossing function rises, and a non-rising root sends the search on past the
 lowest point that follows it.
 
-The search itself is written once, in :mod:`weftsim.kernel.roots` (the compiled path calls it
+The search itself is written once, in :mod:`weftsim.physics.roots` (the compiled path calls it
 compiled); this module calls its plain-Python form with a closure over scipy's dense output.
 The located times are returned; the caller takes the state there from the dense output.
 ``state(t) -> (delta, delta_dot)`` evaluates the dense output (m, m/s).
@@ -29,9 +29,9 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from weftsim.kernel import roots
-from weftsim.kernel.python import python_form
-from weftsim.kernel.roots import END_FRACTION, ROOT_XTOL, SAMPLES  # noqa: F401 - the search's constants
+from weftsim.physics import roots
+from weftsim.physics.python import python_form
+from weftsim.physics.roots import END_FRACTION, ROOT_XTOL, SAMPLES  # noqa: F401 - the search's constants
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -48,7 +48,7 @@ def first_crossing(state: Callable[[float], tuple[float, float]], times: np.ndar
 
     ``state(t) -> (delta, delta_dot)``; ``times``, ``deltas``, ``rates`` sample the step at
     ``SAMPLES + 1`` increasing times; ``sign`` +1 for an onset, -1 for a separation.  Returns
-    ``(t, rate)`` (rate = sign * delta_dot there; :func:`weftsim.kernel.roots.first_crossing`).
+    ``(t, rate)`` (rate = sign * delta_dot there; :func:`weftsim.physics.roots.first_crossing`).
     """
     found, t, rate = _FIRST_CROSSING((state,), times, deltas, rates, sign)
     return (t, rate) if found else None
@@ -58,7 +58,7 @@ def rate_peak(rate_of: Callable[[float], float], times: np.ndarray, rates: np.nd
               held: float) -> tuple[float, float] | None:
     """Time and value of a maximum of delta_dot above ``held`` inside the step, or None.
 
-    ``rate_of(t)`` is delta_dot on the dense output (:func:`weftsim.kernel.roots.rate_peak`).
+    ``rate_of(t)`` is delta_dot on the dense output (:func:`weftsim.physics.roots.rate_peak`).
     """
     found, t, rate = _RATE_PEAK((lambda s: (0.0, rate_of(s)),), times, rates, len(times), held)
     return (t, rate) if found else None

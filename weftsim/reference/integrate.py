@@ -36,12 +36,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.run.guards import RunGuard, failure_message, non_finite_breach
-from weftsim.kernel import chain as kernel_chain
-from weftsim.kernel.chain import rhs as chain_rhs
+from weftsim.checks.guards import RunGuard, failure_message, non_finite_breach
+from weftsim.physics import chain as kernel_chain
+from weftsim.physics.chain import rhs as chain_rhs
 from weftsim.input.params import Scene
 from weftsim.reference import events
-from weftsim.reference.dynamics import initial_state, pack_parameters
+from weftsim.model.dynamics import initial_state, pack_parameters
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -131,14 +131,14 @@ def _add_samples(traj: Trajectory, sample_times: np.ndarray, first: int, t_until
 
 
 def penetration(prm: np.ndarray, t: float, y: np.ndarray) -> tuple[float, float]:
-    """(delta, delta_dot) of a state y at time t: :func:`weftsim.kernel.chain.penetration`."""
+    """(delta, delta_dot) of a state y at time t: :func:`weftsim.physics.chain.penetration`."""
     return kernel_chain.penetration(prm, float(t), np.ascontiguousarray(y, dtype=float))
 
 
 def make_rhs(prm: np.ndarray, counter: list) -> tuple[Callable, Callable]:
     """Right-hand sides y' = f(t, y) for free flight and for contact with held v_imp.
 
-    The compiled right-hand side of :mod:`weftsim.kernel.chain` (the one the compiled path
+    The compiled right-hand side of :mod:`weftsim.physics.chain` (the one the compiled path
     integrates) on the scene's parameter array ``prm``; y = [a, psi, a', psi', W3, D] with
     W3' = -Q3 omega (contact power drawn through the rocker), D' = dissipated power.
     ``counter[0]`` counts the evaluations, ``counter[1]`` those that came out NaN or inf (scipy
@@ -357,7 +357,7 @@ def _integrate(scene: Scene, progress) -> Trajectory:
         else:
             rate = value
             if not rate > 0.0:
-                n_nonpositive += 1  # no rising root found: counted, and judged by weftsim.run.guards
+                n_nonpositive += 1  # no rising root found: counted, and judged by weftsim.checks.guards
             max_penetration_rate = max(max_penetration_rate, rate)
             contact, impact = True, max(rate, joint.min_impact_velocity)
             n_impacts += 1

@@ -201,14 +201,14 @@ def onset_rows(contact: np.ndarray) -> np.ndarray:
 
 
 def onsets(scene: Scene, t: np.ndarray, y: np.ndarray, contact: np.ndarray, impact: np.ndarray) -> Onsets:
-    """Onsets of a reference-engine run from its raw step rows (see ``step_states`` of
+    """Onsets of a reference-engine run from its raw step rows (see ``observe`` of
     :func:`weftsim.reference.solve`), with the approach rate of the state at each onset.
 
-    The rate is :func:`weftsim.reference.dynamics.penetration` of the located onset state,
+    The rate is :func:`weftsim.model.dynamics.penetration` of the located onset state,
     the quantity the engine floors and holds, so the check does not depend on the engine's
     own bookkeeping.
     """
-    from weftsim.reference.dynamics import ChainConstants, penetration
+    from weftsim.model.dynamics import ChainConstants, penetration
 
     p = ChainConstants.from_scene(scene)
     rows = onset_rows(contact)
@@ -236,22 +236,24 @@ def revolution_peaks(result: RunResult, channel: str = "contact_force_N") -> lis
     return [peaks(result, k)[channel]["max"] for k in range(complete_revolutions(result))]
 
 
+def _quiet(text: str) -> None:
+    """A cell's before-run warnings: the study counts onsets, not the design checks."""
+
+
 def measure(cell: Cell) -> dict:
     """Run one cell and return its CSV row (see :func:`csv_fields`); an :data:`EXUDYN` cell has
     the peak and cost columns only."""
-    from weftsim.reference import solve
+    from weftsim.engines import simulate
 
     scene = cell.scene()
     if cell.method == EXUDYN:
-        from weftsim.exudyn_engine import solve as exudyn_solve
-
-        return _peak_columns(cell, scene, exudyn_solve(scene))
-    raw = {}
+        return _peak_columns(cell, scene, simulate(scene, "exudyn", on_warning=_quiet))
+    raw: dict = {}
 
     def keep(t, y, contact, impact):
         raw.update(t=t, y=y, contact=contact, impact=impact)
 
-    result = solve(scene, step_states=keep)
+    result = simulate(scene, "reference", observe=keep, on_warning=_quiet)
     if not raw:
         raise StudyError(f"{cell.scene_name}: the reference engine gave no step states (ideal joint?)")
     row = _peak_columns(cell, scene, result)

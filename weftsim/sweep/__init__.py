@@ -13,8 +13,48 @@
 See docs/sweeps.md.
 """
 
+from __future__ import annotations
+
+import sys
+import types
+from collections.abc import Callable
+from pathlib import Path
+
 from weftsim.sweep.grid import SweepError
 from weftsim.sweep.plan import LARGE_GRID_CELLS, SweepPlan, plan_sweep
 from weftsim.sweep.runner import SweepReport, format_report, run_sweep
 
-__all__ = ["LARGE_GRID_CELLS", "SweepError", "SweepPlan", "SweepReport", "format_report", "plan_sweep", "run_sweep"]
+__all__ = ["LARGE_GRID_CELLS", "SweepError", "SweepPlan", "SweepReport", "format_report", "plan_sweep", "run_sweep",
+           "sweep"]
+
+
+def sweep(scene: str | Path, vary: list[str], outdir: str | Path, *, fixed: list[str] | tuple = (),
+          engine: str = "reference", jobs: int | None = None, scheduler: str | None = None,
+          cell_figures: bool = False, allow_large: bool = False, allow_cwd_engine: bool = False,
+          announce: Callable[[str], None] | None = None, progress: bool = True) -> SweepReport:
+    """A parameter sweep (``weftsim sweep``; ``weftsim.sweep(...)``): every cell of the grid ``vary``
+    (``KEY=V1,V2,...`` or ``KEY=LOW:HIGH:N`` texts) of ``scene`` with ``fixed`` (``KEY=VALUE`` texts) on
+    ``engine``, resumable, into ``outdir``.
+
+    Each cell runs through :func:`weftsim.simulate` (before-run checks, the engine, the vetting).  Returns the
+    :class:`SweepReport` (counts, the table ``sweep.csv``, the figure); :func:`weftsim.load_sweep` reads the
+    grid back.  ``announce`` receives the plan's lines (validation of a large grid, its notes).
+    """
+    plan = plan_sweep(scene, vary, fixed, engine, allow_large=allow_large, allow_cwd_engine=allow_cwd_engine,
+                      announce=announce)
+    for note in plan.notes:
+        if announce is not None:
+            announce(f"weftsim sweep: {note}")
+    return run_sweep(plan, outdir, jobs=jobs, scheduler=scheduler, cell_figures=cell_figures, progress=progress)
+
+
+class _CallableModule(types.ModuleType):
+    """``weftsim.sweep(...)`` is :func:`sweep`, whether ``weftsim.sweep`` names the function (``import weftsim``)
+    or this subpackage (once ``import weftsim.sweep`` has run)."""
+
+    def __call__(self, *args, **kwargs):
+        return sweep(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule
+

@@ -159,7 +159,7 @@ def render_run(result: RunResult, figure: bool) -> dict[str, bytes]:
                 return {p.name: p.read_bytes() for p in sorted(Path(private).iterdir()) if p.is_file()}
         except OSError as exc:  # e.g. the memory file system is full: try the next place
             error = exc
-    raise error
+    raise error if error is not None else OSError("no scratch directory to write the cell's files in")
 
 
 def solve_cell(name: str, scene_keys: dict, engine: str, figure: bool = False, command: str | None = None
@@ -243,7 +243,10 @@ def store_cell(cell_dir: Path, record: dict, files: dict[str, bytes], detail: st
         (cell_dir / stale).unlink(missing_ok=True)
     old = _listed_files(cell_dir)
     for file_name in sorted(files, key=lambda n: n == MANIFEST):  # the run's manifest after its files
-        write_atomic(cell_dir / file_name, lambda tmp, data=files[file_name]: tmp.write_bytes(data))
+        def write(tmp: Path, data: bytes = files[file_name]) -> None:
+            tmp.write_bytes(data)
+
+        write_atomic(cell_dir / file_name, write)
     for stale in old - set(files):
         path = cell_dir / stale
         if path.is_file() and not path.is_symlink():

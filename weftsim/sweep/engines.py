@@ -12,27 +12,27 @@ plausible module name, the risk Python's own ``-P`` / ``PYTHONSAFEPATH`` option 
 from __future__ import annotations
 
 import functools
-import importlib
 import importlib.util
 import os
 from pathlib import Path
 from typing import Callable
 
+from weftsim import engines
+from weftsim.errors import EngineError
 from weftsim.sweep.grid import SweepError
 
-# Engine names -> "module:function" of solve(scene, progress=None) -> RunResult.
-ENGINES = {"reference": "weftsim.reference:solve", "exudyn": "weftsim.exudyn_engine:solve"}
+# The named engines (weftsim.engines, the one registry); anything else is a plug-in ``module:attribute``.
+ENGINES = engines.BUILT_IN
 CWD_FLAG = "--allow-cwd-engine"
 
 
 def split_engine(engine: str) -> tuple[str, str]:
-    """(module, function) of an engine name or ``module:function``."""
-    module, sep, function = ENGINES.get(engine, engine).partition(":")
-    if not sep or not module or not function or not all(part.isidentifier() for part in module.split(".")) \
-            or not function.isidentifier():
-        raise SweepError(f"--engine must be one of {', '.join(ENGINES)} or module:function "
-                         f"(e.g. mypackage.model:solve), got {engine!r}")
-    return module, function
+    """(module, attribute) of an engine name or ``module:attribute`` (:func:`weftsim.engines.split`)."""
+    try:
+        return engines.split(ENGINES.get(engine, engine))
+    except EngineError:
+        raise SweepError(f"--engine must be one of {', '.join(engines.names())} or module:function "
+                         f"(e.g. mypackage.model:solve), got {engine!r}") from None
 
 
 def _location(module: str) -> Path | None:
@@ -49,34 +49,39 @@ def _location(module: str) -> Path | None:
     return Path(spec.origin).resolve().parent if spec.origin and spec.has_location else None
 
 
-def check_engine(engine: str, allow_cwd: bool = False) -> Callable:
-    """Import and return the engine's ``solve`` in the sweep process, or one SweepError line.
+def check_engine(engine: str, allow_cwd: bool = False) -> engines.Engine:
+    """The engine of ``engine`` in the sweep process (:func:`weftsim.engines.get`), or one SweepError line.
 
-    Named engines are always allowed; a plug-in module from the current working directory only
-    with ``allow_cwd``.  Any failure of the import (missing module, syntax error, an exception the
+    Named and registered engines are always allowed; a plug-in module from the current working directory
+    only with ``allow_cwd``.  Any failure of the import (missing module, syntax error, an exception the
     module raises) is reported with its kind and message.
     """
-    module, function = split_engine(engine)
-    if engine not in ENGINES and not allow_cwd and _location(module) == Path(os.getcwd()).resolve():
+    if engine == engines.AUTO or engine in engines.names():
+        return engines.get(engine)
+    module, _ = split_engine(engine)
+    if not allow_cwd and _location(module) == Path(os.getcwd()).resolve():
         raise SweepError(f"--engine {engine}: module {module.partition('.')[0]!r} would be imported from the "
                          f"current directory {os.getcwd()}; a plug-in engine is code that runs, so this is "
                          f"refused unless you pass {CWD_FLAG} (or install the module)")
     try:
-        imported = importlib.import_module(module)
-    except SyntaxError as exc:
-        raise SweepError(f"--engine {engine}: module {module} has a syntax error "
-                         f"({exc.filename}, line {exc.lineno}: {exc.msg})") from None
-    except Exception as exc:  # noqa: BLE001 - importing runs arbitrary code: any failure is the plug-in's
-        raise SweepError(f"--engine {engine}: cannot import {module} ({type(exc).__name__}: {exc})") from None
-    solve = getattr(imported, function, None)
-    if not callable(solve):
-        raise SweepError(f"--engine {engine}: module {module} has no function {function!r}")
-    return solve
+        return engines.get(engine)
+    except EngineError as exc:
+        raise SweepError(f"--engine {str(exc).removeprefix('engine ')}") from None
+
+
+def _quiet(text: str) -> None:
+    """A sweep cell's before-run warnings: not printed per cell (``result.plausibility["checks"]`` keeps them)."""
 
 
 @functools.lru_cache(maxsize=None)
 def engine_solve(engine: str) -> Callable:
-    """The engine's ``solve`` in a worker, imported once per process (later cells reuse the module,
-    its compiled code and its loaded numba cache)."""
-    module, function = split_engine(engine)
-    return getattr(importlib.import_module(module), function)
+    """``solve(scene, progress=None)`` of a cell in a worker: :func:`weftsim.api.simulate` on ``engine`` (the
+    engine imported once per process: later cells reuse the module, its compiled code and numba cache)."""
+    from weftsim.engines import simulate
+
+    engines.get(engine)  # import now (the worker's initializer), fail here rather than in the first cell
+
+    def solve(scene, progress=None):
+        return simulate(scene, engine, progress=progress, on_warning=_quiet)
+
+    return solve

@@ -15,7 +15,7 @@ import sys
 import time
 from typing import Callable
 
-from weftsim.run.progress import RateEstimate
+from weftsim.checks.progress import RateEstimate
 from weftsim.sweep.grid import SweepError
 
 CONNECT_TIMEOUT_S = 20.0  # how long to keep trying to reach a Dask scheduler (it may be starting up)

@@ -4,7 +4,7 @@ Public entry::
 
     predict_to_directory(scene, hours, outdir, ...) -> dict   (the summary written to wear.json)
 
-- :mod:`weftsim.kernel.wear`: the worn clearance c(psi) the contact sees, Archard's deposit on the
+- :mod:`weftsim.physics.wear`: the worn clearance c(psi) the contact sees, Archard's deposit on the
   contact arc (compiled; the reference engine's right-hand side reads the worn geometry);
 - :mod:`.archard`: the wear of one run from its step rows;
 - :mod:`.extrapolate`: the cycle extrapolation with the adaptive update interval;
@@ -13,7 +13,7 @@ Public entry::
 
 Every loose joint wears, each with its own ``[joint_e.wear]`` / ``[joint_f.wear]`` numbers: E, F, or E
 and F together (one run simulates both; :func:`~.updates.wearing_joints`).  A worn F's tables
-follow E's in the kernel parameter array (:mod:`weftsim.kernel.chain_f`), its profiles are
+follow E's in the kernel parameter array (:mod:`weftsim.physics.chain_f`), its profiles are
 :attr:`~.updates.Update.second` (or the first when E is ideal), and every output names the joint
 (``effective_clearance_f_mm``, ``wear_profile_f.png``).  A ``--limit-clearance-mm`` applies to every
 wearing joint: ``hours_to_limit`` is the first joint's to reach it (``limit_joint``), each joint's is
@@ -22,7 +22,9 @@ wearing joint: ``hours_to_limit`` is the first joint's to reach it (``limit_join
 
 from __future__ import annotations
 
+import sys
 import time
+import types
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -33,7 +35,7 @@ if TYPE_CHECKING:
 
     from weftsim.input.params import Scene
 
-__all__ = ["ENGINES", "WearError", "check_engine", "predict", "predict_to_directory"]
+__all__ = ["ENGINES", "WearError", "check_engine", "predict", "predict_to_directory", "wear"]
 
 
 def __getattr__(name: str):
@@ -316,3 +318,28 @@ def _write_results(scene: Scene, updates: list, hours: float, limit: float | Non
     written = write_files(outdir, what, files, scene=scene)
     data["files"] = {k: str(v) for k, v in written.items()}
     return data
+
+
+def wear(scene: Scene, hours: float, outdir: str | Path, *, engine: str = "reference", limit_mm: float | None = None,
+         progress: Callable[[float], None] | None = None, force: bool = False, until_limit: bool = False) -> dict:
+    """The wear of the scene's worn joint(s) over ``hours`` of operation (``weftsim wear``; ``weftsim.wear(...)``)
+    into ``outdir``: Archard's law on the engine's contact, extrapolated over cycles, resumable from
+    ``wear_state.npz``.
+
+    Returns ``wear.json``'s content (:func:`predict_to_directory`); ``limit_mm`` is a clearance limit, mm,
+    whose hours to reach are reported (and where the prediction ends with ``until_limit``).
+    """
+    limit = None if limit_mm is None else limit_mm * 1e-3
+    return predict_to_directory(scene, hours, outdir, engine=engine, limit=limit, progress=progress, force=force,
+                                until_limit=until_limit)
+
+
+class _CallableModule(types.ModuleType):
+    """``weftsim.wear(...)`` is :func:`wear`, whether ``weftsim.wear`` names the function (``import weftsim``)
+    or this subpackage (once ``import weftsim.wear`` has run)."""
+
+    def __call__(self, *args, **kwargs):
+        return wear(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule

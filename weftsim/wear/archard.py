@@ -1,12 +1,12 @@
 """Archard wear of one run at a clearance joint (E or F), from the run's accepted steps (docs/wear.md section 1).
 
 At every step row the kernel gives the normal force F_N, the sliding velocity v_T of the contact
-points (:func:`weftsim.kernel.joint.tangential_velocity`: the journal's rotation relative to the
+points (:func:`weftsim.physics.joint.tangential_velocity`: the journal's rotation relative to the
 bearing plus the tangential eccentricity rate), the contact direction in the bearing's and in the
 journal's frame and the contact half-angle.  The sliding work integral W = int F_N |v_T| dt is
 taken with the trapezoidal weights of the rows (:func:`weftsim.post.analysis.time_weights`), so each row
 i carries dW_i = F_N,i |v_T,i| w_i; each surface of hardness H loses dV = (k / H) dW_i, spread over
-the contact arc (:func:`weftsim.kernel.wear.deposit`).  The worn depth of a profile cell is its
+the contact arc (:func:`weftsim.physics.wear.deposit`).  The worn depth of a profile cell is its
 volume over the cell's area L_b R dpsi (R = R_b for the bearing, R_j for the journal).
 """
 
@@ -20,14 +20,14 @@ import numpy as np
 from numba import njit
 
 from weftsim.post.analysis import time_weights
-from weftsim.kernel import chain_f as kf
-from weftsim.kernel.chain import BEARING_RADIUS, OMEGA, chain, eccentricity, local_clearance, rocker_angle
-from weftsim.kernel.asperity import asperity_half_angle, asperity_load
-from weftsim.kernel.joint import (
+from weftsim.physics import chain_f as kf
+from weftsim.physics.chain import BEARING_RADIUS, OMEGA, chain, eccentricity, local_clearance, rocker_angle
+from weftsim.physics.asperity import asperity_half_angle, asperity_load
+from weftsim.physics.joint import (
     ASPERITY_COEF, BEARING_LENGTH, JOURNAL_RADIUS, N_JOINT, ROUGHNESS, tangential_velocity,
 )  # fmt: skip
-from weftsim.kernel.lubricated import is_lubricated
-from weftsim.kernel.wear import contact_half_angle, deposit
+from weftsim.physics.lubricated import is_lubricated
+from weftsim.physics.wear import contact_half_angle, deposit
 
 if TYPE_CHECKING:
     from weftsim.input.params import ClearanceJoint, Scene
@@ -40,10 +40,10 @@ def contact_rows(prm: np.ndarray, time: np.ndarray, states: np.ndarray, contact:
 
     A lubricated joint: F_N is the load the solids carry, the asperity load F_a plus the dry law's beyond
     e = c, never the film's (no wear under a full film: F_a = 0 while h_min >= 4 sigma); phi0 then covers
-    the asperity arc too (:func:`weftsim.kernel.asperity.asperity_half_angle`).
+    the asperity arc too (:func:`weftsim.physics.asperity.asperity_half_angle`).
 
     ``psi_b``, ``psi_j``: the contact direction n in the bearing's (rocker) and the journal's (rod)
-    frame; ``phi0``: half the contact arc (:func:`weftsim.kernel.wear.contact_half_angle`).  Rows
+    frame; ``phi0``: half the contact arc (:func:`weftsim.physics.wear.contact_half_angle`).  Rows
     out of contact have F_N = 0.
     """
     d = np.empty(6)
@@ -107,10 +107,10 @@ def _row(jp: np.ndarray, f_n: float, c: float, ecc_y: float, ecc_z: float, v_y: 
 def contact_rows_f(prm: np.ndarray, time: np.ndarray, states: np.ndarray, contact: np.ndarray, impact: np.ndarray,
                    joint: int, out: np.ndarray) -> None:
     """:func:`contact_rows` of ``joint`` (0 = E, 1 = F) in the chains with clearance at F
-    (:mod:`weftsim.kernel.chain_f`: ``states`` (n, 6) or (n, 10), ``contact`` the joints' mask,
+    (:mod:`weftsim.physics.chain_f`: ``states`` (n, 6) or (n, 10), ``contact`` the joints' mask,
     ``impact`` (n, 2)).
 
-    Frames as the kernel reads the worn tables (:func:`weftsim.kernel.chain_f.local_clearances`): at E
+    Frames as the kernel reads the worn tables (:func:`weftsim.physics.chain_f.local_clearances`): at E
     the rocker (bearing) and the rod (journal); at F the sector's eye (bearing, angle a = theta_FG) and
     the rod's pin (journal, psi).
     """
@@ -183,9 +183,9 @@ def wear_from_rows(joint: ClearanceJoint, time: np.ndarray, rows: np.ndarray) ->
 def run_wear(scene: Scene, prm: np.ndarray, time: np.ndarray, states: np.ndarray, contact: np.ndarray,
              impact: np.ndarray, joint: str = "e") -> RunWear:
     """Archard wear of ``joint`` ("e" or "f") over the given step rows (times (n,) s, states, contact
-    modes, held impact velocities: as :func:`weftsim.reference.solve` gives them to ``step_states``).
+    modes, held impact velocities: as :func:`weftsim.reference.solve` gives them to ``observe``).
 
-    ``prm``: the kernel parameter array of ``scene`` (:func:`weftsim.reference.dynamics.pack_parameters`).
+    ``prm``: the kernel parameter array of ``scene`` (:func:`weftsim.model.dynamics.pack_parameters`).
     With E alone loose, the rows of :func:`contact_rows` (states (n, 6)); with a clearance at F, those of
     :func:`contact_rows_f` for the joint asked for.
     """

@@ -7,7 +7,7 @@ of the steady revolutions, through the same Archard rows and deposit
 - ``"reference"``: :func:`weftsim.wear.extrapolate.simulate_update` (the reference engine's step rows;
   the dry law's F_N from the kernel at its states, modes and held impact velocities);
 - ``"exudyn"``: the Exudyn engine's kinematic tree on the worn geometry
-  (:func:`weftsim.exudyn_engine.worn.solve_worn`, the same kernel's worn clearance in its contact),
+  (:func:`solve_worn`, the same kernel's worn clearance in its contact),
   Archard's integral over its own contact channels at its accepted steps: the normal force F_N and the
   sliding velocity v_T its force callback applied, the contact angles in the bearing's and the journal's
   frame from its joint coordinates.
@@ -27,6 +27,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable
 
     from weftsim.input.params import Scene
+    from weftsim.post.results import RunResult
     from weftsim.wear.archard import RunWear
 
 ENGINES = ("reference", "exudyn")
@@ -50,12 +51,35 @@ def engine_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray, engine
     return (simulator(engine) or extrapolate.simulate_update)(scene, bearing, journal)
 
 
+def _quiet(text: str) -> None:
+    """An update's before-run warnings: the wear command reports the design checks of the scene once."""
+
+
+def solve_worn(scene: Scene, attempt: int = 0) -> tuple[RunResult, tuple, float]:
+    """(result, (t, states, F_N, v_T), relative tolerance) of one attempt
+    (:data:`weftsim.exudyn_engine.worn.ATTEMPTS`) on ``scene``, through :func:`weftsim.api.simulate`.
+
+    The rows are the Exudyn engine's ``observe`` rows of its kinematic tree: times (n,) s, states (n, 4)
+    [a, psi, a', psi'], the contact's F_N (N) and v_T (m/s) at every accepted step.
+    """
+    from weftsim.engines import simulate
+    from weftsim.exudyn_engine.selection import tree_relative_tolerance
+    from weftsim.exudyn_engine.worn import attempt_scene
+
+    run_scene = attempt_scene(scene, attempt)
+    rows: dict = {}
+    result = simulate(run_scene, "exudyn", observe=lambda *a: rows.update(steps=a), on_warning=_quiet)
+    if "steps" not in rows:  # refused before the run (settings): no rows
+        rows["steps"] = (np.zeros(0), np.zeros((0, 4)), np.zeros(0), np.zeros(0))
+    return result, rows["steps"], tree_relative_tolerance(run_scene)
+
+
 def exudyn_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray) -> tuple[RunWear, dict]:
     """:func:`engine_update` on the Exudyn engine (module docstring); raises
     :class:`~weftsim.wear.extrapolate.UpdateFailed` when every attempt of the run fails."""
-    from weftsim.exudyn_engine.worn import ATTEMPTS, solve_worn
-    from weftsim.run.guards import stop_requested
-    from weftsim.reference.dynamics import pack_parameters
+    from weftsim.exudyn_engine.worn import ATTEMPTS
+    from weftsim.checks.guards import stop_requested
+    from weftsim.model.dynamics import pack_parameters
     from weftsim.wear.archard import rows_from_contact, wear_from_rows
     from weftsim.wear.extrapolate import UpdateFailed, WearInterrupted, wear_response, worn_scene
 

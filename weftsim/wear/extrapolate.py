@@ -207,6 +207,10 @@ def _sliding(wear: RunWear, per_rev: float, joint: str) -> dict:
             if wear.sliding_distance > 0.0 else math.nan}
 
 
+def _quiet(text: str) -> None:
+    """An update's before-run warnings: the wear command reports the design checks of the scene once."""
+
+
 def simulate_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray,
                     second: tuple | None = None) -> tuple[RunWear, dict]:
     """Run the reference engine on the worn geometry; returns (wear per steady revolution, response).
@@ -214,10 +218,10 @@ def simulate_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray,
     ``bearing``, ``journal``: the first wearing joint's profiles; ``second``: F's (bearing, journal) when E
     and F both wear, whose wear is then the returned RunWear's ``second``.  Raises WearError when the run fails.
     """
-    from weftsim import reference
-    from weftsim.reference.dynamics import pack_parameters
+    from weftsim.engines import simulate
+    from weftsim.model.dynamics import pack_parameters
 
-    from weftsim.run.guards import stop_requested
+    from weftsim.checks.guards import stop_requested
 
     joints = wearing_joints(scene)
     w = joint_of(scene, joints[0]).wear  # the run's revolutions: the first wearing joint's table
@@ -226,7 +230,7 @@ def simulate_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray,
         run_scene = worn_scene(scene, bearing, journal, w.settle_revolutions + w.revolutions_per_update, retry,
                                method, second)
         rows = {}
-        result = reference.solve(run_scene, step_states=lambda *a: rows.update(steps=a))
+        result = simulate(run_scene, "reference", observe=lambda *a: rows.update(steps=a), on_warning=_quiet)
         if result.ok:
             break
         if stop_requested() is not None or result.solver_stats.get("failure") == "interrupted":
@@ -317,7 +321,7 @@ def predict(scene: Scene, hours: float, updates: Sequence[Update] = (),
     ``on_update(updates)``: called after each update (storing, progress); ``stop()``: True asks to
     end after the current update.  The last update simulates the final geometry, with N = 0; or,
     when the prediction ends at a geometric limit (:func:`ended_by_limit`), extrapolates up to it.
-    A stop asked for while an update is simulated (:func:`weftsim.run.guards.request_stop`) drops it.
+    A stop asked for while an update is simulated (:func:`weftsim.checks.guards.request_stop`) drops it.
     Every loose joint wears (:func:`wearing_joints`).
     """
     if not (0.0 < hours <= MAX_HOURS):
@@ -374,12 +378,12 @@ def predict(scene: Scene, hours: float, updates: Sequence[Update] = (),
 
 def update_time(scene: Scene, engine: str = "reference") -> float:
     """Estimated wall-clock seconds of one wear update: the engine's estimate
-    (:func:`weftsim.run.progress.estimate_run_time`) for its settle + steady revolutions at the solver
-    tolerance of a worn geometry (:data:`WORN_RTOL` on the reference engine)."""
-    from weftsim.run.progress import estimate_run_time
+    (the engine contract's ``estimate``, :mod:`weftsim.engines`) for its settle + steady revolutions at the
+    solver tolerance of a worn geometry (:data:`WORN_RTOL` on the reference engine)."""
+    from weftsim.engines import get
 
     w = joint_of(scene, (wearing_joints(scene) or ("e",))[0]).wear
     solver = replace(scene.reference_solver, rtol=min(scene.reference_solver.rtol, WORN_RTOL))
     one = replace(scene, drive=replace(scene.drive, revolutions=w.settle_revolutions + w.revolutions_per_update),
                   reference_solver=solver)
-    return estimate_run_time(one, engine)
+    return get(engine).estimate(one).run_time_s

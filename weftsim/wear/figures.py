@@ -24,7 +24,7 @@ def _chosen(updates, count: int = 6):
     return [updates[i] for i in idx]
 
 
-# The bodies whose frames the profiles are tabulated in (weftsim.kernel.chain_f.local_clearances).
+# The bodies whose frames the profiles are tabulated in (weftsim.physics.chain_f.local_clearances).
 FRAMES = {"e": ("rocker", "rod"), "f": ("sector", "rod")}
 
 

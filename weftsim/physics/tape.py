@@ -36,7 +36,7 @@ enters the chain's equation of a through R (the rigid rapier's -m8 s''); the axi
 N_root = (EA / lambda) (sum q_i phi_i'(1) + tau r(1)) (tension positive).
 
 Every number sits in the tape block of the kernel's parameter array, at :data:`TAPE` (where a worn joint's
-tables would go: a tape scene has none), laid out by :func:`block_size` (weftsim.tape.model packs it).
+tables would go: a tape scene has none), laid out by :func:`block_size` (weftsim.model.tape packs it).
 """
 
 from __future__ import annotations
@@ -47,7 +47,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numba import njit
 
-from weftsim.kernel import chain as kc
+from weftsim.physics import chain as kc
 
 if TYPE_CHECKING:
     pass
@@ -190,7 +190,7 @@ def chain_tape(prm: np.ndarray, t: float, y: np.ndarray, contact: bool, impact_v
                out: np.ndarray) -> tuple[float, ...]:
     """y' of the clearance chain with the flexible tape into ``out`` (2 n + 6,; state in the module docstring).
 
-    The chain of :func:`weftsim.kernel.chain.chain` (its M11 holds no rapier mass: the tape and head are
+    The chain of :func:`weftsim.physics.chain.chain` (its M11 holds no rapier mass: the tape and head are
     here) gives its generalized forces Q = M2 a_2 (M2 its 2 x 2 mass matrix, a_2 its accelerations without
     the tape); the coupled accelerations solve
 

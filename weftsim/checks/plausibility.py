@@ -3,7 +3,7 @@
 Engine-independent: everything is read from a result's per-step channels (and the engines' own
 counters where they report them), with numpy only.  Two kinds of finding:
 
-**Defects** (the run fails, :func:`weftsim.run.guards.plausibility_breach`): a contact history no
+**Defects** (the run fails, :func:`weftsim.checks.guards.plausibility_breach`): a contact history no
 correct integration of the model produces.
 
 - *Onset with a non-positive approach rate.*  An onset is a crossing of delta from negative to

@@ -10,8 +10,8 @@ follows it.
 
 The dense output is the global ``state(t, *args) -> (delta, delta_dot)`` (m, m/s) and the
 functions pass its extra arguments ``args`` along: the compiled path binds ``state`` to its compiled
-dense output (:func:`weftsim.kernel.python.specialize`), the scipy path uses the plain-Python form
-(:func:`weftsim.kernel.python.python_form`) with ``state`` bound to a call of a closure over scipy's
+dense output (:func:`weftsim.physics.python.specialize`), the scipy path uses the plain-Python form
+(:func:`weftsim.physics.python.python_form`) with ``state`` bound to a call of a closure over scipy's
 dense output.  Roots by the Illinois variant of regula falsi (Dowell & Jarratt, BIT 11, 1971),
 maxima by golden-section search (Kiefer 1953).
 """

@@ -15,14 +15,14 @@ Lagrange's equations M(q) q'' = Q(q, q', t), with k = m4 L_FG L_EF / 2 and s = s
     Q_psi = -L_EF n(psi).f + M_j + m4 g (L_EF/2) cos psi + k a'^2 s
 
 with n(x) = (-sin x, cos x), f and M_j the contact force and moment on the journal
-(:func:`weftsim.kernel.joint.clearance_force`), J_FG = J5 + J67 (d5/d6)^2 + m8 (d5 d7/d6)^2.
+(:func:`weftsim.physics.joint.clearance_force`), J_FG = J5 + J67 (d5/d6)^2 + m8 (d5 d7/d6)^2.
 The contact's generalized force on the crank side is Q3 = -f . dP_b/dtheta + M_b dtheta_OE/dtheta;
 its power -Q3 omega and the dissipated power (F_N - F_el) delta_dot - F_T v_T are integrated with
 the state y = [a, psi, a', psi', W3, D] so the energy balance closes to the solver tolerance.
 Derivation: docs/reference-solver.md.
 
-Every number comes in one float array: the joint block of :mod:`weftsim.kernel.joint` followed by
-the chain's constants (indices below; :func:`weftsim.reference.dynamics.pack_parameters` builds it
+Every number comes in one float array: the joint block of :mod:`weftsim.physics.joint` followed by
+the chain's constants (indices below; :func:`weftsim.model.dynamics.pack_parameters` builds it
 from a scene), so numba compiles these functions once per machine and loads them from its cache.
 """
 
@@ -33,15 +33,15 @@ from typing import TYPE_CHECKING
 
 from numba import njit
 
-from weftsim.kernel.joint import connector_friction_force_at
-from weftsim.kernel.joint import (  # noqa: F401 - the joint block is part of this array
+from weftsim.physics.joint import connector_friction_force_at
+from weftsim.physics.joint import (  # noqa: F401 - the joint block is part of this array
     BEARING_RADIUS, CLEARANCE, COEF, KIND, MU, N_JOINT, TRACK_MAX, V_MIN, clearance_force, clearance_force_at,
     tangential_velocity,
 )  # fmt: skip
-from weftsim.kernel.laws import elastic_force
-from weftsim.kernel.lubricated import L_DISSIPATED, L_FX, L_FY, L_MB, L_MJ, is_lubricated, lubricated_force
-from weftsim.kernel.lubricated import connector_lubricated_force_at
-from weftsim.kernel.wear import clearance_along
+from weftsim.physics.laws import elastic_force
+from weftsim.physics.lubricated import L_DISSIPATED, L_FX, L_FY, L_MB, L_MJ, is_lubricated, lubricated_force
+from weftsim.physics.lubricated import connector_lubricated_force_at
+from weftsim.physics.wear import clearance_along
 
 if TYPE_CHECKING:
     import numpy as np
@@ -50,8 +50,8 @@ if TYPE_CHECKING:
 (OMEGA, TAN_BETA, COS_OE0, SIN_OE0, L_OE, L_EF, L_FG, L_OG, ROD_MASS, GRAVITY, M11, M22,
  COUPLING) = range(N_JOINT, N_JOINT + 13)  # fmt: skip
 N_PARAMETERS = N_JOINT + 13
-# A worn joint E appends its wear block (weftsim.kernel.wear.wear_block) here, after the blocks of
-# weftsim.kernel.chain_f (joint F's parameters, the topology, J_FG, J4); a round one appends nothing.
+# A worn joint E appends its wear block (weftsim.physics.wear.wear_block) here, after the blocks of
+# weftsim.physics.chain_f (joint F's parameters, the topology, J_FG, J4); a round one appends nothing.
 WEAR_E = N_PARAMETERS + N_JOINT + 3
 
 
@@ -159,7 +159,7 @@ def chain(prm: np.ndarray, t: float, y: np.ndarray, contact: bool, impact_veloci
         # delta_dot also holds -dc/dt, so this term also books the work of the radial force as the
         # wall's profile passes under it (the small-wear normal, docs/wear.md section 2).
         dissipated = -(f_y * v_y + f_z * v_z + m_j * dpsi + m_b * omega * dphi) - f_el * delta_dot
-    if is_lubricated(prm):  # the film loads the joint in free flight too (weftsim.kernel.lubricated)
+    if is_lubricated(prm):  # the film loads the joint in free flight too (weftsim.physics.lubricated)
         lub = lubricated_force(prm, c, ecc_y, ecc_z, v_y, v_z, dpsi, omega * dphi)
         f_y += lub[L_FX]
         f_z += lub[L_FY]
@@ -202,7 +202,7 @@ def tree_joint_force(prm: np.ndarray, t: float, a: float, q1: float, da: float, 
         P_j = G + L_FG u(a) + L_EF u(b),  v_j = L_FG a' u'(a) + L_EF b' u'(b),
 
     less the bearing centre P_b(t) of :func:`crank_side` and its velocity, go through
-    :func:`weftsim.kernel.joint.connector_friction_force_at`: the normal force F_N n on the bearing and,
+    :func:`weftsim.physics.joint.connector_friction_force_at`: the normal force F_N n on the bearing and,
     with friction (``prm[MU]`` > 0, in contact), F_T t on the journal (rod turning at b', rocker at
     omega phi') with the moments M_j = (R_b - |e|) F_T about P_j and M_b = -R_b F_T about P_b.  The force on the bearing is F_b = F_N n - F_T t; the journal's, -F_b,
     and M_j enter the joints by virtual work (db/dq0 = db/dq1 = 1):
@@ -211,7 +211,7 @@ def tree_joint_force(prm: np.ndarray, t: float, a: float, q1: float, da: float, 
         Q0 = L_FG (F_bx sin a - F_by cos a) + Q1.
 
     A lubricated joint adds its film and asperity force at every state
-    (:func:`weftsim.kernel.lubricated.connector_lubricated_force`; F_b, M_j and M_b include them).  A worn
+    (:func:`weftsim.physics.lubricated.connector_lubricated_force`; F_b, M_j and M_b include them).  A worn
     joint (the wear block at :data:`WEAR_E`) takes the local clearance c0 + h_b + h_j along e and its rate
     (:func:`rod_clearance`, the rod's angle psi = b - pi), as :func:`chain` does: delta and delta_dot are then
     |e| - c and e_dot . n - dc/dt.

@@ -26,16 +26,16 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numba import njit
 
-from weftsim.kernel.hold import RESTING_RATE_FRACTION, callback_impact_velocity, damping_rate
-from weftsim.kernel.hold import effective_impact_velocity
-from weftsim.kernel.laws import friction_factor, normal_force
+from weftsim.physics.hold import RESTING_RATE_FRACTION, callback_impact_velocity, damping_rate
+from weftsim.physics.hold import effective_impact_velocity
+from weftsim.physics.laws import friction_factor, normal_force
 
 if TYPE_CHECKING:
     from weftsim.joint.contact import _Law
     from weftsim.input.params import ClearanceJoint
 
 # Indices into the joint parameter block: the dry joint's, then the lubrication's (zeros when dry;
-# weftsim.kernel.lubricated reads them).
+# weftsim.physics.lubricated reads them).
 (KIND, COEF, CLEARANCE, XI, BEARING_RADIUS, MU, V0, V1, V_MIN, TRACK_MAX, DEAD_RATE) = range(11)  # fmt: skip
 (LUBRICATED, VISCOSITY, FILM_MODEL, ROUGHNESS, ASPERITY_COEF, BOUNDARY_MU, FILM_FLOOR, JOURNAL_RADIUS,
  BEARING_LENGTH) = range(11, 20)  # fmt: skip
@@ -61,7 +61,7 @@ def joint_parameters(joint: ClearanceJoint, law: _Law) -> np.ndarray:
     out[TRACK_MAX] = 1.0 if joint.impact_velocity_rule == "max_approach" else 0.0
     out[DEAD_RATE] = RESTING_RATE_FRACTION * joint.min_impact_velocity
     if joint.lubrication is not None:
-        from weftsim.kernel.asperity import greenwood_tripp_coefficient
+        from weftsim.physics.asperity import greenwood_tripp_coefficient
 
         lub = joint.lubrication
         out[LUBRICATED] = 1.0
@@ -81,7 +81,7 @@ def joint_parameters(joint: ClearanceJoint, law: _Law) -> np.ndarray:
 def friction_force(prm: np.ndarray, f_n: float, v_t: float) -> float:
     """F_T, N: the modified Coulomb friction on the journal along t (Ambrosio 2003).
 
-    F_T = -mu c_d(|v_T|) F_N sign(v_T), with c_d the ramp of :func:`~weftsim.kernel.laws.friction_factor`
+    F_T = -mu c_d(|v_T|) F_N sign(v_T), with c_d the ramp of :func:`~weftsim.physics.laws.friction_factor`
     between ``prm[V0]`` and ``prm[V1]``; 0 when mu = 0 or F_N = 0.  ``v_t``: relative tangential velocity
     of the contact points (journal relative to bearing, :func:`tangential_velocity`), m/s.
     """
@@ -106,6 +106,33 @@ def tangential_velocity(ex: float, ey: float, ex_dot: float, ey_dot: float, leng
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def contact_geometry(ex: float, ey: float, ex_dot: float, ey_dot: float, clearance: float) -> tuple[float, ...]:
+    """Penetration delta = |e| - c (m), its rate delta_dot = e_dot . n (m/s) and the normal n = e / |e| of an
+    eccentricity e = P_j - P_b and its rate (docs/physics.md section 2); at e = 0 (centred: no normal)
+    delta = -c, delta_dot = 0, n = 0.  Returns (delta, delta_dot, n_x, n_y).
+
+    The clearance geometry, written once: :func:`clearance_force_at` evaluates it, and the array forms of
+    :mod:`weftsim.joint.clearance` are generated from it (:func:`weftsim.physics.python.python_form`).
+    """
+    length = math.sqrt(ex * ex + ey * ey)
+    if length <= 0.0:
+        return length - clearance, 0.0, 0.0, 0.0
+    nx = ex / length
+    ny = ey / length
+    return length - clearance, ex_dot * nx + ey_dot * ny, nx, ny
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def contact_tangential_velocity(ex: float, ey: float, ex_dot: float, ey_dot: float, omega_j: float, omega_b: float,
+                                r_b: float) -> float:
+    """:func:`tangential_velocity` of an eccentricity e, its rate and the rotations, 0 at e = 0 (no normal)."""
+    length = math.sqrt(ex * ex + ey * ey)
+    if length <= 0.0:
+        return 0.0
+    return tangential_velocity(ex, ey, ex_dot, ey_dot, length, omega_j, omega_b, r_b)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def clearance_force(prm: np.ndarray, ex: float, ey: float, ex_dot: float, ey_dot: float, v_t: float,
                     v_imp: float) -> tuple[float, ...]:
     """Force of the joint at eccentricity e and its rate, with held impact velocity v_imp.
@@ -119,12 +146,12 @@ def clearance_force(prm: np.ndarray, ex: float, ey: float, ex_dot: float, ey_dot
 def clearance_force_at(prm: np.ndarray, clearance: float, clearance_rate: float, ex: float, ey: float, ex_dot: float,
                        ey_dot: float, v_t: float, v_imp: float) -> tuple[float, ...]:
     """Force of the joint with the clearance ``clearance`` along e (m) changing at ``clearance_rate``
-    (m/s; a worn joint's local values, :func:`weftsim.kernel.wear.worn_clearance`; the round joint
+    (m/s; a worn joint's local values, :func:`weftsim.physics.wear.worn_clearance`; the round joint
     passes (c, 0)), at eccentricity e and its rate, held impact velocity v_imp.
 
     ``v_t``: relative tangential velocity of the contact points (journal relative to bearing), m/s,
     read only with friction; ``v_imp`` > 0 in contact, raised by the joint's rule
-    (:func:`~weftsim.kernel.hold.effective_impact_velocity`).
+    (:func:`~weftsim.physics.hold.effective_impact_velocity`).
 
     Returns
     -------
@@ -133,12 +160,10 @@ def clearance_force_at(prm: np.ndarray, clearance: float, clearance_rate: float,
     P_j and P_b (N m).
     """
     length = math.sqrt(ex * ex + ey * ey)
-    delta = length - clearance
+    delta, rate, nx, ny = contact_geometry(ex, ey, ex_dot, ey_dot, clearance)
     if length <= 0.0:
         return 0.0, 0.0, 0.0, 0.0, delta, 0.0, 0.0, 0.0
-    nx = ex / length
-    ny = ey / length
-    delta_dot = ex_dot * nx + ey_dot * ny - clearance_rate
+    delta_dot = rate - clearance_rate
     v = effective_impact_velocity(v_imp, delta_dot, prm[TRACK_MAX] != 0.0)
     f_n = normal_force(prm[KIND], prm[COEF], clearance, prm[XI], delta, delta_dot, v)
     f_t = friction_force(prm, f_n, v_t)
@@ -156,8 +181,8 @@ def connector_force(prm: np.ndarray, ex: float, ey: float, vx: float, vy: float,
     ``(ex, ey)``, ``(vx, vy)``: eccentricity P_j - P_b (m) and its rate (m/s) at a trial state;
     ``held``, ``delta0``, ``rate0``: the held impact velocity and the penetration and rate of the
     last accepted state (the connector's memory).  The impact velocity is
-    :func:`~weftsim.kernel.hold.callback_impact_velocity`, the damping rate has the resting-contact
-    dead zone of :func:`~weftsim.kernel.hold.damping_rate` (+-``prm[DEAD_RATE]``).
+    :func:`~weftsim.physics.hold.callback_impact_velocity`, the damping rate has the resting-contact
+    dead zone of :func:`~weftsim.physics.hold.damping_rate` (+-``prm[DEAD_RATE]``).
 
     The round joint: :func:`connector_force_at` with the clearance ``prm[CLEARANCE]``.
 
@@ -172,7 +197,7 @@ def connector_force(prm: np.ndarray, ex: float, ey: float, vx: float, vy: float,
 def connector_force_at(prm: np.ndarray, clearance: float, clearance_rate: float, ex: float, ey: float, vx: float,
                        vy: float, held: float, delta0: float, rate0: float) -> tuple[float, ...]:
     """:func:`connector_force` with the clearance ``clearance`` along e (m) changing at ``clearance_rate``
-    (m/s): a worn joint's local values (:func:`weftsim.kernel.wear.worn_clearance`), as
+    (m/s): a worn joint's local values (:func:`weftsim.physics.wear.worn_clearance`), as
     :func:`clearance_force_at` takes them; delta = |e| - c, delta_dot = e_dot . n - dc/dt."""
     length = math.sqrt(ex * ex + ey * ey)
     delta = length - clearance

@@ -3,7 +3,7 @@
 An engine that does not integrate the reference chain's state y (the Exudyn kinematic tree) still
 has the rod's angles a, psi and their rates at every accepted step.  Its channels of a worn joint
 need the clearance the contact saw there, c = c0 + h_b(psi_b) + h_j(psi_j)
-(:func:`weftsim.kernel.chain.rod_clearance`, the one definition), and what follows from it: the
+(:func:`weftsim.physics.chain.rod_clearance`, the one definition), and what follows from it: the
 penetration delta = |e| - c, its rate e_dot . n - dc/dt and the law's elastic force and energy at
 the local clearance, as :mod:`weftsim.reference.compiled_channels` writes them for the reference
 engine.  A round joint gives c = c0 and dc/dt = 0.
@@ -16,8 +16,8 @@ from typing import TYPE_CHECKING
 
 from numba import njit
 
-from weftsim.kernel.chain import COEF, KIND, eccentricity, rod_clearance
-from weftsim.kernel.laws import elastic_energy, elastic_force
+from weftsim.physics.chain import COEF, KIND, eccentricity, rod_clearance
+from weftsim.physics.laws import elastic_energy, elastic_force
 
 if TYPE_CHECKING:
     import numpy as np

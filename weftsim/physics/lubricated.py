@@ -3,7 +3,7 @@
 A lubricated joint (``joint.lubrication``, the block of :mod:`.joint` from ``LUBRICATED`` on) is loaded
 at every eccentricity, in contact or not::
 
-    f_journal = f_film(e*, e_dot*, omega_j, omega_b)        oil film, :func:`weftsim.kernel.film.film_force`
+    f_journal = f_film(e*, e_dot*, omega_j, omega_b)        oil film, :func:`weftsim.physics.film.film_force`
               - F_a(|e|) n + F_Ta t                         asperities (Greenwood-Tripp, :mod:`.asperity`)
                                                             and boundary friction on their load
               + f_dry                                       the dry law beyond |e| = c (:mod:`.joint`)
@@ -15,12 +15,12 @@ at every eccentricity, in contact or not::
   the squeeze and wedge terms see the true motion.  The film force then stays finite where the dry law
   starts (its squeeze term grows as (1 - eps^2)^-2.5 towards eps = 1).  The film's shear torques act on
   journal and bearing; its power -(f.e_dot + T_j omega_j + T_b omega_b) is dissipated.
-- **Asperities.** F_a(|e|) of :func:`weftsim.kernel.asperity.asperity_load`, zero while h_min >= 4 sigma,
+- **Asperities.** F_a(|e|) of :func:`weftsim.physics.asperity.asperity_load`, zero while h_min >= 4 sigma,
   continued beyond |e| = c with its slope at c (C1); it has a potential U_a (stored, not dissipated).  Boundary
   friction F_Ta = -mu_b c_d(v_T) F_a sign(v_T) acts at the contact point Q = P_b + R_b n with the moments
-  of the dry friction, M_j = (R_b - |e|) F_Ta, M_b = -R_b F_Ta (:func:`weftsim.kernel.joint.friction_force`
+  of the dry friction, M_j = (R_b - |e|) F_Ta, M_b = -R_b F_Ta (:func:`weftsim.physics.joint.friction_force`
   with mu_b and the joint's friction ramp).
-- **Dry law.** Unchanged (:func:`weftsim.kernel.joint.clearance_force_at`): zero at |e| = c and growing
+- **Dry law.** Unchanged (:func:`weftsim.physics.joint.clearance_force_at`): zero at |e| = c and growing
   from there, so the total radial force is continuous in |e| (the film term is continuous and held
   constant in |e| beyond its floor, the asperity term is C1, the dry law starts from 0).
 
@@ -34,13 +34,13 @@ import math
 
 from numba import njit
 
-from weftsim.kernel.asperity import asperity_load
-from weftsim.kernel.film import film_force
-from weftsim.kernel.joint import (
+from weftsim.physics.asperity import asperity_load
+from weftsim.physics.film import film_force
+from weftsim.physics.joint import (
     ASPERITY_COEF, BEARING_LENGTH, BEARING_RADIUS, BOUNDARY_MU, CLEARANCE, FILM_FLOOR, FILM_MODEL, JOURNAL_RADIUS,
     LUBRICATED, ROUGHNESS, V0, V1, VISCOSITY, connector_friction_force_at, tangential_velocity,
 )  # fmt: skip
-from weftsim.kernel.laws import friction_factor
+from weftsim.physics.laws import friction_factor
 
 # Outputs of lubricated_force, in order (the channels of weftsim.joint.lubrication read them by these indices).
 (L_FX, L_FY, L_MJ, L_MB, L_FILM, L_ASPERITY, L_FILM_TORQUE, L_ASPERITY_ENERGY, L_DISSIPATED, L_FILM_POWER) = range(10)
@@ -80,7 +80,7 @@ def lubricated_force(prm, clearance: float, ex: float, ey: float, vx: float, vy:
 
     ``clearance``: the local clearance along e (m; the round joint's c); ``w_j``, ``w_b``: angular
     velocities of journal and bearing about the joint axis (rad/s).  The dry law is not included
-    (:func:`weftsim.kernel.joint.clearance_force_at` adds it in contact).
+    (:func:`weftsim.physics.joint.clearance_force_at` adds it in contact).
 
     Returns
     -------
@@ -118,7 +118,7 @@ def lubricated_force(prm, clearance: float, ex: float, ey: float, vx: float, vy:
 @njit(cache=True, error_model="numpy")
 def connector_lubricated_force(prm, ex: float, ey: float, vx: float, vy: float, held: float, delta0: float,
                                rate0: float, omega_j: float, omega_b: float) -> tuple[float, ...]:
-    """:func:`weftsim.kernel.joint.connector_friction_force` with the film and asperity terms (Exudyn).
+    """:func:`weftsim.physics.joint.connector_friction_force` with the film and asperity terms (Exudyn).
 
     Returns the same nine values (the force on the bearing, now - f_journal of :func:`lubricated_force`
     added; M_j, M_b including the film's torques and the boundary friction), then the lubricated part's
@@ -135,7 +135,7 @@ def connector_lubricated_force_at(prm, clearance: float, clearance_rate: float, 
                                   vy: float, held: float, delta0: float, rate0: float, omega_j: float,
                                   omega_b: float) -> tuple[float, ...]:
     """:func:`connector_lubricated_force` with a local clearance and its rate (a worn joint,
-    :func:`weftsim.kernel.joint.connector_force_at`): the film and the asperities see the local clearance
+    :func:`weftsim.physics.joint.connector_force_at`): the film and the asperities see the local clearance
     too, as on the reference engine's chain."""
     fx, fy, delta, rate, f_n, f_t, m_j, m_b, v_t = connector_friction_force_at(
         prm, clearance, clearance_rate, ex, ey, vx, vy, held, delta0, rate0, omega_j, omega_b)

@@ -8,7 +8,7 @@ so the flexible head's acceleration departs from the rigid rapier's by about
 
 A_k the amplitudes of the ideal mechanism's rapier acceleration a(theta) over one revolution (its Fourier
 series) and f1 the lowest first frequency over the stroke (the longest free length,
-:func:`weftsim.tape.model.first_frequency`).  Under ``"auto"`` the rigid rapier serves when epsilon is below
+:func:`weftsim.model.tape.first_frequency`).  Under ``"auto"`` the rigid rapier serves when epsilon is below
 :data:`RIGID_SERVES_BELOW`.  The estimate covers the drive's harmonics only: a clearance joint's impacts
 excite the tape at any frequency, and the flexible model (``model = "flexible"``) shows what they do.
 """
@@ -21,7 +21,7 @@ import math
 import numpy as np
 
 from weftsim.input.params import Scene
-from weftsim.tape.model import first_frequency, rigid_equivalent, stroke
+from weftsim.model.tape import first_frequency, rigid_equivalent, stroke
 
 # Relative departure of the head's acceleration from the rigid rapier's below which the rigid rapier serves:
 # a tenth of the engines' agreement on first-revolution peaks (compare.first_revolution_peaks = 1 %).
@@ -96,7 +96,7 @@ def tape_model(scene: Scene) -> str | None:
 
 
 def rigid_scene(scene: Scene) -> Scene:
-    """The scene a run integrates: the rigid equivalent (:func:`weftsim.tape.model.rigid_equivalent`) when its
+    """The scene a run integrates: the rigid equivalent (:func:`weftsim.model.tape.rigid_equivalent`) when its
     tape runs as the rigid rapier, else ``scene`` itself."""
     return rigid_equivalent(scene) if tape_model(scene) == "rigid" else scene
 

@@ -24,7 +24,7 @@ The last two need the whole run's channels: :func:`vet_result` checks them (and 
 first two) on every run an engine considers a success.  ``plausibility`` counts onsets with a
 non-positive approach rate, steps whose damping force exceeds ``max_damping_ratio`` x xi x the
 elastic force (under the ``max_approach`` rule, which bounds it), and contact steps with a negative
-penetration (:mod:`weftsim.run.plausibility`);
+penetration (:mod:`weftsim.checks.plausibility`);
 :func:`vet_result` also attaches those counts and the law-range warnings to every result.
 
 Newton non-convergence is the engines' own (Exudyn's convergence flags; scipy's implicit
@@ -44,7 +44,7 @@ import numpy as np
 from weftsim.input.params import Scene
 
 if TYPE_CHECKING:
-    from weftsim.run.plausibility import Plausibility
+    from weftsim.checks.plausibility import Plausibility
     from weftsim.post.results import RunResult
 
 KINDS = ("non_finite", "penetration", "step_size", "steps", "wall_time", "energy", "plausibility", "interrupted")
@@ -244,7 +244,7 @@ def result_breach(result: RunResult) -> tuple[int, Breach] | None:
     i = _first(~finite)
     if i is not None:
         return i, non_finite_breach("non-finite values (NaN or inf) in the results")
-    from weftsim.run.plausibility import joint_view
+    from weftsim.checks.plausibility import joint_view
 
     scene = result.scene
     for joint in scene.loose_joints:  # each joint against its own journal radius
@@ -252,7 +252,9 @@ def result_breach(result: RunResult) -> tuple[int, Breach] | None:
         guard = RunGuard(joint_scene)
         i = _first(joint_steps["penetration_m"] > guard.max_penetration)
         if i is not None:
-            return i, guard.check(penetration=float(joint_steps["penetration_m"][i]), steps=0)
+            breach = guard.check(penetration=float(joint_steps["penetration_m"][i]), steps=0)
+            if breach is not None:
+                return i, breach
     residual = energy_residual(st)
     scale = float(np.max(np.abs(st["kinetic_energy_J"]))) or 1.0
     limit = scene.limits.max_energy_error
@@ -269,8 +271,8 @@ def result_breach(result: RunResult) -> tuple[int, Breach] | None:
 
 
 def plausibility_breach(result: RunResult, report: Plausibility) -> tuple[int, Breach] | None:
-    """The first step showing a defect of :func:`weftsim.run.plausibility.assess`'s report, and the breach."""
-    from weftsim.run.plausibility import HINT, first_defect_row
+    """The first step showing a defect of :func:`weftsim.checks.plausibility.assess`'s report, and the breach."""
+    from weftsim.checks.plausibility import HINT, first_defect_row
 
     defects = report.defects()
     if not defects:
@@ -279,17 +281,17 @@ def plausibility_breach(result: RunResult, report: Plausibility) -> tuple[int, B
 
 
 def vet_result(result: RunResult) -> RunResult:
-    """``result`` with its plausibility report and design checks attached (:func:`weftsim.run.design_checks.block`),
+    """``result`` with its plausibility report and design checks attached (:func:`weftsim.checks.design_checks.block`),
     failed if a criterion is crossed.
 
     Applied by both engines to every run, so a criterion crossed without the step-by-step
     checks seeing it still fails the run: :func:`result_breach`, then the defects of
-    :func:`weftsim.run.plausibility.assess`.  Runs that already failed keep their message and
+    :func:`weftsim.checks.plausibility.assess`.  Runs that already failed keep their message and
     get the report only.  The channels are kept whole (the run did finish); the message
     names the first step concerned.
     """
-    from weftsim.run.design_checks import block
-    from weftsim.run.plausibility import assess
+    from weftsim.checks.design_checks import block
+    from weftsim.checks.plausibility import assess
 
     report = assess(result)
     result = replace(result, plausibility=block(result, {} if report is None else report.as_dict()))

@@ -123,7 +123,7 @@ def worn_clearance(prm: np.ndarray, start: int, c0: float, angle_b: float, angle
 def block_end(prm: np.ndarray, start: int) -> int:
     """Index just after the wear block at ``prm[start:]`` (``start`` itself when there is none).
 
-    The blocks of several joints follow each other (E's, then F's: :func:`weftsim.reference.dynamics.pack_parameters`);
+    The blocks of several joints follow each other (E's, then F's: :func:`weftsim.model.dynamics.pack_parameters`);
     a joint that does not wear but precedes one that does has the empty block ``[0, 0]``.
     """
     if len(prm) <= start:

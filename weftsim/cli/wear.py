@@ -5,8 +5,8 @@ from __future__ import annotations
 import sys
 from typing import TYPE_CHECKING
 
-from weftsim.cli.exitcodes import EXIT_FAILED
-from weftsim.run.progress import format_duration
+from weftsim.errors import EXIT_FAILED
+from weftsim.checks.progress import format_duration
 
 if TYPE_CHECKING:
     import argparse
@@ -54,7 +54,7 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     """Predict, report progress on stderr and the result on stdout; Ctrl-C keeps the state for a resume."""
     from weftsim.cli.grammar import CliError
     from weftsim.post.output import prepare_directory
-    from weftsim.run.progress import Progress
+    from weftsim.checks.progress import Progress
     from weftsim.wear import WearError, check_engine, check_request, predict_to_directory
     from weftsim.wear.extrapolate import MAX_HOURS, update_time
     from weftsim.wear.store import StateMismatch

@@ -21,11 +21,11 @@ come from the run's contact force channels (peaks over every solver step, means 
 which is uniform in time) and the sliding speed of the ideal kinematics at the same crank angle, from
 revolution 2 on when the run has two (:func:`running`: revolution 1 holds the start-up impact of the
 centred journal, which a running machine does not see); the law's range (penetration, Hertz) is judged
-over the whole run, as :mod:`weftsim.run.plausibility` judges it.
+over the whole run, as :mod:`weftsim.checks.plausibility` judges it.
 Joint checks are made at each joint with a clearance (E, and F when it has one).  A check whose
 limit the scene does not give has the verdict ``"no_limit"``; the reflected mass is always
 ``"info"``.  The ``hertz_pressure`` and ``penetration`` warnings after the run are
-:func:`weftsim.run.plausibility.validity_warnings`' own (not repeated here).
+:func:`weftsim.checks.plausibility.validity_warnings`' own (not repeated here).
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from weftsim.mechanism.pin_loads import SAMPLES, ideal_pin_loads, sliding_speed
-from weftsim.run.plausibility import (
+from weftsim.checks.plausibility import (
     TRESCA_LINE_CONTACT_YIELD,
     Plausibility,
     _yield_strength,
@@ -240,7 +240,7 @@ def after_run(result: RunResult) -> list[Check]:
     The machine's loads (pin pressure, p x v, rapier acceleration) are judged from revolution 2 on
     when the run has two or more (:func:`running`; ``numbers["from_time_s"]`` says where); the
     contact law's range (penetration, Hertz pressure) over the whole run, as
-    :func:`weftsim.run.plausibility.validity_warnings` judges and words it.
+    :func:`weftsim.checks.plausibility.validity_warnings` judges and words it.
     """
     from weftsim.joint.contact import make_law
 
@@ -293,7 +293,7 @@ def warnings_of(checks: list[Check]) -> list[str]:
 
 def block(result: RunResult, report: dict) -> dict:
     """The ``plausibility`` block of a result: ``report`` (the contact-history counts and law warnings of
-    :mod:`weftsim.run.plausibility`, empty for the ideal mechanism) with ``checks`` (before and after the
+    :mod:`weftsim.checks.plausibility`, empty for the ideal mechanism) with ``checks`` (before and after the
     run) and the after-run checks' warnings added to ``warnings``."""
     before, after = before_run(result.scene), after_run(result)
     out = dict(report)
@@ -350,7 +350,7 @@ def summary_line(checks: list[dict], stage: str) -> str:
 
 
 def format_lines(result: RunResult) -> list[str]:
-    """The counts line, the after-run design checks' numbers (:mod:`weftsim.run.design_checks`), and one
+    """The counts line, the after-run design checks' numbers (:mod:`weftsim.checks.design_checks`), and one
     ``warning:`` line per validity warning and per after-run design-check warning (stderr)."""
     block = result.plausibility
     if not block:
@@ -366,7 +366,7 @@ def format_lines(result: RunResult) -> list[str]:
 
 
 def report_lines(result: RunResult, label: str) -> None:
-    """The plausibility counts (:mod:`weftsim.run.plausibility`), the after-run design checks' numbers and each
+    """The plausibility counts (:mod:`weftsim.checks.plausibility`), the after-run design checks' numbers and each
     warning of a finished run, one line each on stderr (``weftsim <label>: ...``; once per run, where its
     results are written).  A failed run says
     only why it failed (its summary.json still holds the block)."""

@@ -1,7 +1,7 @@
 """Constants of the clearance-mode equations, their parameter array, and the initial state.
 
 The equations themselves (members 1-3 prescribed by theta = omega t, members 4-8 a 2-DOF chain
-q = (a, psi) forced through the contact at E) are written once, in :mod:`weftsim.kernel.chain`;
+q = (a, psi) forced through the contact at E) are written once, in :mod:`weftsim.physics.chain`;
 both paths of the reference engine integrate that compiled right-hand side (the scipy path is
 the independent integrator check over the same physics) and its output channels come from it.
 This module turns a scene into the kernel's numbers (:class:`ChainConstants`,
@@ -22,12 +22,12 @@ from numba import njit
 
 from weftsim.mechanism import kinematics as kin
 from weftsim.joint.contact import make_law
-from weftsim.kernel import chain as kc
-from weftsim.kernel import chain_f as kf
-from weftsim.kernel.joint import N_JOINT, joint_parameters
-from weftsim.kernel.wear import wear_block
+from weftsim.physics import chain as kc
+from weftsim.physics import chain_f as kf
+from weftsim.physics.joint import N_JOINT, joint_parameters
+from weftsim.physics.wear import wear_block
 from weftsim.input.params import Scene
-from weftsim.reference.ideal import sector_chain_inertia
+from weftsim.model.ideal import sector_chain_inertia
 
 if TYPE_CHECKING:
     from types import ModuleType
@@ -85,7 +85,7 @@ class ChainConstants:
 
 
 def _chain_block(p: ChainConstants) -> np.ndarray:
-    """The chain's constants of the kernel's parameter array (indices of :mod:`weftsim.kernel.chain`)."""
+    """The chain's constants of the kernel's parameter array (indices of :mod:`weftsim.physics.chain`)."""
     out = np.zeros(kc.N_PARAMETERS)
     out[kc.OMEGA], out[kc.TAN_BETA] = p.omega, p.tan_beta
     out[kc.COS_OE0], out[kc.SIN_OE0] = math.cos(p.rocker_arm_angle), math.sin(p.rocker_arm_angle)
@@ -97,7 +97,7 @@ def _chain_block(p: ChainConstants) -> np.ndarray:
 
 
 def topology(scene: Scene) -> int:
-    """The kernel's topology (:mod:`weftsim.kernel.chain_f`): E_ONLY (also the ideal mechanism), F_ONLY, E_AND_F."""
+    """The kernel's topology (:mod:`weftsim.physics.chain_f`): E_ONLY (also the ideal mechanism), F_ONLY, E_AND_F."""
     if scene.joint_f.is_ideal:
         return kf.E_ONLY
     return kf.F_ONLY if scene.joint.is_ideal else kf.E_AND_F
@@ -106,14 +106,14 @@ def topology(scene: Scene) -> int:
 def pack_parameters(scene: Scene) -> np.ndarray:
     """Every number the kernel needs for this scene: the joint block at E, the chain's constants,
     the joint block at F (zeros while F is ideal), the topology, J_FG and J4; then the wear tables
-    of the worn joints (:mod:`weftsim.kernel.wear`): E's at ``kc.WEAR_E``, then F's (E's block is the
-    empty ``[0, 0]`` when only F is worn; :func:`weftsim.kernel.chain_f.wear_start_f`).
+    of the worn joints (:mod:`weftsim.physics.wear`): E's at ``kc.WEAR_E``, then F's (E's block is the
+    empty ``[0, 0]`` when only F is worn; :func:`weftsim.physics.chain_f.wear_start_f`).
 
-    A scene whose tape runs flexible (:func:`weftsim.tape.selection.tape_model`) gets topology E_TAPE and the
-    tape block (:func:`weftsim.tape.model.flexible_parameters`); one whose tape runs rigid, its rigid equivalent's."""
+    A scene whose tape runs flexible (:func:`weftsim.model.tape_selection.tape_model`) gets topology E_TAPE and the
+    tape block (:func:`weftsim.model.tape.flexible_parameters`); one whose tape runs rigid, its rigid equivalent's."""
     if scene.rapier_tape is not None:
-        from weftsim.tape import model as tape_model_
-        from weftsim.tape.selection import tape_model
+        from weftsim.model import tape as tape_model_
+        from weftsim.model.tape_selection import tape_model
 
         if tape_model(scene) == "rigid":
             return pack_parameters(tape_model_.rigid_equivalent(scene))
@@ -157,7 +157,7 @@ def eccentricity(xp: ModuleType | None, p: ChainConstants, t: ArrayLike, a: Arra
                  dpsi: ArrayLike) -> tuple[np.ndarray | float, ...]:
     """Eccentricity e = P_j - P_b, its rate and the bearing's motion, over arrays (broadcast).
 
-    :func:`weftsim.kernel.chain.eccentricity` at every element (``xp`` is ignored: kept for callers
+    :func:`weftsim.physics.chain.eccentricity` at every element (``xp`` is ignored: kept for callers
     that passed the numpy namespace).
 
     Returns
@@ -173,7 +173,7 @@ def eccentricity(xp: ModuleType | None, p: ChainConstants, t: ArrayLike, a: Arra
 
 
 def penetration(p: ChainConstants, t: float, y: np.ndarray) -> tuple[float, float]:
-    """delta = |e| - c (m) and delta_dot = e_dot . n (m/s) of a state y (:func:`weftsim.kernel.chain.penetration`)."""
+    """delta = |e| - c (m) and delta_dot = e_dot . n (m/s) of a state y (:func:`weftsim.physics.chain.penetration`)."""
     return kc.penetration(_geometry_parameters(p), float(t), np.asarray(y[:4], dtype=float))
 
 
@@ -194,14 +194,21 @@ def initial_state(scene: Scene) -> np.ndarray:
     and the two integrated energy terms 0 (the same with clearance at F alone: psi is then the
     rod's angle about E of the rocker).
     With clearance at E and F (4 coordinates) the state is [a, Y, Z, psi, a', Y', Z', psi', W3, D],
-    (Y, Z) the rod's centre of mass (:mod:`weftsim.kernel.chain_f`).
+    (Y, Z) the rod's centre of mass (:mod:`weftsim.physics.chain_f`).
     """
-    if scene.rapier_tape is not None:  # [a, psi, q, a', psi', q', W3, D] (weftsim.kernel.tape)
-        from weftsim.tape import model as tape_model_
-        from weftsim.tape.selection import tape_model
+    if scene.rapier_tape is not None:  # [a, psi, q, a', psi', q', W3, D] (weftsim.physics.tape)
+        from weftsim.model import tape as tape_model_
+        from weftsim.model.tape_selection import tape_model
 
+        if tape_model(scene) == "rigid":
+            return initial_state(tape_model_.rigid_equivalent(scene))
+        # The wheel's acceleration at t = 0 with the tape as the rigid rapier: the tape starts in equilibrium with it.
+        rigid = tape_model_.rigid_equivalent(scene)
+        y = initial_state(rigid)
+        rate = np.empty(y.size)
+        kc.chain(pack_parameters(rigid), 0.0, y, False, 0.0, rate)
         chain = initial_state(tape_model_.massless_rapier(scene))
-        return chain if tape_model(scene) == "rigid" else tape_model_.flexible_initial_state(scene, chain)
+        return tape_model_.flexible_initial_state(scene, chain, scene.geometry.rapier_ratio * rate[2])
     omega = scene.drive.speed
     st = kin.linkage_state(0.0, scene.geometry, scene.inertia.rocker_com)
     if topology(scene) == kf.E_AND_F:

@@ -1,7 +1,7 @@
 """The tape's Ritz matrices, its block of the kernel's parameter array, closed forms and its initial state.
 
 :func:`ritz_matrices` integrates the products of the Ritz functions phi_i(eta) = (1 - eta) P_i(2 eta - 1)
-of :mod:`weftsim.kernel.tape` (P_i the Legendre polynomials) by Gauss-Legendre quadrature, exact for these
+of :mod:`weftsim.physics.tape` (P_i the Legendre polynomials) by Gauss-Legendre quadrature, exact for these
 polynomials.  :func:`first_frequency` is the textbook closed form of a bar of mass M = mu lambda clamped at
 one end with a mass m at the other: beta lambda tan(beta lambda) = M / m, omega = beta sqrt(E / rho)
 (e.g. Blevins, Formulas for Natural Frequency and Mode Shape, table of bars with a tip mass), the check of the
@@ -19,7 +19,7 @@ from numpy.polynomial import Polynomial
 from numpy.polynomial import legendre
 
 from weftsim.input.params import RapierTape, Scene
-from weftsim.kernel import tape as kt
+from weftsim.physics import tape as kt
 
 # Quadrature points: exact for the products of two Ritz functions of degree <= 8 and their derivatives.
 _GAUSS_POINTS = 24
@@ -27,27 +27,14 @@ _GAUSS_POINTS = 24
 
 def stroke(scene: Scene) -> float:
     """The rapier's stroke (largest s of the ideal kinematics over a revolution), m."""
-    from weftsim.mechanism.kinematics import rapier_motion
+    from weftsim.mechanism.kinematics import rapier_stroke
 
-    theta = np.linspace(0.0, 2.0 * math.pi, 1441)
-    return float(np.max(rapier_motion(theta, scene.drive.speed, scene.geometry)[0]))
-
-
-def tape_problem(scene: Scene) -> str | None:
-    """What is wrong with the scene's ``[rapier_tape]`` (one line), or None."""
-    tape = scene.rapier_tape
-    if tape is None:
-        return None
-    longest = tape.free_length + stroke(scene)
-    if tape.length < longest * (1.0 - 1e-12):
-        return (f"key 'rapier_tape.length_mm' must be at least free_length_mm + the stroke = "
-                f"{longest * 1e3:.1f} mm (the tape cannot run out of the wheel), got {tape.length * 1e3:g}")
-    return None
+    return rapier_stroke(scene.geometry)
 
 
 @functools.lru_cache(maxsize=8)
 def ritz_matrices(n: int) -> dict[str, np.ndarray]:
-    """P, S, B, C, G, H (n x n) and p, h, d1, D1 (n) of the Ritz functions (:mod:`weftsim.kernel.tape`)."""
+    """P, S, B, C, G, H (n x n) and p, h, d1, D1 (n) of the Ritz functions (:mod:`weftsim.physics.tape`)."""
     x, w = legendre.leggauss(_GAUSS_POINTS)
     x, w = 0.5 * (x + 1.0), 0.5 * w
     funcs = [Polynomial([1.0, -1.0]) * legendre.Legendre.basis(i, domain=[0.0, 1.0]).convert(kind=Polynomial)
@@ -68,7 +55,7 @@ def ritz_matrices(n: int) -> dict[str, np.ndarray]:
 
 
 def tape_block(scene: Scene, ratio: float, a0: float) -> np.ndarray:
-    """The tape block of the kernel's parameter array (layout: :mod:`weftsim.kernel.tape`).
+    """The tape block of the kernel's parameter array (layout: :mod:`weftsim.physics.tape`).
 
     ``ratio``: ds/da = d5 d7 / d6 (m/rad); ``a0``: theta_FG at s = 0 (rad).
     """
@@ -124,7 +111,7 @@ def ritz_frequencies(tape: RapierTape, free_length: float) -> np.ndarray:
 def quasi_static(tape: RapierTape, free_length: float, wheel_acceleration: float) -> np.ndarray:
     """q of the tape at rest relative to a wheel accelerating at ``wheel_acceleration`` (m/s^2).
 
-    With s' = q' = 0 the tape's equations (:mod:`weftsim.kernel.tape`) ask M_sq s'' + M_qq q'' = -EA S q /
+    With s' = q' = 0 the tape's equations (:mod:`weftsim.physics.tape`) ask M_sq s'' + M_qq q'' = -EA S q /
     lambda; q'' = 0 gives (EA S / lambda - mu s'' B) q = -(mu lambda p + m h) s''.
     """
     m = ritz_matrices(tape.modes)
@@ -142,7 +129,7 @@ def rigid_equivalent(scene: Scene) -> Scene:
 def flexible_parameters(scene: Scene, base: np.ndarray) -> np.ndarray:
     """The kernel's parameter array of a flexible-tape scene from ``base``, the array of the same scene with a
     rapier of mass 0 (the tape and head move in the tape's equations): topology E_TAPE and the tape block."""
-    from weftsim.kernel import chain_f as kf
+    from weftsim.physics import chain_f as kf
     from weftsim.mechanism.kinematics import linkage_state
 
     out = base[:kf.N_PARAMETERS].copy()
@@ -156,23 +143,16 @@ def massless_rapier(scene: Scene) -> Scene:
     return replace(scene, inertia=replace(scene.inertia, rapier_mass=0.0), rapier_tape=None)
 
 
-def flexible_initial_state(scene: Scene, chain_state: np.ndarray) -> np.ndarray:
+def flexible_initial_state(scene: Scene, chain_state: np.ndarray, wheel_acceleration: float) -> np.ndarray:
     """[a, psi, q, a', psi', q', W3, D] at t = 0 from the chain's [a, psi, a', psi', W3, D].
 
     The journal starts centred with the ideal mechanism's velocities (docs/physics.md section 2), in free
     flight; the tape starts at rest on the wheel and in equilibrium with the wheel's acceleration there
-    (:func:`quasi_static`), the acceleration of the same start with the tape and head as the rigid rapier
-    (:func:`rigid_equivalent`).  So a stiff tape starts as the rigid rapier does, and the tape's vibration
-    comes from the run (the start-up impact), not from its initial state.
+    (:func:`quasi_static`), ``wheel_acceleration`` (m/s^2): that of the same start with the tape and head as the
+    rigid rapier (:func:`rigid_equivalent`; :func:`weftsim.model.dynamics.initial_state` computes it).  So a
+    stiff tape starts as the rigid rapier does, and the tape's vibration comes from the run (the start-up
+    impact), not from its initial state.
     """
-    from weftsim.kernel import chain as kc
-    from weftsim.reference.dynamics import initial_state, pack_parameters
-
-    rigid = rigid_equivalent(scene)
-    y = initial_state(rigid)
-    rate = np.empty(y.size)
-    kc.chain(pack_parameters(rigid), 0.0, y, False, 0.0, rate)
-    wheel_acceleration = scene.geometry.rapier_ratio * rate[2]
     tape = scene.rapier_tape
     q0 = quasi_static(tape, tape.free_length, wheel_acceleration)
     n = tape.modes

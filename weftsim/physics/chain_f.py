@@ -1,7 +1,7 @@
 """The chains with clearance at F (rod 4 - sector 5), alone or with clearance at E (the one definition).
 
 Members 1-3 are prescribed by theta = omega t as in :mod:`.chain`; the bearing of E is the point E
-of the rocker, P_E(t) (:func:`weftsim.kernel.chain.crank_side`).  At F the **journal is the rod's
+of the rocker, P_E(t) (:func:`weftsim.physics.chain.crank_side`).  At F the **journal is the rod's
 pin** (centre P_jF on member 4) and the **bearing the sector's eye** (centre P_bF = F of the sector,
 G + L_FG u(a)), so that member 4 carries the journal at both joints.  Four-bar plane coordinates
 (Y, Z), u(x) = (cos x, sin x), n(x) = (-sin x, cos x), g = (0, -g)::
@@ -21,18 +21,18 @@ G + L_FG u(a)), so that member 4 carries the journal at both joints.  Four-bar p
 with J_FG = J5 + J67 (d5/d6)^2 + m8 (d5 d7/d6)^2 (sector, gears and rapier reflected onto theta_FG;
 the sector and gears are balanced, so gravity acts on the rod alone), M22 = m4 L_EF^2/4 + J4, a_E
 = omega^2 d^2P_E/dtheta^2, f_k and M_jk, M_bk the force on the journal and the friction moments of
-joint k (:func:`weftsim.kernel.joint.clearance_force`).  The generalized force of the rod on the
+joint k (:func:`weftsim.physics.joint.clearance_force`).  The generalized force of the rod on the
 crank side is Q3 = (force on the rocker at E) . dP_E/dtheta (+ the friction moment at E); W3' =
 -Q3 omega and D' = the power both contacts dissipate, so the energy balance closes as with E alone
 (docs/reference-solver.md, "Clearance at F").
 
 The parameter array is that of :mod:`.chain` followed by joint F's block (same layout as joint E's,
-:func:`weftsim.kernel.joint.joint_parameters`) and the constants below.  Topology E_ONLY is the chain
+:func:`weftsim.physics.joint.joint_parameters`) and the constants below.  Topology E_ONLY is the chain
 of :mod:`.chain` itself: :func:`rhs_any` and :func:`penetration_at` call it unchanged there, so a
 scene with clearance at E alone integrates bit for bit as before.
 
 Worn joints (``weftsim wear``; docs/wear.md) append their wear tables after :data:`N_PARAMETERS`
-(= :data:`weftsim.kernel.chain.WEAR_E`): joint E's block (:func:`weftsim.kernel.wear.wear_block`; the
+(= :data:`weftsim.physics.chain.WEAR_E`): joint E's block (:func:`weftsim.physics.wear.wear_block`; the
 empty ``[0, 0]`` when only F wears), then joint F's (:func:`wear_start_f`).  Each joint's contact then
 sees its own worn clearance c(n) (:func:`local_clearances`), in the forces, the penetration the event
 search follows and the energy balance, as the chain with E alone does.
@@ -45,12 +45,12 @@ from typing import TYPE_CHECKING
 
 from numba import njit
 
-from weftsim.kernel import chain as kc
-from weftsim.kernel.joint import BEARING_RADIUS, CLEARANCE, KIND, COEF, MU, N_JOINT, clearance_force_at, tangential_velocity
-from weftsim.kernel.laws import elastic_force
-from weftsim.kernel.lubricated import L_DISSIPATED, L_FX, L_FY, L_MB, L_MJ, is_lubricated, lubricated_force
-from weftsim.kernel.tape import chain_state, chain_tape
-from weftsim.kernel.wear import block_end, clearance_along
+from weftsim.physics import chain as kc
+from weftsim.physics.joint import BEARING_RADIUS, CLEARANCE, KIND, COEF, MU, N_JOINT, clearance_force_at, tangential_velocity
+from weftsim.physics.laws import elastic_force
+from weftsim.physics.lubricated import L_DISSIPATED, L_FX, L_FY, L_MB, L_MJ, is_lubricated, lubricated_force
+from weftsim.physics.tape import chain_state, chain_tape
+from weftsim.physics.wear import block_end, clearance_along
 
 if TYPE_CHECKING:
     import numpy as np
@@ -59,9 +59,9 @@ if TYPE_CHECKING:
 JOINT_F = kc.N_PARAMETERS
 TOPOLOGY, SECTOR_CHAIN, ROD_INERTIA = range(JOINT_F + N_JOINT, JOINT_F + N_JOINT + 3)
 N_PARAMETERS = JOINT_F + N_JOINT + 3
-assert N_PARAMETERS == kc.WEAR_E, "the wear tables of a worn E follow this layout (weftsim.kernel.chain.WEAR_E)"
+assert N_PARAMETERS == kc.WEAR_E, "the wear tables of a worn E follow this layout (weftsim.physics.chain.WEAR_E)"
 # Topologies: which joints have a clearance; E_TAPE: clearance at E with the flexible rapier tape
-# (weftsim.kernel.tape; its state appends the tape's coordinates to E_ONLY's).
+# (weftsim.physics.tape; its state appends the tape's coordinates to E_ONLY's).
 E_ONLY, F_ONLY, E_AND_F, E_TAPE = 0, 1, 2, 3
 # Joint numbers (bits of the contact mask, rows of the held impact velocities).
 JOINT_E_INDEX, JOINT_F_INDEX = 0, 1
@@ -110,10 +110,10 @@ def contact_terms(jp: np.ndarray, c: float, c_rate: float, ecc_y: float, ecc_z: 
     """Force of one joint in contact (block ``jp``) on its journal, and the power it dissipates.
 
     ``c``, ``c_rate``: the clearance along e and its rate (m, m/s; a round joint's (c0, 0), a worn
-    one's :func:`local_clearances`); as in :func:`weftsim.kernel.chain.chain`, delta_dot holds -dc/dt.
+    one's :func:`local_clearances`); as in :func:`weftsim.physics.chain.chain`, delta_dot holds -dc/dt.
 
     ``w_j``, ``w_b``: angular velocities of the journal's and the bearing's bodies (rad/s).
-    v_T = e_dot.t + w_j (R_b - |e|) - w_b R_b (:func:`weftsim.kernel.joint.tangential_velocity`);
+    v_T = e_dot.t + w_j (R_b - |e|) - w_b R_b (:func:`weftsim.physics.joint.tangential_velocity`);
     dissipated power = -(f.e_dot + M_j w_j + M_b w_b) - F_el delta_dot (the contact's power less
     the rate of its elastic energy).
 
@@ -177,7 +177,7 @@ def _rate(e_y, e_z, v_y, v_z):
 @njit(cache=True, error_model="numpy")
 def wear_start_f(prm: np.ndarray) -> int:
     """Index of joint F's wear block: after joint E's (``[0, 0]`` when E does not wear) at
-    :data:`weftsim.kernel.chain.WEAR_E`; ``prm.size`` or beyond when F has none (a round F)."""
+    :data:`weftsim.physics.chain.WEAR_E`; ``prm.size`` or beyond when F has none (a round F)."""
     return block_end(prm, kc.WEAR_E)
 
 
@@ -186,8 +186,8 @@ def local_clearances(prm: np.ndarray, t: float, y: np.ndarray, q: tuple) -> tupl
     """(c_E, dc_E/dt, c_F, dc_F/dt) along each joint's eccentricity (topologies F_ONLY, E_AND_F), m and m/s.
 
     ``q``: :func:`eccentricities` of (t, y).  A round joint gives (c0, 0); a worn one c0 + h_b + h_j
-    (:func:`weftsim.kernel.wear.clearance_along`) with its bodies' frames: at E the bearing is the
-    rocker (theta_OE, :func:`weftsim.kernel.chain.rocker_angle`) and the journal the rod (psi); at F the
+    (:func:`weftsim.physics.wear.clearance_along`) with its bodies' frames: at E the bearing is the
+    rocker (theta_OE, :func:`weftsim.physics.chain.rocker_angle`) and the journal the rod (psi); at F the
     bearing is the sector's eye (a = theta_FG) and the journal the rod's pin (psi).  Profiles are tables
     over each body's own frame, so the same wear tables serve E in either chain.
     """
@@ -250,7 +250,7 @@ def chain_f(prm: np.ndarray, t: float, y: np.ndarray, contact: int, impact: np.n
     if contact & 2:
         ff_y, ff_z, ff_n, delta_f, m_jf, m_bf, diss_f = contact_terms(jf, c_f, rate_f, ef_y, ef_z, vf_y, vf_z, dpsi, da,
                                                                       impact[1])  # fmt: skip
-    # Lubricated joints carry their film at every state (weftsim.kernel.lubricated).
+    # Lubricated joints carry their film at every state (weftsim.physics.lubricated).
     if both and is_lubricated(prm):
         lub = lubricated_force(prm, c_e, e_y, e_z, ve_y, ve_z, dpsi, w_rocker)
         fe_y, fe_z, m_je, m_be = fe_y + lub[L_FX], fe_z + lub[L_FY], m_je + lub[L_MJ], m_be + lub[L_MB]
@@ -300,8 +300,8 @@ def chain_f(prm: np.ndarray, t: float, y: np.ndarray, contact: int, impact: np.n
 def rhs_any(prm: np.ndarray, t: float, y: np.ndarray, contact: int, impact: np.ndarray, out: np.ndarray) -> float:
     """y' of any topology into ``out``; returns delta of the first loose joint (the E-only chain's value).
 
-    E_ONLY: :func:`weftsim.kernel.chain.chain` with contact bit 0 and impact[0], unchanged; E_TAPE:
-    :func:`weftsim.kernel.tape.chain_tape` likewise.
+    E_ONLY: :func:`weftsim.physics.chain.chain` with contact bit 0 and impact[0], unchanged; E_TAPE:
+    :func:`weftsim.physics.tape.chain_tape` likewise.
     """
     if prm[TOPOLOGY] == E_ONLY:
         return kc.chain(prm, t, y, (contact & 1) != 0, impact[0], out)[2]

@@ -3,7 +3,7 @@
 :data:`weftsim.post.results.CHANNELS` (the rapier's channels are the wheel's pitch-circle motion; the energy
 channels hold the tape: its kinetic energy in ``kinetic_energy_J``, its strain energy in
 ``potential_energy_J``, its damping and guide friction in ``dissipated_energy_J``) and
-:data:`weftsim.post.results.TAPE_CHANNELS`, from :func:`weftsim.kernel.tape.chain_tape`.
+:data:`weftsim.post.results.TAPE_CHANNELS`, from :func:`weftsim.physics.tape.chain_tape`.
 """
 
 from __future__ import annotations
@@ -14,11 +14,12 @@ import numpy as np
 from numba import njit
 
 from weftsim.input.params import Scene
-from weftsim.kernel import chain as kc
-from weftsim.kernel import tape as kt
-from weftsim.kernel.laws import elastic_energy
+from weftsim.physics import chain as kc
+from weftsim.physics import tape as kt
+from weftsim.physics.laws import elastic_energy
 from weftsim.post.results import CHANNELS, TAPE_CHANNELS
-from weftsim.reference.compiled_channels import crank_side_eval
+from weftsim.model.dynamics import initial_state, pack_parameters
+from weftsim.reference.compiled_channels import crank_side_eval, crank_side_table
 
 
 @njit(cache=True, error_model="numpy")
@@ -80,15 +81,20 @@ def _fill_tape(prm, table, a0, ratio, time, states, contact, impact, out):
         out[i, base + 7] = strain
 
 
-def tape_channels(scene: Scene, prm: np.ndarray, table: np.ndarray, a0: float, time: np.ndarray,
-                  states: np.ndarray, contact: np.ndarray, impact: np.ndarray) -> dict[str, np.ndarray]:
-    """All CHANNELS and TAPE_CHANNELS at the given rows (``contact`` bool, ``impact`` (n,) at E)."""
-    from weftsim.tape.model import first_frequency
+def tape_channels(scene: Scene, time: np.ndarray, states: np.ndarray, contact: np.ndarray,
+                  impact: np.ndarray) -> dict[str, np.ndarray]:
+    """All CHANNELS and TAPE_CHANNELS at the given rows of a flexible-tape run (``contact`` bool, ``impact``
+    (n,) at E), as :func:`weftsim.reference.compiled_channels.compiled_channels` gives a rigid run's."""
+    from weftsim.model.tape import first_frequency
 
+    time = np.ascontiguousarray(time, dtype=float)
+    prm = pack_parameters(scene)
+    y0 = initial_state(scene)
+    states = np.ascontiguousarray(states, dtype=float).reshape(time.size, y0.size)
     names = CHANNELS + TAPE_CHANNELS
     out = np.empty((time.size, len(names)))
-    _fill_tape(prm, table, a0, scene.geometry.rapier_ratio, time, states, np.asarray(contact, dtype=np.bool_),
-               np.asarray(impact, dtype=float), out)
+    _fill_tape(prm, crank_side_table(scene), float(y0[0]), scene.geometry.rapier_ratio, time, states,
+               np.asarray(contact, dtype=np.bool_), np.asarray(impact, dtype=float), out)
     channels = dict(zip(names, np.ascontiguousarray(out.T)))
     channels["tape_frequency_hz"] = first_frequency(scene.rapier_tape, channels["tape_free_length_m"])
     return channels
