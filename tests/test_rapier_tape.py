@@ -282,3 +282,20 @@ def test_both_engines_agree_on_the_heads_acceleration_under_a_wheel_pulse():
     assert head.max() > 1.5 * 2000.0  # the tape rings: the check is not the rigid rapier's
     assert head.max() == pytest.approx(exudyn_head.max(), rel=1e-2)
     assert head.min() == pytest.approx(exudyn_head.min(), rel=1e-2)
+
+
+def test_without_the_table_the_rigid_rapier_is_untouched():
+    """No [rapier_tape]: the kernel's parameters and state are the rigid chain's (no tape block, topology E_ONLY,
+    6 states), the run has no tape channels and its path no tape verdict; the stored peaks of
+    tests/test_regression.py hold the rigid rapier's numbers themselves."""
+    from weftsim.model.dynamics import initial_state, pack_parameters
+    from weftsim.physics import chain_f as kf
+    from weftsim.post.results import TAPE_CHANNELS, scene_channels
+
+    scene = load_scene("loom", {"drive.revolutions": 0.02})
+    assert scene.rapier_tape is None
+    prm = pack_parameters(scene)
+    assert prm.size == kf.N_PARAMETERS and prm[kf.TOPOLOGY] == kf.E_ONLY and initial_state(scene).size == 6
+    assert not set(TAPE_CHANNELS) & set(scene_channels(scene))
+    result = simulate(scene, engine="reference")
+    assert "rapier" not in result.path and not set(TAPE_CHANNELS) & set(result.samples)
