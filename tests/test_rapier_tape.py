@@ -299,3 +299,14 @@ def test_without_the_table_the_rigid_rapier_is_untouched():
     assert not set(TAPE_CHANNELS) & set(scene_channels(scene))
     result = simulate(scene, engine="reference")
     assert "rapier" not in result.path and not set(TAPE_CHANNELS) & set(result.samples)
+
+
+def test_the_automatic_engine_of_a_flexible_tape_is_the_reference_engine():
+    """engine 'auto' is the Exudyn engine, which has no flexible tape yet: a scene whose tape runs flexible
+    goes to the reference engine instead; a tape run as the rigid rapier stays on the default."""
+    from weftsim import engines
+
+    flexible = load_scene("loom_tape", {"drive.revolutions": 0.01})
+    assert engines.resolve("auto", flexible) == "reference"
+    assert engines.resolve("auto", load_scene("loom_tape", {"rapier_tape.model": "rigid"})) == engines.DEFAULT_ENGINE
+    assert simulate(flexible).engine == "reference"

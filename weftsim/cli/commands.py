@@ -310,7 +310,7 @@ def _solve(scene, engine: str, label: str | None = None, announce: bool = False)
     from weftsim.api import resolve_engine, select_path, simulate
     from weftsim.checks.progress import Progress
 
-    engine = resolve_engine(engine)
+    engine = resolve_engine(engine, scene)
     if announce:  # `run`: its first line is the model and method it takes, and why
         path = select_path(scene, engine)
         print(f"scene {scene.name}, engine {engine}: {path['model']}, {path['method']} ({path['reason']})", flush=True)
