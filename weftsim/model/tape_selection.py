@@ -30,13 +30,17 @@ _HARMONIC_SAMPLES = 4096
 _ROUND_OFF = 1e-9  # relative amplitude below which a harmonic is the FFT's round-off
 
 
-def drive_harmonics(scene: Scene) -> np.ndarray:
-    """Amplitudes A_k (m/s^2, k = 0 .. N/2) of the ideal rapier acceleration over one revolution."""
+def _ideal(scene: Scene) -> np.ndarray:
+    """The ideal mechanism's rapier acceleration at the drive speed over one revolution, m/s^2."""
     from weftsim.mechanism.kinematics import rapier_motion
 
     theta = np.arange(_HARMONIC_SAMPLES) * (2.0 * math.pi / _HARMONIC_SAMPLES)
-    accel = rapier_motion(theta, scene.drive.speed, scene.geometry)[2]
-    amplitude = np.abs(np.fft.rfft(accel)) * (2.0 / _HARMONIC_SAMPLES)
+    return rapier_motion(theta, scene.drive.speed, scene.geometry)[2]
+
+
+def drive_harmonics(scene: Scene) -> np.ndarray:
+    """Amplitudes A_k (m/s^2, k = 0 .. N/2) of the ideal rapier acceleration over one revolution."""
+    amplitude = np.abs(np.fft.rfft(_ideal(scene))) * (2.0 / _HARMONIC_SAMPLES)
     amplitude[0] *= 0.5
     return amplitude
 
@@ -78,13 +82,6 @@ def tape_check(scene: Scene) -> dict:
         reason += f"; rapier_tape.model = {tape.model!r}"
     return {"first_frequency_hz": [float(f1[0]), float(f1[1])], "drive_hz": f_rev, "harmonic_error": error,
             "limit": RIGID_SERVES_BELOW, "rigid_serves": serves, "model": chosen, "reason": reason}
-
-
-def _ideal(scene: Scene) -> np.ndarray:
-    from weftsim.mechanism.kinematics import rapier_motion
-
-    theta = np.arange(_HARMONIC_SAMPLES) * (2.0 * math.pi / _HARMONIC_SAMPLES)
-    return rapier_motion(theta, scene.drive.speed, scene.geometry)[2]
 
 
 @functools.lru_cache(maxsize=64)
