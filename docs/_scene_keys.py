@@ -19,6 +19,7 @@ UNITS: tuple[tuple[str, str, float], ...] = (
     ("_mpa_m_s", "MPa m/s", 1e6),
     ("_mpa_s", "mPa s", 1e-3),
     ("_um", "µm", 1e-6),
+    ("_us", "µs", 1e-6),
     ("_kg_m2", "kg m²", 1.0),
     ("_m_s2", "m/s²", 1.0),
     ("_m_s", "m/s", 1.0),

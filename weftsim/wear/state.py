@@ -51,11 +51,14 @@ def scene_identity(scene: Scene) -> str:
     """The scene's file keys as canonical JSON: what a stored state must match to be resumed.
 
     An ideal joint F's ``[joint_f.wear]`` keys are left out: they change nothing, and a state written before F
-    could wear (which did not know them) stays the same scene's.
+    could wear (which did not know them) stays the same scene's.  So are the ``[rapier_tape]`` keys of a scene
+    without a tape (all unset), for a state written before the tape existed.
     """
     from weftsim.input.scene import to_file_keys
 
     keys = to_file_keys(scene)
     if scene.joint_f.is_ideal:
         keys = {k: v for k, v in keys.items() if not k.startswith("joint_f.wear.")}
+    if scene.rapier_tape is None:
+        keys = {k: v for k, v in keys.items() if not k.startswith("rapier_tape.")}
     return json.dumps(keys, sort_keys=True, default=str)
