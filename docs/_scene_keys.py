@@ -23,6 +23,7 @@ UNITS: tuple[tuple[str, str, float], ...] = (
     ("_mpa_m_s", "MPa m/s", 1e6),
     ("_mpa_s", "mPa s", 1e-3),
     ("_um", "µm", 1e-6),
+    ("_us", "µs", 1e-6),
     ("_kg_m2", "kg m²", 1.0),
     ("_m_s2", "m/s²", 1.0),
     ("_m_s", "m/s", 1.0),
@@ -70,6 +71,7 @@ SECTIONS: tuple[tuple[str, str, str], ...] = (
     ("limits.max_damping_ratio", "physics.md#2-clearance-joint-at-e-flores-ambrósio-formulation",
      "physics §2"),
     ("limits.", "hard-cases.md#2-failure-detection", "hard cases §2"),
+    ("rapier_tape.", "rapier-tape.md", "rapier tape"),
 )
 
 # One paragraph per table of the scene file, in the order of the schema.
@@ -99,6 +101,9 @@ TABLES: dict[str, str] = {
     "output": "The output grid.",
     "compare": "Tolerances of `weftsim compare` between the engines.",
     "limits": "What ends a run as failed ([Hard cases](hard-cases.md)), and the rapier heads' limit.",
+    "rapier_tape": "The flexible rapier tape and its head ([The rapier tape](rapier-tape.md)), optional: absent, "
+                   "the rigid rapier of mass `inertia.rapier_mass_kg`; given (even empty), the tape with these "
+                   "keys' defaults, and `inertia.rapier_mass_kg` is not used.",
 }
 
 

@@ -2,7 +2,7 @@
 
 import dataclasses
 
-from weftsim.input.params import Lubrication, Scene
+from weftsim.input.params import Lubrication, RapierTape, Scene
 from weftsim.input.scene import SCHEMA, to_file_keys
 
 
@@ -11,7 +11,8 @@ def main() -> None:
     # with its one required key.
     lubricated = dataclasses.replace(Scene().joint, lubrication=Lubrication(viscosity=0.0))
     joint_f = dataclasses.replace(Scene().joint_f, lubrication=lubricated.lubrication)
-    scene = dataclasses.replace(Scene(), joint=lubricated, joint_f=joint_f)
+    # [rapier_tape] is optional too (absent: the rigid rapier); its defaults are those of an empty table.
+    scene = dataclasses.replace(Scene(), joint=lubricated, joint_f=joint_f, rapier_tape=RapierTape())
     defaults = to_file_keys(scene)
     print("| key | default | allowed | meaning |")
     print("|---|---|---|---|")

@@ -118,10 +118,10 @@ def bundled_scenes() -> list[str]:
     return names()
 
 
-def resolve_engine(engine: str) -> str:
-    """The engine ``engine`` names: ``"auto"`` is :data:`DEFAULT_ENGINE`; an unknown name is an EngineError
-    (:func:`weftsim.engines.resolve`)."""
-    return engines.resolve(engine)
+def resolve_engine(engine: str, scene: Scene | None = None) -> str:
+    """The engine ``engine`` names: ``"auto"`` is :data:`DEFAULT_ENGINE` (the reference engine for a ``scene``
+    whose rapier tape runs flexible); an unknown name is an EngineError (:func:`weftsim.engines.resolve`)."""
+    return engines.resolve(engine, scene)
 
 
 def select_path(scene: Scene, engine: str = "auto") -> dict[str, str]:
@@ -131,7 +131,7 @@ def select_path(scene: Scene, engine: str = "auto") -> dict[str, str]:
     >>> weftsim.select_path(weftsim.load_scene("ideal"), "reference")["model"]
     'ideal joint'
     """
-    return engines.get(engine).select_path(scene)
+    return engines.get(engines.resolve(engine, scene)).select_path(scene)
 
 
 def estimate(scene: Scene | str | os.PathLike, engine: str = "auto") -> engines.Estimate:
@@ -142,7 +142,8 @@ def estimate(scene: Scene | str | os.PathLike, engine: str = "auto") -> engines.
     >>> weftsim.estimate("ideal", "reference").run_time_s   # the closed form: nothing to integrate
     0.0
     """
-    return engines.get(engine).estimate(_as_scene(scene))
+    scene = _as_scene(scene)
+    return engines.get(engines.resolve(engine, scene)).estimate(scene)
 
 
 def _as_scene(scene: Scene | str | os.PathLike) -> Scene:

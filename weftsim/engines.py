@@ -109,10 +109,16 @@ def names() -> tuple[str, ...]:
     return tuple(BUILT_IN) + tuple(sorted(_REGISTERED))
 
 
-def resolve(name: str) -> str:
-    """The engine ``name`` names: ``"auto"`` is :data:`DEFAULT_ENGINE`; a ``module:attribute`` plug-in is
-    itself; an unknown name is an EngineError naming the engines (and the closest one)."""
+def resolve(name: str, scene: Scene | None = None) -> str:
+    """The engine ``name`` names: ``"auto"`` is :data:`DEFAULT_ENGINE`, or for a ``scene`` whose rapier tape runs
+    flexible the reference engine (the one that models it, docs/rapier-tape.md); a ``module:attribute`` plug-in
+    is itself; an unknown name is an EngineError naming the engines (and the closest one)."""
     if name == AUTO:
+        if scene is not None and scene.rapier_tape is not None:
+            from weftsim.model.tape_selection import tape_model
+
+            if tape_model(scene) == "flexible":
+                return "reference"
         return DEFAULT_ENGINE
     if isinstance(name, str) and (name in BUILT_IN or name in _REGISTERED or ":" in name):
         return name
@@ -260,6 +266,8 @@ def simulate(scene: Scene | str | os.PathLike, engine: str = "auto", *,
         raise ArgumentError(f"simulate: progress must be None or a function called with the completed fraction "
                             f"(e.g. lambda f: print(f)), got {type(progress).__name__} {progress!r:.40}")
     scene = _as_scene(scene)
+    if engine == AUTO:  # a flexible rapier tape runs on the engine that models it
+        chosen = get(resolve(engine, scene))
     if any(getattr(scene, attr).lubrication is not None and getattr(scene, attr).lubrication.has_oil
            for attr in ("joint", "joint_f")):
         from weftsim.joint.bearing import resolve_scene

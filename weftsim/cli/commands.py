@@ -367,10 +367,12 @@ def _solve(scene, engine: str, label: str | None = None, announce: bool = False)
     from weftsim.api import resolve_engine, select_path, simulate
     from weftsim.checks.progress import Progress
 
-    engine = resolve_engine(engine)
+    engine = resolve_engine(engine, scene)
     if announce:  # `run`: its first line is the model and method it takes, and why
         path = select_path(scene, engine)
         print(f"scene {scene.name}, engine {engine}: {path['model']}, {path['method']} ({path['reason']})", flush=True)
+        if "rapier" in path:  # a scene with a [rapier_tape]: whether the rigid rapier serves (docs/rapier-tape.md)
+            print(f"rapier: {path['rapier']}", flush=True)
     progress = Progress(label or f"{engine} {scene.name}")
     try:  # the before-run checks are printed once by the command (_announce_checks)
         return simulate(scene, engine, progress=progress, on_warning=_quiet)

@@ -96,7 +96,16 @@ def select_model(scene: Scene) -> tuple[str, str]:
 
 
 def select_path(scene: Scene) -> dict:
-    """``{"model", "method", "reason"}`` of the run :func:`weftsim.exudyn_engine.solve` makes of ``scene``."""
+    """``{"model", "method", "reason"}`` of the run :func:`weftsim.exudyn_engine.solve` makes of ``scene``
+    (and ``"rapier"``, the tape's verdict, for a scene with a ``[rapier_tape]``)."""
+    if scene.rapier_tape is not None:
+        from weftsim.model.tape_selection import rigid_scene, tape_check
+
+        check = tape_check(scene)
+        if check["model"] == "flexible":
+            return {"model": "none", "method": "none", "reason": "no flexible rapier tape in the Exudyn engine yet",
+                    "rapier": check["reason"]}
+        return dict(select_path(rigid_scene(scene)), rapier=check["reason"])
     s = scene.exudyn_solver
     model, reason = select_model(scene)
     if model == "kinematic_tree":

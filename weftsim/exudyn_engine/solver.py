@@ -181,6 +181,8 @@ def solve(scene: Scene, progress: Callable[[float], None] | None = None, callbac
         steps, Newton iterations, Jacobians, contact events, route, step size and wall
         time; ``events["first_contact_time_s"]`` located within its step.
     """
+    if scene.rapier_tape is not None:
+        return _solve_tape_scene(scene, progress, callback, observe)
     wall0 = _time.perf_counter()
     if callback is not None:  # the route is part of the scene the selection sees (selection.py)
         scene = dataclasses.replace(scene, exudyn_solver=dataclasses.replace(scene.exudyn_solver, callback=callback))
@@ -193,6 +195,21 @@ def solve(scene: Scene, progress: Callable[[float], None] | None = None, callbac
                               f"this scene runs on the {path['model']} model", 0.0)
     result = _solve_model(scene, path["model"], progress, None, wall0, observe)
     object.__setattr__(result, "path", path)
+    return result
+
+
+def _solve_tape_scene(scene: Scene, progress, callback, observe) -> RunResult:
+    """A scene with a ``[rapier_tape]``: its rigid equivalent when the tape runs as the rigid rapier
+    (:func:`weftsim.model.tape_selection.tape_model`), else a failed result (this engine has no flexible tape yet)."""
+    from weftsim.model.tape_selection import rigid_scene, tape_check
+
+    check = tape_check(scene)
+    if check["model"] == "flexible":
+        return _failed(scene, "the Exudyn engine does not model the flexible rapier tape yet (docs/rapier-tape.md); "
+                              "run it on engine 'reference', or set rapier_tape.model = 'rigid'", 0.0)
+    result = solve(rigid_scene(scene), progress, callback, observe)
+    object.__setattr__(result, "path", dict(result.path, rapier=check["reason"]))
+    object.__setattr__(result, "scene", scene)
     return result
 
 

@@ -516,6 +516,74 @@ def joint_problem(joint: ClearanceJoint) -> str | None:
 LOOM_JOINT_E = ClearanceJoint(clearance=0.25e-3, law="variable_kd")
 
 
+TAPE_MODELS = ("auto", "flexible", "rigid")
+
+
+@dataclass(frozen=True)
+class RapierTape:
+    """The flexible rapier tape and its head (docs/rapier-tape.md), the scene's ``[rapier_tape]`` table.
+
+    The defaults are a stated basis, not published tape data (none was found): a carbon/epoxy laminate of
+    two thirds 0 deg and one third 90 deg plies of AS4/3501-6 (E1 = 145 GPa, E2 = 10.5 GPa, 1.58 g/cm^3,
+    lamina data of the composites literature, e.g. Daniel and Ishai, Engineering Mechanics of Composite
+    Materials), axial modulus by the iso-strain rule of mixtures 2/3 145 + 1/3 10.5 = 100 GPa; an assumed
+    cross-section of 30 x 2.5 mm; a Kelvin-Voigt time of 1 us (loss factor omega tau = 0.5 % at the first
+    mode of the mid-stroke free length, of the order of carbon/epoxy's low material damping).
+
+    Attributes
+    ----------
+    length : float
+        Whole tape from the head to its tail behind the wheel, m (>= free length + stroke).
+    width, thickness : float
+        Cross-section, m.
+    axial_modulus : float
+        E along the tape, Pa.
+    density : float
+        rho, kg/m^3.
+    damping_time : float
+        Kelvin-Voigt retardation time tau, s: stress = E (strain + tau strain rate).
+    head_mass : float
+        The rapier head at the tape's end, kg.
+    free_length : float
+        The wheel's engagement: tape between the point where it leaves the wheel and the head with the
+        rapier outermost (s = 0), m.
+    guide_friction_coefficient : float
+        Coulomb friction of the head and the free tape on the guide rail under their weight; 0 = off.
+    model : str
+        "auto" (the rigid rapier when the tape's first mode over the stroke is far above the drive's
+        harmonics, :func:`weftsim.model.tape.rigid_serves`), "flexible" or "rigid".
+    modes : int
+        Ritz functions of the tape's axial displacement.
+    """
+
+    length: float = 1.9
+    width: float = 0.030
+    thickness: float = 0.0025
+    axial_modulus: float = 100e9
+    density: float = 1580.0
+    damping_time: float = 1e-6
+    head_mass: float = 0.125
+    free_length: float = 0.25
+    guide_friction_coefficient: float = 0.0
+    model: str = "auto"
+    modes: int = 4
+
+    @property
+    def mass_per_length(self) -> float:
+        """mu = rho A, kg/m."""
+        return self.density * self.width * self.thickness
+
+    @property
+    def axial_stiffness(self) -> float:
+        """EA, N."""
+        return self.axial_modulus * self.width * self.thickness
+
+    @property
+    def mass(self) -> float:
+        """Tape and head, kg: the rigid rapier's m8."""
+        return self.head_mass + self.mass_per_length * self.length
+
+
 @dataclass(frozen=True)
 class Drive:
     """Crank speed and run length; the drive law of a stop-start's transient (:func:`weftsim.physics.chain.crank_motion`).
@@ -711,6 +779,8 @@ class Scene:
     output: Output = field(default_factory=Output)
     compare: CompareTolerance = field(default_factory=CompareTolerance)
     limits: Limits = field(default_factory=Limits)
+    # The flexible rapier tape ([rapier_tape], docs/rapier-tape.md); None: the rigid rapier of mass m8.
+    rapier_tape: RapierTape | None = None
     source: str = ""
     # Keys of [joint_f] (without the table name) that F takes from [joint_e] because the scene does not
     # give them (weftsim.input.joint_keys); bookkeeping of how the scene was written, not part of the machine.

@@ -61,6 +61,8 @@ MAX_SCENE_BYTES = 1 << 20
 # Longest `extends` chain: the deepest in models/ is 2 files; 64 leaves room for any layering
 # a user builds and stops a runaway chain with one line instead of a RecursionError.
 MAX_EXTENDS_DEPTH = 64
+# The optional table of the flexible rapier tape (docs/rapier-tape.md): given even empty, the scene has a tape.
+TAPE_TABLE = "rapier_tape"
 
 
 def _spelling(table: tuple[str, ...], name: str) -> str:
@@ -78,7 +80,9 @@ def _flatten(table: dict, where: str, prefix: tuple[str, ...] = (),
     for name, value in table.items():
         path = ".".join(prefix + (name,))
         if isinstance(value, dict):
-            if not value:
+            if not value and path == TAPE_TABLE:  # an empty [rapier_tape]: the tape with its defaults
+                flat[path] = {}
+            elif not value:
                 _check_empty_table(path, where)
             flat.update(_flatten(value, where, prefix + (name,), seen))
             continue
@@ -410,6 +414,15 @@ def _check_scene(scene: params.Scene, where: str, origin: dict[str, Path]) -> No
             "(the four-bar O-E-F-G does not close: check mechanism.l_oe_mm, l_ef_mm, l_fg_mm, l_og_mm "
             "and rocker_arm_angle_deg)"
         )
+    if scene.rapier_tape is not None:
+        from weftsim.mechanism.kinematics import rapier_stroke
+
+        tape = scene.rapier_tape
+        longest = tape.free_length + rapier_stroke(scene.geometry)
+        if tape.length < longest * (1.0 - 1e-12):  # the tape cannot run out of the wheel
+            raise SceneError(f"{at('rapier_tape.length_mm')}: key 'rapier_tape.length_mm' must be at least "
+                             f"free_length_mm + the stroke = {longest * 1e3:.1f} mm (the tape cannot run out of the "
+                             f"wheel), got {tape.length * 1e3:g}")
 
 
 def _known(path: str, where: str) -> Key:
@@ -443,6 +456,9 @@ def scene_from_keys(flat: dict[str, Any], where: str = "scene", origin: dict[str
     _check_lubrication_given(flat, where)
     for path, value in flat.items():
         if path in TOP_LEVEL:
+            continue
+        if path == TAPE_TABLE:  # an empty [rapier_tape] table (_flatten)
+            scene = replace(scene, rapier_tape=scene.rapier_tape or params.RapierTape())
             continue
         src = str(origin.get(path, where))
         key = _known(path, src)
@@ -506,7 +522,7 @@ def load_scene(path: str | os.PathLike, overrides: dict[str, Any] | None = None,
         flat[dotted] = value
         origin[dotted] = Path(overrides_from)
     for dotted in flat:  # a misspelt key is reported as such, not as the missing one it stands for
-        if dotted not in TOP_LEVEL:
+        if dotted not in TOP_LEVEL and dotted != TAPE_TABLE:
             _known(dotted, str(origin.get(dotted, path)))
     if "joint_f.clearance_mm" not in flat:  # a [joint_f] table without a clearance describes an ideal joint
         stray = [key for key in flat if key.startswith("joint_f.") and describes_joint(key)

@@ -151,6 +151,35 @@ def LUBRICATION_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 -
     )
 
 
+# [rapier_tape] (docs/rapier-tape.md): optional as a whole (absent: the rigid rapier of mass m8); given, every key
+# defaults (params.RapierTape states the defaults' basis).  Ranges: what the axial bar model describes.
+TAPE_MODELS = params.TAPE_MODELS
+RAPIER_TAPE_KEYS: tuple[Key, ...] = (
+    Key("rapier_tape.length_mm", "rapier_tape.length", "float", MM, 0, 1e5,
+        doc="whole tape from the head to its tail behind the wheel (>= free_length_mm + the stroke); default 1900"),
+    Key("rapier_tape.width_mm", "rapier_tape.width", "float", MM, 0, 1000, doc="tape width (default 30, assumed)"),
+    Key("rapier_tape.thickness_mm", "rapier_tape.thickness", "float", MM, 0, 100,
+        doc="tape thickness (default 2.5, assumed)"),
+    Key("rapier_tape.axial_modulus_gpa", "rapier_tape.axial_modulus", "float", GPA, 0, 1000,
+        doc="axial Young's modulus (default 100: carbon/epoxy laminate, 2/3 of the plies at 0 deg)"),
+    Key("rapier_tape.density_kg_m3", "rapier_tape.density", "float", 1, 0, 20000,
+        doc="density (default 1580: carbon/epoxy)"),
+    Key("rapier_tape.damping_time_us", "rapier_tape.damping_time", "float", 1e-6, 0, 1e4, False,
+        doc="Kelvin-Voigt structural damping, stress = E (strain + tau strain rate) (default 1 us); 0 = none"),
+    Key("rapier_tape.head_mass_kg", "rapier_tape.head_mass", "float", 1, 0, 100, doc="rapier head (default 0.125)"),
+    Key("rapier_tape.free_length_mm", "rapier_tape.free_length", "float", MM, 0, 1e5,
+        doc="the wheel's engagement: free tape from where it leaves the wheel to the head, rapier outermost "
+            "(default 250)"),
+    Key("rapier_tape.guide_friction_coefficient", "rapier_tape.guide_friction_coefficient", "float", 1, 0, 2,
+        False, doc="Coulomb friction of head and free tape on the guide rail under their weight (default 0: off)"),
+    Key("rapier_tape.model", "rapier_tape.model", "str", choices=TAPE_MODELS,
+        doc="auto: the rigid rapier when the tape's first mode over the stroke is far above the drive's "
+            "harmonics, else the flexible tape; flexible; rigid (tape and head as one mass)"),
+    Key("rapier_tape.modes", "rapier_tape.modes", "int", 1, 2, 8, False, False,
+        doc="Ritz functions of the tape's axial displacement (default 4)"),
+)
+
+
 SCHEMA: tuple[Key, ...] = (
     Key("mechanism.crank_inclination_deg", "geometry.crank_inclination", "float", DEG, 0, 90, True, True,
         doc="beta, arc A-B of the spherical 4R"),
@@ -307,7 +336,7 @@ def _joint_f_keys() -> tuple[Key, ...]:
     return tuple(out)
 
 
-SCHEMA = SCHEMA + _joint_f_keys()
+SCHEMA = SCHEMA + _joint_f_keys() + RAPIER_TAPE_KEYS
 _BY_PATH = {key.path: key for key in SCHEMA}
 TOP_LEVEL = ("name", "description", "extends")
 # Sections that describe the machine: a scene must give all their keys, itself or through
@@ -344,4 +373,6 @@ def _set(scene: params.Scene, target: str, value: Any) -> params.Scene:
     inner = getattr(scene, head)
     if inner is None and head == "lubrication":  # the table's first key: the film starts from the defaults
         inner = params.Lubrication(viscosity=0.0)
+    if inner is None and head == "rapier_tape":  # the table's first key: the tape starts from the defaults
+        inner = params.RapierTape()
     return replace(scene, **{head: _set(inner, rest, value)})

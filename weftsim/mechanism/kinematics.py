@@ -275,6 +275,12 @@ def linkage_state(theta: ArrayLike, geometry: Geometry, rocker_com_distance: flo
     )  # fmt: skip
 
 
+def rapier_stroke(geometry: Geometry, samples: int = 1441) -> float:
+    """The rapier's stroke: the largest s of a revolution (s = 0 outermost), m, on ``samples`` crank angles."""
+    theta = np.linspace(0.0, 2.0 * np.pi, samples)
+    return float(np.max(linkage_state(theta, geometry).rapier_displacement))
+
+
 def rapier_motion(theta: ArrayLike, omega: float, geometry: Geometry) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Rapier displacement, velocity and acceleration at constant crank speed.
 

@@ -128,7 +128,17 @@ def pack_parameters(scene: Scene) -> np.ndarray:
     """Every number the kernel needs for this scene: the joint block at E, the chain's constants,
     the joint block at F (zeros while F is ideal), the topology, J_FG and J4; then the wear tables
     of the worn joints (:mod:`weftsim.physics.wear`): E's at ``kc.WEAR_E``, then F's (E's block is the
-    empty ``[0, 0]`` when only F is worn; :func:`weftsim.physics.chain_f.wear_start_f`)."""
+    empty ``[0, 0]`` when only F is worn; :func:`weftsim.physics.chain_f.wear_start_f`).
+
+    A scene whose tape runs flexible (:func:`weftsim.model.tape_selection.tape_model`) gets topology E_TAPE and the
+    tape block (:func:`weftsim.model.tape.flexible_parameters`); one whose tape runs rigid, its rigid equivalent's."""
+    if scene.rapier_tape is not None:
+        from weftsim.model import tape as tape_model_
+        from weftsim.model.tape_selection import tape_model
+
+        if tape_model(scene) == "rigid":
+            return pack_parameters(tape_model_.rigid_equivalent(scene))
+        return tape_model_.flexible_parameters(scene, pack_parameters(tape_model_.massless_rapier(scene)))
     out = np.zeros(kf.N_PARAMETERS)
     out[:kc.N_PARAMETERS] = _chain_block(ChainConstants.from_scene(scene))
     if not scene.joint.is_ideal or scene.joint_f.is_ideal:
@@ -241,6 +251,19 @@ def initial_state(scene: Scene) -> np.ndarray:
     With clearance at E and F (4 coordinates) the state is [a, Y, Z, psi, a', Y', Z', psi', W3, D],
     (Y, Z) the rod's centre of mass (:mod:`weftsim.physics.chain_f`).
     """
+    if scene.rapier_tape is not None:  # [a, psi, q, a', psi', q', W3, D] (weftsim.physics.tape)
+        from weftsim.model import tape as tape_model_
+        from weftsim.model.tape_selection import tape_model
+
+        if tape_model(scene) == "rigid":
+            return initial_state(tape_model_.rigid_equivalent(scene))
+        # The wheel's acceleration at t = 0 with the tape as the rigid rapier: the tape starts in equilibrium with it.
+        rigid = tape_model_.rigid_equivalent(scene)
+        y = initial_state(rigid)
+        rate = np.empty(y.size)
+        kc.chain(pack_parameters(rigid), 0.0, y, False, 0.0, rate)
+        chain = initial_state(tape_model_.massless_rapier(scene))
+        return tape_model_.flexible_initial_state(scene, chain, scene.geometry.rapier_ratio * rate[2])
     omega = scene.drive.speed
     if scene.drive.law != "constant":
         return _transient_state(scene)

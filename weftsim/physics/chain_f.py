@@ -49,6 +49,7 @@ from weftsim.physics import chain as kc
 from weftsim.physics.joint import BEARING_RADIUS, CLEARANCE, KIND, COEF, MU, N_JOINT, clearance_force_at, tangential_velocity
 from weftsim.physics.laws import elastic_force
 from weftsim.physics.lubricated import L_DISSIPATED, L_FX, L_FY, L_MB, L_MJ, is_lubricated, lubricated_force
+from weftsim.physics.tape import chain_state, chain_tape
 from weftsim.physics.wear import block_end, clearance_along
 
 if TYPE_CHECKING:
@@ -59,8 +60,9 @@ JOINT_F = kc.N_PARAMETERS
 TOPOLOGY, SECTOR_CHAIN, ROD_INERTIA = range(JOINT_F + N_JOINT, JOINT_F + N_JOINT + 3)
 N_PARAMETERS = JOINT_F + N_JOINT + 3
 assert N_PARAMETERS == kc.WEAR_E, "the wear tables of a worn E follow this layout (weftsim.physics.chain.WEAR_E)"
-# Topologies: which joints have a clearance.
-E_ONLY, F_ONLY, E_AND_F = 0, 1, 2
+# Topologies: which joints have a clearance; E_TAPE: clearance at E with the flexible rapier tape
+# (weftsim.physics.tape; its state appends the tape's coordinates to E_ONLY's).
+E_ONLY, F_ONLY, E_AND_F, E_TAPE = 0, 1, 2, 3
 # Joint numbers (bits of the contact mask, rows of the held impact velocities).
 JOINT_E_INDEX, JOINT_F_INDEX = 0, 1
 N_JOINTS = 2
@@ -80,7 +82,7 @@ def joint_is_loose(prm: np.ndarray, joint: int) -> bool:
     topology = prm[TOPOLOGY]
     if joint == JOINT_E_INDEX:
         return topology != F_ONLY and prm[CLEARANCE] > 0.0
-    return topology != E_ONLY
+    return topology != E_ONLY and topology != E_TAPE
 
 
 @njit(cache=True, error_model="numpy")
@@ -207,6 +209,8 @@ def penetration_at(prm: np.ndarray, t: float, y: np.ndarray, joint: int) -> tupl
     """(delta, delta_dot) of ``joint`` (0 = E, 1 = F) of state y at time t (m, m/s)."""
     if prm[TOPOLOGY] == E_ONLY:
         return kc.penetration(prm, t, y)
+    if prm[TOPOLOGY] == E_TAPE:  # E's chain with the tape: the same first four coordinates, a round joint
+        return kc.penetration(prm[:kc.WEAR_E], t, chain_state(prm, y))
     q = eccentricities(prm, t, y)
     c_e, rate_e, c_f, rate_f = local_clearances(prm, t, y, q)
     if joint == JOINT_E_INDEX:
@@ -296,10 +300,13 @@ def chain_f(prm: np.ndarray, t: float, y: np.ndarray, contact: int, impact: np.n
 def rhs_any(prm: np.ndarray, t: float, y: np.ndarray, contact: int, impact: np.ndarray, out: np.ndarray) -> float:
     """y' of any topology into ``out``; returns delta of the first loose joint (the E-only chain's value).
 
-    E_ONLY: :func:`weftsim.physics.chain.chain` with contact bit 0 and impact[0], unchanged.
+    E_ONLY: :func:`weftsim.physics.chain.chain` with contact bit 0 and impact[0], unchanged; E_TAPE:
+    :func:`weftsim.physics.tape.chain_tape` likewise.
     """
     if prm[TOPOLOGY] == E_ONLY:
         return kc.chain(prm, t, y, (contact & 1) != 0, impact[0], out)[2]
+    if prm[TOPOLOGY] == E_TAPE:
+        return chain_tape(prm, t, y, (contact & 1) != 0, impact[0], out)[2]
     r = chain_f(prm, t, y, contact, impact, out)
     return r[2] if prm[TOPOLOGY] == E_AND_F else r[6]
 

@@ -12,7 +12,8 @@ import math
 import numpy as np
 
 from weftsim.post.results import (
-    PEAK_CHANNELS, PEAK_CHANNELS_F, PEAK_CHANNELS_LUBRICATION, PEAK_CHANNELS_LUBRICATION_F, RunResult,
+    PEAK_CHANNELS, PEAK_CHANNELS_F, PEAK_CHANNELS_LUBRICATION, PEAK_CHANNELS_LUBRICATION_F, PEAK_CHANNELS_TAPE,
+    RunResult,
 )  # fmt: skip
 
 
@@ -27,6 +28,8 @@ def peak_channels(result: RunResult) -> tuple[str, ...]:
     if "film_ratio_f" in result.steps:
         names += ("film_ratio_f",) + PEAK_CHANNELS_LUBRICATION_F
     names += tuple(name for name in ("joint_force_N", "joint_force_f_N") if name in result.steps)
+    if "head_acceleration_m_s2" in result.steps:  # the flexible rapier tape (docs/rapier-tape.md)
+        names += PEAK_CHANNELS_TAPE
     return names
 
 

@@ -38,6 +38,13 @@ PANELS_LUBRICATION = (
 )
 
 
+# Added when every curve has the flexible rapier tape (weftsim.post.results.TAPE_CHANNELS).
+PANELS_TAPE = (
+    ("head_acceleration_m_s2", "head acceleration [m/s²]", 1.0),
+    ("tape_force_wheel_N", "tape force at the wheel [N]", 1.0),
+)
+
+
 def clearance_label(scene: Scene) -> str:
     """``c = 0.25 mm`` (clearance at E alone, as before), or the clearance of each joint: ``c_E = 0.25, c_F = 0.25 mm``."""
     if scene.joint_f.is_ideal:
@@ -92,6 +99,7 @@ def channel_panels(curves: list[tuple], title: str, panels: tuple | None = None)
     if panels is None:
         panels = PANELS + (PANELS_F if curves and all("contact_force_f_N" in data for _, data, _ in curves) else ())
         panels += PANELS_LUBRICATION if curves and all("film_ratio" in data for _, data, _ in curves) else ()
+        panels += PANELS_TAPE if curves and all(PANELS_TAPE[0][0] in data for _, data, _ in curves) else ()
     from weftsim.post.results import LOAD_FALLBACK
 
     rows = len(panels) // 2

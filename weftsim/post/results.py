@@ -87,6 +87,21 @@ JOINT_FORCE_CHANNELS: tuple[str, ...] = ("joint_force_N",)
 JOINT_FORCE_CHANNELS_F: tuple[str, ...] = ("joint_force_f_N",)
 # What a result saved before the load channels existed gives in their place: its dry law's contact force.
 LOAD_FALLBACK = {"joint_force_N": "contact_force_N", "joint_force_f_N": "contact_force_f_N"}
+# Channels of the flexible rapier tape (docs/rapier-tape.md), present exactly when the run models the tape as
+# flexible (weftsim.model.tape_selection.tape_model): the head's motion (s of the head's rigid position plus the tape's
+# axial displacement there), the tape's axial force where it leaves the wheel and at the head (tension
+# positive), the free length, its first axial natural frequency (the closed form at that length) and the
+# tape's strain energy.  rapier_* stay the wheel's pitch-circle motion (the rigid rapier's).
+TAPE_CHANNELS: tuple[str, ...] = (
+    "head_displacement_m",
+    "head_velocity_m_s",
+    "head_acceleration_m_s2",
+    "tape_force_wheel_N",
+    "tape_force_head_N",
+    "tape_free_length_m",
+    "tape_frequency_hz",
+    "tape_strain_energy_J",
+)
 
 # Joint E's channel of each joint-F channel (same quantity at the other joint).
 JOINT_E_NAME = dict(zip(JOINT_F_CHANNELS, ("contact_force_N", "penetration_m", "eccentricity_y_m",
@@ -120,10 +135,13 @@ PEAK_CHANNELS_F: tuple[str, ...] = ("contact_force_f_N", "penetration_f_m")
 # Peak channels of a lubricated joint (E's, F's); the film ratio's minimum is its summary (analysis).
 PEAK_CHANNELS_LUBRICATION: tuple[str, ...] = ("film_force_N", "asperity_force_N", "film_torque_Nm")
 PEAK_CHANNELS_LUBRICATION_F: tuple[str, ...] = ("film_force_f_N", "asperity_force_f_N", "film_torque_f_Nm")
+# Peak channels of the flexible rapier tape; the first frequency's min and max span the stroke.
+PEAK_CHANNELS_TAPE: tuple[str, ...] = ("head_displacement_m", "head_velocity_m_s", "head_acceleration_m_s2",
+                                       "tape_force_wheel_N", "tape_force_head_N", "tape_frequency_hz")
 
 
 OPTIONAL_GROUPS = (JOINT_F_CHANNELS, LUBRICATION_CHANNELS, LUBRICATION_CHANNELS_F, JOINT_FORCE_CHANNELS,
-                   JOINT_FORCE_CHANNELS_F)
+                   JOINT_FORCE_CHANNELS_F, TAPE_CHANNELS)
 
 
 def optional_channels(names) -> tuple[str, ...]:
@@ -146,7 +164,7 @@ def _as_channels(data: dict[str, np.ndarray], what: str) -> dict[str, np.ndarray
     names = CHANNELS
     for group, label in ((JOINT_F_CHANNELS, "joint F"), (LUBRICATION_CHANNELS, "lubrication"),
                          (LUBRICATION_CHANNELS_F, "joint F lubrication"), (JOINT_FORCE_CHANNELS, "joint E load"),
-                         (JOINT_FORCE_CHANNELS_F, "joint F load")):
+                         (JOINT_FORCE_CHANNELS_F, "joint F load"), (TAPE_CHANNELS, "rapier tape")):
         given = [name for name in group if name in data]
         if given:
             if len(given) != len(group):
@@ -304,6 +322,11 @@ def scene_channels(scene: Scene) -> tuple[str, ...]:
         names += JOINT_FORCE_CHANNELS
     if not scene.joint_f.is_ideal:
         names += JOINT_FORCE_CHANNELS_F
+    if scene.rapier_tape is not None:
+        from weftsim.model.tape_selection import tape_model
+
+        if tape_model(scene) == "flexible":
+            names += TAPE_CHANNELS
     return names
 
 

@@ -56,6 +56,9 @@ def _check(scene: Scene) -> str | None:
             import numba  # noqa: F401 - a dependency; checked for installs that lost it
         except ImportError:
             return f"`solver.reference.method` = {settings.method!r} needs numba installed; use 'DOP853' (scipy)"
+    if _flexible_tape(scene) and compiled_method(scene) is None:
+        return (f"`solver.reference.method` = {settings.method!r} cannot run the flexible rapier tape: the scipy path "
+                f"carries the rigid chain only; use 'auto' or one of {list(COMPILED_METHODS)}")
     if not scene.joint_f.is_ideal and compiled_method(scene) is None:
         return (f"`solver.reference.method` = {settings.method!r} cannot run a clearance at F (joint_f): the scipy "
                 f"path carries the clearance at E only; use 'auto' or one of {list(COMPILED_METHODS)}")
@@ -112,6 +115,10 @@ def compiled_method(scene: Scene) -> str | None:
     """
     method = scene.reference_solver.method
     if method == AUTO:
+        if _flexible_tape(scene):
+            # The tape's Ritz modes reach 10^5-10^6 rad/s, overdamped by the Kelvin-Voigt damping: a stiff
+            # system for an explicit method (docs/rapier-tape.md); RODAS4's step follows the accuracy alone.
+            return "numba_RODAS4"
         if any(j.is_lubricated for j in (scene.joint, scene.joint_f) if not j.is_ideal):
             # The film loads the joint at every step, not in contact segments alone: RODAS4 throughout
             # (loom, 600 rpm, c = 0.02 mm, 80 mPa s, one revolution: 20 897 steps against 363 870 of
@@ -119,6 +126,15 @@ def compiled_method(scene: Scene) -> str | None:
             return "numba_RODAS4"
         return "numba_DOP853_RODAS4" if stiff_joints(scene) else "numba_DOP853"
     return method if method in COMPILED_METHODS else None
+
+
+def _flexible_tape(scene: Scene) -> bool:
+    """True when the scene's rapier tape runs flexible (:func:`weftsim.model.tape_selection.tape_model`)."""
+    if scene.rapier_tape is None:
+        return False
+    from weftsim.model.tape_selection import tape_model
+
+    return tape_model(scene) == "flexible"
 
 
 def effective_rtol(scene: Scene) -> float:
@@ -143,7 +159,22 @@ def switches_by_sliding(scene: Scene) -> bool:
 
 
 def select_path(scene: Scene) -> dict:
-    """``{"model", "method", "reason"}`` of the run :func:`solve` makes of ``scene``."""
+    """``{"model", "method", "reason"}`` of the run :func:`solve` makes of ``scene`` (and ``"rapier"``: the
+    tape's verdict, :func:`weftsim.model.tape_selection.tape_check`, when the scene has a ``[rapier_tape]``)."""
+    if scene.rapier_tape is not None:
+        from weftsim.model.tape_selection import rigid_scene, tape_check
+
+        check = tape_check(scene)
+        path = select_path(rigid_scene(scene)) if check["model"] == "rigid" else _select_path(scene)
+        if check["model"] == "flexible":
+            path["model"] += f" with the flexible rapier tape ({scene.rapier_tape.modes} Ritz functions)"
+        else:
+            path["model"] += " with the tape and head as the rigid rapier"
+        return dict(path, rapier=check["reason"])
+    return _select_path(scene)
+
+
+def _select_path(scene: Scene) -> dict:
     if scene.is_ideal:
         return {"model": "ideal joint", "method": "closed form",
                 "reason": "clearance 0: no free coordinate, nothing to integrate"}
@@ -219,7 +250,15 @@ def solve(scene: Scene, progress: Callable[[float], None] | None = None,
         integration fails; what was computed up to then is kept.  Invalid solver settings
         also give a failed result naming the setting.
     """
-    problem = _check(scene)
+    original = scene
+    problem = None
+    if scene.rapier_tape is not None:
+        from weftsim.model.tape_selection import flexible_problem, rigid_scene
+
+        scene = rigid_scene(scene)
+        problem = flexible_problem(scene) if scene.rapier_tape is not None else None
+    if problem is None:
+        problem = _check(scene)
     if problem is not None:
         empty = empty_channels(not scene.joint_f.is_ideal)
         return RunResult(scene, "reference", "failed", problem, empty, empty,
@@ -228,5 +267,6 @@ def solve(scene: Scene, progress: Callable[[float], None] | None = None,
         result = _solve_ideal(scene, progress)
     else:
         result = _solve_clearance(scene, progress, observe)
-    object.__setattr__(result, "path", select_path(scene))
+    object.__setattr__(result, "path", select_path(original))
+    object.__setattr__(result, "scene", original)  # a tape run as the rigid rapier: the scene asked for
     return result  # vetted once, outside the engines, by weftsim.api.simulate (weftsim.checks.guards.vet_result)

@@ -184,8 +184,12 @@ def solve_compiled(scene: Scene, progress: Callable[[float], None] | None = None
         observe(*steps)
     wall0 = _time.perf_counter()
 
+    fill = compiled_channels
+    if scene.rapier_tape is not None:  # the flexible tape (a rigid one arrives as its rigid equivalent)
+        from weftsim.reference.tape_channels import tape_channels as fill
+
     def channels(arrays):
-        return compiled_channels(scene, *arrays) if arrays[0].size else empty_channels(not scene.joint_f.is_ideal)
+        return fill(scene, *arrays) if arrays[0].size else empty_channels(not scene.joint_f.is_ideal)
 
     step_channels, sample_channels = channels(steps), channels(samples)
     stats["postprocess_time_s"] = _time.perf_counter() - wall0

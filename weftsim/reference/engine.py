@@ -41,6 +41,11 @@ EXPLICIT_STIFF_FACTOR = 1500.0
 # Recorded step rows per revolution of the implicit path with friction, ~13 000 (3 200 steps); the dry
 # default's is weftsim.checks.progress.STEP_ROWS_PER_REVOLUTION.
 IMPLICIT_STEP_ROWS_PER_REVOLUTION = 1.3e4
+# The flexible rapier tape (RODAS4 throughout): loom_tape, 600 rpm, two revolutions, 3.8 s of CPU and 92 300 steps
+# against 0.068 s and 2 670 steps of the rigid loom on numba_DOP853 (issue 33, one process, load average 12):
+# per revolution, 1.9 s and ~50 000 step rows (docs/rapier-tape.md, section 6).
+FLEXIBLE_TAPE_SECONDS_PER_REVOLUTION = 1.9
+FLEXIBLE_TAPE_STEP_ROWS_PER_REVOLUTION = 5e4
 
 
 def _path(scene: Scene) -> tuple[str, bool]:
@@ -59,6 +64,14 @@ def estimate(scene: Scene) -> Estimate:
     """The run's cost (:class:`weftsim.engines.Estimate`): 0 for the closed-form ideal joint; else the path's
     rate at its tolerance, x :data:`EXPLICIT_STIFF_FACTOR` on an explicit path with a stiff joint law
     (:func:`weftsim.model.stiffness.stiff_joints`); the step rows per revolution likewise."""
+    if scene.rapier_tape is not None:
+        from weftsim.model.tape_selection import rigid_scene
+
+        if rigid_scene(scene).rapier_tape is not None:  # the flexible tape
+            revolutions = scene.drive.revolutions
+            return Estimate(revolutions * FLEXIBLE_TAPE_SECONDS_PER_REVOLUTION,
+                            revolutions * FLEXIBLE_TAPE_STEP_ROWS_PER_REVOLUTION * NPZ_BYTES_PER_ROW, False)
+        scene = rigid_scene(scene)
     if scene.is_ideal:
         return Estimate(0.0, 0.0, False)
     revolutions = scene.drive.revolutions

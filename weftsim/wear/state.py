@@ -57,7 +57,8 @@ def scene_identity(scene: Scene) -> str:
 
     An ideal joint F's ``[joint_f.wear]`` keys are left out: they change nothing, and a state written before F
     could wear (which did not know them) stays the same scene's; so are the oil's and its heat balance's keys of a
-    joint that names no oil (a fixed viscosity or a dry joint), for a state written before they existed.
+    joint that names no oil (a fixed viscosity or a dry joint), for a state written before they existed.  So are the
+    ``[rapier_tape]`` keys of a scene without a tape (all unset), for a state written before the tape existed.
     """
     from weftsim.input.scene import to_file_keys
 
@@ -81,6 +82,8 @@ def scene_identity(scene: Scene) -> str:
     for table, joint in (("joint_e", scene.joint), ("joint_f", scene.joint_f)):
         if joint.lubrication is None or not joint.lubrication.has_oil:  # the oil's keys change nothing without one
             keys = {k: v for k, v in keys.items() if k not in {f"{table}.lubrication.{name}" for name in HEAT_KEYS}}
+    if scene.rapier_tape is None:
+        keys = {k: v for k, v in keys.items() if not k.startswith("rapier_tape.")}
     return json.dumps(keys, sort_keys=True, default=str)
 
 
