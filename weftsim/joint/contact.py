@@ -473,7 +473,7 @@ def exact_hysteresis(restitution: float) -> float:
 class Cylindrical(_Law):
     """The conformal pin in its bushing, fitted to a plane-strain finite-element model (issue 37).
 
-    F_el = k delta^n, a power law in the approach delta (the multibody penetration |e| - c), with
+    F_el = k delta^n, a power law in the approach delta (the multibody penetration ``|e| - c``), with
 
         k = L_b E* R^(1 - n) exp(k0 + k1 ln(c/R) + k2 ln(t/R)),    n = n0 + n1 ln(c/R) + n2 ln(t/R),
 

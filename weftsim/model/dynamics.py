@@ -194,7 +194,7 @@ def eccentricity(xp: ModuleType | None, p: ChainConstants, t: ArrayLike, a: Arra
 
 
 def penetration(p: ChainConstants, t: float, y: np.ndarray) -> tuple[float, float]:
-    """delta = |e| - c (m) and delta_dot = e_dot . n (m/s) of a state y (:func:`weftsim.physics.chain.penetration`)."""
+    """``delta = |e| - c`` (m) and delta_dot = e_dot . n (m/s) of a state y (:func:`weftsim.physics.chain.penetration`)."""
     return kc.penetration(_geometry_parameters(p), float(t), np.asarray(y[:4], dtype=float))
 
 
