@@ -49,7 +49,7 @@ from weftsim.physics.python import python_form
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from numba.core.registry import CPUDispatcher
+    from numba.core.dispatcher import Dispatcher
 
     from weftsim.joint.contact import _Law
 
@@ -93,7 +93,7 @@ def parameters_for_route(prm: np.ndarray, route: str) -> np.ndarray | list[float
     return prm.tolist() if route == "python" else prm
 
 
-def kernel_form(function: CPUDispatcher, route: str) -> Callable:
+def kernel_form(function: Dispatcher, route: str) -> Callable:
     if route == "python":
         return python_form(function)
     if route == "numba":
