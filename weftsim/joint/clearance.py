@@ -224,10 +224,10 @@ def make_clearance_kernel(law: _Law, joint: ClearanceJoint, jit: bool = False) -
             return fx, fy, f_n, delta, delta_dot, m_j, m_b
 
         return compiled
-    force = python_form(kernel_joint.clearance_force)
+    python_force = python_form(kernel_joint.clearance_force)
 
     def kernel(ex: float, ey: float, ex_dot: float, ey_dot: float, v_t: float, v_imp: float):
-        fx, fy, f_n, _, delta, delta_dot, m_j, m_b = force(prm, ex, ey, ex_dot, ey_dot, v_t, v_imp)
+        fx, fy, f_n, _, delta, delta_dot, m_j, m_b = python_force(prm, ex, ey, ex_dot, ey_dot, v_t, v_imp)
         return fx, fy, f_n, delta, delta_dot, m_j, m_b
 
     return kernel
