@@ -16,6 +16,7 @@ import pytest
 
 from weftsim import exudyn_engine, reference
 from weftsim.physics import chain as kc
+from weftsim.physics.laws import elastic_force
 from weftsim.physics.wear import worn_clearance
 from weftsim.model.dynamics import initial_state, pack_parameters
 from weftsim.input.scene import load_scene
@@ -75,6 +76,39 @@ def test_the_tree_contact_reads_the_same_worn_clearance_as_the_reference_chain()
         assert round_tree[2] - tree[2] == pytest.approx(depth, abs=1e-15)
         depths.append(depth)
     assert max(depths) > 0.3 * c0 and min(depths) < 0.01 * c0  # the states meet the worn spots and unworn wall
+
+
+def test_the_trees_powers_on_a_worn_wall_are_the_reference_chains():
+    """The drawn and dissipated powers the explicit tree integrates (W3', D' of :func:`tree_joint_force`) equal
+    the reference chain's at penetrated states of a worn joint, where the wall's profile passes under the journal
+    (dc/dt != 0): D' holds the radial force's work F_N dc/dt there, as the chain's does."""
+    scene = load_scene("loom")
+    worn = _worn(scene, 1.0)[0]
+    prm = pack_parameters(worn)
+    rng = np.random.default_rng(5)
+    a0, psi0 = initial_state(scene)[:2]
+    moving = 0
+    for t in rng.uniform(0.0, 2e-4, 3000):
+        y = np.array([a0 + rng.normal(0.0, 3e-5), psi0 + rng.normal(0.0, 3e-5), rng.normal(0.0, 5.0),
+                      rng.normal(0.0, 5.0), 0.0, 0.0])  # fmt: skip
+        delta, rate = kc.penetration(prm, t, y)
+        if delta <= 0.0:
+            continue
+        held = max(rate, 0.05)  # one impact velocity for both (the chain's argument, the tree's held one)
+        out = np.zeros(6)
+        f_n = kc.chain(prm, t, y, True, held, out)[1]
+        tree = kc.tree_joint_force(prm, t, y[0], y[1] + math.pi - y[0], y[2], y[3] - y[2], held, 1e-6, rate)
+        ecc_y, ecc_z, v_y, v_z = kc.eccentricity(prm, t, y)[:4]
+        c, c_rate = kc.local_clearance(prm, t, ecc_y, ecc_z, v_y, v_z, y)
+        # the same kernel in two coordinate sets: 1e-8 (the round joint's, test_friction_agreement) of the size of
+        # the terms W3' and D' are differences of, (F_N + F_el) (|e_dot| + |dc/dt|) (measured: 3.5e-9 of it; F_N
+        # alone can be 0 where the damping clips it, D' = -F_el delta_dot then)
+        f_el = elastic_force(prm[kc.KIND], prm[kc.COEF], c, delta)
+        scale = 1e-8 * (f_n + f_el) * (math.hypot(v_y, v_z) + abs(c_rate))
+        assert tree[12] == pytest.approx(out[4], rel=1e-8, abs=scale)
+        assert tree[13] == pytest.approx(out[5], rel=1e-8, abs=scale)
+        moving += abs(f_n * c_rate) > 0.01 * abs(out[5])  # the term the tree once left out matters here
+    assert moving >= 10  # states on the worn spots with the profile moving under the journal
 
 
 def test_a_worn_scene_agrees_between_the_engines_to_the_compare_tolerances():
