@@ -166,14 +166,15 @@ def test_the_exudyn_update_integrates_archard_over_its_own_contact_channels():
     # at rtol 1e-5 .. 1e-11: 279.3, 291.7, 291.1, 277.9, 281.1 J; Exudyn at 1e-7 .. 1e-11: 287.0, 273.9, 278.5,
     # 277.0, 290.2 J), while the round joint's converges on both (245.84 J, engines 9e-5 apart at 1e-9).  So
     # the Exudyn update must fall within the reference engine's scatter over three of its tolerances widened by
-    # that scatter's width (the criterion of the chaotic hours, test_both_engines_agree_on_the_hours_...).
+    # that scatter's width (the criterion of the chaotic hours, test_both_engines_agree_on_the_hours_...):
+    # measured 279.3, 286.5, 285.5 J (2.5 %), Exudyn 287.0 J, 0.46 of the width from their mean.
     # Not the sliding distance: it counts rows of any load, and where the journal crosses the worn spot under a
     # few N the engines end the light contact at different steps.
     works = [ref.sliding_work] + [engine_update(replace(scene, reference_solver=replace(
         scene.reference_solver, rtol=rtol, atol=1e-12)), bearing, journal, "reference")[0].sliding_work
         for rtol in (1e-7, 1e-9)]
     spread = max(works) - min(works)
-    assert spread > 0.01 * np.mean(works)  # the scatter is there (measured 4.4 %)
+    assert spread > 0.01 * np.mean(works)  # the scatter is there (measured 2.5 %)
     assert abs(ex.sliding_work - np.mean(works)) <= spread, (works, ex.sliding_work)
     assert int(np.argmax(ex.bearing)) == int(np.argmax(ref.bearing))
     assert int(np.argmax(ex.journal)) == int(np.argmax(ref.journal))
