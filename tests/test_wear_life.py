@@ -49,8 +49,8 @@ def test_the_how_to_scene_ends_at_the_limit(tmp_path):
     there and the last line gives the hours.  The hours follow from the wear rates of the updates: the wear
     speeds up as the clearance opens (the impacts grow with it), so they lie below the first update's rate carried
     on to the limit, and above the fastest update's (measured: 37.39 h under the loom's cylindrical law, between
-    6.0 and 82.9 h; ~108 h under variable_kd, whose softer contact slid its impacts under lower peak loads:
-    docs/wear.md section 9)."""
+    6.0 and 82.9 h; 146.7 h under variable_kd, whose softer contact slid its impacts under lower peak loads:
+    docs/wear.md sections 3 and 9)."""
     import subprocess
     import sys
 
