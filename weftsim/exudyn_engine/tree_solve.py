@@ -231,6 +231,7 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
     energy = np.zeros(n)
     f_el[inside] = law.elastic_force(delta[inside])
     energy[inside] = law.elastic_energy(delta[inside])
+    radial_rate = rate  # e_dot . n: F_N works along it (delta_dot of a worn joint also holds -dc/dt)
     if scene.joint.is_worn:  # the local clearance the callback saw (weftsim.physics.worn_rows), as the reference's
         delta, rate, f_el, energy = worn_channels(scene, t, a, psi, da, dpsi)
     # A lubricated joint: the film and boundary friction dissipate at every step (the quadratic rule of
@@ -246,7 +247,9 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
         drawn, dissipated = q_t[:, 3] - q_t[0, 3], q_t[:, 4] - q_t[0, 4]
     else:  # quadrature over the steps (the implicit tree with an oil film)
         drawn = contact_work(-q3 * omega, t, loaded)
-        dissipated = contact_work((f_n - f_el) * rate - friction_power, t, delta) + lubricated_work
+        # the tree_joint_force's D': F_N (delta_dot + dc/dt) - F_el delta_dot - F_T v_T
+        dissipated = contact_work((f_n - f_el) * rate + f_n * (radial_rate - rate) - friction_power, t, delta) \
+            + lubricated_work
     hist = model.tracker.history()
     row = np.clip(np.searchsorted(hist["time"], t * (1.0 + 1e-12), side="right") - 1, 0, len(hist["time"]) - 1)
     ratio = scene.geometry.rapier_ratio

@@ -20,15 +20,23 @@ if TYPE_CHECKING:
 
 def conditions(scene: Scene, joints: Sequence[str] = ("e",)) -> str:
     """What a wear figure's numbers depend on, for its title: the speed and each joint's Archard k and
-    hardnesses, bearing/journal (``600 rpm; E: k = 1e-07, H 2000/2000 MPa``)."""
+    hardnesses, bearing/journal (``600 rpm; E: k = 1e-07 (boundary), H 1670/6900 MPa``).
+
+    k is the one the joint's solid contact wears with (its regime's, or the single ``wear_coefficient``
+    that overrides the regimes); an oiled joint's asperities add theirs (``asperities 1e-07``)."""
     import math
 
     rpm = scene.drive.speed * 30.0 / math.pi
     parts = []
     for j in joints:
-        w = (scene.joint if j == "e" else scene.joint_f).wear
-        parts.append(f"{j.upper()}: k = {w.wear_coefficient:.3g}, H {w.bearing_hardness / 1e6:g}/"
-                     f"{w.journal_hardness / 1e6:g} MPa")
+        joint = scene.joint if j == "e" else scene.joint_f
+        w = joint.wear
+        k = f"k = {w.contact_wear_coefficient:.3g}"
+        if w.wear_coefficient is None:
+            k += f" ({w.regime})"
+        if joint.lubrication is not None:
+            k += f", asperities {w.asperity_wear_coefficient:.3g}"
+        parts.append(f"{j.upper()}: {k}, H {w.bearing_hardness / 1e6:g}/{w.journal_hardness / 1e6:g} MPa")
     return f"{rpm:g} rpm; " + "; ".join(parts)
 
 
