@@ -3,7 +3,7 @@ clearance and the response against the hours.  matplotlib is imported only when 
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
@@ -13,6 +13,7 @@ if TYPE_CHECKING:
     from collections.abc import Sequence
 
     from matplotlib.figure import Figure
+    from matplotlib.projections.polar import PolarAxes
 
     from weftsim.input.params import Scene
     from weftsim.wear.extrapolate import Update
@@ -61,7 +62,7 @@ def profile_figure(scene: Scene, updates: Sequence[Update], title: str = "", joi
     psi = np.append(np.arange(n), 0) * (2.0 * np.pi / n)
     frames = FRAMES[joint]
     for k, which in enumerate(("bearing", "journal")):
-        ax = fig.add_subplot(1, 2, k + 1, projection="polar")
+        ax = cast("PolarAxes", fig.add_subplot(1, 2, k + 1, projection="polar"))
         radii = []
         for u in _chosen(list(zip(updates, parts))):
             u, part = u
