@@ -337,6 +337,7 @@ def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, ca
             return False
         return True
 
+    solver: exu.MainSolverImplicitSecondOrder | exu.MainSolverExplicit
     if implicit:
         register_post_step(mbs, post_step)  # first: the step controller's hook plans the next step after it
         solver = exu.MainSolverImplicitSecondOrder()
@@ -354,19 +355,20 @@ def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, ca
     status, message, kind = "success", "", None
     wall_solve = _time.perf_counter()
     try:
-        if not solver.SolveSystem(mbs, settings):
+        if not solver.SolveSystem(mbs, settings):  # type: ignore[call-arg, misc]  # exudyn stub: SolveSystem lacks self
             if implicit:
                 status = "failed"
                 kind, message = implicit_failure(solver, scene)
             else:
-                status, kind, message = "failed", "solver", solver.GetErrorString() or "the explicit solver stopped"
+                reason = solver.GetErrorString()  # type: ignore[misc]  # exudyn stub: GetErrorString lacks self
+                status, kind, message = "failed", "solver", reason or "the explicit solver stopped"
     except exu.ExudynError as exc:
         text = str(exc).strip().splitlines()
         last = text[-1].split(" [Python file ")[0] if text else ""
         status, message = "failed", f"{type(exc).__name__}: {last}"
         kind = "non_finite" if isinstance(exc, exu.SolverError) else "model" if isinstance(exc, exu.ModelError) else "solver"
     wall_solve = _time.perf_counter() - wall_solve
-    data = {k: mbs.GetSensorStoredData(v) for k, v in sensors.items()}
+    data = {k: np.asarray(mbs.GetSensorStoredData(v)) for k, v in sensors.items()}  # the stub says ArrayLike
     data["force"] = np.array(model.bearing_force).reshape(-1, RECORD_COLUMNS)
     steps = tree_channels(model, data) if min(len(v) for v in data.values()) else empty_channels()
     if observe is not None:

@@ -174,8 +174,8 @@ def _eccentricity_rows(prm, t, a, psi, da, dpsi, out):
         out[4, i], out[5, i], out[6, i] = dphi, db_y, db_z
 
 
-def eccentricity(xp: ModuleType | None, p: ChainConstants, t: ArrayLike, a: ArrayLike, psi: ArrayLike, da: ArrayLike,
-                 dpsi: ArrayLike) -> tuple[np.ndarray | float, ...]:
+def eccentricity(xp: ModuleType | SimpleNamespace | None, p: ChainConstants, t: ArrayLike, a: ArrayLike,
+                 psi: ArrayLike, da: ArrayLike, dpsi: ArrayLike) -> tuple[np.ndarray | float, ...]:
     """Eccentricity e = P_j - P_b, its rate and the bearing's motion, over arrays (broadcast).
 
     :func:`weftsim.physics.chain.eccentricity` at every element (``xp`` is ignored: kept for callers
