@@ -284,7 +284,8 @@ SCHEMA: tuple[Key, ...] = (
             "numba_DOP853_RODAS4 at rtol <= 1e-6, or with a lubricated joint numba_RODAS4 (the fastest paths "
             "meeting the accuracy targets)"),
     Key("solver.reference.rtol", "reference_solver.rtol", "float", 1, TOLERANCE_FLOOR, 1e-2, False, doc="relative tolerance"),
-    Key("solver.reference.atol", "reference_solver.atol", "float", 1, ATOL_FLOOR, 1e-2, False, doc="absolute tolerance"),
+    Key("solver.reference.atol", "reference_solver.atol", "float", 1, ATOL_FLOOR, 1e-2, False,
+        doc="absolute tolerance"),
     Key("solver.reference.max_step_deg", "reference_solver.max_step", "float", DEG, 0, 90,
         doc="largest step, as crank angle"),
     Key("solver.exudyn.model", "exudyn_solver.model", "str", choices=EXUDYN_MODELS,

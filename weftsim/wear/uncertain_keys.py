@@ -33,8 +33,8 @@ or would change what is modelled instead of a value of it:
 Every other key (geometry, inertia, speed, the joint's pin, materials, friction, restitution, film
 values of a lubricated joint, k and the hardnesses, the stop-starts of the duty cycle) enters the dynamics or
 Archard's law; ``duty.hours_per_day`` and ``days_per_week`` spread the calendar days to the limit (the life
-report, docs/wear.md section 12): it may be uncertain.  The names are those ``--set`` takes: a dotted key, or its last part where that is unique
-(:func:`weftsim.sweep.grid.resolve_key`).
+report, docs/wear.md section 12): it may be uncertain.  The names are those ``--set`` takes: a dotted key, or
+its last part where that is unique (:func:`weftsim.sweep.grid.resolve_key`).
 """
 
 from __future__ import annotations
