@@ -124,23 +124,38 @@ def test_an_edited_curve_is_run_again_not_a_traceback(wear_and_ensemble, tmp_pat
 # --- the keys an ensemble may take -------------------------------------------------------------------------
 
 def _fingerprint(scene) -> tuple:
-    """Everything a wear prediction of ``scene`` depends on: the kernel's parameters (geometry, inertia, the
-    joints' laws, materials, friction, film), the speed, and Archard's numbers at E (k, the hardnesses, and the
-    bearing's length and radii that spread the worn volume into a depth, weftsim.wear.archard)."""
+    """Everything a wear ensemble of ``scene`` depends on: the kernel's parameters (geometry, inertia, the
+    joints' laws, materials, friction, film at its film temperature, the tape), the speed, Archard's numbers at E
+    (the k of the solid contact and of an oil film's asperities, the hardnesses, and the bearing's length and
+    radii that spread the worn volume into a depth, weftsim.wear.archard), the film's roughness as it runs in
+    over the worn depth (weftsim.wear.extrapolate), the stop-starts (weftsim.wear.duty.with_stops: none when
+    the loom does not stop) and the calendar days of a running hour (the life report, weftsim.wear.life)."""
     from weftsim.model.dynamics import pack_parameters
+    from weftsim.wear.extrapolate import run_in_roughness
 
     j = scene.joint
     w = j.wear
-    return (pack_parameters(scene).tobytes(), scene.drive.speed, w.wear_coefficient, w.bearing_hardness,
-            w.journal_hardness, j.bearing_length, j.journal_radius, j.bearing_radius)
+    lub = j.lubrication
+    asperity = w.asperity_wear_coefficient if lub is not None else None
+    running_in = tuple(run_in_roughness(w, lub.roughness, depth) for depth in (0.5e-6, 2e-6, 20e-6)) \
+        if lub is not None else ()
+    duty = scene.duty
+    stops = (duty.stops_per_hour, duty.startup_revolutions, duty.rundown_revolutions) \
+        if duty.stops_per_hour > 0.0 else ()
+    return (pack_parameters(scene).tobytes(), scene.drive.speed, w.contact_wear_coefficient, asperity,
+            w.bearing_hardness, w.journal_hardness, j.bearing_length, j.journal_radius, j.bearing_radius, running_in,
+            stops, duty.calendar_days(1.0))
 
 
 def _nudged(scene, key):
-    """``scene`` with ``key`` moved by 5 % of its value (or to a small value from 0), within its range."""
+    """``scene`` with ``key`` moved by 5 % of its value, within its range; from an unset or zero value (a
+    ``wear_coefficient`` not given, no running-in, no stops) to a small value inside the range."""
     spec = next(k for k in SCHEMA if k.path == key)
     value = to_file_keys(scene)[key]
-    new = value * 1.05 if value else 0.05
-    if spec.high is not None and new > spec.high:
+    if key.endswith("wear.wear_coefficient") and value is None:
+        value = scene.joint.wear.contact_wear_coefficient  # the k it would replace
+    new = value * 1.05 if value else min(0.05, 0.5 * spec.high)
+    if new > spec.high:
         new = value * 0.95
     return apply_overrides(scene, {key: new}, refuse_ideal_keys=False)
 
@@ -148,14 +163,21 @@ def _nudged(scene, key):
 FLOAT_KEYS = [k.path for k in SCHEMA if k.kind == "float"]
 
 
-@pytest.mark.parametrize("scene_name", ["reference", "loom-oiled"])
+SCENES = {"reference": lambda: load_scene(REFERENCE),
+          "loom-oiled": lambda: load_scene("loom", {"joint_e.lubrication.viscosity_mpa_s": 80.0}),
+          # an oil by its grade, its film temperature from the heat balance, and 15 stops an hour
+          "loom_oiled": lambda: load_scene("loom_oiled"),
+          "loom_tape": lambda: load_scene("loom_tape")}
+
+
+@pytest.mark.parametrize("scene_name", list(SCENES))
 @pytest.mark.parametrize("key", FLOAT_KEYS)
 def test_an_accepted_key_changes_what_the_wear_depends_on(scene_name, key):
     """The class, decided from the model: every real-valued key the ensemble accepts changes the kernel's
-    parameters, the speed or Archard's numbers at E when it changes; every key refused for having no physics
-    or for being a setting of the prediction changes none of them."""
-    scene = load_scene("loom", {"joint_e.lubrication.viscosity_mpa_s": 80.0}) if scene_name == "loom-oiled" \
-        else load_scene(REFERENCE)
+    parameters, the speed, Archard's numbers at E, the running-in, the stop-starts or the calendar time when it
+    changes; every key refused for having no physics, for doing nothing in this scene or for being a setting of
+    the prediction changes none of them."""
+    scene = SCENES[scene_name]()
     problem = uncertain_key_problem(key, scene)
     if problem is None:
         assert _fingerprint(_nudged(scene, key)) != _fingerprint(scene), key
@@ -275,3 +297,17 @@ def test_a_negative_seed_is_refused_before_any_simulation(capsys, tmp_path):
 
         wear_ensemble(load_scene(REFERENCE), [K], 20, 0.26e-3, tmp_path / "e", seed=-1)
     assert not (tmp_path / "e").exists()
+
+
+def test_a_key_that_counts_only_beside_another_uncertain_key_is_taken_with_it():
+    """A stop's transients do nothing on a loom that does not stop, unless its stop rate is uncertain too (then
+    every sample with stops wears them); the same for the running-in depth beside its roughness."""
+    reference = load_scene(REFERENCE)
+    with pytest.raises(WearError, match="does not stop"):
+        check_uncertain_key("duty.startup_revolutions", reference)
+    assert check_uncertain_key("startup_revolutions", reference, ("stops_per_hour",)) == "duty.startup_revolutions"
+    oiled = load_scene("loom_oiled")
+    with pytest.raises(WearError, match="no run_in_roughness_um"):
+        check_uncertain_key("joint_e.wear.run_in_depth_um", oiled)
+    assert check_uncertain_key("joint_e.wear.run_in_depth_um", oiled, ("joint_e.wear.run_in_roughness_um",)) \
+        == "joint_e.wear.run_in_depth_um"

@@ -454,16 +454,23 @@ def scene_from_keys(flat: dict[str, Any], where: str = "scene", origin: dict[str
         raise SceneError(f"{where}: key 'name' must be a non-empty line of printable characters "
                          f"(no newline or escape sequence), got {name!r}")
     scene = params.Scene(name=name, source=where)
-    _check_lubrication_given(flat, where)
+    # Every key against its own type and range first, then the checks between keys: a value past its bound is
+    # named as that (oil.nu40_mm2_s = 1e6 beside a viscosity_mpa_s was reported as "both given").
+    converted = {}
     for path, value in flat.items():
-        if path in TOP_LEVEL:
-            continue
-        if path == TAPE_TABLE:  # an empty [rapier_tape] table (_flatten)
-            scene = replace(scene, rapier_tape=scene.rapier_tape or params.RapierTape())
+        if path in TOP_LEVEL or path == TAPE_TABLE:
             continue
         src = str(origin.get(path, where))
         key = _known(path, src)
-        value = _convert(key, value, src)
+        converted[path] = key, _convert(key, value, src), src
+    _check_lubrication_given(flat, where)
+    for path in flat:
+        if path == TAPE_TABLE:  # an empty [rapier_tape] table (_flatten)
+            scene = replace(scene, rapier_tape=scene.rapier_tape or params.RapierTape())
+            continue
+        if path not in converted:
+            continue
+        key, value, src = converted[path]
         if key.path == "mechanism.fourbar_branch":
             value = BRANCHES[value]
         scene = _set_checked(scene, key.target, value, src)

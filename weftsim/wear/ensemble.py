@@ -236,7 +236,8 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
 
     from weftsim.wear.uncertain_keys import check_uncertain_key
 
-    parsed = [replace(u, key=check_uncertain_key(u.key, scene)) for u in parsed]  # dotted keys from here on
+    names = tuple(u.key for u in parsed)
+    parsed = [replace(u, key=check_uncertain_key(u.key, scene, names)) for u in parsed]  # dotted keys from here on
     job_list, dynamic, nodes = plan(scene, parsed, chaos_runs, design_points)
     job_horizon = min(10.0 * horizon, MAX_HOURS)
     for name, s in job_list:

@@ -134,7 +134,8 @@ def plan(scene: Scene, uncertain: list[Uncertain], chaos_runs: int = 6, design_p
     from weftsim.wear.uncertain_keys import check_uncertain_key, resolve
 
     # the names --set takes (a dotted key or its unique last part), each a key that changes the wear at E
-    uncertain = [replace(u, key=check_uncertain_key(u.key, scene)) for u in uncertain]
+    names = tuple(u.key for u in uncertain)
+    uncertain = [replace(u, key=check_uncertain_key(u.key, scene, names)) for u in uncertain]
     design_points = {resolve(k): n for k, n in (design_points or {}).items()}
     seen = set()
     for u in uncertain:

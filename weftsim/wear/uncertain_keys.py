@@ -18,12 +18,23 @@ or would change what is modelled instead of a value of it:
   ``clearance_mm`` would make F loose, another model);
 - it belongs to ``[joint_e.lubrication]`` while joint E is dry (a viscosity would make it lubricated:
   another model; give the table in the scene to make the oil's values uncertain);
-- it is joint E's ``clearance_mm`` while E is ideal (there would be no contact to wear).
+- it is joint E's ``clearance_mm`` while E is ideal (there would be no contact to wear);
+- it belongs to ``[rapier_tape]`` while the scene has none (a tape key would add the flexible tape: another
+  model), or it is the rigid rapier's ``inertia.rapier_mass_kg`` while the scene has a tape (which replaces it);
+- nothing of the scene reads it: ``bushing_wall_mm`` under a law other than ``cylindrical``; a regime's k the
+  joint does not wear in (``dry_wear_coefficient`` in the boundary regime, ``mixed_wear_coefficient`` on a dry
+  joint, any regime's k under a given ``wear_coefficient``); running-in on a dry joint, or its depth without
+  ``run_in_roughness_um``; the oil's properties and the heat balance under a fixed ``viscosity_mpa_s``;
+  a stop's ``stop_minutes``, ``startup_revolutions`` or ``rundown_revolutions`` on a loom that does not stop
+  (``stops_per_hour = 0``, unless that is uncertain too);
+- it would change the lubricant's model: a grade's ``oil.nu40_mm2_s`` / ``oil.nu100_mm2_s``, a fixed
+  ``viscosity_mpa_s`` on a joint given an oil.
 
 Every other key (geometry, inertia, speed, the joint's pin, materials, friction, restitution, film
-values of a lubricated joint, k and the hardnesses) enters the dynamics or Archard's law: it may be
-uncertain.  The names are those ``--set`` takes: a dotted key, or its last part where that is unique
-(:func:`weftsim.sweep.grid.resolve_key`).
+values of a lubricated joint, k and the hardnesses, the stop-starts of the duty cycle) enters the dynamics or
+Archard's law; ``duty.hours_per_day`` and ``days_per_week`` spread the calendar days to the limit (the life
+report, docs/wear.md section 12): it may be uncertain.  The names are those ``--set`` takes: a dotted key, or
+its last part where that is unique (:func:`weftsim.sweep.grid.resolve_key`).
 """
 
 from __future__ import annotations
@@ -70,8 +81,9 @@ def resolve(name: str) -> str:
         raise WearError(f"--uncertain {name}: {text}") from None
 
 
-def uncertain_key_problem(key: str, scene: Scene) -> str | None:
-    """Why ``key`` (dotted) cannot be an uncertain input of a wear ensemble of ``scene``, or None if it can."""
+def uncertain_key_problem(key: str, scene: Scene, others: tuple[str, ...] = ()) -> str | None:
+    """Why ``key`` (dotted) cannot be an uncertain input of a wear ensemble of ``scene``, or None if it can
+    (``others``: the ensemble's other uncertain keys, dotted)."""
     from weftsim.input.schema import _BY_PATH
 
     spec = _BY_PATH.get(key)
@@ -102,15 +114,81 @@ def uncertain_key_problem(key: str, scene: Scene) -> str | None:
                 "[joint_e.lubrication] in the scene to make the oil's values uncertain")
     if key == "joint_e.clearance_mm" and scene.joint.is_ideal:
         return "joint E is ideal in this scene: there is no contact to wear"
+    if key.startswith("rapier_tape.") and scene.rapier_tape is None:
+        return ("the scene has no [rapier_tape] (the rigid rapier of mass m8): a tape key would add the flexible tape, "
+                "another model; give [rapier_tape] in the scene to make the tape's values uncertain")
+    if key == "inertia.rapier_mass_kg" and scene.rapier_tape is not None:
+        return ("the scene's rapier is its [rapier_tape] (the head's and the tape's masses): the rigid rapier's mass "
+                "does not change the wear")
+    if key.startswith("joint_e."):
+        return _joint_e_problem(key, scene, others)
+    if key.startswith("duty.") and key.rpartition(".")[2] in STOP_KEYS and not scene.duty.stops_per_hour > 0.0 \
+            and "duty.stops_per_hour" not in others:
+        return ("the loom of this scene does not stop ([duty] stops_per_hour = 0): a stop's length and its transients "
+                "do not change the wear or the calendar time")
     return None
 
 
-def check_uncertain_key(name: str, scene: Scene) -> str:
-    """The dotted key of ``name`` if it may be uncertain in an ensemble of ``scene``; WearError (one line) if not."""
+# The [duty] keys that describe one stop: they count only on a loom that stops (weftsim.wear.duty.with_stops,
+# weftsim.input.params.Duty.calendar_days).
+STOP_KEYS = ("stop_minutes", "startup_revolutions", "rundown_revolutions")
+# The [joint_e.lubrication] keys of an oil and of its heat balance (weftsim.joint.heat): read only when the joint is
+# given an oil, its viscosity following from the film temperature.
+OIL_VISCOSITIES = ("oil.nu40_mm2_s", "oil.nu100_mm2_s")
+HEAT_KEYS = OIL_VISCOSITIES + ("oil.density_kg_m3", "oil.heat_capacity_j_kg_k", "ambient_temperature_c",
+                               "housing_heat_transfer_w_k")
+REGIME_KEYS = {"dry_wear_coefficient": "dry", "boundary_wear_coefficient": "boundary",
+               "mixed_wear_coefficient": "mixed"}
+
+
+def _joint_e_problem(key: str, scene: Scene, others: tuple[str, ...]) -> str | None:
+    """Why a ``joint_e.*`` key changes nothing of this scene's joint E (or its model), or None."""
+    joint, name = scene.joint, key.partition(".")[2]
+    wear, lub = joint.wear, joint.lubrication
+    if name == "bushing_wall_mm" and joint.law != "cylindrical":
+        return (f"only the cylindrical contact law reads the bushing's wall, and joint E's law is {joint.law!r}: it "
+                "does not change the wear")
+    regime = REGIME_KEYS.get(name.removeprefix("wear."))
+    if regime is not None:
+        if wear.wear_coefficient is not None and "joint_e.wear.wear_coefficient" not in others:
+            return ("joint E's wear_coefficient is given and is the k of every load, the regime's k does not change "
+                    "the wear")
+        if regime == "mixed" and not joint.is_lubricated:
+            return ("mixed_wear_coefficient is the k of an oil film's asperity load, and joint E is dry: it does not "
+                    "change the wear")
+        if regime != "mixed" and wear.regime != regime:
+            return (f"joint E's solid contact wears in the {wear.regime!r} regime ([joint_e.wear] regime): the "
+                    f"{regime} k does not change the wear")
+    if name in ("wear.run_in_roughness_um", "wear.run_in_depth_um") and not joint.is_lubricated:
+        return "running-in lowers an oil film's roughness, and joint E is dry: it does not change the wear"
+    if name == "wear.run_in_depth_um" and wear.run_in_roughness is None \
+            and "joint_e.wear.run_in_roughness_um" not in others:
+        return ("joint E has no run_in_roughness_um: its roughness does not run in, so the depth of running-in does "
+                "not change the wear")
+    if lub is not None and name.startswith("lubrication."):
+        field = name.partition(".")[2]
+        if field in OIL_VISCOSITIES and lub.oil:
+            return (f"joint E's oil is the grade {lub.oil!r}, whose viscosities are the grade's: a custom oil would be "
+                    "another model; give the custom oil (nu40_mm2_s and nu100_mm2_s) in the scene to make them "
+                    "uncertain")
+        if field in HEAT_KEYS and not lub.has_oil:
+            return ("joint E's film has a fixed viscosity_mpa_s, not an oil: the oil's properties and the heat balance "
+                    "do not change the wear; name the oil in the scene to make them uncertain")
+        if field == "viscosity_mpa_s" and lub.has_oil:
+            return ("joint E is given an oil, whose viscosity follows from the film temperature: a fixed viscosity "
+                    "would be another model; make the oil's values uncertain instead")
+    return None
+
+
+def check_uncertain_key(name: str, scene: Scene, others: tuple[str, ...] = ()) -> str:
+    """The dotted key of ``name`` if it may be uncertain in an ensemble of ``scene``; WearError (one line) if not.
+
+    ``others``: the names of the ensemble's other uncertain keys (a stop's keys count when ``stops_per_hour``
+    is uncertain, a regime's k when ``wear_coefficient`` is, the running-in depth when its roughness is)."""
     key = resolve(name)
-    problem = uncertain_key_problem(key, scene)
+    problem = uncertain_key_problem(key, scene, tuple(resolve(o) for o in others))
     if problem is not None:
         raise WearError(f"--uncertain {key}: {problem}; an uncertain key must change the wear of joint E "
                         "(the geometry, inertia, speed, the joint's pin, materials, friction or film values, k or "
-                        "a hardness: docs/wear.md section 9)")
+                        "a hardness, the duty cycle: docs/wear.md sections 9 and 12)")
     return key
