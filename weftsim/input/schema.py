@@ -387,7 +387,8 @@ def shown(text: str) -> str:
     return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii") for c in text)
 
 
-def _set(scene: params.Scene, target: str, value: Any) -> params.Scene:
+def _set(scene: Any, target: str, value: Any) -> Any:
+    """``scene`` (a Scene or one of its tables) with the dotted ``target`` set to ``value``."""
     head, _, rest = target.partition(".")
     if not rest:
         return replace(scene, **{head: value})

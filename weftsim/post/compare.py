@@ -111,16 +111,18 @@ def agreement_checks(exudyn: RunResult, reference: RunResult) -> list[dict]:
                                      tol.first_revolution_peaks))
     n = min(complete_revolutions(exudyn), complete_revolutions(reference))
     if n >= STATISTICS_MIN_REVOLUTIONS:
-        se, sr = statistics(exudyn), statistics(reference)
-        pairs = (("rapier_acceleration_m_s2", "rms"), ("driving_torque_Nm", "rms"))
+        stats_e, stats_r = statistics(exudyn), statistics(reference)
+        assert stats_e is not None and stats_r is not None  # both have n >= 2 complete revolutions
+        pairs: tuple[tuple[str, str], ...] = (("rapier_acceleration_m_s2", "rms"), ("driving_torque_Nm", "rms"))
         pairs += (("joint_force_N", "mean"),) if not reference.scene.joint.is_ideal else ()
         for name, stat in pairs + ((("joint_force_f_N", "mean"),) if loose_f else ()):
-            checks.append(_check(f"{name}: {stat} over revolutions 2..{n}", se[name][stat], sr[name][stat], tol.rms))
+            checks.append(_check(f"{name}: {stat} over revolutions 2..{n}", stats_e[name][stat], stats_r[name][stat],
+                                 tol.rms))
             # The 99th percentile of the magnitude: for two-sided channels the signed p99 sits in one
             # tail, decided by a handful of impacts, and moved by 14-39% under tolerance changes of
             # one engine alone (docs/paper-comparison.md); the magnitude's moved by 2-14%.
             checks.append(_check(f"{name}: 99th percentile of the magnitude over revolutions 2..{n}",
-                                 se[name]["p99_abs"], sr[name]["p99_abs"], tol.percentile_99))
+                                 stats_e[name]["p99_abs"], stats_r[name]["p99_abs"], tol.percentile_99))
     return checks
 
 
