@@ -15,7 +15,7 @@ from weftsim.errors import SceneError
 from weftsim.input.params import ClearanceJoint, Lubrication
 from weftsim.joint.film_flow import flow_variables, flows
 from weftsim.joint.heat import heat_balance
-from weftsim.joint.oil import ISO_VG, Oil, grade_oil, walther_kinematic
+from weftsim.physics.oil import ISO_VG, Oil, grade_oil, walther_kinematic
 from weftsim.joint.reynolds import RAIMONDI_BOYD
 from weftsim.joint.steady import steady_point
 

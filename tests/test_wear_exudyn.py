@@ -16,6 +16,7 @@ import pytest
 
 from weftsim import exudyn_engine, reference
 from weftsim.physics import chain as kc
+from weftsim.physics.laws import elastic_force
 from weftsim.physics.wear import worn_clearance
 from weftsim.model.dynamics import initial_state, pack_parameters
 from weftsim.input.scene import load_scene
@@ -77,6 +78,39 @@ def test_the_tree_contact_reads_the_same_worn_clearance_as_the_reference_chain()
     assert max(depths) > 0.3 * c0 and min(depths) < 0.01 * c0  # the states meet the worn spots and unworn wall
 
 
+def test_the_trees_powers_on_a_worn_wall_are_the_reference_chains():
+    """The drawn and dissipated powers the explicit tree integrates (W3', D' of :func:`tree_joint_force`) equal
+    the reference chain's at penetrated states of a worn joint, where the wall's profile passes under the journal
+    (dc/dt != 0): D' holds the radial force's work F_N dc/dt there, as the chain's does."""
+    scene = load_scene("loom")
+    worn = _worn(scene, 1.0)[0]
+    prm = pack_parameters(worn)
+    rng = np.random.default_rng(5)
+    a0, psi0 = initial_state(scene)[:2]
+    moving = 0
+    for t in rng.uniform(0.0, 2e-4, 3000):
+        y = np.array([a0 + rng.normal(0.0, 3e-5), psi0 + rng.normal(0.0, 3e-5), rng.normal(0.0, 5.0),
+                      rng.normal(0.0, 5.0), 0.0, 0.0])  # fmt: skip
+        delta, rate = kc.penetration(prm, t, y)
+        if delta <= 0.0:
+            continue
+        held = max(rate, 0.05)  # one impact velocity for both (the chain's argument, the tree's held one)
+        out = np.zeros(6)
+        f_n = kc.chain(prm, t, y, True, held, out)[1]
+        tree = kc.tree_joint_force(prm, t, y[0], y[1] + math.pi - y[0], y[2], y[3] - y[2], held, 1e-6, rate)
+        ecc_y, ecc_z, v_y, v_z = kc.eccentricity(prm, t, y)[:4]
+        c, c_rate = kc.local_clearance(prm, t, ecc_y, ecc_z, v_y, v_z, y)
+        # the same kernel in two coordinate sets: 1e-8 (the round joint's, test_friction_agreement) of the size of
+        # the terms W3' and D' are differences of, (F_N + F_el) (|e_dot| + |dc/dt|) (measured: 3.5e-9 of it; F_N
+        # alone can be 0 where the damping clips it, D' = -F_el delta_dot then)
+        f_el = elastic_force(prm[kc.KIND], prm[kc.COEF], c, delta)
+        scale = 1e-8 * (f_n + f_el) * (math.hypot(v_y, v_z) + abs(c_rate))
+        assert tree[12] == pytest.approx(out[4], rel=1e-8, abs=scale)
+        assert tree[13] == pytest.approx(out[5], rel=1e-8, abs=scale)
+        moving += abs(f_n * c_rate) > 0.01 * abs(out[5])  # the term the tree once left out matters here
+    assert moving >= 10  # states on the worn spots with the profile moving under the journal
+
+
 def test_a_worn_scene_agrees_between_the_engines_to_the_compare_tolerances():
     """The loom's start-up impact on the worn joint: the worn spots move the first contact by more than
     ``compare``'s first-contact tolerance and the peak force by more than its peak tolerance, and the
@@ -111,7 +145,8 @@ def test_a_worn_scene_agrees_between_the_engines_to_the_compare_tolerances():
 def test_the_exudyn_update_integrates_archard_over_its_own_contact_channels():
     """An update on Exudyn of a worn geometry: the profiles hold k/H times the sliding work (Archard's
     volume), the sliding work is its rows' integral of F_N |v_T| dt, and the update agrees with the
-    reference engine's (the same deposit): sliding work within 1e-3, the deepest wear at the same cell."""
+    reference engine's (the same deposit): sliding work within the reference engine's own scatter over its
+    tolerances, the deepest wear at the same cell."""
     scene = load_scene("loom")
     scene = replace(scene, joint=replace(scene.joint, wear=replace(scene.joint.wear, revolutions_per_update=1)))
     bearing, journal = _profiles(scene.joint.wear.profile_points, scene.joint.clearance)
@@ -125,11 +160,22 @@ def test_the_exudyn_update_integrates_archard_over_its_own_contact_channels():
     assert volume_b == pytest.approx(cell_b * ex.sliding_work, rel=1e-12)
     assert ex.bearing_volume == pytest.approx(cell_b * ex.sliding_work, rel=1e-15)
     assert response["sliding_work_per_rev_e_J"] == pytest.approx(ex.sliding_work, rel=1e-15)
-    # the engines: 1e-3 is 5x the difference measured on this update (1.8e-4, the two integrators' error at
-    # their default tolerances).  Not the sliding distance: it counts rows of any load, and where the journal
-    # crosses the worn spot under a few N the engines end the light contact at different steps (4e-3 apart
-    # at every tolerance down to 1e-9, while the work there, F_N |v_T| dt, differs by 2e-6).
-    assert ex.sliding_work == pytest.approx(ref.sliding_work, rel=1e-3)
+    # The engines.  Under the loom's cylindrical law (issue 37; 3-15 times stiffer than variable_kd, under which
+    # the engines agreed to 1.8e-4 here) this worn revolution is sensitive to the integration itself: the journal
+    # chatters across the worn spots, and neither engine's sliding work converges with its tolerance (reference
+    # at rtol 1e-5 .. 1e-11: 279.3, 291.7, 291.1, 277.9, 281.1 J; Exudyn at 1e-7 .. 1e-11: 287.0, 273.9, 278.5,
+    # 277.0, 290.2 J), while the round joint's converges on both (245.84 J, engines 9e-5 apart at 1e-9).  So
+    # the Exudyn update must fall within the reference engine's scatter over three of its tolerances widened by
+    # that scatter's width (the criterion of the chaotic hours, test_both_engines_agree_on_the_hours_...):
+    # measured 279.3, 286.5, 285.5 J (2.5 %), Exudyn 287.0 J, 0.46 of the width from their mean.
+    # Not the sliding distance: it counts rows of any load, and where the journal crosses the worn spot under a
+    # few N the engines end the light contact at different steps.
+    works = [ref.sliding_work] + [engine_update(replace(scene, reference_solver=replace(
+        scene.reference_solver, rtol=rtol, atol=1e-12)), bearing, journal, "reference")[0].sliding_work
+        for rtol in (1e-7, 1e-9)]
+    spread = max(works) - min(works)
+    assert spread > 0.01 * np.mean(works)  # the scatter is there (measured 2.5 %)
+    assert abs(ex.sliding_work - np.mean(works)) <= spread, (works, ex.sliding_work)
     assert int(np.argmax(ex.bearing)) == int(np.argmax(ref.bearing))
     assert int(np.argmax(ex.journal)) == int(np.argmax(ref.journal))
 
@@ -182,19 +228,23 @@ def test_cli_wear_on_exudyn_writes_its_prediction_and_agrees_on_the_first_update
     """``weftsim wear --engine exudyn`` runs (its own default directory, the engine in wear.json), and its first
     update (the unworn joint, before any chaos from the wear) agrees with the reference engine's."""
     out = {}
+    # The tree at rtol 1e-8: the loom's 1e-7 (its cylindrical law's start-up, loom.toml: peaks within 0.1 % of
+    # 1e-8) leaves 1.4e-3 in this update's deepest wear; at 1e-8 6e-5, at 1e-10 4e-5 of the reference engine's
+    # (which moves 5e-5 between its rtol 1e-5 and 1e-9)
+    tighter = {"exudyn": ["--set", "solver.exudyn.relative_tolerance=1e-8"], "reference": []}
     for engine in ("reference", "exudyn"):
         run = subprocess.run([sys.executable, "-m", "weftsim.cli", "wear", "loom", "--engine", engine, "--hours", "0.3",
-                              "--limit-clearance-mm", "0.0201", "--no-plot", "-o", str(tmp_path / engine)],
-                             capture_output=True, text=True)  # fmt: skip
+                              "--limit-clearance-mm", "0.0201", "--no-plot", "-o", str(tmp_path / engine),
+                              *tighter[engine]], capture_output=True, text=True)  # fmt: skip
         assert run.returncode == 0, run.stderr
         assert f"on the {engine} engine" in run.stderr
         out[engine] = json.loads((tmp_path / engine / "wear.json").read_text())
         assert out[engine]["engine"] == engine
         # the result checks itself on either engine: the profiles hold Archard's volume
         assert out[engine]["profile_volume_e_mm3"] == pytest.approx(out[engine]["archard_volume_e_mm3"], rel=1e-9)
-    # 0.0201 mm is reached in the first update: its wear rate alone sets the hours (0.146215 h on the reference
-    # engine, 0.146225 h on Exudyn: 7e-5).  1e-3: 5x the engines' difference in the first update's deepest wear
-    # (2e-4, measured at their default tolerances, 8e-5 on the journal)
+    # 0.0201 mm is reached in the first update: its wear rate alone sets the hours (0.09118 h on the reference
+    # engine under the cylindrical law; 0.1462 h under variable_kd).  1e-3: 16x the engines' difference in the
+    # first update's deepest wear at these tolerances (6e-5, above)
     assert out["exudyn"]["hours_to_limit"] == pytest.approx(out["reference"]["hours_to_limit"], rel=1e-3)
     assert out["exudyn"]["updates"] == out["reference"]["updates"]
 

@@ -208,6 +208,14 @@ def test_the_limit_is_the_first_joint_to_reach_it_and_outputs_name_the_joints(bo
         assert np.all(np.isfinite(table[f"contact_force_{j}_mean_N"]))
     profile = np.genfromtxt(outdir / "wear_profile_f.csv", delimiter=",", names=True)
     assert profile.dtype.names[1].startswith("h_b_f_mm_update0")
+    # The terminal's limit lines: one a joint with its hours, the first to reach the limit marked.
+    from weftsim.cli.wear import limit_lines
+
+    lines = limit_lines(data, data["joints"])
+    first = data["limit_joint"].upper()
+    for j, line in zip(("e", "f"), lines):
+        marked = " (first)" if j.upper() == first else ""
+        assert line.startswith(f"  at {j.upper()}{marked}: {each[j]:.6g} h"), line
 
 
 def test_an_edited_f_array_of_a_state_is_refused(both, tmp_path):
@@ -353,7 +361,10 @@ def test_the_command_line_wears_f_and_says_which_joint_reaches_the_limit(tmp_pat
     assert done.returncode == 0, done.stderr
     assert "wear at F over 1 h" in done.stderr and "Traceback" not in done.stderr
     assert "at F: effective clearance 0.25 ->" in done.stdout
-    assert "reached first at F after" in done.stdout
     data = json.loads((out / "wear.json").read_text())
     assert data["joints"] == ["f"] and data["limit_joint"] == "f" and 0.0 < data["hours_to_limit_f"] < 1.0
+    # The last line is the planner's: F's hours to the limit as wear.json has them; the prediction ends there.
+    last = done.stdout.strip().splitlines()[-1]
+    assert last.startswith(f"  at F: {data['hours_to_limit_f']:.6g} h") and "to the limit 0.252 mm" in last, last
+    assert data["hours_reached"] == pytest.approx(data["hours_to_limit_f"], rel=1e-12)  # cut at the limit
     assert (out / "wear_profile_f.csv").exists() and not (out / "wear_profile_e.csv").exists()

@@ -23,7 +23,7 @@ import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, overload
 
 from weftsim.post.analysis import complete_revolutions, peaks, statistics
 
@@ -175,11 +175,15 @@ def quantities(result: RunResult) -> dict | None:
     }
 
 
+@overload
+def errors(q: dict, ref: dict) -> dict: ...
+@overload
+def errors(q: None, ref: dict) -> None: ...
 def errors(q: dict | None, ref: dict) -> dict | None:
     """Relative errors of one run's quantities against the converged ones (means relative to the RMS)."""
     if q is None:
         return None
-    out = {"peak": {ch: abs(q["peak"][ch] - ref["peak"][ch]) / abs(ref["peak"][ch]) for ch in QUANTITY_CHANNELS}}
+    out: dict[str, Any] = {"peak": {ch: abs(q["peak"][ch] - ref["peak"][ch]) / abs(ref["peak"][ch]) for ch in QUANTITY_CHANNELS}}
     out["peak_max"] = max(out["peak"].values())
     if q["rms"] is not None and ref["rms"] is not None and q["revolutions"] >= ref["revolutions"]:
         out["rms"] = {ch: abs(q["rms"][ch] - ref["rms"][ch]) / ref["rms"][ch] for ch in QUANTITY_CHANNELS}
@@ -206,10 +210,13 @@ def converged_solution(case: str, models: str | Path, revolutions: float, log: C
         result, wall, _ = timed_solve(scene, "reference")
         if not result.ok:
             raise RuntimeError(f"converged solution {method} rtol {rtol:g} of {case} failed: {result.message}")
-        members.append({"method": method, "rtol": rtol, "wall_s": wall, **quantities(result)})
+        q = quantities(result)
+        if q is None:
+            raise RuntimeError(f"converged solution {method} rtol {rtol:g} of {case} has no complete revolution")
+        members.append({"method": method, "rtol": rtol, "wall_s": wall, **q})
         log(f"  converged {case}: {method} rtol {rtol:.0e} in {wall:.2f} s")
     best = members[0]
-    ref = {"revolutions": best["revolutions"], "peak": best["peak"], "first_contact_deg": best["first_contact_deg"]}
+    ref: dict[str, Any] = {"revolutions": best["revolutions"], "peak": best["peak"], "first_contact_deg": best["first_contact_deg"]}
     if best["rms"] is not None:
         ref["rms"] = {ch: _stats.median(m["rms"][ch] for m in members) for ch in QUANTITY_CHANNELS}
         ref["mean"] = {ch: _stats.median(m["mean"][ch] for m in members) for ch in QUANTITY_CHANNELS}
@@ -231,7 +238,7 @@ def measure(case: str, setting: Setting, ref: dict, models: str | Path, revoluti
     """
     scene = load_case(case, models, revolutions, setting.overrides)
     result, wall, cpu = timed_solve(scene, setting.engine)
-    row = {"case": case, "engine": setting.engine, "family": setting.family, "label": setting.label,
+    row: dict[str, Any] = {"case": case, "engine": setting.engine, "family": setting.family, "label": setting.label,
            "setting": setting.name, "overrides": setting.overrides, "status": result.status,
            "message": result.message, "failure": result.solver_stats.get("failure"),
            "loom_time_s": scene.drive.end_time}  # fmt: skip
@@ -303,7 +310,7 @@ def run_benchmark(outdir: str | Path, models: str | Path = "models", quick: bool
     if unknown:
         raise ValueError(f"unknown cases {unknown}; choose from {list(CASES)}")
     started = time.perf_counter()
-    report = {"mode": "quick" if quick else "full", "revolutions": revolutions, "repeats": repeats,
+    report: dict[str, Any] = {"mode": "quick" if quick else "full", "revolutions": revolutions, "repeats": repeats,
               "repeat_limit_s": repeat_limit, "timing_revolutions": 1.0, "targets": TARGETS,
               "machine_start": machine_info(), "cases": {}}  # fmt: skip
     log("start-up costs")

@@ -12,7 +12,7 @@ from __future__ import annotations
 import os
 import platform
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -56,7 +56,7 @@ def _status(row) -> str:
 
 def best_settings(report: dict, case: str = "c0.25mm-400rpm") -> dict:
     """Per engine family: the fastest run meeting both targets on ``case`` (or None)."""
-    out = {}
+    out: dict[str, Any] = {}
     runs = report["cases"].get(case, {}).get("runs", [])
     for row in runs:
         err = row["errors"] or {}
@@ -120,7 +120,7 @@ def figure(report: dict, case: str) -> Figure:
     data = report["cases"][case]
     fig, axes = plt.subplots(1, 2, figsize=(13, 5.5), sharex=True)
     families = list(dict.fromkeys(r["family"] for r in data["runs"]))  # in run order
-    styles = {}
+    styles: dict[str, dict[str, str]] = {}
     palettes = {"reference": ["tab:blue", "tab:cyan", "navy", "slateblue", "steelblue"],
                 "exudyn tree": ["tab:red", "tab:orange", "salmon", "brown"],
                 "exudyn rigid_body": ["tab:green", "olive", "limegreen"]}  # fmt: skip

@@ -71,7 +71,7 @@ def _process_walls(commands: list[list[str]], warmup: int = 0) -> dict:
 
     Stops at the first command that fails, keeping its exit status and the end of its stderr.
     """
-    walls = []
+    walls: list[float] = []
     for i, command in enumerate(commands):
         t0 = time.perf_counter()
         done = subprocess.run(command, capture_output=True, text=True)

@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import sys
 from dataclasses import dataclass, field, fields
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -147,7 +147,8 @@ def pressure_checks(stage: str, table: str, joint, force_peak: float, force_mean
     yield_pressure = None if strength is None else TRESCA_LINE_CONTACT_YIELD * strength
     hertz = line_contact_pressure(hertz_force, joint)
     verdict = _judge(hertz, yield_pressure)
-    message = "" if verdict != "warning" or stage == "after" else (  # after: validity_warnings says it
+    # after: validity_warnings says it; a "warning" has a limit (_judge gives "no_limit" for yield_pressure None)
+    message = "" if verdict != "warning" or stage == "after" or yield_pressure is None else (
         f"{table}: the ideal mechanism's peak pin force {hertz_force / 1e3:.4g} kN gives a Hertz contact pressure "
         f"of {hertz / 1e6:.4g} MPa (before the run), above first yield {yield_pressure / 1e6:.4g} MPa (1.67 x the "
         f"smaller {table}.*_material.yield_strength_mpa): a larger pin or a smaller clearance ({table}.clearance_mm)")
@@ -391,7 +392,8 @@ def format_lines(result: RunResult) -> list[str]:
     lines = []
     if "onsets" in block:  # a mechanism with a clearance joint: the contact-history counts
         names = {f.name for f in fields(Plausibility)}
-        report = Plausibility(**{k: v if k != "warnings" else tuple(v) for k, v in block.items() if k in names})
+        counts: dict[str, Any] = {k: v if k != "warnings" else tuple(v) for k, v in block.items() if k in names}
+        report = Plausibility(**counts)
         lines.append(report.summary_line())
     if block.get("checks"):
         lines.append(summary_line(block["checks"], "after"))

@@ -272,7 +272,7 @@ def joint_view(result: RunResult, joint: str) -> tuple[Scene, dict[str, np.ndarr
     channels under joint E's names (joint F's ``_f`` channels renamed), so every check reads one joint."""
     import dataclasses
 
-    from weftsim.post.results import JOINT_E_NAME
+    from weftsim.model.channels import JOINT_E_NAME
 
     if joint == "e":
         return result.scene, result.steps

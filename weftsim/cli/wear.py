@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from weftsim.errors import EXIT_FAILED
@@ -173,7 +174,7 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     return 0
 
 
-def limit_lines(data: dict, joints: list[str]) -> list[str]:
+def limit_lines(data: dict, joints: Sequence[str]) -> list[str]:
     """The terminal's last lines of a prediction with a clearance limit: the hours to it at each joint (and the
     calendar days where ``wear.json`` has them), or why it was not reached."""
     limit = data["limit_clearance_mm"]

@@ -49,7 +49,7 @@ from weftsim.physics.python import python_form
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from numba.core.registry import CPUDispatcher
+    from numba.core.dispatcher import Dispatcher
 
     from weftsim.joint.contact import _Law
 
@@ -93,7 +93,7 @@ def parameters_for_route(prm: np.ndarray, route: str) -> np.ndarray | list[float
     return prm.tolist() if route == "python" else prm
 
 
-def kernel_form(function: CPUDispatcher, route: str) -> Callable:
+def kernel_form(function: Dispatcher, route: str) -> Callable:
     if route == "python":
         return python_form(function)
     if route == "numba":
@@ -162,18 +162,18 @@ def make_tree_force(prm: np.ndarray, memory: list, stash: list, route: str = "nu
     force = kernel_form(kernel_chain.tree_joint_force, route)
     prm = prm.copy()
     prm[kernel_joint.DEAD_RATE] = RESTING_RATE_FRACTION * prm[kernel_joint.V_MIN]
-    prm = parameters_for_route(prm, route)
+    route_prm = parameters_for_route(prm, route)
     counter = [0] if counter is None else counter
     if route == "numba":
-        force(prm, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0)  # load (or compile) now
+        force(route_prm, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0)  # load (or compile) now
 
     def tree_force(mbs, t, itemNumber, q, q_t):
         counter[0] += 1
         (g0, g1, stash[1], stash[2], stash[3], stash[4], stash[5], stash[6], stash[7], stash[8], stash[9],
          stash[10], stash[11], stash[12]) = force(
-            prm, t, q[0], q[1], q_t[0], q_t[1], memory[0], memory[1], memory[2])
+            route_prm, t, q[0], q[1], q_t[0], q_t[1], memory[0], memory[1], memory[2])
         stash[0] = t
         return [g0, g1, stash[11], stash[12]] if powers else [g0, g1]
 
-    tree_force.prm = prm
+    setattr(tree_force, "prm", route_prm)  # a function attribute (mypy has no type for one)
     return tree_force

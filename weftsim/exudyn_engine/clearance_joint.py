@@ -68,6 +68,8 @@ from weftsim.input.params import ClearanceJoint
 if TYPE_CHECKING:
     from collections.abc import Callable
 
+    import exudyn.exudynCPP  # the index classes' module (exudyn's stub imports them from itself)
+
     from weftsim.joint.contact import _Law
 
 ROUTES = callbacks.ROUTES
@@ -154,6 +156,8 @@ class ClearanceJointModel:
     def state(self, mbs: exu.MainSystem) -> tuple[float, float]:
         """Current (delta, delta_dot) of the joint, m and m/s (a worn joint: at the local clearance)."""
         if self.joint.is_worn:
+            if self.friction is None:  # add_clearance_joint gives a worn joint its JointFriction
+                raise JointMisuse("a worn clearance joint needs its JointFriction (build it with add_clearance_joint)")
             return self.friction.penetration(mbs)
         u = mbs.GetObjectOutput(self.connector, exu.OutputVariableType.Displacement)
         v = mbs.GetObjectOutput(self.connector, exu.OutputVariableType.Velocity)
@@ -173,7 +177,8 @@ class ClearanceJointModel:
             self.friction.lubrication_history.clear()
 
 
-def add_clearance_joint(mbs: exu.MainSystem, marker_bearing: exu.MarkerIndex, marker_journal: exu.MarkerIndex,
+def add_clearance_joint(mbs: exu.MainSystem, marker_bearing: exudyn.exudynCPP.MarkerIndex,
+                        marker_journal: exudyn.exudynCPP.MarkerIndex,
                         joint: ClearanceJoint, law: _Law | None = None, callback: str = "auto",
                         call_counter: list | None = None) -> ClearanceJointModel:
     """Add a planar revolute clearance joint between two position markers.
@@ -230,6 +235,7 @@ def add_clearance_joint(mbs: exu.MainSystem, marker_bearing: exu.MarkerIndex, ma
     max_approach = joint.impact_velocity_rule == "max_approach"
     tracker = OnsetTracker(c, v_min, rule=joint.impact_velocity_rule)  # checks the rule's name
     friction = None
+    model: ClearanceJointModel  # built below, after the connector; the callbacks read it only once it is
     if joint.friction_coefficient > 0.0 or joint.is_lubricated or joint.is_worn:
         prm = joint_parameters(joint, law)
         if joint.is_worn:  # the wear block after the joint block (weftsim.physics.worn_joint)
@@ -241,7 +247,6 @@ def add_clearance_joint(mbs: exu.MainSystem, marker_bearing: exu.MarkerIndex, ma
         force = callbacks.make_python_force(law, c, v_min, call_counter, max_approach)
     else:
         force = callbacks.make_numba_force(law, c, v_min, max_approach)
-    model = None
     # The latest trial time the callback saw.  A call at a later time while the tracker's last accepted
     # time is still below that one means a step ended there and the bookkeeping never ran.
     trial = [tracker.t]

@@ -48,6 +48,9 @@ from weftsim.physics.worn_joint import connector_worn_force, connector_worn_lubr
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
+    import exudyn.exudynCPP  # the index classes' module (exudyn's stub imports them from itself)
+    from numba.core.dispatcher import Dispatcher
+
 _ROTATING = ("RigidBody", "RigidBody2D")
 _FIXED = ("Ground", "MassPoint", "MassPoint2D")
 _OMEGA = exu.OutputVariableType.AngularVelocity
@@ -99,6 +102,7 @@ class JointFriction:
         # asperities added, then their power, potential and channels (weftsim.physics.lubricated).
         self.lubricated = bool(prm[kernel_joint.LUBRICATED] != 0.0)
         self.worn = len(prm) > kernel_joint.N_JOINT  # a wear block follows the joint block
+        function: Dispatcher  # the four kernels take different arguments (the worn ones the angles too)
         if self.worn:
             function = connector_worn_lubricated_force if self.lubricated else connector_worn_force
         else:
@@ -109,8 +113,8 @@ class JointFriction:
             self.kernel(self.prm, 1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0, *((0.0, 0.0) if self.worn else ()))
         self.memory = memory
         self.connector = None
-        self._key = None
-        self._value = None
+        self._key: tuple[float, ...] | None = None  # evaluate's memo: the state last evaluated, its kernel value
+        self._value: tuple[float, ...] = ()
         self.history: list = []
         self.lubrication_history: list = []
 
@@ -156,7 +160,7 @@ class JointFriction:
         v = mbs.GetObjectOutput(self.connector, exu.OutputVariableType.Velocity)
         return self.evaluate(mbs, u[0], u[1], v[0], v[1])
 
-    def install(self, mbs: exu.MainSystem, connector: exu.ObjectIndex) -> None:
+    def install(self, mbs: exu.MainSystem, connector: exudyn.exudynCPP.ObjectIndex) -> None:
         """Add the torque loads M_j and M_b on the bodies that rotate (after the connector exists)."""
         self.connector = connector
 

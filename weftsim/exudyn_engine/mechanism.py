@@ -70,7 +70,7 @@ def to_exudyn(vector: ArrayLike) -> np.ndarray:
     return np.asarray(vector, dtype=float) @ SPEC_TO_EXUDYN.T
 
 
-def plane_point(yz: Sequence[float]) -> list[float]:
+def plane_point(yz: Sequence[float] | np.ndarray) -> list[float]:
     """Four-bar plane point (Y, Z) to an Exudyn position (X, Y, 0)."""
     return [float(yz[0]), float(yz[1]), 0.0]
 

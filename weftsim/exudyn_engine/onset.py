@@ -48,7 +48,11 @@ from weftsim.physics.hold import (  # noqa: F401 - the rules' one definition, re
     onset_fraction,
     onset_velocity,
 )
+from weftsim.physics.joint import contact_geometry
+from weftsim.physics.python import python_form
 from weftsim.input.scene import IMPACT_VELOCITY_RULES
+
+_GEOMETRY = python_form(contact_geometry)
 
 
 def positive_onset_velocity(t0: float, delta0: float, rate0: float, t1: float, delta1: float,
@@ -144,17 +148,14 @@ def hermite_extremum(delta0: float, rate0: float, delta1: float, rate1: float, h
 def penetration_state(ex: float, ey: float, vx: float, vy: float, clearance: float) -> tuple[float, float]:
     """delta = |e| - c and delta_dot = e_dot . e/|e| of an in-plane eccentricity (m, m/s).
 
-    delta_dot is 0 when the journal is exactly centred (e = 0: no normal defined).
-
-    The kernel's :func:`weftsim.physics.joint.contact_geometry` is the same geometry as e_dot . (e / |e|);
-    this form, (e_dot . e) / |e|, rounds differently in the last bits, and the tracker's onsets and held
-    impact velocities follow it, so moving to the kernel's form changes the Exudyn engine's results at
-    round-off: left for a change that documents that (issue 32 kept every result bit for bit).
+    delta_dot is 0 when the journal is exactly centred (e = 0: no normal defined).  The kernel's
+    :func:`weftsim.physics.joint.contact_geometry`, the clearance geometry written once, in its plain-Python
+    form (:func:`weftsim.physics.python.python_form`).  (Until issue 32 this was its own form,
+    (e_dot . e) / |e| against the kernel's e_dot . (e / |e|): the Exudyn engine's results moved at round-off
+    when it took the kernel's.)
     """
-    length = math.sqrt(ex * ex + ey * ey)
-    if length <= 0.0:
-        return -clearance, 0.0
-    return length - clearance, (vx * ex + vy * ey) / length
+    delta, rate, _, _ = _GEOMETRY(ex, ey, vx, vy, clearance)
+    return delta, rate
 
 
 class OnsetTracker:

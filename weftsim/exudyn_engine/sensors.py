@@ -81,7 +81,10 @@ def _cumtrapz(y, x):
 def step_channels(mbs: exu.MainSystem, model: MechanismModel, sensors: dict) -> dict[str, np.ndarray]:
     """All :data:`~weftsim.post.results.CHANNELS` at every stored step (rows cut to a common length)."""
     scene = model.scene
-    get = mbs.GetSensorStoredData
+
+    def get(sensor) -> np.ndarray:  # a SensorIndex; exudyn's stub says ArrayLike, it is the (steps, 1 + k) array
+        return np.asarray(mbs.GetSensorStoredData(sensor))
+
     crank = get(sensors["crank"])
     n = len(crank)
     data = {k: get(v)[:n] for k, v in sensors.items() if k not in ("kinetic", "heights")}

@@ -78,8 +78,9 @@ def check_settings(scene: Scene) -> str | None:
         return roundoff_problem(scene)
     if not (s.local_error > 0.0 and math.isfinite(s.local_error)):
         return f"`solver.exudyn.local_error_m` must be > 0 (m), got {s.local_error}"
-    if route_error(s.callback):
-        return f"`solver.exudyn.{route_error(s.callback)[1:]}"
+    route_problem = route_error(s.callback)
+    if route_problem:
+        return f"`solver.exudyn.{route_problem[1:]}"
     if s.callback == "numba" and not scene.is_ideal:
         try:
             import numba  # noqa: F401 - optional dependency of this route only
@@ -213,9 +214,9 @@ def _solve_tape_scene(scene: Scene, progress, callback, observe) -> RunResult:
     return result
 
 
-def _solve_model(scene: Scene, model: str, progress, callback: str | None, wall0: float,
+def _solve_model(scene: Scene, path_model: str, progress, callback: str | None, wall0: float,
                  observe: Callable[..., None] | None = None) -> RunResult:
-    if model == "kinematic_tree":
+    if path_model == "kinematic_tree":
         from weftsim.exudyn_engine.tree_solve import solve_tree
 
         return solve_tree(scene, progress, callback, observe)
@@ -260,7 +261,7 @@ def _solve_model(scene: Scene, model: str, progress, callback: str | None, wall0
     status, message, kind = "success", "", None
     wall_solve = _time.perf_counter()
     try:
-        if not solver.SolveSystem(mbs, simulation_settings(scene, n_steps)):
+        if not solver.SolveSystem(mbs, simulation_settings(scene, n_steps)):  # type: ignore[call-arg, misc]  # exudyn stub
             status = "failed"
             kind, message = failure_reason(solver, scene)
     except exu.ExudynError as exc:  # NaN (SolverError), user-function exception (ModelError), ...

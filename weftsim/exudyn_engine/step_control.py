@@ -101,8 +101,8 @@ class StepController:
         self.sample_period = sample_period
         self.factor = abs(newmark_beta - 1.0 / 6.0)
         self.jump = jump
-        self.accel_start = None  # relative acceleration at the last accepted state
-        self.accel_trial = None
+        self.accel_start: np.ndarray | None = None  # relative acceleration at the last accepted state
+        self.accel_trial: np.ndarray | None = None
         self.error_trial = 0.0
         self.next_step = self.max_step
         self.rejected = 0
@@ -133,6 +133,8 @@ class StepController:
         term within a step is far smaller).
         """
         a0 = self.accel_start
+        if a0 is None:  # post_step runs at t = 0, before any step's post-Newton call
+            raise RuntimeError("StepController.error: no accepted state yet (post_step was not called at t = 0)")
         if self.jump is not None:
             return self.factor * h * h * self.jump(a0, a1)
         jump = math.hypot(a1[0] - a0[0], a1[1] - a0[1]) + self.arm * abs(a1[2] - a0[2])

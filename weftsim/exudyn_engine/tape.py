@@ -101,5 +101,5 @@ def driven_head_acceleration(tape: RapierTape, free_length: float, wheel: Callab
     settings.timeIntegration.newton.useModifiedNewton = True
     silence(settings)
     mbs.SolveDynamic(settings)
-    data = mbs.GetSensorStoredData(sensor)
+    data = np.asarray(mbs.GetSensorStoredData(sensor))
     return data[:, 0], data[:, 1]

@@ -45,6 +45,7 @@ two against each other.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import exudyn as exu
@@ -61,6 +62,16 @@ UNSPECIFIED_MASS = 1.0  # sector mass (balanced, on its fixed axis: no effect), 
 POWER_JOINTS = 2  # build_tree(powers=True): the integrators of W3 and D
 
 
+def _matrices(items: list[np.ndarray]) -> exu.Matrix3DList:
+    """``exu.Matrix3DList(items)``: 3x3 matrices for the kinematic tree."""
+    return exu.Matrix3DList(items)  # type: ignore[call-arg]  # exudyn stub: no __init__ taking the list
+
+
+def _vectors(items: list[list[float]]) -> exu.Vector3DList:
+    """``exu.Vector3DList(items)``: 3-vectors for the kinematic tree."""
+    return exu.Vector3DList(items)  # type: ignore[call-arg]  # exudyn stub: no __init__ taking the list
+
+
 @dataclass
 class TreeModel:
     """Items of the kinematic-tree model and the clearance bookkeeping."""
@@ -68,7 +79,7 @@ class TreeModel:
     scene: Scene
     node: object  # NodeGenericODE2 with q = [a, psi + pi - a]
     tree: object  # ObjectKinematicTree, contact through its forceUserFunction
-    force: object  # the forceUserFunction (python or numba route)
+    force: Callable[..., list[float]]  # the forceUserFunction (python or numba route)
     tracker: OnsetTracker
     route: str
     memory: list  # [v_held, delta0, rate0] read by the force callback
@@ -125,12 +136,13 @@ def build_tree(mbs: exu.MainSystem, scene: Scene, callback: str = "auto", powers
     tree = mbs.AddObject(ObjectKinematicTree(
         nodeNumber=node, jointTypes=[exu.JointType.RevoluteZ] * 2 + [exu.JointType.PrismaticZ] * extra,
         linkParents=[-1, 0] + [-1] * extra,
-        jointTransformations=exu.Matrix3DList([np.eye(3)] * (2 + extra)),
-        jointOffsets=exu.Vector3DList([[0.0, 0.0, 0.0], [g.l_fg, 0.0, 0.0]] + [[0.0, 0.0, 0.0]] * extra),
-        linkInertiasCOM=exu.Matrix3DList([np.eye(3) * sector_chain_inertia(scene), np.eye(3) * m.rod_inertia]
-                                         + [np.eye(3)] * extra),
-        linkCOMs=exu.Vector3DList([[0.0, 0.0, 0.0], [0.5 * g.l_ef, 0.0, 0.0]] + [[0.0, 0.0, 0.0]] * extra),
+        jointTransformations=_matrices([np.eye(3)] * (2 + extra)),
+        jointOffsets=_vectors([[0.0, 0.0, 0.0], [g.l_fg, 0.0, 0.0]] + [[0.0, 0.0, 0.0]] * extra),
+        linkInertiasCOM=_matrices([np.eye(3) * sector_chain_inertia(scene), np.eye(3) * m.rod_inertia]
+                                  + [np.eye(3)] * extra),
+        linkCOMs=_vectors([[0.0, 0.0, 0.0], [0.5 * g.l_ef, 0.0, 0.0]] + [[0.0, 0.0, 0.0]] * extra),
         linkMasses=[UNSPECIFIED_MASS, m.rod_mass] + [1.0] * extra, baseOffset=[g.l_og, 0.0, 0.0],
-        gravity=[0.0, -m.gravity, 0.0], forceUserFunction=force,
+        gravity=[0.0, -m.gravity, 0.0],
+        forceUserFunction=force,  # type: ignore[arg-type]  # exudyn stub: wants an ndarray back (takes a list)
     ))  # fmt: skip
     return TreeModel(scene, node, tree, force, tracker, route, memory, stash, calls)

@@ -244,6 +244,7 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
     energy = np.zeros(n)
     f_el[inside] = law.elastic_force(delta[inside])
     energy[inside] = law.elastic_energy(delta[inside])
+    radial_rate = rate  # e_dot . n: F_N works along it (delta_dot of a worn joint also holds -dc/dt)
     if scene.joint.is_worn:  # the local clearance the callback saw (weftsim.physics.worn_rows), as the reference's
         delta, rate, f_el, energy = worn_channels(scene, t, a, psi, da, dpsi)
     # A lubricated joint: the film and boundary friction dissipate at every step (the quadratic rule of
@@ -259,7 +260,9 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
         drawn, dissipated = q_t[:, 3] - q_t[0, 3], q_t[:, 4] - q_t[0, 4]
     else:  # quadrature over the steps (the implicit tree with an oil film)
         drawn = contact_work(-q3 * omega, t, loaded)
-        dissipated = contact_work((f_n - f_el) * rate - friction_power, t, delta) + lubricated_work
+        # the tree_joint_force's D': F_N (delta_dot + dc/dt) - F_el delta_dot - F_T v_T
+        dissipated = contact_work((f_n - f_el) * rate + f_n * (radial_rate - rate) - friction_power, t, delta) \
+            + lubricated_work
     hist = model.tracker.history()
     row = np.clip(np.searchsorted(hist["time"], t * (1.0 + 1e-12), side="right") - 1, 0, len(hist["time"]) - 1)
     ratio = scene.geometry.rapier_ratio
@@ -347,6 +350,7 @@ def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, ca
             return False
         return True
 
+    solver: exu.MainSolverImplicitSecondOrder | exu.MainSolverExplicit
     if implicit:
         register_post_step(mbs, post_step)  # first: the step controller's hook plans the next step after it
         solver = exu.MainSolverImplicitSecondOrder()
@@ -364,19 +368,20 @@ def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, ca
     status, message, kind = "success", "", None
     wall_solve = _time.perf_counter()
     try:
-        if not solver.SolveSystem(mbs, settings):
+        if not solver.SolveSystem(mbs, settings):  # type: ignore[call-arg, misc]  # exudyn stub: SolveSystem lacks self
             if implicit:
                 status = "failed"
                 kind, message = implicit_failure(solver, scene)
             else:
-                status, kind, message = "failed", "solver", solver.GetErrorString() or "the explicit solver stopped"
+                reason = solver.GetErrorString()  # type: ignore[misc]  # exudyn stub: GetErrorString lacks self
+                status, kind, message = "failed", "solver", reason or "the explicit solver stopped"
     except exu.ExudynError as exc:
         text = str(exc).strip().splitlines()
         last = text[-1].split(" [Python file ")[0] if text else ""
         status, message = "failed", f"{type(exc).__name__}: {last}"
         kind = "non_finite" if isinstance(exc, exu.SolverError) else "model" if isinstance(exc, exu.ModelError) else "solver"
     wall_solve = _time.perf_counter() - wall_solve
-    data = {k: mbs.GetSensorStoredData(v) for k, v in sensors.items()}
+    data = {k: np.asarray(mbs.GetSensorStoredData(v)) for k, v in sensors.items()}  # the stub says ArrayLike
     data["force"] = np.array(model.bearing_force).reshape(-1, RECORD_COLUMNS)
     steps = tree_channels(model, data) if min(len(v) for v in data.values()) else empty_channels()
     if observe is not None:

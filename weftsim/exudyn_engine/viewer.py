@@ -133,8 +133,8 @@ class Recording:
     """
 
     path: Path
-    system_container: object
-    mbs: object
+    system_container: exu.SystemContainer
+    mbs: exu.MainSystem
     model: MechanismModel
     coordinates: int
     rows: int
@@ -185,7 +185,7 @@ def record_solution(scene: Scene, path: str | Path) -> Recording:
     output.writeInitialValues = True
     path.parent.mkdir(parents=True, exist_ok=True)
     try:
-        ok = solver.SolveSystem(mbs, settings)
+        ok = solver.SolveSystem(mbs, settings)  # type: ignore[call-arg, misc]  # exudyn stub: SolveSystem lacks self
     except exu.ExudynError as exc:
         lines = str(exc).strip().splitlines()
         last = lines[-1] if lines else type(exc).__name__
@@ -216,7 +216,7 @@ def show_solution(recording: Recording) -> None:
 
     settings = recording.system_container.visualizationSettings
     settings.general.autoFitScene = True
-    settings.openGL.initialZoom = 1.0
+    settings.openGL.advanced.initialZoom = 1.0  # openGL.initialZoom is its deprecated alias (Exudyn 1.13)
     settings.nodes.show = False
     settings.connectors.show = False
     settings.markers.show = False

@@ -19,6 +19,7 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
+from weftsim.errors import SceneError
 from weftsim.input.schema import _BY_PATH, SCHEMA, _set, shown
 
 if TYPE_CHECKING:
@@ -96,6 +97,9 @@ def resync_joint_f(scene: Scene, overridden: set[str] | dict) -> Scene:
 def _lubricant_of_e(scene: Scene) -> Scene:
     """``scene`` with joint F's lubricant (fixed viscosity or oil) set to E's, in one step (no state naming both)."""
     e, f = scene.joint.lubrication, scene.joint_f.lubrication
+    if e is None or f is None:  # resync_joint_f calls this only when F has a film and takes E's (then E has one)
+        raise SceneError("joint F takes its lubricant from joint E, but joint "
+                         f"{'E' if e is None else 'F'} has no [lubrication] table (a dry joint)")
     lub = replace(f, viscosity=e.viscosity if not e.has_oil else 0.0, oil=e.oil, oil_nu40=e.oil_nu40,
                   oil_nu100=e.oil_nu100, film_temperature=None)
     return replace(scene, joint_f=replace(scene.joint_f, lubrication=lub))
@@ -105,7 +109,8 @@ def ideal_joint_keys(scene: Scene, keys) -> list[str]:
     """The keys among ``keys`` that describe a joint which is ideal in ``scene`` (they change nothing)."""
     out = []
     for key in keys:
-        if describes_joint(key) and getattr(scene, JOINTS[joint_table(key)][1]).is_ideal:
+        table = joint_table(key)
+        if table is not None and describes_joint(key) and getattr(scene, JOINTS[table][1]).is_ideal:
             out.append(key)
     return out
 
@@ -113,6 +118,8 @@ def ideal_joint_keys(scene: Scene, keys) -> list[str]:
 def ideal_key_message(key: str, where: str = "command line") -> str:
     """The one line refusing ``key`` on an ideal joint, the same for ``run --set``, ``--vary`` and the API."""
     table = joint_table(key)
+    if table is None:
+        raise ValueError(f"ideal_key_message: '{key}' is not a key of a joint table (one of {sorted(JOINTS)})")
     letter = JOINTS[table][0]
     return (f"{where}: key '{shown(key)}' describes the clearance joint at {letter}, but joint {letter} is ideal "
             f"in this scene ({table}.{CLEARANCE} = 0 or not given), so it would change nothing; give "

@@ -223,7 +223,7 @@ class Lubrication:
         floor's while the asperities take the rest.  In [0.25, 4] (the rough film's table reaches
         sigma / 4); default 1 (film ratio 1).
     oil : str
-        An ISO 3448 grade (``"ISO VG 220"``, :func:`weftsim.joint.oil.grade_names`): the viscosity then follows
+        An ISO 3448 grade (``"ISO VG 220"``, :func:`weftsim.physics.oil.grade_names`): the viscosity then follows
         from the film's temperature (:mod:`weftsim.joint.heat`) instead of ``viscosity``.  Empty: not given.
     oil_nu40, oil_nu100 : float
         A custom oil instead of a grade: kinematic viscosities at 40 and 100 C, m^2/s (0: not given).
@@ -271,8 +271,8 @@ class Lubrication:
 
     @property
     def oil_model(self):
-        """The :class:`weftsim.joint.oil.Oil` named, or None."""
-        from weftsim.joint.oil import Oil, grade_oil
+        """The :class:`weftsim.physics.oil.Oil` named, or None."""
+        from weftsim.physics.oil import Oil, grade_oil
 
         if self.oil:
             return grade_oil(self.oil, self.oil_density, self.oil_heat_capacity)
@@ -320,7 +320,7 @@ OIL_SUPPLIES = ("fed", "sump")
 
 def oil_problem(lub: Lubrication) -> str | None:
     """One line naming the first invalid oil field of ``lub`` (:class:`Lubrication`), or None."""
-    from weftsim.joint.oil import custom_problem, grade_problem
+    from weftsim.physics.oil import custom_problem, grade_problem
 
     if not isinstance(lub.oil, str):
         return f"`lubrication.oil` must be a grade name such as 'ISO VG 220', got {lub.oil!r}"

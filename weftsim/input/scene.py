@@ -76,7 +76,7 @@ def _flatten(table: dict, where: str, prefix: tuple[str, ...] = (),
     """Dotted keys of a TOML table; one key given twice (a quoted dotted key at one level and
     the same key in its table) is a :class:`SceneError` naming both places."""
     seen = {} if seen is None else seen
-    flat = {}
+    flat: dict[str, Any] = {}
     for name, value in table.items():
         path = ".".join(prefix + (name,))
         if isinstance(value, dict):
@@ -96,7 +96,7 @@ def _flatten(table: dict, where: str, prefix: tuple[str, ...] = (),
 
 def _tables() -> set[str]:
     """Every table a scene file may hold (``joint_e``, ``joint_e.wear``, ``solver.reference``, ...)."""
-    out = set()
+    out: set[str] = set()
     for key in SCHEMA:
         parts = key.path.split(".")
         out.update(".".join(parts[:i]) for i in range(1, len(parts)))
@@ -262,7 +262,8 @@ def _read_merged(path: Path) -> tuple[dict[str, Any], dict[str, Path]]:
             path = scene_source(parent, path.parent).resolve()
         except SceneError as exc:
             raise SceneError(f"{path}: key 'extends' = {shown(repr(parent))}: {exc}") from None
-    merged, origin = {}, {}
+    merged: dict[str, Any] = {}
+    origin: dict[str, Any] = {}
     for index, (path, flat) in enumerate(reversed(chain)):
         if index:  # a base file's name and description do not describe the scene extending it
             merged.pop("name", None)

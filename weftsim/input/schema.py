@@ -129,7 +129,7 @@ def LUBRICATION_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 -
         Key(at + "film_floor_ratio", to + "film_floor_ratio", "float", 1, 0.25, 4, False,
             doc="numerical guard: the film force is evaluated no closer than this many RMS roughnesses (default 1; "
                 "the rough film's table reaches 0.25)"),
-        # The oil and the heat balance (weftsim.joint.oil, weftsim.joint.heat): instead of viscosity_mpa_s.
+        # The oil and the heat balance (weftsim.physics.oil, weftsim.joint.heat): instead of viscosity_mpa_s.
         Key(at + "oil", to + "oil", "str",
             doc="an ISO 3448 grade (\"ISO VG 220\"): the viscosity follows from the film temperature of the "
                 "bearing's heat balance (instead of viscosity_mpa_s)"),

@@ -20,10 +20,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from weftsim.errors import SceneError
+
+if TYPE_CHECKING:
+    from weftsim.input.params import Scene
 
 # The Stribeck curve: journal speeds from 1e-3 to 10 x the operating point's, log-spaced.
 STRIBECK_POINTS, STRIBECK_SPAN = 41, (1e-3, 10.0)
@@ -141,7 +145,7 @@ def _balanced(part):
     return replace(part, clearance=part.clearance + worn, bearing_wear=(), journal_wear=())
 
 
-def resolve_scene(scene):
+def resolve_scene(scene: Scene) -> Scene:
     """``scene`` with each oiled joint's viscosity at its effective film temperature (the heat balance at the
     ideal mechanism's mean load and sliding speed, :func:`weftsim.joint.heat.with_film_temperature`); scenes
     without an oil are returned as they are."""

@@ -119,15 +119,16 @@ def tangential_velocity(ecc: ArrayLike, bearing_velocity: ArrayLike, bearing_ang
         v_Q,b = v_Pb + w_b R_b t,  v_Q,j = v_Pj + w_j (R_b - |e|) t, and
         v_T = (v_Q,j - v_Q,b) . t = (v_Pj - v_Pb) . t + w_j (R_b - |e|) - w_b R_b.
 
+    0 where e = 0 (no normal, no contact).  The kernel's :func:`weftsim.physics.joint.tangential_velocity` at
+    every element.
+
     Parameters
     ----------
     ecc : (..., 2) eccentricity e = P_j - P_b, m.
     bearing_velocity, journal_velocity : (..., 2) velocities of the centres P_b, P_j, m/s.
     bearing_angular_velocity, journal_angular_velocity : (...,) rad/s about +z.
-    bearing_radius : float, R_b, m.
-
-    Returns 0 where e = 0 (no normal, no contact).  The kernel's
-    :func:`weftsim.physics.joint.tangential_velocity` at every element.
+    bearing_radius : float
+        R_b, m.
     """
     e = np.asarray(ecc, dtype=float)
     dv = np.asarray(journal_velocity, dtype=float) - np.asarray(bearing_velocity, dtype=float)
@@ -223,10 +224,10 @@ def make_clearance_kernel(law: _Law, joint: ClearanceJoint, jit: bool = False) -
             return fx, fy, f_n, delta, delta_dot, m_j, m_b
 
         return compiled
-    force = python_form(kernel_joint.clearance_force)
+    python_force = python_form(kernel_joint.clearance_force)
 
     def kernel(ex: float, ey: float, ex_dot: float, ey_dot: float, v_t: float, v_imp: float):
-        fx, fy, f_n, _, delta, delta_dot, m_j, m_b = force(prm, ex, ey, ex_dot, ey_dot, v_t, v_imp)
+        fx, fy, f_n, _, delta, delta_dot, m_j, m_b = python_force(prm, ex, ey, ex_dot, ey_dot, v_t, v_imp)
         return fx, fy, f_n, delta, delta_dot, m_j, m_b
 
     return kernel

@@ -153,7 +153,7 @@ def bai_zhao_stiffness(penetration: ArrayLike, clearance: float, effective_modul
                       penetration)  # fmt: skip
 
 
-def check_impact_velocity(delta: ArrayLike, impact_velocity: ArrayLike) -> None:
+def check_impact_velocity(delta: np.ndarray, impact_velocity: np.ndarray) -> None:
     """``ValueError`` where delta > 0 and the impact velocity is not > 0 (arrays, broadcast)."""
     bad = (delta > 0.0) & ~(impact_velocity > 0.0)
     if np.any(bad):
@@ -209,7 +209,7 @@ class _Law:
         raise NotImplementedError
 
     @property
-    def parameters(self) -> tuple[int, float, float, float]:
+    def parameters(self) -> tuple[float, float, float, float]:
         """(kind, coef, clearance, xi): the law's numbers for :mod:`weftsim.physics.laws`."""
         return self.kind, self.coefficient, getattr(self, "clearance", 0.0), self.hysteresis
 
@@ -251,12 +251,13 @@ class _Law:
         check_impact_velocity(d, v)
         d, rate, v = np.broadcast_arrays(d, np.asarray(penetration_rate, dtype=float), np.where(v > 0.0, v, 1.0))
         flat = [np.ascontiguousarray(x).ravel() for x in (d, rate, v)]
+        d_flat, rate_flat, v_flat = flat
         if d.size < _COMPILED_FROM:
             form = functools.partial(python_form(kernel.normal_force), *self.parameters)
             out = np.fromiter((form(*row) for row in zip(*(x.tolist() for x in flat))), float, d.size)
         else:
             out = np.empty(d.size)
-            _map_normal_force(*self.parameters, *flat, out)
+            _map_normal_force(*self.parameters, d_flat, rate_flat, v_flat, out)
         return out.reshape(d.shape)[()]
 
     def scalar(self) -> ScalarLaw:
@@ -473,7 +474,7 @@ def exact_hysteresis(restitution: float) -> float:
 class Cylindrical(_Law):
     """The conformal pin in its bushing, fitted to a plane-strain finite-element model (issue 37).
 
-    F_el = k delta^n, a power law in the approach delta (the multibody penetration |e| - c), with
+    F_el = k delta^n, a power law in the approach delta (the multibody penetration ``|e| - c``), with
 
         k = L_b E* R^(1 - n) exp(k0 + k1 ln(c/R) + k2 ln(t/R)),    n = n0 + n1 ln(c/R) + n2 ln(t/R),
 

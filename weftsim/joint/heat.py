@@ -15,7 +15,7 @@ conducted through the housing to the air (ISO 7902-1 / DIN 31652-1: P_f = P_th,L
 - **Housing**: k A (T_eff - T_amb), the convection term of ISO 7902-1 / DIN 31652 with the bearing at the
   effective temperature; k A is the scene's ``housing_heat_transfer_w_k`` or :func:`housing_estimate`.
 
-eta(T) is the oil's (:mod:`weftsim.joint.oil`), P_f, Q and Qs follow from the steady bearing at eta, so the
+eta(T) is the oil's (:mod:`weftsim.physics.oil`), P_f, Q and Qs follow from the steady bearing at eta, so the
 balance is one equation in T_eff: g(T) = P_f - heat out.  g(T_amb) = P_f > 0 and the oil thins as T rises; the
 first root above T_amb is the temperature a bearing warming from ambient settles at.  It is bracketed by steps
 from T_amb of 0.5 K, doubled each time (:data:`STEP_K`), up to the oil's limit (nu = 2 mm^2/s, or 200 C), and

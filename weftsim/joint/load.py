@@ -26,7 +26,7 @@ from weftsim.physics import chain_f as kf
 from weftsim.physics.joint import BEARING_RADIUS, friction_force, tangential_velocity
 from weftsim.joint.lubrication import joint_states
 from weftsim.physics.lubricated import L_FX, L_FY, is_lubricated, lubricated_force
-from weftsim.post.results import JOINT_FORCE_CHANNELS, JOINT_FORCE_CHANNELS_F, LOAD_FALLBACK
+from weftsim.model.channels import JOINT_FORCE_CHANNELS, JOINT_FORCE_CHANNELS_F, LOAD_FALLBACK
 
 JOINT_FORCE, JOINT_FORCE_F = JOINT_FORCE_CHANNELS + JOINT_FORCE_CHANNELS_F
 

@@ -7,7 +7,7 @@ states (:func:`weftsim.model.dynamics.initial_state` layout: [a, psi, a', psi', 
 the 4-DOF or F-only layouts of :mod:`weftsim.physics.chain_f` otherwise); the Exudyn kinematic tree
 converts its joint coordinates to that layout first.
 
-Channels (:data:`weftsim.post.results.LUBRICATION_CHANNELS`, ``_F`` for joint F): minimum film thickness
+Channels (:data:`weftsim.model.channels.LUBRICATION_CHANNELS`, ``_F`` for joint F): minimum film thickness
 h_min = max(c - |e|, 0) (m), film ratio h_min / sigma, film force |f_film| (N), asperity load F_a (N),
 film shear torque on the journal T_j (N m).
 """
@@ -24,7 +24,7 @@ from weftsim.physics import chain_f as kf
 from weftsim.physics.joint import ROUGHNESS
 from weftsim.physics.lubricated import L_ASPERITY, L_ASPERITY_ENERGY, L_FILM, L_FILM_TORQUE, lubricated_force
 from weftsim.input.params import Scene
-from weftsim.post.results import LUBRICATION_CHANNELS, LUBRICATION_CHANNELS_F
+from weftsim.model.channels import LUBRICATION_CHANNELS, LUBRICATION_CHANNELS_F
 
 # Rows of the compiled table: h_min, ratio, |f_film|, F_a, T_j, U_a.
 N_ROWS = 6

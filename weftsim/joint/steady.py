@@ -109,7 +109,7 @@ def steady_point(joint, load: float, omega: float, viscosity: float, prm: np.nda
     eps_film = min(ecc, c - lub.film_floor_ratio * lub.roughness) / c
     q_in, q_side = flow_variables(eps_film, length / (2.0 * radius))
     scale = radius * c * n * length
-    numbers = (load, omega, viscosity, sommerfeld, ecc / c, attitude, h_min, ratio, torque,
-               torque / (load * radius) if load > 0.0 else math.inf, torque * omega, film, asperity, dry,
-               q_in * scale, q_side * scale)
-    return SteadyPoint(*(float(x) for x in numbers), regime_of(ratio))
+    f = float  # plain floats for JSON
+    return SteadyPoint(f(load), f(omega), f(viscosity), f(sommerfeld), f(ecc / c), f(attitude), f(h_min), f(ratio),
+                       f(torque), f(torque / (load * radius)) if load > 0.0 else math.inf, f(torque * omega),
+                       f(film), f(asperity), f(dry), f(q_in * scale), f(q_side * scale), regime_of(ratio))

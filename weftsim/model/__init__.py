@@ -9,5 +9,6 @@ multibody model.
   eccentricity and energy of the chain;
 - :mod:`.ideal`: the crank side (members 1-3) in closed form, its equivalent inertia J13 and potential
   U13 and their derivatives, and the ideal mechanism's channels;
-- :mod:`.stiffness`: which joint laws of a scene are stiff for an explicit integrator.
+- :mod:`.stiffness`: which joint laws of a scene are stiff for an explicit integrator;
+- :mod:`.channels`: the names of the channels every engine reports and their optional groups.
 """

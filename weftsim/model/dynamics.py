@@ -174,8 +174,8 @@ def _eccentricity_rows(prm, t, a, psi, da, dpsi, out):
         out[4, i], out[5, i], out[6, i] = dphi, db_y, db_z
 
 
-def eccentricity(xp: ModuleType | None, p: ChainConstants, t: ArrayLike, a: ArrayLike, psi: ArrayLike, da: ArrayLike,
-                 dpsi: ArrayLike) -> tuple[np.ndarray | float, ...]:
+def eccentricity(xp: ModuleType | SimpleNamespace | None, p: ChainConstants, t: ArrayLike, a: ArrayLike,
+                 psi: ArrayLike, da: ArrayLike, dpsi: ArrayLike) -> tuple[np.ndarray | float, ...]:
     """Eccentricity e = P_j - P_b, its rate and the bearing's motion, over arrays (broadcast).
 
     :func:`weftsim.physics.chain.eccentricity` at every element (``xp`` is ignored: kept for callers
@@ -187,19 +187,19 @@ def eccentricity(xp: ModuleType | None, p: ChainConstants, t: ArrayLike, a: Arra
     """
     args = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (t, a, psi, da, dpsi)))
     shape = args[0].shape
-    flat = [np.ascontiguousarray(v).ravel() for v in args]
-    out = np.empty((7, flat[0].size))
-    _eccentricity_rows(_geometry_parameters(p), *flat, out)
+    t_flat, a_flat, psi_flat, da_flat, dpsi_flat = (np.ascontiguousarray(v).ravel() for v in args)
+    out = np.empty((7, t_flat.size))
+    _eccentricity_rows(_geometry_parameters(p), t_flat, a_flat, psi_flat, da_flat, dpsi_flat, out)
     return tuple(row.reshape(shape)[()] for row in out)
 
 
 def penetration(p: ChainConstants, t: float, y: np.ndarray) -> tuple[float, float]:
-    """delta = |e| - c (m) and delta_dot = e_dot . n (m/s) of a state y (:func:`weftsim.physics.chain.penetration`)."""
+    """``delta = |e| - c`` (m) and delta_dot = e_dot . n (m/s) of a state y (:func:`weftsim.physics.chain.penetration`)."""
     return kc.penetration(_geometry_parameters(p), float(t), np.asarray(y[:4], dtype=float))
 
 
-def chain_energy(p: ChainConstants, a: ArrayLike, psi: ArrayLike, da: ArrayLike,
-                 dpsi: ArrayLike) -> tuple[np.ndarray | float, np.ndarray | float]:
+def chain_energy(p: ChainConstants, a: np.ndarray | float, psi: np.ndarray | float, da: np.ndarray | float,
+                 dpsi: np.ndarray | float) -> tuple[np.ndarray | float, np.ndarray | float]:
     """Kinetic and potential energy of members 4-8 (J): 1/2 q'^T M q', m4 g z4."""
     m12 = -p.coupling * np.cos(np.asarray(psi) - a)
     kinetic = 0.5 * (p.m11 * da * da + 2.0 * m12 * da * dpsi + p.m22 * dpsi * dpsi)

@@ -25,6 +25,13 @@ from weftsim.physics import tape as kt
 _GAUSS_POINTS = 24
 
 
+
+def tape_of(scene: Scene) -> RapierTape:
+    """The scene's ``[rapier_tape]`` (ValueError for a scene without one: a rigid rapier has no tape model)."""
+    if scene.rapier_tape is None:
+        raise ValueError(f"scene {scene.name!r} has no [rapier_tape]: its rapier is rigid")
+    return scene.rapier_tape
+
 def stroke(scene: Scene) -> float:
     """The rapier's stroke (largest s of the ideal kinematics over a revolution), m."""
     from weftsim.mechanism.kinematics import rapier_stroke
@@ -59,7 +66,7 @@ def tape_block(scene: Scene, ratio: float, a0: float) -> np.ndarray:
 
     ``ratio``: ds/da = d5 d7 / d6 (m/rad); ``a0``: theta_FG at s = 0 (rad).
     """
-    tape = scene.rapier_tape
+    tape = tape_of(scene)
     n = tape.modes
     out = np.zeros(kt.block_size(n))
     out[kt.MODES], out[kt.MU], out[kt.EA] = n, tape.mass_per_length, tape.axial_stiffness
@@ -122,7 +129,7 @@ def quasi_static(tape: RapierTape, free_length: float, wheel_acceleration: float
 
 def rigid_equivalent(scene: Scene) -> Scene:
     """The scene with its tape and head as the rigid rapier's mass m8 (and no ``rapier_tape``)."""
-    tape = scene.rapier_tape
+    tape = tape_of(scene)
     return replace(scene, inertia=replace(scene.inertia, rapier_mass=tape.mass), rapier_tape=None)
 
 
@@ -153,7 +160,7 @@ def flexible_initial_state(scene: Scene, chain_state: np.ndarray, wheel_accelera
     stiff tape starts as the rigid rapier does, and the tape's vibration comes from the run (the start-up
     impact), not from its initial state.
     """
-    tape = scene.rapier_tape
+    tape = tape_of(scene)
     q0 = quasi_static(tape, tape.free_length, wheel_acceleration)
     n = tape.modes
     return np.concatenate([chain_state[:2], q0, chain_state[2:4], np.zeros(n), chain_state[4:6]])

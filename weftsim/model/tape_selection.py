@@ -21,7 +21,7 @@ import math
 import numpy as np
 
 from weftsim.input.params import Scene
-from weftsim.model.tape import first_frequency, rigid_equivalent, stroke
+from weftsim.model.tape import first_frequency, rigid_equivalent, stroke, tape_of
 
 # Relative departure of the head's acceleration from the rigid rapier's below which the rigid rapier serves:
 # a tenth of the engines' agreement on first-revolution peaks (compare.first_revolution_peaks = 1 %).
@@ -52,7 +52,7 @@ def tape_check(scene: Scene) -> dict:
     "harmonic_error": epsilon, "limit": RIGID_SERVES_BELOW, "rigid_serves": bool, "model": "rigid" or
     "flexible" (what the run takes), "reason": one line}``.
     """
-    tape = scene.rapier_tape
+    tape = tape_of(scene)
     f_rev = scene.drive.speed / (2.0 * math.pi)
     lengths = np.array([tape.free_length + stroke(scene), tape.free_length])
     f1 = first_frequency(tape, lengths)

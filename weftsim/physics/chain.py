@@ -274,7 +274,8 @@ def tree_joint_force(prm: np.ndarray, t: float, a: float, q1: float, da: float, 
     as the reference engine integrates W3 and D in :func:`chain`):
 
         W3' = -Q3 omega,  Q3 = F_b . dP_b/dtheta + M_b phi'       (drawn through the rocker)
-        D'  = (F_N - F_el(delta)) delta_dot - F_T v_T + D'_lub     (damping, friction, film)
+        D'  = F_N (delta_dot + dc/dt) - F_el(delta) delta_dot - F_T v_T + D'_lub  (damping, friction, film,
+              and on a worn wall the radial force's work as the profile passes under it, as in :func:`chain`)
 
     Returns (Q0, Q1, delta, delta_dot, F_bx, F_by, F_N, M_b, F_T v_T, v_T, D'_lub, U_a, W3', D'): N m, N m, m,
     m/s, N, N, N, N m, W (the dry friction power on the pair, <= 0; 0 without friction), m/s (the sliding speed
@@ -305,6 +306,8 @@ def tree_joint_force(prm: np.ndarray, t: float, a: float, q1: float, da: float, 
             prm, c, c_rate, ex, ey, evx, evy, held, delta0, rate0, db, omega * dphi)
     g1 = l_ef * (fx * sb - fy * cb) + m_j
     drawn = -(fx * db_y + fy * db_z + m_b * dphi) * omega
-    dissipated = (f_n - elastic_force(prm[KIND], prm[COEF], c, delta)) * rate - f_t * v_t + lub_power
+    # F_N e_dot.n = F_N (delta_dot + dc/dt): on a worn wall the radial force also works as the profile passes
+    # under it, which :func:`chain` books as dissipated (its D' from the forces' work on both bodies).
+    dissipated = (f_n - elastic_force(prm[KIND], prm[COEF], c, delta)) * rate + f_n * c_rate - f_t * v_t + lub_power
     return (l_fg * (fx * sa - fy * ca) + g1, g1, delta, rate, fx, fy, f_n, m_b, f_t * v_t, v_t, lub_power,
             asperity_energy, drawn, dissipated)  # fmt: skip

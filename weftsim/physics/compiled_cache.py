@@ -53,4 +53,4 @@ def use_keyed_cache() -> None:
         return
     from numba.core import config
 
-    config.CACHE_DIR = str(cache_folder())
+    config.CACHE_DIR = str(cache_folder())  # type: ignore[attr-defined]  # set at run time

@@ -23,6 +23,8 @@ from numba.core.registry import CPUDispatcher
 if TYPE_CHECKING:
     from collections.abc import Callable
 
+    from numba.core.dispatcher import Dispatcher
+
 _FORMS: dict = {}
 
 
@@ -45,7 +47,7 @@ def _rebuild(fn, bind: dict, compile_it: bool, memo: dict):
     return result
 
 
-def python_form(fn: CPUDispatcher, **bind: Callable) -> Callable:
+def python_form(fn: Dispatcher, **bind: Callable) -> Callable:
     """The plain-Python function of the numba function ``fn``, calling plain-Python callees.
 
     ``bind``: globals of ``fn`` and its callees to replace (by name), e.g. a state function.
@@ -57,7 +59,7 @@ def python_form(fn: CPUDispatcher, **bind: Callable) -> Callable:
     return form
 
 
-def specialize(fn: CPUDispatcher, **bind: Callable) -> CPUDispatcher:
+def specialize(fn: Dispatcher, **bind: Callable) -> Dispatcher:
     """``fn`` and its callees compiled (``cache=True``) with the globals in ``bind`` replaced.
 
     Bind each name to one function per process: numba's cache keys a function by its source and

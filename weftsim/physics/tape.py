@@ -235,7 +235,7 @@ def chain_tape(prm: np.ndarray, t: float, y: np.ndarray, contact: bool, impact_v
         for j in range(n):
             a[2 + i, 2 + j] = m_qq[i, j]
         acc[2 + i] = f_q[i]
-    acc = np.linalg.solve(a, acc)
+    acc[:] = np.linalg.solve(a, acc)
     h = _vec(prm, 1, n)
     hqdd = 0.0
     out[0], out[1] = y6[2], y6[3]

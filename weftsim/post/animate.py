@@ -358,11 +358,14 @@ def animation_figure(result: RunResult, frames: MechanismFrames,
     caption = (f"scene {scene.name}, engine {result.engine}, {rpm:g} rpm, {joint_caption(frames, magnification)}\n"
                "projection on the four-bar plane x = 0 (view along axis D)")
     flags = {"E": frames.in_contact, "F": frames.in_contact_f}
+    if frames.clearance_f > 0.0 and frames.in_contact_f is None:
+        raise ValueError("frames with a clearance at joint F need in_contact_f (its contact flags)")
+    in_contact: dict[str, np.ndarray] = {name: flag for name, flag in flags.items() if flag is not None}
 
     def draw(k: int):
         move_linkage(k)
         move_rapier(k)
-        states = [f"journal at {name} {'in contact' if flags[name][k] else 'free flight'}"
+        states = [f"journal at {name} {'in contact' if in_contact[name][k] else 'free flight'}"
                   for name, _ in frames.joints()] or ["ideal joints"]
         title.set_text(f"{caption}\ncrank angle {frames.crank_angle_deg[k]:5.1f} deg, {', '.join(states)}")
 
@@ -429,10 +432,13 @@ def _mp4(frames, fps: float, target: Path, comment: str = "") -> None:
                "-r", f"{fps:g}", "-i", "pipe:", "-vcodec", "libx264", "-pix_fmt", "yuv420p",
                *(["-metadata", f"comment={comment}"] if comment else []), "-f", "mp4", str(target)]
     with subprocess.Popen(command, stdin=subprocess.PIPE, stderr=subprocess.PIPE) as ffmpeg:
+        stdin, stderr = ffmpeg.stdin, ffmpeg.stderr
+        if stdin is None or stderr is None:  # never: both are pipes
+            raise OSError("ffmpeg was started without its stdin and stderr pipes")
         for rgb in (first, *frames):
-            ffmpeg.stdin.write(np.ascontiguousarray(rgb[:height, :width]).tobytes())
-        ffmpeg.stdin.close()
-        error = ffmpeg.stderr.read().decode(errors="replace").strip()
+            stdin.write(np.ascontiguousarray(rgb[:height, :width]).tobytes())
+        stdin.close()
+        error = stderr.read().decode(errors="replace").strip()
     if ffmpeg.returncode:
         raise OSError(f"ffmpeg failed (exit {ffmpeg.returncode}): {error.splitlines()[-1] if error else 'no message'}")
 

@@ -34,7 +34,10 @@ from weftsim.post.record import MANIFEST, SCENE_FILE, check_same_kind, check_sam
 from weftsim.post.results import RunResult
 
 if TYPE_CHECKING:
+    from collections.abc import Mapping
+
     from matplotlib.figure import Figure
+    from numpy.typing import ArrayLike
 
     from weftsim.input.params import Scene
 
@@ -120,7 +123,7 @@ def _umask() -> int:
     return mask
 
 
-def write_atomic(target: Path, write: Callable[[Path], None]) -> Path:
+def write_atomic(target: Path, write: Callable[[Path], object]) -> Path:
     """Call ``write(tmp_path)`` and rename the temporary file onto ``target``.
 
     The file gets mode 0666 less the umask, as a file opened for writing would.
@@ -173,7 +176,7 @@ def write_json(target: Path, data: dict) -> Path:
     return write_text(target, to_json(data))
 
 
-def write_csv(target: Path, columns: dict[str, np.ndarray]) -> Path:
+def write_csv(target: Path, columns: Mapping[str, ArrayLike]) -> Path:
     """Columns of equal length, header = column names, full double precision."""
     names = list(columns)
     table = np.column_stack([np.asarray(columns[n], dtype=float) for n in names]) if names else np.zeros((0, 0))

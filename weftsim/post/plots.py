@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -52,7 +52,7 @@ def clearance_label(scene: Scene) -> str:
     return f"c_E = {scene.joint.clearance * 1e3:g}, c_F = {scene.joint_f.clearance * 1e3:g} mm"
 
 
-def figure(**options: object) -> Figure:
+def figure(**options: Any) -> Figure:
     """A matplotlib Figure drawn by the Agg backend, without pyplot (whose import costs ~0.2 s of a
     ``weftsim run``); save it with :func:`weftsim.post.output.write_figure`."""
     from matplotlib.figure import Figure
@@ -130,7 +130,7 @@ def plot_channels(results: Sequence[RunResult], labels: Sequence[str] | None = N
     """Six panels over the last complete revolution of each result."""
     labels = labels or [f"{r.engine}, {clearance_label(r.scene)}, "
                         f"{r.scene.drive.speed * 30 / math.pi:g} rpm" for r in results]
-    curves = []
+    curves: list[tuple[str, dict[str, np.ndarray], dict[str, Any]]] = []
     for result, label in zip(results, labels):
         data, k = last_revolution(result)
         curves.append((label, {**data, "crank_angle_deg": data["crank_angle_deg"] - 360.0 * k}, {}))

@@ -161,7 +161,7 @@ def _field_type(hint: Any) -> tuple[type | None, bool, Any]:
         optional = type(None) in args
         rest = [a for a in args if a is not type(None)]
         hint = rest[0] if len(rest) == 1 else hint
-    return (hint if dataclasses.is_dataclass(hint) else None), optional, hint
+    return (hint if isinstance(hint, type) and dataclasses.is_dataclass(hint) else None), optional, hint
 
 
 def _value(hint: Any, value: Any, where: str) -> Any:
@@ -210,7 +210,7 @@ def rebuild(cls: type, data: Any, where: str = "scene") -> Any:
     if missing:
         raise ValueError(f"{where} lacks field(s) {', '.join(missing[:4])}")
     hints = typing.get_type_hints(cls, vars(params))
-    values = {}
+    values: dict[str, Any] = {}
     for name, value in data.items():
         nested, optional, hint = _field_type(hints[name])
         at = f"{where}.{name}"
@@ -269,7 +269,7 @@ def read_npz(path: str | os.PathLike):
             problem = channels_problem(names, scene)
             if problem:
                 raise _fail(path, problem)
-            tables = {}
+            tables: dict[str, dict[str, Any]] = {}
             for table in TABLES:
                 tables[table] = {}
                 for name in names:

@@ -34,7 +34,7 @@ from weftsim.physics.python import python_form
 from weftsim.physics.roots import END_FRACTION, ROOT_XTOL, SAMPLES  # noqa: F401 - the search's constants
 
 if TYPE_CHECKING:
-    from collections.abc import Callable
+    from collections.abc import Callable, Sequence
 
     import numpy as np
 
@@ -42,8 +42,8 @@ _FIRST_CROSSING = python_form(roots.first_crossing)
 _RATE_PEAK = python_form(roots.rate_peak)
 
 
-def first_crossing(state: Callable[[float], tuple[float, float]], times: np.ndarray, deltas: np.ndarray,
-                   rates: np.ndarray, sign: float) -> tuple[float, float] | None:
+def first_crossing(state: Callable[[float], tuple[float, float]], times: np.ndarray,
+                   deltas: np.ndarray | Sequence[float], rates: np.ndarray | Sequence[float], sign: float) -> tuple[float, float] | None:
     """First rising crossing of g = sign * delta within the sampled step, or None.
 
     ``state(t) -> (delta, delta_dot)``; ``times``, ``deltas``, ``rates`` sample the step at
@@ -54,8 +54,8 @@ def first_crossing(state: Callable[[float], tuple[float, float]], times: np.ndar
     return (t, rate) if found else None
 
 
-def rate_peak(rate_of: Callable[[float], float], times: np.ndarray, rates: np.ndarray,
-              held: float) -> tuple[float, float] | None:
+def rate_peak(rate_of: Callable[[float], float], times: np.ndarray | Sequence[float],
+              rates: np.ndarray | Sequence[float], held: float) -> tuple[float, float] | None:
     """Time and value of a maximum of delta_dot above ``held`` inside the step, or None.
 
     ``rate_of(t)`` is delta_dot on the dense output (:func:`weftsim.physics.roots.rate_peak`).

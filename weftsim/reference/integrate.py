@@ -32,11 +32,11 @@ import math
 import time as _time
 import warnings
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from weftsim.checks.guards import RunGuard, failure_message, non_finite_breach
+from weftsim.checks.guards import Breach, RunGuard, failure_message, non_finite_breach
 from weftsim.physics import chain as kernel_chain
 from weftsim.physics.chain import rhs as chain_rhs
 from weftsim.input.params import Scene
@@ -231,6 +231,7 @@ def _integrate(scene: Scene, progress) -> Trajectory:
             fail(f"cannot start a segment ({type(exc).__name__}: {exc})")
             break
         n_segments += 1
+        breach: Breach | None
         event = None  # (kind, time, value): "onset" / "separation" (value: rate), "peak" (value: new held)
         g_old, r_old = penetration(p, t, y)
         sign = -1.0 if contact else 1.0  # the crossing looked for: delta falls (contact) / rises (free)
@@ -252,11 +253,14 @@ def _integrate(scene: Scene, progress) -> Trajectory:
                         f"which scipy shrank down to the float resolution of t ({message})"
                     )  # fmt: skip
                 else:
-                    breach = guard.check(step_size=10.0 * np.spacing(t), steps=0)
+                    collapsed = guard.check(step_size=10.0 * np.spacing(t), steps=0)
                     why = f"scipy: {message or 'step failed'}"
                     if name in ("Radau", "BDF"):
                         why += f"; {name} also halves the step when its Newton iterations do not converge"
-                    breach = dataclasses.replace(breach, what=f"{breach.what}; {why}")
+                    if collapsed is None:  # limits.min_step_s below 10 floats of t (no criterion crossed)
+                        collapsed = Breach("step_size", "the step size collapsed to the float resolution of t "
+                                           f"(limits.min_step_s = {scene.limits.min_step:.3g} s is below it)", "")
+                    breach = dataclasses.replace(collapsed, what=f"{collapsed.what}; {why}")
                 fail(breach.what, breach.hint, breach.kind)
                 break
             n_steps += 1
@@ -296,7 +300,9 @@ def _integrate(scene: Scene, progress) -> Trajectory:
                 fail(breach.what, breach.hint, breach.kind)
                 break
             t_stop = t_new
-            dense = None
+            # scipy's DenseOutput of the step (scipy is untyped: Any): made below whenever contact or an event
+            # may lie in the step, so the contact substeps and an event's state read it, or for the samples
+            dense: Any = None
             grid = None
             if contact or possible:
                 dense = solver.dense_output()

@@ -85,7 +85,7 @@ def tape_channels(scene: Scene, time: np.ndarray, states: np.ndarray, contact: n
                   impact: np.ndarray) -> dict[str, np.ndarray]:
     """All CHANNELS and TAPE_CHANNELS at the given rows of a flexible-tape run (``contact`` bool, ``impact``
     (n,) at E), as :func:`weftsim.reference.compiled_channels.compiled_channels` gives a rigid run's."""
-    from weftsim.model.tape import first_frequency
+    from weftsim.model.tape import first_frequency, tape_of
 
     time = np.ascontiguousarray(time, dtype=float)
     prm = pack_parameters(scene)
@@ -96,5 +96,5 @@ def tape_channels(scene: Scene, time: np.ndarray, states: np.ndarray, contact: n
     _fill_tape(prm, crank_side_table(scene), float(y0[0]), scene.geometry.rapier_ratio, time, states,
                np.asarray(contact, dtype=np.bool_), np.asarray(impact, dtype=float), out)
     channels = dict(zip(names, np.ascontiguousarray(out.T)))
-    channels["tape_frequency_hz"] = first_frequency(scene.rapier_tape, channels["tape_free_length_m"])
+    channels["tape_frequency_hz"] = first_frequency(tape_of(scene), channels["tape_free_length_m"])
     return channels

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -145,7 +145,9 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
     results = {c: common.solve(common.load(models, name, overrides, scene), progress=progress)
                for c, name in SCENES.items()}
     metrics = {c: common.run_metrics(r) for c, r in results.items()}
-    written, curves, deviations = {}, [], []
+    written: dict[str, Any] = {}
+    curves: list[tuple[str, Any, dict[str, Any]]] = []
+    deviations: list[tuple[str, Any, dict[str, Any]]] = []
     last = max(ideal["revolutions"] - 1, 0)
     ideal_curve = common.revolution_steps(ideal_result, last)
     written["curves-ideal"] = common.write_curves(outdir, "clearance-curves-ideal", ideal_curve)

@@ -79,7 +79,7 @@ def base_scene(models: str | Path, base: str | Path | None, overrides: dict) -> 
     return load_scene(scene_path(models, REFERENCE) if base is None else base, overrides)
 
 
-def open_directory(outdir: Path, force: bool, scene: Scene) -> Path:
+def open_directory(outdir: str | Path, force: bool, scene: Scene) -> Path:
     """:func:`weftsim.post.output.prepare_directory` for a study of ``scene`` (a directory holding a study of
     another scene or other overrides is refused unless ``force``)."""
     from weftsim.post.output import prepare_directory

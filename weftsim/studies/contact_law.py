@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -98,15 +98,16 @@ def law_comparison(joint: ClearanceJoint, loads_kn=COMPARISON_LOADS_KN) -> list[
     def approach(law, force):
         return brentq(lambda d: float(law.elastic_force(d)) - force, 1e-14, 1.0, xtol=1e-16, rtol=1e-12)
 
-    rows, checked = [], None
+    rows: list[dict[str, Any]] = []
+    checked: list[float] | None = None
     for name in sorted(LAWS, key=lambda n: (n != FE_CHECKED, n)):
         try:
             law = make_law(replace(joint, law=name))
         except ValueError as err:
             rows.append({"law": name, "error": str(err)})
             continue
-        row = {"law": name, "fe_checked": name == FE_CHECKED, "exponent": law.exponent,
-               "approach_um": [approach(law, f * 1e3) * 1e6 for f in loads_kn]}
+        row: dict[str, Any] = {"law": name, "fe_checked": name == FE_CHECKED, "exponent": law.exponent,
+                               "approach_um": [approach(law, f * 1e3) * 1e6 for f in loads_kn]}
         if name == FE_CHECKED:
             checked = row["approach_um"]
         rows.append(row)
@@ -151,16 +152,16 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
     overrides = common.study_overrides("contact-law", SETS, revolutions, REVOLUTIONS, overrides)
     source, base = scene, common.base_scene(models, scene, overrides)
     outdir = common.open_directory(outdir, force, base)
-    scene = common.load(models, SCENE, {"drive.speed_rpm": SPEED_RPM, "name": "contact_law_0p01mm_500rpm",
+    study_scene = common.load(models, SCENE, {"drive.speed_rpm": SPEED_RPM, "name": "contact_law_0p01mm_500rpm",
                                         **overrides}, source)
-    curve = stiffness_curve(scene.joint)
-    result = common.solve(scene, "reference", progress=progress)
+    curve = stiffness_curve(study_scene.joint)
+    result = common.solve(study_scene, "reference", progress=progress)
     from weftsim.post.analysis import complete_revolutions
 
     n = complete_revolutions(result)
     revolution = max(n - 1, 0)
     steps = contact_steps(result, revolution)
-    law = make_law(scene.joint)
+    law = make_law(study_scene.joint)
     written = {
         "curve": write_csv(outdir / "contact-law-stiffness.csv", {
             "penetration_mm": curve["penetration_mm"],
@@ -179,7 +180,7 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
         for q, what in ((100, "largest"), (50, "median")):
             v = float(np.percentile(steps["impact_velocity_m_s"], q))
             law_lines.append((f"law at v_imp = {v:.3g} m/s ({what})", delta, law.damping(delta * 1e-3, v)))
-    rpm = common.speed_rpm(scene)
+    rpm = common.speed_rpm(study_scene)
     title = (f"contact law {law.name}, c = {curve['clearance_mm']:g} mm, {rpm:g} rpm "
              f"(revolution {revolution + 1} of {n}, reference engine)" + common.title_note(base, overrides))
     written["figure"] = write_figure(outdir / "study-contact-law.png",
@@ -205,7 +206,7 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
     report = {
         "study": "contact-law",
         **common.record(base, overrides),
-        "scene": scene.name,
+        "scene": study_scene.name,
         "clearance_mm": curve["clearance_mm"],
         "speed_rpm": rpm,
         "law": curve["law"],

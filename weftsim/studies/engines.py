@@ -59,13 +59,13 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
     overrides = common.study_overrides("engines", SETS, revolutions, REVOLUTIONS, overrides)
     source, base = scene, common.base_scene(models, scene, overrides)
     outdir = common.open_directory(outdir, force, base)
-    scene = common.load(models, SCENE, overrides, source)
-    results = {engine: common.solve(scene, engine, progress=progress) for engine in ENGINES}
+    study_scene = common.load(models, SCENE, overrides, source)
+    results = {engine: common.solve(study_scene, engine, progress=progress) for engine in ENGINES}
     metrics = {engine: common.run_metrics(r) for engine, r in results.items()}
     comparison = compare_results(results["exudyn"], results["reference"])
     written = {}
     n = min(m["revolutions"] for m in metrics.values())
-    rpm = common.speed_rpm(scene)
+    rpm = common.speed_rpm(study_scene)
     for which, revolution in (("first", 0), ("last", max(n - 1, 0))):
         curves = []
         for engine in ENGINES:
@@ -76,14 +76,14 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
         name = "study-engines.png" if which == "first" else "study-engines-last.png"
         note = "where the engines must agree" if which == "first" else "an illustration: impacts not reproducible"
         written[f"figure-{which}"] = write_figure(outdir / name, channel_panels(
-            curves, f"c = {scene.joint.clearance * 1e3:g} mm, {rpm:g} rpm: revolution {revolution + 1} of {n} "
+            curves, f"c = {study_scene.joint.clearance * 1e3:g} mm, {rpm:g} rpm: revolution {revolution + 1} of {n} "
                     f"({note}; cf. paper Fig. 16)" + common.title_note(base, overrides)))
     ratios = peak_ratios(metrics["reference"], metrics["exudyn"])
     report = {
         "study": "engines",
         **common.record(base, overrides),
-        "scene": scene.name,
-        "clearance_mm": common.clearance_mm(scene),
+        "scene": study_scene.name,
+        "clearance_mm": common.clearance_mm(study_scene),
         "speed_rpm": rpm,
         "revolutions": n,
         "runs": metrics,

@@ -85,12 +85,12 @@ def markdown_report(rows: list[dict], command: str) -> str:
               "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
     for r in ok:
         ratio, rev, scene_ratio = _float(r, "worst_ratio"), r.get("worst_revolution", ""), pooled.get(row_key(r))
-        own = f"**{ratio:.2f}**" if ratio > OUTLIER_RATIOS[0] else f"{ratio:.2f}"
+        own_cell = f"**{ratio:.2f}**" if ratio > OUTLIER_RATIOS[0] else f"{ratio:.2f}"
         scene = "" if scene_ratio is None else (f"**{scene_ratio:.2f}**" if scene_ratio > OUTLIER_RATIOS[0]
                                                else f"{scene_ratio:.2f}")  # fmt: skip
         angles = r.get("nonpositive_onset_angles_deg", "")
         lines.append(
-            f"| {r['scene']} | {r['method']} | {r['rtol']} | {own} ({rev}) | {scene} | "
+            f"| {r['scene']} | {r['method']} | {r['rtol']} | {own_cell} ({rev}) | {scene} | "
             f"{np.max(later_peaks(r)):.3g} | {_float(r, 'median_peak_N'):.3g} | {_float(r, 'peak_rev1_N'):.3g} | "
             f"{_float(r, 'max_abs_acceleration_m_s2'):.3g} | {r['steps']} | {r['wall_time_s']} | {r['onsets']} | "
             f"{r['nonpositive_onsets']}{f' ({angles})' if angles else ''} | {_float(r, 'min_onset_rate_m_s'):.2g} |"

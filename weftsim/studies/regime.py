@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -61,7 +62,7 @@ def _cell(scene_name: str, models, overrides: dict, progress: bool, base: str | 
     wall = time.perf_counter() - start
     steps = _last_revolution(result)
     joint = steps["contact_force_N"]
-    out = {"wall_time_per_revolution_s": wall / result.scene.drive.revolutions,
+    out: dict[str, Any] = {"wall_time_per_revolution_s": wall / result.scene.drive.revolutions,
            "steps": int(result.solver_stats.get("steps", 0)), "contact_force_max_N": float(joint.max()),
            "driving_torque_max_Nm": float(np.abs(steps["driving_torque_Nm"]).max())}
     if "film_ratio" in steps:

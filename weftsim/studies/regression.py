@@ -163,6 +163,9 @@ def quantities(case: Case, result: RunResult) -> dict[str, float]:
             out[f"{channel}.{stat}"] = first[channel][stat]
     if case.kind == "first_revolution":
         out["contact_force_N.max"] = first["contact_force_N"]["max"]
+        if result.first_contact_angle_deg is None:
+            raise ValueError(f"case {case.name} has no contact in its first revolution (its first contact angle "
+                             "is a stored quantity)")
         out["first_contact_crank_angle_deg"] = result.first_contact_angle_deg
     if case.kind == "statistics":
         stats = statistics(result)
@@ -251,7 +254,8 @@ def environment() -> dict:
     """Versions and platform of the machine that generates the table (exudyn's from its metadata)."""
     from importlib.metadata import PackageNotFoundError, version
 
-    out = {"python": platform.python_version(), "machine": platform.machine(), "system": platform.system()}
+    out: dict[str, str | None] = {"python": platform.python_version(), "machine": platform.machine(),
+                                  "system": platform.system()}
     for package in ("numpy", "scipy", "exudyn", "numba"):
         try:
             out[package] = version(package)

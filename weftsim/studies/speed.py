@@ -15,7 +15,7 @@ Besides the overlaid curves of the last revolution, it gives
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -50,6 +50,8 @@ def amplitude_measures(metrics: dict, channel: str) -> dict[str, float | None]:
 def spectrum_summary(spectrum: Spectrum, speed_rpm: float) -> dict:
     f_rev = speed_rpm / 60.0
     peak_f, peak_a = spectrum.peak()
+    band_f: float | None
+    band_a: float | None
     try:
         band_f, band_a = spectrum.peak(0.0, PAPER_BAND_HZ)
     except ValueError:  # lines every f_rev / revolutions may all lie above 10 Hz
@@ -94,7 +96,11 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
     c = f"c = {common.clearance_mm(results[500.0].scene):g} mm"  # the paper's 0.25 mm, or the scene's
     metrics = {rpm: common.run_metrics(r) for rpm, r in results.items()}
     ideal_metrics = {rpm: common.run_metrics(r) for rpm, r in ideals.items()}
-    written, curves, spectra, spectrum_rows, table = {}, [], [], {}, {}
+    written: dict[str, Any] = {}
+    curves: list[tuple[str, Any, dict[str, Any]]] = []
+    spectra: list[tuple[str, Any, dict[str, Any]]] = []
+    spectrum_rows: dict[str, dict[str, Any]] = {}
+    table: dict[str, dict[str, Any]] = {}
     for rpm, result in results.items():
         n = metrics[rpm]["revolutions"]
         data = common.revolution_steps(result, max(n - 1, 0))
@@ -114,7 +120,7 @@ def run(outdir: str | Path, models: str | Path = "models", revolutions: float | 
             written[f"spectrum-{rpm:g}"] = write_csv(outdir / f"speed-spectrum-{rpm:g}rpm.csv", {
                 "frequency_hz": spectrum.frequency_hz, "amplitude_m_s2": spectrum.amplitude,
                 "ideal_amplitude_m_s2": ideal_spectrum.amplitude})
-    ratios = {}
+    ratios: dict[str, dict[str, Any]] = {}
     for high, low in PAIRS:
         key = f"{high:g}/{low:g}"
         ratios[key] = {"ideal_kinematics": (high / low) ** 2}

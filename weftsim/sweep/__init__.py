@@ -2,7 +2,7 @@
 
 - :mod:`.grid`: the ``--vary`` / ``--set`` grammar and the cells of a grid;
 - :mod:`.plan`: the validated plan of a sweep (:func:`plan_sweep`);
-- :mod:`.engines`: named and plug-in engines (a plug-in is code that runs);
+- :mod:`weftsim.sweep.engines`: named and plug-in engines (a plug-in is code that runs);
 - :mod:`.cell`: one cell solved in a worker from data, and its record on disk;
 - :mod:`.pool`, :mod:`.worker`: the local process pool (workers die with the sweep) or a Dask cluster;
 - :mod:`.lock`: one sweep at a time in a directory;

@@ -108,16 +108,18 @@ def plan_sweep(scene_path: str | Path, vary: list[str], fixed: list[str] | tuple
                          "or pass --yes to plan and run them all")
     axes = tuple(parse_vary(text) for text in vary)
     fixed_overrides = dict(parse_set(text) for text in fixed)
-    idle = wear_only_keys([axis.key for axis in axes] + list(fixed_overrides))
-    if idle:
-        raise SweepError(wear_only_message(idle[0], "sweep"))
+    wear_only = wear_only_keys([axis.key for axis in axes] + list(fixed_overrides))
+    if wear_only:
+        raise SweepError(wear_only_message(wear_only[0], "sweep"))
     size = grid_size(axes)
     cells = grid_cells(axes, fixed_overrides)
     check_engine(engine, allow_cwd_engine)
     base = load_scene(scene_path, fixed_overrides, refuse_ideal_keys=False)  # checked over the cells below
     if announce and size > LARGE_GRID_CELLS // 10:
         announce(f"sweep: validating the scenes of {size:,} cells (about 1 ms each)")
-    planned, problems, notes = [], {}, []
+    planned: list[PlannedCell] = []
+    problems: dict[str, list[str]] = {}
+    notes: list[str] = []
     idle_everywhere: set[str] | None = None  # keys at a joint that is ideal in every cell so far
     for cell in cells:
         candidate = PlannedCell(cell, {**cell.overrides, "name": f"{base.name}[{cell.name}]"})

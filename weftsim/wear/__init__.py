@@ -22,6 +22,7 @@ wearing joint: ``hours_to_limit`` is the first joint's to reach it (``limit_join
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 import types
@@ -173,6 +174,7 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
     if until_limit and past_limit:
         raise WearError("--past-limit needs --hours: without them the prediction runs until the clearance limit")
     at_limit = limit is not None and not past_limit  # end where the first joint reaches the limit
+    cap = limit if limit is not None else math.inf  # the limit, m, where at_limit uses it
     outdir = prepare_directory(outdir, force, scene, kind="wear")
     check_engine(outdir, engine, force)
     what = {"kind": "wear", "scene": scene.name, "engine": engine, **provenance(scene)}  # from the first update on
@@ -208,19 +210,19 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
             # whichever is nearer its end (the estimate of the time left then follows what ends the run)
             done_share = 0.0 if until_limit else updates[-1].hours / hours
             if at_limit:
-                done_share = max(done_share, _grown(scene, updates[-1], share=limit))
+                done_share = max(done_share, _grown(scene, updates[-1], share=cap))
             progress(min(done_share, 1.0))
 
     asked_stop = stop
     if at_limit:
 
         def stop() -> bool:
-            return (asked_stop is not None and asked_stop()) or (bool(latest) and _beyond(scene, latest[-1], limit))
+            return (asked_stop is not None and asked_stop()) or (bool(latest) and _beyond(scene, latest[-1], cap))
 
     try:
         updates = predict(scene, hours, done, on_update=on_update, stop=stop, simulate=simulator(engine))
-        if at_limit and updates and _beyond(scene, updates[-1], limit):
-            updates[-1] = _cut_at(scene, updates[-1], limit)
+        if at_limit and updates and _beyond(scene, updates[-1], cap):
+            updates[-1] = _cut_at(scene, updates[-1], cap)
             save(updates)
         if not updates:  # stopped (Ctrl-C) before the first update was done: nothing to write
             raise KeyboardInterrupt
@@ -231,7 +233,7 @@ def predict_to_directory(scene: Scene, hours: float, outdir: str | Path, engine:
                               str(exc), engine)
         raise WearError(f"{exc}; the prediction stopped there, {reached_text(scene, data)}: the {len(latest)} "
                         f"updates before it are in {outdir}/wear.csv and wear.json") from None
-    reached = at_limit and _beyond(scene, updates[-1], limit * (1.0 - 1e-12))
+    reached = at_limit and _beyond(scene, updates[-1], cap * (1.0 - 1e-12))
     return _write_results(scene, updates, hours, limit, time.perf_counter() - wall0, outdir, what, figures,
                           engine=engine, reached_limit=reached)
 
@@ -326,7 +328,7 @@ def _write_results(scene: Scene, updates: list, hours: float, limit: float | Non
     data = store.summary(scene, updates, hours, limit, wall)
     data["engine"] = engine
     ended = ended_by_limit(scene, updates)
-    if ended is None and reached_limit:  # run until the clearance limit: the last update extrapolates up to it
+    if ended is None and reached_limit and limit is not None:  # run until the limit: the last update reaches it
         ended = f"the effective clearance reaches the limit {limit * 1e3:g} mm (--limit-clearance-mm)"
     data["ended"] = ended
     data["failure"] = failure
@@ -354,24 +356,29 @@ def _write_results(scene: Scene, updates: list, hours: float, limit: float | Non
         data.update(limit_note(scene, updates, limit, data.get("hours_to_limit")))
     data.update(duty_summary(scene, updates, data))
     columns = store.table(scene, updates)
-    files = {
+    files: dict[str, tuple[str, Callable[[Path], Path]]] = {
         "state": (store.STATE, lambda p: p),
         "table": ("wear.csv", lambda p: store.write_table(p, scene, updates)),
         "summary": ("wear.json", lambda p: write_json(p, data)),
     }
+
+    def profile(which: str, j: str) -> Callable[[Path], Path]:
+        return lambda p: store.write_profiles(p, updates, which, j)
+
     for joint in joints:
-        files[f"profile_{joint}"] = (f"wear_profile_{joint}.csv",
-                                     lambda p, j=joint: store.write_profiles(p, updates, "bearing", j))
-        files[f"journal_profile_{joint}"] = (f"wear_profile_journal_{joint}.csv",
-                                             lambda p, j=joint: store.write_profiles(p, updates, "journal", j))
+        files[f"profile_{joint}"] = (f"wear_profile_{joint}.csv", profile("bearing", joint))
+        files[f"journal_profile_{joint}"] = (f"wear_profile_journal_{joint}.csv", profile("journal", joint))
     if figures:
         from weftsim.wear.figures import conditions, growth_figure, profile_figure
 
         engine_tag = "" if engine == "reference" else f" ({engine} engine)"
+
+        def profile_png(j: str, t: str) -> Callable[[Path], Path]:
+            return lambda p: write_figure(p, profile_figure(scene, updates, t, j))
+
         for joint in joints:
             title = f"{scene.name}: wear at {joint.upper()}{engine_tag}\n{conditions(scene, (joint,))}"
-            files[f"profile_figure_{joint}"] = (
-                f"wear_profile_{joint}.png", lambda p, j=joint, t=title: write_figure(p, profile_figure(scene, updates, t, j)))
+            files[f"profile_figure_{joint}"] = (f"wear_profile_{joint}.png", profile_png(joint, title))
         name = "".join(joints)
         title = f"{scene.name}: wear at {' and '.join(j.upper() for j in joints)}{engine_tag}\n{conditions(scene, joints)}"
         limit_mm = None if limit is None else 1e3 * limit

@@ -76,15 +76,15 @@ def _window(run_scene: Scene, t_from: float, t_to: float, engine: str) -> RunWea
     if engine == "reference":
         from weftsim.engines import simulate
 
-        rows = {}
-        result = simulate(run_scene, "reference", observe=lambda *a: rows.update(steps=a), on_warning=_quiet)
+        observed: dict[str, tuple] = {}
+        result = simulate(run_scene, "reference", observe=lambda *a: observed.update(steps=a), on_warning=_quiet)
         if not result.ok:
             raise WearError(f"the stop-start transient ({run_scene.drive.law.replace('_', '-')}) failed on the "
                             f"reference engine: {result.message}")
-        t, y, contact, impact = rows["steps"]
+        t, y, contact, impact = observed["steps"]
         keep = (t >= t_from) & (t <= t_to)
         return run_wear(run_scene, pack_parameters(run_scene), t[keep], y[keep], contact[keep], impact[keep])
-    from weftsim.exudyn_engine.worn import solve_worn
+    from weftsim.wear.engines import solve_worn
 
     result, (t, states, f_n, v_t), _ = solve_worn(run_scene, 0)
     if not result.ok:
@@ -102,7 +102,8 @@ def stop_start_wear(scene: Scene, engine: str = "reference") -> tuple[RunWear, R
     """(run-down, start-up): the Archard wear of one stop-start of ``scene`` (its worn geometry as given) on
     ``engine`` (module docstring)."""
     check_duty(scene)
-    return tuple(_window(s, t0, t1, engine) for s, t0, t1 in transient_scenes(scene))
+    (down, down_from, down_to), (up, up_from, up_to) = transient_scenes(scene)
+    return _window(down, down_from, down_to, engine), _window(up, up_from, up_to, engine)
 
 
 def add(*wears: RunWear, weights: tuple[float, ...]) -> RunWear:

@@ -98,13 +98,13 @@ def wall_slope(profile: np.ndarray, radius: float) -> float:
 def geometric_limit(scene: Scene, bearing: np.ndarray, journal: np.ndarray, joint: str = "e") -> str | None:
     """Why the worn geometry (bearing, journal; m) of ``joint`` is beyond the model, as one clause, or None."""
     table = f"joint_{joint}"
-    joint = joint_of(scene, joint)
-    c_eff = effective_clearance(joint.clearance, bearing, journal)
-    if c_eff >= joint.journal_radius * (1.0 - 1e-9):
+    pin = joint_of(scene, joint)
+    c_eff = effective_clearance(pin.clearance, bearing, journal)
+    if c_eff >= pin.journal_radius * (1.0 - 1e-9):
         return (f"the effective clearance at {table[-1].upper()} reaches the journal radius "
-                f"{joint.journal_radius * 1e3:g} mm (the bound of {table}.clearance_mm; the journal would be worn "
+                f"{pin.journal_radius * 1e3:g} mm (the bound of {table}.clearance_mm; the journal would be worn "
                 "through)")
-    slope = max(wall_slope(bearing, joint.bearing_radius), wall_slope(journal, joint.journal_radius))
+    slope = max(wall_slope(bearing, pin.bearing_radius), wall_slope(journal, pin.journal_radius))
     if slope >= MAX_WALL_SLOPE * (1.0 - 1e-9):
         return (f"a worn wall's slope at {table[-1].upper()} reaches {MAX_WALL_SLOPE:g} rad (the small-wear "
                 "geometry the contact model assumes, docs/wear.md section 2)")
@@ -282,7 +282,7 @@ def simulate_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray,
     for retry, method in attempts:
         run_scene = worn_scene(scene, bearing, journal, w.settle_revolutions + w.revolutions_per_update, retry,
                                method, second)
-        rows = {}
+        rows: dict[str, tuple] = {}
         result = simulate(run_scene, "reference", observe=lambda *a: rows.update(steps=a), on_warning=_quiet)
         if result.ok:
             break

@@ -3,7 +3,7 @@ clearance and the response against the hours.  matplotlib is imported only when 
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
@@ -13,6 +13,7 @@ if TYPE_CHECKING:
     from collections.abc import Sequence
 
     from matplotlib.figure import Figure
+    from matplotlib.projections.polar import PolarAxes
 
     from weftsim.input.params import Scene
     from weftsim.wear.extrapolate import Update
@@ -20,15 +21,23 @@ if TYPE_CHECKING:
 
 def conditions(scene: Scene, joints: Sequence[str] = ("e",)) -> str:
     """What a wear figure's numbers depend on, for its title: the speed and each joint's Archard k and
-    hardnesses, bearing/journal (``600 rpm; E: k = 1e-07, H 2000/2000 MPa``)."""
+    hardnesses, bearing/journal (``600 rpm; E: k = 1e-07 (boundary), H 1670/6900 MPa``).
+
+    k is the one the joint's solid contact wears with (its regime's, or the single ``wear_coefficient``
+    that overrides the regimes); an oiled joint's asperities add theirs (``asperities 1e-07``)."""
     import math
 
     rpm = scene.drive.speed * 30.0 / math.pi
     parts = []
     for j in joints:
-        w = (scene.joint if j == "e" else scene.joint_f).wear
-        parts.append(f"{j.upper()}: k = {w.wear_coefficient:.3g}, H {w.bearing_hardness / 1e6:g}/"
-                     f"{w.journal_hardness / 1e6:g} MPa")
+        joint = scene.joint if j == "e" else scene.joint_f
+        w = joint.wear
+        k = f"k = {w.contact_wear_coefficient:.3g}"
+        if w.wear_coefficient is None:
+            k += f" ({w.regime})"
+        if joint.lubrication is not None:
+            k += f", asperities {w.asperity_wear_coefficient:.3g}"
+        parts.append(f"{j.upper()}: {k}, H {w.bearing_hardness / 1e6:g}/{w.journal_hardness / 1e6:g} MPa")
     return f"{rpm:g} rpm; " + "; ".join(parts)
 
 
@@ -53,7 +62,7 @@ def profile_figure(scene: Scene, updates: Sequence[Update], title: str = "", joi
     psi = np.append(np.arange(n), 0) * (2.0 * np.pi / n)
     frames = FRAMES[joint]
     for k, which in enumerate(("bearing", "journal")):
-        ax = fig.add_subplot(1, 2, k + 1, projection="polar")
+        ax = cast("PolarAxes", fig.add_subplot(1, 2, k + 1, projection="polar"))
         radii = []
         for u in _chosen(list(zip(updates, parts))):
             u, part = u

@@ -51,7 +51,7 @@ def curve_problem(stored: object, identity: str, limit: float, horizon: float) -
     return None
 
 
-def run_job(scene: Scene, limit: float, directory: str, horizon: float | None = None) -> dict:
+def run_job(scene: Scene, limit: float, directory: str | Path, horizon: float | None = None) -> dict:
     """Predict the wear of ``scene`` until its effective clearance reaches ``limit`` (m).
 
     Returns a dict: ``hours`` and ``clearance_m`` (c_eff at each update, then at the limit),

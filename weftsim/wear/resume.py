@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -54,7 +54,7 @@ AGREE = 1e-9
 MAX_SCENE_TEXT = 4 * 2**20  # characters of the stored scene keys (a few kB)
 
 
-def digest(arrays: dict[str, np.ndarray]) -> str:
+def digest(arrays: dict[str, Any]) -> str:
     """SHA-256 of the state's arrays (every one but ``digest``, by name, as float64 or text): the
     numbers no check can recompute (the response statistics) are covered by it."""
     import hashlib
@@ -184,7 +184,7 @@ def _shape_problem(headers: dict, names: dict[str, str], points: dict[str, int],
     if len(updates) != 1 or updates[0] < 1:
         return f"'hours' has shape {headers['hours'][0]}; it holds one time per update (at least one)"
     n = updates[0]
-    wanted = {"response": (n, responses)}
+    wanted: dict[str, tuple[int, ...]] = {"response": (n, responses)}
     for name, stored in names.items():
         joint = name.rpartition("_")[2]
         wanted[stored] = (n, points[joint]) if name.rpartition("_")[0] in PROFILES else (n,)

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -32,7 +32,7 @@ def response_row(update: Update) -> list[float]:
 
 
 def save_state(outdir: Path, scene: Scene, updates: list[Update]) -> Path:
-    arrays = {
+    arrays: dict[str, Any] = {  # keywords of np.savez (whose stub types one of them as allow_pickle)
         "scene": np.array(scene_identity(scene)),
         "hours": np.array([u.hours for u in updates]),
         "revolutions": np.array([u.revolutions for u in updates]),
@@ -76,7 +76,7 @@ def volumes(updates: list[Update], joint: str | None = None) -> np.ndarray:
 
 def table(scene: Scene, updates: list[Update]) -> dict[str, np.ndarray]:
     """Columns of ``wear.csv`` (one row per update, at the geometry it simulated)."""
-    col = {
+    col: dict[str, Any] = {
         "hours": [u.hours for u in updates],
         "revolutions": [u.revolutions for u in updates],
         "update_revolutions": [u.step_revolutions for u in updates],

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from weftsim.errors import WearError
-from weftsim.joint.oil import DENSITY_15C, DENSITY_PER_K
+from weftsim.physics.oil import DENSITY_15C, DENSITY_PER_K
 
 # Each distribution and its parameters, in the key's file units: the one source of the parser, its
 # messages and the command line's help (``weftsim wear --help``).
@@ -31,7 +31,7 @@ SIGNATURES = {"normal": ("mean", "sd"), "lognormal": ("median", "sigma_of_log"),
               "triangular": ("low", "mode", "high"), "walther": ("nu40", "nu100", "t_low", "t_high")}
 KINDS = {kind: len(names) for kind, names in SIGNATURES.items()}
 ALLOWED = ", ".join(f"{kind}({','.join(names)})" for kind, names in SIGNATURES.items())
-# Density of a mineral oil, g/cm^3 at 15 C, and its fall per kelvin (weftsim.joint.oil, in kg/m^3 there).
+# Density of a mineral oil, g/cm^3 at 15 C, and its fall per kelvin (weftsim.physics.oil, in kg/m^3 there).
 OIL_DENSITY_15C, OIL_DENSITY_PER_K = 1e-3 * DENSITY_15C, 1e-3 * DENSITY_PER_K
 
 _TEXT = re.compile(r"^\s*([A-Za-z0-9_.]+)\s*=\s*([a-z]+)\s*\(([^()]*)\)\s*$")
@@ -101,10 +101,10 @@ def parse_uncertain(text: str) -> Uncertain:
 def walther_viscosity(nu40: float, nu100: float, t_c: np.ndarray) -> np.ndarray:
     """Dynamic viscosity (mPa s) at ``t_c`` (C) of an oil with kinematic viscosities nu40, nu100 (mm^2/s).
 
-    Walther's relation of ASTM D341 through the two points (:func:`weftsim.joint.oil.walther_kinematic`), times
-    the density of a mineral oil (:func:`weftsim.joint.oil.density`, OIL_DENSITY_15C at 15 C).
+    Walther's relation of ASTM D341 through the two points (:func:`weftsim.physics.oil.walther_kinematic`), times
+    the density of a mineral oil (:func:`weftsim.physics.oil.density`, OIL_DENSITY_15C at 15 C).
     """
-    from weftsim.joint.oil import density, walther_kinematic
+    from weftsim.physics.oil import density, walther_kinematic
 
     return walther_kinematic(nu40, nu100, t_c) * density(1e3 * OIL_DENSITY_15C, t_c) * 1e-3
 

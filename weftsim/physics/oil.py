@@ -127,7 +127,9 @@ def grade_oil(name: str, density_15c: float = DENSITY_15C, heat_capacity: float 
     problem = grade_problem(name)
     if problem is not None:
         raise ValueError(problem)
-    grade = int(_GRADE.match(name).group(1))
+    match = _GRADE.match(name)
+    assert match is not None  # grade_problem accepted the name
+    grade = int(match.group(1))
     nu40, nu100 = ISO_VG[grade]
     return Oil(f"ISO VG {grade}", 1e-6 * nu40, 1e-6 * nu100, density_15c, heat_capacity)
 
