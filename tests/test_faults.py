@@ -32,7 +32,8 @@ from weftsim.cli import commands as cli
 from weftsim.post import output
 from weftsim.errors import EXIT_DISAGREE, EXIT_FAILED
 from weftsim.post.output import MANIFEST
-from weftsim.post.results import CHANNELS
+from weftsim.input.scene import load_scene
+from weftsim.post.results import scene_channels
 
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE = ROOT / "models" / "reference.toml"
@@ -48,6 +49,11 @@ def popen(*args, cwd=None, env=None, **kwargs) -> subprocess.Popen:
 def run_cli(*args, cwd=None, env=None) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-m", "weftsim.cli", *map(str, args)], capture_output=True, text=True,
                           cwd=cwd, env=env or ENV, timeout=300)  # fmt: skip
+
+
+def _header(csv: Path) -> list[str]:
+    """The column names of a CSV file weftsim wrote."""
+    return csv.read_text().split("\n", 1)[0].split(",")
 
 
 def error_line(stderr: str) -> str:
@@ -105,8 +111,10 @@ def test_a_stopped_run_keeps_its_partial_results_and_says_where(tmp_path, engine
     assert summary["solver"].get("failure", "interrupted") == "interrupted"
     assert json.loads((out / MANIFEST).read_text())["state"] == "complete"  # every file written
     channels = np.loadtxt(out / "channels.csv", delimiter=",", skiprows=1, ndmin=2)  # one row if stopped early
-    # The channels run from the start to where the run stopped, on the output grid.
-    assert channels[0, 0] == 0.0 and channels.shape[1] == len(CHANNELS)
+    # Every channel of the scene (the loose joint E's load among them), from the start to where the run
+    # stopped, on the output grid.
+    assert _header(out / "channels.csv") == list(scene_channels(load_scene(scene)))
+    assert channels[0, 0] == 0.0 and channels.shape[1] == len(scene_channels(load_scene(scene)))
     assert 0.0 < summary["simulated_time_s"] < 1000 * 60 / 400
     assert channels[-1, 0] <= summary["simulated_time_s"] + 1e-12
     assert summary["simulated_time_s"] - channels[-1, 0] < 0.5 / 360 * 60 / 400 + 1e-12  # within one sample
@@ -211,8 +219,9 @@ def test_disk_full_rescues_every_file_and_marks_the_manifest(tmp_path, monkeypat
     assert sorted(p.name for p in kept.iterdir()) == files
     table = files[0]
     data = np.loadtxt(kept / table, delimiter=",", skiprows=1)
-    if command == "run":  # all of the run's samples: 0.05 revolutions on the 0.5 deg grid
-        assert data.shape == (37, len(CHANNELS)) and data[-1, 1] == pytest.approx(18.0)
+    if command == "run":  # all of the run's samples: 0.05 revolutions on the 0.5 deg grid, every scene channel
+        assert _header(kept / table) == list(scene_channels(load_scene(REFERENCE)))
+        assert data.shape == (37, len(scene_channels(load_scene(REFERENCE)))) and data[-1, 1] == pytest.approx(18.0)
         assert json.loads((kept / "summary.json").read_text())["complete"] is True
     else:  # one revolution on the 0.5 deg grid
         assert data.shape[0] == 721 and data[-1, 0] == pytest.approx(360.0)

@@ -269,7 +269,8 @@ def test_engines_agree_on_the_lubricated_loom(clearance_mm, viscosity):
     generalized-alpha), a quarter revolution at 600 rpm: a full film at 0.02 mm, a film gone at the floor with
     asperities carrying at 0.1 mm, and the mixed regime of thin oil (10 mPa s at 0.02 mm: the rough film and the
     dissipating asperities share the load).  Within the dry runs' first-revolution tolerance (measured over one
-    revolution: maxima within 1.3e-3, the smallest film ratio 8.7988 against 8.8058 at 0.02 mm)."""
+    revolution: maxima within 1.3e-3, the smallest film ratio 8.7988 against 8.8058 at 0.02 mm); the mixed
+    regime's asperity peak at tolerances that resolve it (below)."""
     scene = load_scene("loom", {**OIL, "drive.revolutions": 0.25, "joint_e.clearance_mm": clearance_mm,
                                 "joint_e.lubrication.viscosity_mpa_s": viscosity, "joint_e.law": "variable_kd"})
     ref, tree = solve(scene), weftsim.simulate(scene, "exudyn")
@@ -278,12 +279,27 @@ def test_engines_agree_on_the_lubricated_loom(clearance_mm, viscosity):
     for name in ("driving_torque_Nm", "film_force_N", "rapier_acceleration_m_s2", "joint_force_N"):
         assert np.abs(tree.steps[name]).max() == pytest.approx(np.abs(ref.steps[name]).max(), rel=tolerance), name
     if viscosity == 10.0:  # mixed: the asperities carry part of the load on both engines
-        assert ref.steps["asperity_force_N"].max() > 0.0
-        assert tree.steps["asperity_force_N"].max() == pytest.approx(ref.steps["asperity_force_N"].max(),
-                                                                     rel=tolerance)
-    if clearance_mm == 0.02:  # a full film: both engines read its thinnest point, never at the floor
+        assert ref.steps["asperity_force_N"].max() > 0.0 and tree.steps["asperity_force_N"].max() > 0.0
+        # The asperity load is steep in the film ratio (Greenwood-Tripp, about 5 times its relative change at
+        # lambda = 1.57): at the engines' defaults the smallest film ratio is 1.5702 (RODAS4 rtol 1e-5) and
+        # 1.5619 (generalized-alpha, local error 3e-12 m) against 1.5669 converged, and the asperity peak, 33 N
+        # of a 12 kN load, is 1.0 % low and 1.5 % high: 32.48 and 33.28 N against 32.795 N (reference DOP853
+        # rtol 1e-9 and the Exudyn tree's DOPRI5 at 1e-9 agree to 3e-5).  The engines' asperity laws are
+        # compared where that peak is converged: RODAS4 at rtol 1e-7 gives 32.794 N, generalized-alpha at
+        # 3e-13 m 32.902 N (its error falls as the local error's 2/3 power: 33.03 N at 1e-12, 32.85 at 1e-13).
+        fine_ref = solve(dataclasses.replace(scene, reference_solver=dataclasses.replace(scene.reference_solver,
+                                                                                         rtol=1e-7)))
+        fine_tree = weftsim.simulate(dataclasses.replace(scene, exudyn_solver=dataclasses.replace(
+            scene.exudyn_solver, local_error=3e-13)), "exudyn")
+        assert fine_ref.ok and fine_tree.ok, (fine_ref.message, fine_tree.message)
+        assert fine_tree.steps["asperity_force_N"].max() == pytest.approx(fine_ref.steps["asperity_force_N"].max(),
+                                                                          rel=tolerance)
+    if clearance_mm == 0.02:  # a film above the floor: both engines read its thinnest point
         assert tree.steps["film_ratio"].min() == pytest.approx(ref.steps["film_ratio"].min(), rel=tolerance)
-        assert ref.steps["film_ratio"].min() > 3.0
+        # A full film with the thick oil (smallest ratio 8.8); the thin oil's film is mixed (1.57)
+        from weftsim.studies.regime import regime
+
+        assert regime(ref.steps["film_ratio"].min()) == ("hydrodynamic" if viscosity == 80.0 else "mixed")
 
 
 def test_reusable_exudyn_joint_carries_the_film(runs):

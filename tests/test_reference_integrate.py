@@ -15,7 +15,7 @@ from weftsim.input.params import ReferenceSolver, Scene
 from conftest import door
 solve = door("reference")
 from weftsim.model.ideal import ideal_torque
-from weftsim.post.results import CHANNELS
+from weftsim.post.results import CHANNELS, scene_channels
 
 # This file tests the scipy path (weftsim.reference.integrate), at the tolerances it was written for
 # (the reference engine's default until issue 12; the automatic path is the compiled one).
@@ -65,7 +65,10 @@ def test_energy_balance_over_a_revolution(one_revolution):
 def test_contact_events_and_channels(one_revolution):
     r = one_revolution
     st, sa = r.steps, r.samples
-    assert set(st) == set(CHANNELS)
+    # The base channels and the loose joint E's load, joint_force_N; a dry frictionless joint carries exactly
+    # its contact force (weftsim.joint.load).
+    assert set(st) == set(CHANNELS) | {"joint_force_N"} == set(scene_channels(r.scene))
+    assert np.array_equal(st["joint_force_N"], st["contact_force_N"])
     # Free flight from the centred journal until the first onset: located where delta crosses 0.
     t0 = r.events["first_contact_time_s"]
     assert t0 is not None and 0.0 < t0 < r.scene.drive.period

@@ -219,21 +219,41 @@ def test_weftsim_run_announces_an_explicit_friction_run_before_it_starts(capsys)
 
 
 def test_friction_on_the_loom_takes_rodas4_near_its_ramp_only_at_the_converged_peaks():
-    """Issue 36: the worn loom with friction (c = 0.1 mm, mu = 0.15) took 16 340 RODAS4 steps a revolution
-    against 938 dry: it is in contact 99.8 % of the time, and RODAS4 (order 4) in lasting contact needs ~15x the
-    steps of DOP853 (order 8), friction or not (dry on RODAS4: 14 010).  The ramp's stiff eigenvalue (~-3e7 1/s)
-    is there only while the rocker reverses; now RODAS4 runs only within 10 v1 of it.  First-revolution peaks
-    against DOP853 at rtol 1e-10 (which agrees with RODAS4 at 1e-10 to 5e-5): measured 9.3e-5 at most."""
+    """Issue 36: the worn loom with friction (c = 0.1 mm, mu = 0.15) is in contact 99.9 % of the time, and RODAS4
+    (order 4) in lasting contact needs many times the steps of DOP853 (order 8), friction or not.  The ramp's
+    stiff eigenvalue (~-3e7 1/s) is there only while the rocker reverses; RODAS4 runs only within 10 v1 of it.
+
+    Measured under the loom's cylindrical law (issue 37), one revolution at rtol 1e-7: the hybrid path 10 972
+    steps (7 614 on RODAS4), RODAS4 alone 78 270, DOP853 alone 77 142, dry 1 296 (under the former variable_kd:
+    3 664 (1 996), 34 489, 26 491, 938).  Against DOP853 at rtol 1e-10 (which agrees with RODAS4 at 1e-10 to
+    6e-5): the start-up impact's maxima (3.2 deg) of rapier acceleration, contact force and joint load within
+    3.2e-5.  The driving torque's first-revolution maximum is no longer reproducible: after about 119 deg every
+    run leaves the rtol 1e-11 one (DOP853 at 1e-7 .. 1e-10, RODAS4 at 1e-7 .. 1e-10), and its later impacts are
+    draws: the hybrid's maximum is 11 331 N m at 287 deg, the converged 7 669 N m at 98 deg, DOP853 alone gives
+    10 213 .. 11 897 N m at 1e-7 .. 1e-9.  As ``weftsim compare`` does (weftsim.post.compare), a maximum reached
+    at crank angles further apart than the first-contact tolerance is judged by the start-up impact's
+    (518.12 against 518.13 N m)."""
+    from weftsim.post.compare import _max_angle_deg, startup_impact_max
+
     overrides = {"joint_e.clearance_mm": 0.1, "drive.revolutions": 1.0}
-    rough = solve(load_scene("loom", {**overrides, "joint_e.friction_coefficient": 0.15}))
-    dry = solve(load_scene("loom", overrides))
-    converged = solve(load_scene("loom", {**overrides, "joint_e.friction_coefficient": 0.15,
-                                                    "solver.reference.method": "numba_DOP853",
-                                                    "solver.reference.rtol": 1e-10, "solver.reference.atol": 1e-13}))
-    assert rough.ok and dry.ok and converged.ok
-    for name in ("rapier_acceleration_m_s2", "driving_torque_Nm", "contact_force_N"):
-        peak, want = (np.abs(r.steps[name]).max() for r in (rough, converged))
+    friction = {**overrides, "joint_e.friction_coefficient": 0.15}
+    rough = solve(load_scene("loom", friction))
+    rodas = solve(load_scene("loom", {**friction, "solver.reference.method": "numba_RODAS4",
+                                      "solver.reference.rtol": 1e-7}))  # the hybrid's rtol (asserted below)
+    converged = solve(load_scene("loom", {**friction, "solver.reference.method": "numba_DOP853",
+                                          "solver.reference.rtol": 1e-10, "solver.reference.atol": 1e-13}))
+    assert rough.ok and rodas.ok and converged.ok
+    assert rough.path["method"].startswith("numba_DOP853_RODAS4 rtol 1e-07")
+    tolerance = np.degrees(rough.scene.compare.first_contact_angle)
+    for name in ("rapier_acceleration_m_s2", "driving_torque_Nm", "contact_force_N", "joint_force_N"):
+        if abs(_max_angle_deg(rough, name) - _max_angle_deg(converged, name)) > tolerance:
+            peak, want = (startup_impact_max(r, name) for r in (rough, converged))
+        else:
+            peak, want = (np.abs(r.steps[name]).max() for r in (rough, converged))
+        # 1e-3: thirty times the measured 3.2e-5; a path that loses the impact's peak misses it by percents.
         assert peak == pytest.approx(want, rel=1e-3), name
     stats = rough.solver_stats
-    assert stats["implicit_steps"] < 0.7 * stats["steps"]  # measured 1 996 of 3 664
-    assert stats["steps"] < 6 * dry.solver_stats["steps"]  # measured 3.9x (all on RODAS4: 17x)
+    # RODAS4 only near the ramp: the hybrid takes a seventh of the steps of RODAS4 alone at the same rtol
+    # (measured 10 972 against 78 270; 1 / 9.4 under variable_kd), of which 69 % on RODAS4 (54 % then).
+    assert stats["steps"] < 0.25 * rodas.solver_stats["steps"]
+    assert 0 < stats["implicit_steps"] < 0.8 * stats["steps"]
