@@ -84,7 +84,7 @@ def _window(run_scene: Scene, t_from: float, t_to: float, engine: str) -> RunWea
         t, y, contact, impact = observed["steps"]
         keep = (t >= t_from) & (t <= t_to)
         return run_wear(run_scene, pack_parameters(run_scene), t[keep], y[keep], contact[keep], impact[keep])
-    from weftsim.wear.engines import solve_worn
+    from weftsim.wear.worn_run import solve_worn
 
     result, (t, states, f_n, v_t), _ = solve_worn(run_scene, 0)
     if not result.ok:

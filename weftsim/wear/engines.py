@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from weftsim.errors import WearError
+from weftsim.wear.worn_run import solve_worn
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -53,25 +54,6 @@ def engine_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray, engine
 
 def _quiet(text: str) -> None:
     """An update's before-run warnings: the wear command reports the design checks of the scene once."""
-
-
-def solve_worn(scene: Scene, attempt: int = 0) -> tuple[RunResult, tuple, float]:
-    """(result, (t, states, F_N, v_T), relative tolerance) of one attempt
-    (:data:`weftsim.exudyn_engine.worn.ATTEMPTS`) on ``scene``, through :func:`weftsim.api.simulate`.
-
-    The rows are the Exudyn engine's ``observe`` rows of its kinematic tree: times (n,) s, states (n, 4)
-    [a, psi, a', psi'], the contact's F_N (N) and v_T (m/s) at every accepted step.
-    """
-    from weftsim.engines import simulate
-    from weftsim.exudyn_engine.selection import tree_relative_tolerance
-    from weftsim.exudyn_engine.worn import attempt_scene
-
-    run_scene = attempt_scene(scene, attempt)
-    rows: dict = {}
-    result = simulate(run_scene, "exudyn", observe=lambda *a: rows.update(steps=a), on_warning=_quiet)
-    if "steps" not in rows:  # refused before the run (settings): no rows
-        rows["steps"] = (np.zeros(0), np.zeros((0, 4)), np.zeros(0), np.zeros(0))
-    return result, rows["steps"], tree_relative_tolerance(run_scene)
 
 
 def exudyn_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray) -> tuple[RunWear, dict]:
