@@ -45,6 +45,30 @@ def test_every_numeric_key_is_bounded_and_a_value_past_it_names_the_key(key):
     assert key.path in text and key.allowed() in text and "\n" not in text, text
 
 
+def _below(key) -> float:
+    """A value just past the key's lower bound: the bound itself where it is excluded, else a tenth of a
+    positive bound (1e-9 rpm against >= 1), one below a zero or negative one."""
+    if key.low_open:
+        return key.low
+    return key.low / 10 if key.low > 0 else key.low - 1
+
+
+@pytest.mark.parametrize("key", NUMERIC, ids=lambda k: k.path)
+def test_every_numeric_key_refuses_a_value_below_its_bound_naming_the_key(key):
+    """The lower side of the same class (issue 35: --speed-rpm 1e-9 hung without a progress line, atol 1e-20
+    collapsed the first step): a value past the lower bound is refused in one line naming the key and its
+    range, before any run."""
+    value = _below(key)
+    if key.kind == "int":
+        value = math.floor(value) if not key.low_open else int(key.low)
+    if key.kind in ("floats2", "floats3"):
+        value = [value, 0.5 * key.high] if key.kind == "floats2" else [value] * 3
+    with pytest.raises(SceneError) as err:
+        load_scene("reference", {**_context(key.path), key.path: value})
+    text = str(err.value)
+    assert key.path in text and key.allowed() in text and "\n" not in text, text
+
+
 @pytest.mark.parametrize("key, value", [("solver.reference.atol", 1e-20), ("solver.reference.rtol", 1e-20),
                                         ("solver.exudyn.local_error_m", 1e-20),
                                         ("joint_e.lubrication.viscosity_mpa_s", 1e300),
