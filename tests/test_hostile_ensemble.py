@@ -311,3 +311,26 @@ def test_a_key_that_counts_only_beside_another_uncertain_key_is_taken_with_it():
         check_uncertain_key("joint_e.wear.run_in_depth_um", oiled)
     assert check_uncertain_key("joint_e.wear.run_in_depth_um", oiled, ("joint_e.wear.run_in_roughness_um",)) \
         == "joint_e.wear.run_in_depth_um"
+
+
+def test_a_bound_too_few_samples_give_is_not_called_censored():
+    """With 20 samples the 90 % order-statistic interval has no lower bound for p10 (P(no sample below the
+    true p10) = 0.9^20 = 0.12 > 0.05) and no upper bound for p90; `weftsim wear --uncertain --samples 20`
+    printed both as the censored "> 1e+05 h" ("p10: 1.161 h (90 % interval > 1e+05 h - 1.415 h)").  A bound
+    beyond the horizon (among censored samples) still reads "> H h"."""
+    from scipy import stats
+
+    from weftsim.wear.censored import text_interval
+    from weftsim.wear.ensemble import quantile_table
+
+    assert stats.binom.ppf(0.05, 20, 0.1) == 0 and stats.binom.ppf(0.95, 20, 0.9) + 1 > 20  # no rank in 1..20
+    table = quantile_table(np.arange(1.0, 21.0), 1e5)
+    p10, p90 = table["p10"], table["p90"]
+    assert p10["low"] is None and p10["low_beyond_hours"] is None and p10["high"] == 5.0
+    assert p90["high"] is None and p90["high_beyond_hours"] is None and p90["low"] == 16.0
+    assert text_interval(p10, 20) == "0 h - 5 h: 20 samples are too few for a lower bound"
+    assert text_interval(p90, 20) == "16 h - unbounded: 20 samples are too few for an upper bound"
+    # 100 samples, the last 20 censored at 1e5 h: p90's bounds lie among them, beyond the horizon.
+    censored = quantile_table(np.r_[np.arange(1.0, 81.0), [np.inf] * 20], 1e5)["p90"]
+    assert censored["censored"] and censored["low_beyond_hours"] == censored["high_beyond_hours"] == 1e5
+    assert text_interval(censored, 100) == "> 1e+05 h - > 1e+05 h"

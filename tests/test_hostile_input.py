@@ -45,12 +45,50 @@ def test_every_numeric_key_is_bounded_and_a_value_past_it_names_the_key(key):
     assert key.path in text and key.allowed() in text and "\n" not in text, text
 
 
+def _below(key) -> float:
+    """A value just past the key's lower bound: the bound itself where it is excluded, else a tenth of a
+    positive bound (1e-9 rpm against >= 1), one below a zero or negative one."""
+    if key.low_open:
+        return key.low
+    return key.low / 10 if key.low > 0 else key.low - 1
+
+
+@pytest.mark.parametrize("key", NUMERIC, ids=lambda k: k.path)
+def test_every_numeric_key_refuses_a_value_below_its_bound_naming_the_key(key):
+    """The lower side of the same class (issue 35: --speed-rpm 1e-9 hung without a progress line, atol 1e-20
+    collapsed the first step): a value past the lower bound is refused in one line naming the key and its
+    range, before any run."""
+    value = _below(key)
+    if key.kind == "int":
+        value = math.floor(value) if not key.low_open else int(key.low)
+    if key.kind in ("floats2", "floats3"):
+        value = [value, 0.5 * key.high] if key.kind == "floats2" else [value] * 3
+    with pytest.raises(SceneError) as err:
+        load_scene("reference", {**_context(key.path), key.path: value})
+    text = str(err.value)
+    assert key.path in text and key.allowed() in text and "\n" not in text, text
+
+
 @pytest.mark.parametrize("key, value", [("solver.reference.atol", 1e-20), ("solver.reference.rtol", 1e-20),
                                         ("solver.exudyn.local_error_m", 1e-20),
-                                        ("joint_e.lubrication.viscosity_mpa_s", 1e300)])
+                                        ("joint_e.lubrication.viscosity_mpa_s", 1e300),
+                                        ("drive.speed_rpm", 1e-9)])
 def test_the_absurd_values_of_the_issue_are_refused_naming_the_key(key, value):
+    """--speed-rpm 1e-9 ran 120 s without reaching the first 1 % of its progress (issue 35): the crank
+    speed is bounded below (drive.speed_rpm >= 1), refused before the run like atol 1e-20 and 1e300 mPa s."""
     with pytest.raises(SceneError, match=key.replace(".", r"\.")):
         load_scene("reference", {key: value})
+
+
+def test_the_command_line_refuses_a_crank_that_would_not_turn(tmp_path, capsys):
+    """The issue's own command line: one line naming the key and its bound, exit 2, nothing written."""
+    from weftsim.cli.commands import main
+
+    out = tmp_path / "slow"
+    assert main(["run", "reference", "--speed-rpm", "1e-9", "--revolutions", "0.01", "-o", str(out)]) == 2
+    lines = [line for line in capsys.readouterr().err.splitlines() if line.strip()]
+    assert len(lines) == 1 and "drive.speed_rpm" in lines[0] and ">= 1" in lines[0], lines
+    assert not out.exists()
 
 
 @pytest.mark.parametrize("key, value, words", [

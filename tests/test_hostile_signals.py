@@ -76,3 +76,57 @@ def test_sigterm_during_an_ensemble_says_how_to_resume(tmp_path):
     assert "Traceback" not in rest
     again = subprocess.run(cmd, capture_output=True, text=True, timeout=900)
     assert again.returncode == 0, again.stderr
+
+
+_START = ("import os, signal, sys, time\n"
+          "sys.argv = [{argv0!r}]\n"
+          "{ignore}"
+          "import weftsim\n"
+          "os.kill(os.getpid(), signal.SIGINT)\n"
+          "time.sleep(0.5)\n"
+          "print('still running')\n")
+
+
+def _start(argv0: str, ignore: bool = False) -> subprocess.CompletedProcess:
+    code = _START.format(argv0=argv0, ignore="signal.signal(signal.SIGINT, signal.SIG_IGN)\n" if ignore else "")
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
+                          preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+
+
+def test_ctrl_c_while_the_command_imports_is_one_line():
+    """A Ctrl-C in the first ~0.4 s of `weftsim run reference` (numpy, scipy, numba loading before main()
+    can catch it) printed a KeyboardInterrupt traceback of whatever module was loading, or that module's
+    ImportError/RuntimeError (measured here: every delay from 0.05 to 0.3 s).  In the weftsim command's own
+    process the SIGINT that arrives while it imports ends it with one line and status 130."""
+    done = _start("/somewhere/bin/weftsim")
+    assert done.returncode == 130, done.stderr
+    assert done.stderr == "weftsim: interrupted while starting\n" and "still running" not in done.stdout
+
+
+def test_a_library_import_and_an_ignored_sigint_are_left_alone():
+    """Importing weftsim from another program changes no signal handler (a Ctrl-C stays its KeyboardInterrupt),
+    and a command started with SIGINT ignored (a background job of a script) keeps ignoring it."""
+    library = _start("/somewhere/bin/myscript")
+    assert library.returncode == -signal.SIGINT and "KeyboardInterrupt" in library.stderr, library.stderr
+    ignored = _start("/somewhere/bin/weftsim", ignore=True)
+    assert ignored.returncode == 0 and "still running" in ignored.stdout, ignored.stderr
+
+
+def test_main_gives_sigint_back_before_the_command_runs(monkeypatch):
+    """Once main() has parsed the command line, a Ctrl-C is a KeyboardInterrupt again, which the commands turn
+    into their own lines (the run's stop handler, 'interrupted')."""
+    import weftsim.cli.startup as startup
+
+    seen = {}
+
+    def cmd(args):
+        seen["handler"] = signal.getsignal(signal.SIGINT)
+        return 0
+
+    monkeypatch.setitem(__import__("weftsim.cli.commands").cli.commands.COMMANDS, "scenes", cmd)
+    previous = signal.signal(signal.SIGINT, startup._stop)
+    try:
+        assert main(["scenes"]) == 0
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    assert seen["handler"] is signal.default_int_handler

@@ -162,3 +162,25 @@ def test_a_fixed_step_in_the_round_off_is_refused_and_one_above_it_gives_the_phy
     ref = reference.solve(load_scene("loom", {"drive.revolutions": 0.01, "solver.reference.rtol": 1e-12,
                                               "solver.reference.atol": 1e-14}))  # fmt: skip
     assert peak == pytest.approx(np.abs(ref.steps["rapier_acceleration_m_s2"]).max(), rel=1e-3)
+
+
+def test_the_command_line_refuses_the_round_off_step_before_the_run(tmp_path, capsys):
+    """The issue's command line: refused in one line with exit 2 before anything runs or is written (it was
+    estimated at ~73 s and ~829 MB, then failed at its first step with exit 3 and incomplete result files);
+    weftsim.estimate refuses it as a SceneError (the engine's estimate checks its settings)."""
+    import weftsim
+    from weftsim.cli.commands import main
+    from weftsim.errors import SceneError
+
+    overrides = {"solver.exudyn.model": "rigid_body", "solver.exudyn.step_control": "fixed",
+                 "solver.exudyn.step_size_s": 1e-9, "drive.revolutions": 0.01}
+    with pytest.raises(SceneError, match="round-off floor"):
+        weftsim.estimate(load_scene("loom", overrides), "exudyn")
+    out = tmp_path / "fine"
+    argv = ["run", "loom", "--engine", "exudyn", "--no-plot", "-o", str(out)]
+    for key, value in overrides.items():
+        argv += ["--set", f"{key}={value}"]
+    assert main(argv) == 2
+    err = [line for line in capsys.readouterr().err.splitlines() if line.strip()]
+    assert len(err) == 1 and "round-off floor" in err[0] and "step_size_s" in err[0], err
+    assert not out.exists() or not any(out.iterdir())

@@ -43,7 +43,11 @@ Example::
         table = weftsim.simulate(scene, engine).to_pandas()
 """
 
-from weftsim.version import __version__  # noqa: F401 (weftsim.__version__)
+from weftsim.cli.startup import guard_command_start
+
+guard_command_start()  # before the imports below: a Ctrl-C while they load is one line (weftsim.cli.startup)
+
+from weftsim.version import __version__  # noqa: E402, F401 (weftsim.__version__)
 from weftsim.api import (
     DEFAULT_ENGINE,
     ENGINE_NAMES,

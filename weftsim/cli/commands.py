@@ -642,11 +642,14 @@ def _one_line(text: object) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
+    from weftsim.cli.startup import release
+
+    parser = build_parser()  # imports what the flags' help lists (numba among them): still weftsim.cli.startup's
     args = parser.parse_args(argv)
     set_command(sys.argv[1:] if argv is None else argv)  # recorded in every output directory (weftsim.post.record)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(name)s: %(message)s")
+    release()  # from here a Ctrl-C is a KeyboardInterrupt again, caught below and by the commands
     try:
         return COMMANDS[args.command](args)
     except WeftsimError as exc:  # its message is the line to print, its class the exit status

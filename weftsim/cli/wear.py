@@ -253,7 +253,7 @@ def run_ensemble(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     m = data["method"]
     print(f"scene {scene.name}: hours to an effective clearance of {args.limit_clearance_mm:g} mm at E, "
           f"{data['samples']} samples ({len(data['jobs'])} simulated predictions, {data['wall_time_s']:.0f} s)")
-    from weftsim.wear.censored import text_hours
+    from weftsim.wear.censored import text_hours, text_interval
 
     horizon, never = data["horizon_hours"], bool(data["never"])
     reach = data["reaching_limit"]
@@ -267,7 +267,7 @@ def run_ensemble(args: argparse.Namespace, scene: Scene, outdir: str | Path,
                   + f" ({100 * table['reaching']['fraction']:.3g} % reach it within {horizon:g} h)")
     for name, q in data["hours_to_limit"].items():
         print(f"  {name}: {text_hours(q['hours'], horizon)} ({100 * m['quantile_confidence']:g} % interval "
-              f"{text_hours(q['low'], horizon)} - {text_hours(q['high'], horizon)})")
+              f"{text_interval(q, data['samples'])})")
     if reach["fraction"] < 1.0 and data.get("hours_of_those_reaching"):
         print("  of those reaching it: " + ", ".join(f"{name} {text_hours(q['hours'], horizon)}" for name, q in
                                                      data["hours_of_those_reaching"].items()))

@@ -101,6 +101,40 @@ def json_hours(value: float, horizon: float) -> dict:
     return {"hours": None, "censored": True, "beyond_hours": float(horizon)}
 
 
+def interval_bounds(low: float, high: float, horizon: float) -> dict:
+    """An interval's bounds for JSON: ``{"low", "high", "low_beyond_hours", "high_beyond_hours"}``.
+
+    A bound from :func:`censored_quantile` is a number, ``inf`` (it falls among the censored samples: None,
+    beyond ``horizon``) or NaN: the order statistic's rank lies outside 1..n, so the samples give no bound
+    on that side (20 samples bound neither p10 from below nor p90 from above at 90 %): None, and no
+    ``*_beyond_hours``, since it is not a censored value.
+    """
+    out: dict = {}
+    for name, value in (("low", low), ("high", high)):
+        out[name] = float(value) if math.isfinite(value) else None
+        out[f"{name}_beyond_hours"] = float(horizon) if value == math.inf else None
+    return out
+
+
+def text_interval(q: dict, samples: int) -> str:
+    """``"1.5 h - 2.8 h"`` of a quantile's interval (:func:`interval_bounds`): a censored bound as
+    ``"> H h"``, a bound the samples cannot give as ``"0 h"`` below (hours are not negative) or
+    ``"unbounded"`` above, saying so."""
+    def bound(name: str) -> str:
+        if q[name] is not None:
+            return f"{q[name]:.4g} h"
+        if q.get(f"{name}_beyond_hours") is not None:
+            return f"> {q[f'{name}_beyond_hours']:.4g} h"
+        return "0 h" if name == "low" else "unbounded"
+
+    missing = [side for side, name in (("lower", "low"), ("upper", "high"))
+               if q[name] is None and q.get(f"{name}_beyond_hours") is None]
+    what = ("lower and upper bounds" if len(missing) == 2 else
+            f"{'an' if missing[0] == 'upper' else 'a'} {missing[0]} bound" if missing else "")
+    note = f": {samples} samples are too few for {what}" if what else ""
+    return f"{bound('low')} - {bound('high')}{note}"
+
+
 def text_hours(value: float, horizon: float, never: bool = False) -> str:
     """``"123.4 h"``, or ``"never"`` / ``"> H h"`` for a censored value."""
     if value is None or not math.isfinite(value):

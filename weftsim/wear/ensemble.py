@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from weftsim.errors import WearError
-from weftsim.wear.censored import censored_quantile, fraction_interval, json_hours
+from weftsim.wear.censored import censored_quantile, fraction_interval, interval_bounds, json_hours
 from weftsim.wear.ensemble_design import (DESIGN_QUANTILES, RESCALED, k_scale, _lagrange, centre_name,  # noqa: F401
                                           interpolate, plan)
 from weftsim.wear.jobs import hours_at, run_job
@@ -162,12 +162,13 @@ def combine(scene: Scene, uncertain: list[Uncertain], dynamic: list[Uncertain], 
 def quantile_table(hours: np.ndarray, horizon: float = HORIZON_HOURS) -> dict:
     """{"p10": {"hours", "low", "high", "censored", "beyond_hours"}, ...} with CONFIDENCE order-statistic
     intervals; a quantile among the censored samples (``inf``) has ``hours`` None and ``censored`` True
-    (it lies beyond ``horizon``), an interval bound among them is None."""
+    (it lies beyond ``horizon``); an interval bound is None either among them (``low_beyond_hours`` /
+    ``high_beyond_hours`` = ``horizon``) or where too few samples give none (``*_beyond_hours`` None:
+    :func:`weftsim.wear.censored.interval_bounds`)."""
     out = {}
     for p in QUANTILES:
         est, low, high = censored_quantile(hours, p, CONFIDENCE)
-        out[f"p{round(100 * p)}"] = {**json_hours(est, horizon), "low": low if math.isfinite(low) else None,
-                                     "high": high if math.isfinite(high) else None}
+        out[f"p{round(100 * p)}"] = {**json_hours(est, horizon), **interval_bounds(low, high, horizon)}
     return out
 
 
