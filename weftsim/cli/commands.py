@@ -46,8 +46,8 @@ from weftsim.errors import WeftsimError
 from weftsim.post.record import set_command
 from weftsim.cli.signals import Terminated, terminated_as_interrupt  # noqa: F401 (Terminated: for subcommands)
 from weftsim.errors import EXIT_DISAGREE, EXIT_FAILED, EXIT_USAGE  # noqa: F401 (re-exported)
+from weftsim.cli.startup import EXIT_INTERRUPTED  # 128 + SIGINT, defined once for start-up and the commands
 
-EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a command stopped by Ctrl-C
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE: the reader of stdout went away (`| head`), as for any Unix tool
 
 

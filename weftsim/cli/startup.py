@@ -17,7 +17,7 @@ import signal
 import sys
 
 _LINE = b"weftsim: interrupted while starting\n"
-EXIT_INTERRUPTED = 128 + signal.SIGINT  # weftsim.errors.EXIT_INTERRUPTED, without importing it
+EXIT_INTERRUPTED = 128 + signal.SIGINT  # 130, as a shell reports a command stopped by Ctrl-C (every command's)
 
 
 def _stop(signum, frame) -> None:  # noqa: ARG001 (a signal handler's signature)
