@@ -164,23 +164,50 @@ def test_a_fixed_step_in_the_round_off_is_refused_and_one_above_it_gives_the_phy
     assert peak == pytest.approx(np.abs(ref.steps["rapier_acceleration_m_s2"]).max(), rel=1e-3)
 
 
-def test_the_command_line_refuses_the_round_off_step_before_the_run(tmp_path, capsys):
+ROUNDOFF_STEP = {"solver.exudyn.model": "rigid_body", "solver.exudyn.step_control": "fixed",
+                 "solver.exudyn.step_size_s": 1e-9, "drive.revolutions": 0.01}
+
+
+@pytest.mark.parametrize("command", [
+    ["run", "loom", "--engine", "exudyn", "--no-plot"],
+    ["compare", "loom"],
+    ["sweep", "loom", "--engine", "exudyn", "--vary", "joint_e.clearance_mm=0.1,0.2"],
+    [],  # run without -o: the default folder under the working directory
+])
+def test_the_command_line_refuses_the_round_off_step_before_the_run(command, tmp_path, capsys, monkeypatch):
     """The issue's command line: refused in one line with exit 2 before anything runs or is written (it was
-    estimated at ~73 s and ~829 MB, then failed at its first step with exit 3 and incomplete result files);
-    weftsim.estimate refuses it as a SceneError (the engine's estimate checks its settings)."""
+    estimated at ~73 s and ~829 MB, then failed at its first step with exit 3 and incomplete result files;
+    then refused, but after its output folder had been created: an empty folder was left behind).  compare
+    refuses it as run does; a sweep whose every cell would be refused runs none (each cell failed with an
+    error.txt, exit 3).  weftsim.estimate refuses it as a SceneError (the engine's estimate checks its settings)."""
     import weftsim
     from weftsim.cli.commands import main
     from weftsim.errors import SceneError
 
-    overrides = {"solver.exudyn.model": "rigid_body", "solver.exudyn.step_control": "fixed",
-                 "solver.exudyn.step_size_s": 1e-9, "drive.revolutions": 0.01}
     with pytest.raises(SceneError, match="round-off floor"):
-        weftsim.estimate(load_scene("loom", overrides), "exudyn")
+        weftsim.estimate(load_scene("loom", ROUNDOFF_STEP), "exudyn")
+    monkeypatch.chdir(tmp_path)
     out = tmp_path / "fine"
-    argv = ["run", "loom", "--engine", "exudyn", "--no-plot", "-o", str(out)]
-    for key, value in overrides.items():
+    argv = command + ["-o", str(out)] if command else ["run", "loom", "--engine", "exudyn", "--no-plot"]
+    for key, value in ROUNDOFF_STEP.items():
         argv += ["--set", f"{key}={value}"]
     assert main(argv) == 2
     err = [line for line in capsys.readouterr().err.splitlines() if line.strip()]
     assert len(err) == 1 and "round-off floor" in err[0] and "step_size_s" in err[0], err
-    assert not out.exists() or not any(out.iterdir())
+    assert not any(tmp_path.iterdir()), sorted(tmp_path.rglob("*"))  # nothing behind, not even an empty folder
+
+
+def test_a_refused_run_leaves_a_folder_as_it_was(tmp_path, capsys):
+    """A run refused before it starts leaves what the folder held untouched (a file of the user's, written into
+    with --force): no manifest, scene or result file is added."""
+    from weftsim.cli.commands import main
+
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / "notes.txt").write_text("kept\n")
+    argv = ["run", "loom", "--engine", "exudyn", "--no-plot", "--force", "-o", str(out)]
+    for key, value in ROUNDOFF_STEP.items():
+        argv += ["--set", f"{key}={value}"]
+    assert main(argv) == 2
+    assert "round-off floor" in capsys.readouterr().err
+    assert [p.name for p in out.iterdir()] == ["notes.txt"] and (out / "notes.txt").read_text() == "kept\n"

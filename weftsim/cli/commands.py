@@ -426,9 +426,12 @@ def cmd_run(args: argparse.Namespace) -> int:
     engine = resolve_engine(args.engine)
     outdir = output_directory(args, scene, engine)
     _check_fits(scene, outdir)
-    outdir = prepare_directory(outdir, args.force, scene, kind="run")
+    # Checked before the estimate, which may still refuse the run (the engine's settings); created after it, so a
+    # refused run leaves no directory behind.
+    prepare_directory(outdir, args.force, scene, kind="run", create=False)
     with _stop_on_interrupt("run") as stop:  # from here a Ctrl-C stops the run (the estimate imports the engine)
         _announce_run_time(scene, (engine,), "run")
+        outdir = prepare_directory(outdir, args.force, scene, kind="run")
         _announce_checks(scene, "run")
         result = _solve(scene, engine, announce=True)
     written = write_run(result, outdir, figure=not args.no_plot, force=args.force, npz=True,
@@ -522,9 +525,10 @@ def cmd_compare(args: argparse.Namespace) -> int:
     scene = scene_from_args(args)
     outdir = output_directory(args, scene, "compare")
     _check_fits(scene, outdir, runs=2)
-    prepare_directory(outdir, args.force, scene, kind="compare")  # refused before the estimate is shown
+    prepare_directory(outdir, args.force, scene, kind="compare", create=False)  # refused before the estimate
     with _stdout_to_stderr() if args.json else contextlib.nullcontext():  # the estimate imports Exudyn
-        _announce_run_time(scene, ("reference", "exudyn"), "compare")
+        _announce_run_time(scene, ("reference", "exudyn"), "compare")  # may refuse an engine's settings
+        prepare_directory(outdir, args.force, scene, kind="compare")  # created once nothing refuses the run
         _announce_checks(scene, "compare")
         report = compare(scene, outdir, solve=_solve, force=args.force)
         status, problem = verdict(report, outdir)

@@ -108,6 +108,7 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
         raise CliError("--past-limit goes on wearing past --limit-clearance-mm up to --hours: give both")
     hours = MAX_HOURS if until_limit else args.hours
     check_request(scene, hours, args.engine, limit)  # a WearError is one line, exit 2
+    update_seconds = update_time(scene, args.engine)  # the engine's estimate may refuse its settings: before mkdir
     outdir = prepare_directory(outdir, args.force, scene, kind="wear")
     try:
         check_engine(outdir, args.engine, args.force)  # a state of the other engine: one line, or --force
@@ -124,7 +125,7 @@ def run(args: argparse.Namespace, scene: Scene, outdir: str | Path,
             f"{args.limit_clearance_mm:g} mm")
     print(f"scene {scene.name}, wear at {at} {span} on the {args.engine} engine; each update simulates "
           f"{first.settle_revolutions} + {first.revolutions_per_update} revolutions "
-          f"(~{_duration(update_time(scene, args.engine))}), the update interval grows each clearance by at most "
+          f"(~{_duration(update_seconds)}), the update interval grows each clearance by at most "
           + ", ".join(f"{100 * joint_of(scene, j).wear.max_clearance_change:g} % at {j.upper()}" for j in joints),
           file=sys.stderr, flush=True)
     if resumed:

@@ -56,7 +56,7 @@ MEMORY_BYTES_PER_VALUE = 24
 
 
 def prepare_directory(path: str | Path, force: bool = False, scene: Scene | None = None,
-                      kind: str | None = None) -> Path:
+                      kind: str | None = None, create: bool = True) -> Path:
     """Create ``path`` (and parents) and check it is a writable directory of ours.
 
     A directory that already holds files but no weftsim manifest was not written by
@@ -65,6 +65,9 @@ def prepare_directory(path: str | Path, force: bool = False, scene: Scene | None
     (unless ``force``; :func:`weftsim.post.record.check_same_scene`), before anything is written.
     With ``kind`` (the manifest's ``"kind"`` the caller writes: ``"run"``, ``"wear"``, ``"wear ensemble"``,
     ...), a directory holding another command's results is refused too (:func:`~weftsim.post.record.check_same_kind`).
+    With ``create = False`` every check is made and nothing is created (a directory that does not exist yet must
+    be creatable): the command line checks its output before the checks that may still refuse the run (the
+    engines' estimates), so a refused run leaves no empty directory behind, and creates it once they passed.
     """
     path = Path(path)
     if path.is_dir() and not force and not (path / MANIFEST).exists() and any(path.iterdir()):
@@ -76,12 +79,18 @@ def prepare_directory(path: str | Path, force: bool = False, scene: Scene | None
         check_same_scene(path, scene, force)
     if kind is not None:
         check_same_kind(path, kind, force)
-    try:
-        path.mkdir(parents=True, exist_ok=True)
-    except FileExistsError:
-        raise OutputError(f"output directory {path} exists and is not a directory") from None
-    except OSError as exc:
-        raise OutputError(f"cannot create output directory {path}: {exc.strerror}") from None
+    if create:
+        try:
+            path.mkdir(parents=True, exist_ok=True)
+        except FileExistsError:
+            raise OutputError(f"output directory {path} exists and is not a directory") from None
+        except OSError as exc:
+            raise OutputError(f"cannot create output directory {path}: {exc.strerror}") from None
+    elif not (path.exists() or path.is_symlink()):
+        check_file_target(path / MANIFEST)  # to be created: its nearest existing ancestor a writable directory
+        return path
+    elif not path.is_dir():
+        raise OutputError(f"output directory {path} exists and is not a directory")
     if not os.access(path, os.W_OK | os.X_OK):
         raise OutputError(f"output directory {path} is not writable")
     manifest = path / MANIFEST

@@ -72,6 +72,21 @@ class SweepPlan:
         return normalise(to_file_keys(self.scene(planned)))
 
 
+def refused_settings(engine: str, scene: Scene) -> str | None:
+    """Why the named engine refuses to run the scene's settings (its estimate's SceneError, what ``weftsim run``
+    refuses before the run), or None; a plug-in engine's settings are its own (None)."""
+    from weftsim import engines
+    from weftsim.input.scene import SceneError
+
+    if engine != engines.AUTO and engine not in engines.names():
+        return None
+    try:
+        engines.get(engines.resolve(engine, scene)).estimate(scene)
+    except SceneError as exc:
+        return str(exc)
+    return None
+
+
 def plan_sweep(scene_path: str | Path, vary: list[str], fixed: list[str] | tuple = (),
                engine: str = "reference", allow_large: bool = False, allow_cwd_engine: bool = False,
                announce: Callable[[str], None] | None = None) -> SweepPlan:
@@ -127,6 +142,10 @@ def plan_sweep(scene_path: str | Path, vary: list[str], fixed: list[str] | tuple
             scene = apply_overrides(base, candidate.overrides, CELL_NAME_CHECK, refuse_ideal_keys=False)
         except SceneError as exc:
             problems.setdefault(str(exc), []).append(cell.name)
+            continue
+        problem = refused_settings(engine, scene)
+        if problem is not None:
+            problems.setdefault(problem, []).append(cell.name)
             continue
         idle = set(ideal_joint_keys(scene, cell.overrides))
         idle_everywhere = idle if idle_everywhere is None else idle_everywhere & idle
