@@ -33,7 +33,12 @@ from weftsim.optimize.problem import Design, design_of
 # kinematic test problems' optima within 0.5 mm of the dense grid's (tests/test_optimize.py); scipy's default
 # 1e-2 stopped 1.6 mm short on a stroke-bound arm length.
 CONVERGENCE_TOL = 1e-3
-FRONT_WEIGHT_AUGMENT = 1e-3  # the augmented Tchebycheff term: keeps the front's ends off weakly dominated points
+FRONT_WEIGHT_AUGMENT = 1e-3
+# Designs proposed (constraints judged) per objective evaluation of the budget before a DE run gives up: a
+# design that violates a constraint costs ~10 ms of kinematics, so a problem whose constraints few designs keep
+# (or none: an infeasible one) still ends, after at most this many times the budget of such checks.
+PROPOSALS_PER_EVALUATION = 10
+MAX_GENERATIONS = 1000  # the augmented Tchebycheff term: keeps the front's ends off weakly dominated points
 
 
 @dataclass
@@ -76,7 +81,10 @@ def minimise(evaluator: Evaluator, scalar: Callable[[dict], float], names: tuple
     best = [math.inf]
     judged_names = components(problem.constraints)
 
+    proposed = [0]
+
     def violations(x) -> np.ndarray:
+        proposed[0] += 1
         judged = evaluator.check(design_of(x, variables)).judged
         return np.array([judged[n]["violation"] or 0.0 for n in judged_names])
 
@@ -97,6 +105,10 @@ def minimise(evaluator: Evaluator, scalar: Callable[[dict], float], names: tuple
         if len(trajectory.requested) + size > budget:
             trajectory.stop = f"the budget ({budget} evaluations)"
             raise StopIteration
+        if proposed[0] + size > PROPOSALS_PER_EVALUATION * budget:
+            trajectory.stop = (f"{proposed[0]} designs proposed, {PROPOSALS_PER_EVALUATION} times the budget: few "
+                               "designs keep the constraints")
+            raise StopIteration
 
     constraint = NonlinearConstraint(violations, -np.inf, 0.0)
     x0 = None
@@ -105,7 +117,7 @@ def minimise(evaluator: Evaluator, scalar: Callable[[dict], float], names: tuple
         if all(lo <= c <= hi for c, (lo, hi) in zip(coords, bounds)):
             x0 = np.array(coords)  # the start design joins the first generation
     result = differential_evolution(
-        _never_called, bounds, rng=seed, popsize=population, maxiter=max(budget // size - 1, 0), polish=False,
+        _never_called, bounds, rng=seed, popsize=population, maxiter=MAX_GENERATIONS, polish=False,
         updating="deferred", workers=mapper, constraints=(constraint,), callback=callback, x0=x0,
         integrality=[v.integral for v in variables], tol=CONVERGENCE_TOL)
     if not trajectory.stop:

@@ -99,7 +99,7 @@ def convergence_figure(runs: list[Trajectory], names: tuple[str, ...], units: di
     ax.set_ylabel(f"best {names[0]}, {units[names[0]]}" if single else "best scalarised value (Tchebycheff, 1 = spread)")
     ax.set_title(title, fontsize=9)
     ax.grid(True, alpha=0.3)
-    if runs:
+    if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize=7)
     fig.tight_layout()
     return fig
