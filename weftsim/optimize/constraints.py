@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
@@ -169,12 +169,13 @@ def _excess(value: float, low: float | None, high: float | None) -> float:
 
 
 def judge(constraints: tuple[Constraint, ...], geometry: Geometry, scene: Scene | None, scene_error: str,
-          checks: list[dict] | None) -> dict[str, dict]:
+          checks: Callable[[], list[dict]]) -> dict[str, dict]:
     """Each constraint's ``value``, ``violation`` (>= 0, None where not judged) and ``message`` for one design.
 
     ``geometry``: the design's linkage (judged even where the scene validation refuses it); ``scene``: its
-    validated scene, or None with ``scene_error`` the validation's line; ``checks``: its before-run design
-    checks (:func:`weftsim.checks.design_checks.before_run`, as dicts).
+    validated scene, or None with ``scene_error`` the validation's line; ``checks()``: its before-run design
+    checks (:func:`weftsim.checks.design_checks.before_run`, as dicts), asked for only when the kinematic
+    constraints hold (the pin loads cost four times the kinematics).
     """
     out: dict[str, dict] = {}
     assembly = assembly_violation(geometry)
@@ -185,7 +186,6 @@ def judge(constraints: tuple[Constraint, ...], geometry: Geometry, scene: Scene 
     out["scene"] = {"value": 0.0 if valid else 1.0, "violation": 0.0 if valid or assembly > 0.0 else 100.0,
                     "message": "" if valid or assembly > 0.0 else scene_error}
     values = kinematic_values(scene) if valid else {}
-    bushing = bushing_values(checks or []) if valid else {}
     for c in constraints:
         if not valid:
             out[c.name] = {"value": None, "violation": None, "message": "not judged (the design is not a valid scene)"}
@@ -194,10 +194,14 @@ def judge(constraints: tuple[Constraint, ...], geometry: Geometry, scene: Scene 
             excess = _excess(value, c.low, c.high)
             out[c.name] = {"value": value, "violation": excess,
                            "message": "" if excess == 0.0 else f"{c.name} = {value:.5g}, outside {c.text()}"}
-        else:  # bushing
+    kinematics_kept = valid and not any(entry["violation"] for entry in out.values())
+    for c in constraints:
+        if c.name in FLAGS and valid and not kinematics_kept:
+            out[c.name] = {"value": None, "violation": None, "message": "not judged (a kinematic constraint fails)"}
+        elif c.name in FLAGS and valid:  # bushing
             over = []
             violation = 0.0
-            for name, (value, limit) in sorted(bushing.items()):
+            for name, (value, limit) in sorted(bushing_values(checks()).items()):
                 if limit is not None and value > limit:
                     violation += 100.0 * (value / limit - 1.0)
                     over.append(f"ideal {name} {value / 1e6:.4g} above {limit / 1e6:.4g}")

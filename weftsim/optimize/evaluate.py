@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable
 
 from weftsim.optimize.constraints import Constraint, feasible, judge
-from weftsim.optimize.objectives import objective_values, runs_needed, solve_design
+from weftsim.optimize.objectives import OBJECTIVES, objective_values, runs_needed, solve_design
 from weftsim.optimize.problem import Design, Variable, design_geometry
 from weftsim.optimize.store import EvaluationLog, normalise, read_evaluations
 
@@ -80,25 +80,31 @@ class Evaluator:
         from weftsim.checks.design_checks import before_run, joint_checks_before
         from weftsim.errors import SceneError
         from weftsim.input.scene import apply_overrides
+        from weftsim.optimize.objectives import ideal_values
 
         p = self.problem
         overrides = design.overrides(p.variables)
         geometry = design_geometry(p.base, overrides)
-        scene, error, checks = None, "", []
+        scene, error = None, ""
         try:
             scene = apply_overrides(p.base, {**overrides, "name": f"{p.base.name}[design]"}, "design",
                                     refuse_ideal_keys=False)
         except SceneError as exc:
             error = str(exc)
-        if scene is not None:
-            found = before_run(scene)
-            if "e" not in scene.loose_joints:  # the ideal joint at E: its loads are still the pin's
-                found = joint_checks_before(scene, "e") + found
-            checks = [c.as_dict() for c in found]
-        judged = judge(p.constraints, geometry, scene, error, checks)
-        from weftsim.optimize.objectives import ideal_values
+        found: list[dict] = []
 
-        checked = Checked(design, judged, feasible(judged), scene, ideal_values(checks))
+        def checks() -> list[dict]:  # the before-run design checks, computed once and only when asked for
+            if scene is not None and not found:
+                before = before_run(scene)
+                if "e" not in scene.loose_joints:  # the ideal joint at E: its loads are still the pin's
+                    before = joint_checks_before(scene, "e") + before
+                found.extend(c.as_dict() for c in before)
+            return found
+
+        judged = judge(p.constraints, geometry, scene, error, checks)
+        ok = feasible(judged)
+        wanted = ok and any(not OBJECTIVES[name].runs for name in p.objectives)
+        checked = Checked(design, judged, ok, scene, ideal_values(checks()) if wanted else {})
         self.checked[design.id] = checked
         return checked
 
