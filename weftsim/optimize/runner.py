@@ -226,31 +226,41 @@ COMPARE_DESIGNS = 3  # of a front: its two ends and its middle are re-run on bot
 def compare_designs(problem: Problem, evaluator: Evaluator, outdir: Path, start, best: list) -> list[dict]:
     """The start and best design(s) on both engines at the worn clearance: each engine's objectives and the
     ``weftsim compare`` verdict (its files in ``compare-<label>/``)."""
-    from weftsim.api import compare
+    from weftsim.engines import simulate
     from weftsim.input.scene import scene_from_keys
-    from weftsim.optimize.objectives import objective_values, solve_design
+    from weftsim.optimize.objectives import objective_values, run_metrics, solve_design
+    from weftsim.post.compare import run_compare
 
     if len(best) > COMPARE_DESIGNS:
         best = [best[0], best[len(best) // 2], best[-1]]
     out = []
     for label, checked in [("start", evaluator.check(start))] + [(f"best-{k + 1}", c) for k, c in enumerate(best)]:
         scenes = evaluator.run_scenes(checked) if evaluator.runs else {}
-        by_engine = {}
+        entry: dict[str, Any] = {"design": label, "keys": checked.design.overrides(problem.variables)}
+        if not scenes:  # the ideal mechanism's objectives: the same on every engine
+            out.append(entry)
+            continue
+        results: dict[str, Any] = {}
+
+        def solve(scene, engine, results=results):
+            results[engine] = simulate(scene, engine, on_warning=lambda text: None)
+            return results[engine]
+
+        try:
+            report, _, _ = run_compare(scene_from_keys(scenes["worn"], f"design {label}"), outdir / f"compare-{label}",
+                                       solve, force=True)
+            entry["compare"] = {"agree": report.get("agree"), "directory": f"compare-{label}"}
+        except (SceneError, OSError) as exc:
+            entry["compare"] = {"agree": None, "error": str(exc)}
+        engines = {}
         for engine in ("reference", "exudyn"):
-            runs = {run: solve_design(label, keys, engine) for run, keys in scenes.items()}
-            by_engine[engine] = {"objectives": objective_values(problem.objectives, checked.ideal,
-                                                                {r: v["metrics"] for r, v in runs.items()}),
-                                 "status": {r: v["status"] for r, v in runs.items()},
-                                 "error": "; ".join(v["error"] for v in runs.values() if v["error"])}
-        entry: dict[str, Any] = {"design": label, "keys": checked.design.overrides(problem.variables),
-                                 "engines": by_engine}
-        if scenes:
-            keys = scenes["worn"] if "worn" in scenes else next(iter(scenes.values()))
-            try:
-                report = compare(scene_from_keys(keys, f"design {label}"), outdir / f"compare-{label}", force=True)
-                entry["compare"] = {"agree": report.get("agree"), "directory": f"compare-{label}"}
-            except (SceneError, OSError) as exc:
-                entry["compare"] = {"agree": None, "error": str(exc)}
+            runs = {"worn": run_metrics(results[engine])} if engine in results and results[engine].ok else {}
+            if "new" in scenes:
+                new = solve_design(label, scenes["new"], engine)
+                if new["status"] == "success":
+                    runs["new"] = new["metrics"]
+            engines[engine] = objective_values(problem.objectives, checked.ideal, runs)
+        entry["engines"] = engines
         out.append(entry)
     return out
 
@@ -278,8 +288,10 @@ def format_report(report: OptimizeReport) -> str:
     for k, entry in enumerate(data["best"]):
         lines.append(show("best" if len(data["best"]) == 1 else f"front {k + 1}", entry))
     for entry in data.get("compare", []):
-        parts = [f"{engine}: " + ", ".join(f"{n} = {_short(e['objectives'].get(n))}" for n in names)
-                 for engine, e in entry["engines"].items()]
+        if "engines" not in entry:
+            continue
+        parts = [f"{engine}: " + ", ".join(f"{n} = {_short(values.get(n))}" for n in names)
+                 for engine, values in entry["engines"].items()]
         agree = entry.get("compare", {}).get("agree")
         lines.append(f"  {entry['design']} on both engines: {'; '.join(parts)}; compare agree = {agree}")
     for path in report.files.values():
