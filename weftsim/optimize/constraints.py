@@ -185,7 +185,7 @@ def judge(constraints: tuple[Constraint, ...], geometry: Geometry, scene: Scene 
     valid = scene is not None
     out["scene"] = {"value": 0.0 if valid else 1.0, "violation": 0.0 if valid or assembly > 0.0 else 100.0,
                     "message": "" if valid or assembly > 0.0 else scene_error}
-    values = kinematic_values(scene) if valid else {}
+    values = kinematic_values(scene) if scene is not None else {}
     for c in constraints:
         if not valid:
             out[c.name] = {"value": None, "violation": None, "message": "not judged (the design is not a valid scene)"}

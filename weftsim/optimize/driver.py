@@ -52,8 +52,8 @@ class Trajectory:
     stop: str = ""
 
 
-def _scalar_of(names: tuple[str, ...], weights: tuple[float, float] | None, ideal: tuple[float, float],
-               spread: tuple[float, float]) -> Callable[[dict], float]:
+def _scalar_of(names: tuple[str, ...], weights: tuple[float, float] | None, ideal: tuple[float, ...],
+               spread: tuple[float, ...]) -> Callable[[dict], float]:
     """The value DE minimises for an entry: the one objective, or the Tchebycheff scalarisation of two."""
 
     def scalar(entry: dict) -> float:
@@ -129,7 +129,7 @@ def _never_called(x):  # DE's func: the workers= map evaluates whole generations
     raise AssertionError("the objective is evaluated by the map of a generation")
 
 
-def pareto(points: list[tuple[str, tuple[float, float]]]) -> list[str]:
+def pareto(points: list[tuple[str, tuple[float, ...]]]) -> list[str]:
     """Ids of the non-dominated points (both minimised), ordered by the first objective."""
     ordered = sorted(points, key=lambda p: (p[1][0], p[1][1]))
     front, lowest = [], math.inf
@@ -167,10 +167,11 @@ def optimise(evaluator: Evaluator, seed: int, budget: int, population: int, fron
         runs.append(minimise(evaluator, _scalar_of((name,), None, (0.0, 0.0), (1.0, 1.0)), (name,), seed + k,
                              share, population, f"minimise {name}", start))
     values = feasible_values(evaluator, names)
-    ends = [runs[i].best for i in range(2)]
-    if None not in ends and all(e in values for e in ends):
-        ideal = (values[ends[0]][0], values[ends[1]][1])
-        spread = tuple(max(values[ends[1 - i]][i] - ideal[i], abs(ideal[i]) * 1e-9, 1e-300) for i in range(2))
+    first, second = runs[0].best, runs[1].best
+    if first in values and second in values:
+        ends = (values[first], values[second])  # each optimum's two objectives
+        ideal = (ends[0][0], ends[1][1])
+        spread = tuple(max(ends[1 - i][i] - ideal[i], abs(ideal[i]) * 1e-9, 1e-300) for i in range(2))
         for k in range(1, front_points - 1):
             w = 1.0 - k / (front_points - 1)
             runs.append(minimise(evaluator, _scalar_of(names, (w, 1.0 - w), ideal, spread), names, seed + 1 + k,

@@ -161,6 +161,7 @@ def design_geometry(base: Scene, overrides: dict[str, Any]) -> Geometry:
         if key is None or not key.target.startswith("geometry."):
             continue
         field = key.target.partition(".")[2]
-        si = BRANCHES[value] if path == "mechanism.fourbar_branch" else float(value) * key.scale
-        geometry = replace(geometry, **{field: si})
+        si: Any = BRANCHES[value] if path == "mechanism.fourbar_branch" else float(value) * key.scale
+        changes: dict[str, Any] = {field: si}
+        geometry = replace(geometry, **changes)
     return geometry

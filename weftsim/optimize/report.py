@@ -105,14 +105,15 @@ def convergence_figure(runs: list[Trajectory], names: tuple[str, ...], units: di
     return fig
 
 
-def pareto_figure(points: list[tuple[float, float]], front: list[tuple[float, float]], start: tuple | None,
+def pareto_figure(points: list[tuple[float, ...]], front: list[tuple[float, ...]], start: tuple | None,
                   names: tuple[str, ...], units: dict[str, str], title: str) -> Figure:
     from weftsim.post.plots import figure
 
     fig = figure(figsize=(6.5, 4.8))
     ax = fig.add_subplot(1, 1, 1)
     if points:
-        ax.scatter(*zip(*points), s=8, color="0.7", label="feasible designs evaluated")
+        xs, ys = zip(*points)
+        ax.scatter(xs, ys, s=8, color="0.7", label="feasible designs evaluated")
     if front:
         ax.plot(*zip(*front), "o-", color="C0", label="Pareto front")
     if start is not None and None not in start:

@@ -47,7 +47,7 @@ def _differences(old: dict, new: dict) -> list[str]:
     for field in ("engine", "design_keys", "objectives", "at_clearance_mm"):
         if old.get(field) != new[field]:
             out.append(f"{field} {old.get(field)!r} there, {new[field]!r} here")
-    base_old = old.get("base_scene") if isinstance(old.get("base_scene"), dict) else {}
+    base_old: dict = old["base_scene"] if isinstance(old.get("base_scene"), dict) else {}
     changed = sorted(k for k in set(base_old) | set(new["base_scene"]) if base_old.get(k) != new["base_scene"].get(k))
     if changed:
         shown = ", ".join(f"{k} = {base_old.get(k)!r} there, {new['base_scene'].get(k)!r} here" for k in changed[:3])
