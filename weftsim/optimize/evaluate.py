@@ -59,7 +59,7 @@ class Evaluator:
     """Constraints and objectives of designs, cached; runs on the sweep's pool (module docstring)."""
 
     def __init__(self, problem: Problem, outdir: Path, jobs: int | None = None, scheduler: str | None = None,
-                 on_evaluated: Callable[[], None] | None = None):
+                 on_evaluated: Callable[[dict], None] | None = None):
         self.problem = problem
         self.runs = runs_needed(problem.objectives)
         self.stored = read_evaluations(outdir, problem.objectives, len(problem.variables))
@@ -151,7 +151,7 @@ class Evaluator:
         self.stored[entry["id"]] = normalise(entry)
         self.run_count += 1
         if self.on_evaluated is not None:
-            self.on_evaluated()
+            self.on_evaluated(entry)
 
     def _evaluate_new(self, todo: list[Checked]) -> None:
         if not self.runs:

@@ -130,12 +130,13 @@ def run_problem(problem: Problem, outdir: str | Path, *, max_evaluations: int = 
         lock.acquire()
         bar = SweepProgress(max_evaluations + 1, 0, stream, what="optimize", unit="designs evaluated") \
             if progress else None
-        counted = [0]
+        counted = [0, 0]  # designs evaluated, of which failed
 
-        def tick() -> None:
+        def tick(entry: dict) -> None:
             counted[0] += 1
+            counted[1] += entry["status"] != "success"
             if bar is not None:
-                bar.update(min(counted[0], max_evaluations + 1), 0)
+                bar.update(min(counted[0], max_evaluations + 1), counted[1])
 
         evaluator = Evaluator(problem, outdir, jobs, scheduler, on_evaluated=tick)
         if evaluator.resumed:
@@ -147,7 +148,7 @@ def run_problem(problem: Problem, outdir: str | Path, *, max_evaluations: int = 
         runs, best = optimise(evaluator, seed, max_evaluations, population, front_points, start)
         interrupted = False
         if bar is not None:
-            bar.update(min(counted[0], max_evaluations + 1), 0, final=True)
+            bar.update(min(counted[0], max_evaluations + 1), counted[1], final=True)
     finally:
         if evaluator is not None:
             evaluator.close(interrupted)
