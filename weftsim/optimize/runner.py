@@ -71,8 +71,6 @@ def plan_problem(scene: str | Path, vary: list[str], objectives: list[str], cons
     both = sorted({v.key for v in variables} & set(fixed_overrides))
     if both:
         raise OptimizeError(f"key(s) {', '.join(both)} both varied (--vary) and fixed (--set)")
-    if at_clearance_mm is not None and any(v.key == "joint_e.clearance_mm" for v in variables):
-        pass  # the new joint's clearance is a design key, the worn one fixed: clearance_sensitivity's use
     base = load_scene(scene, fixed_overrides, refuse_ideal_keys=False)
     names = check_objectives(list(objectives), at_clearance_mm, base.joint.clearance * 1e3)
     return Problem(str(scene), base, normalise(to_file_keys(base)), engine, tuple(variables), names, tuple(parsed),
