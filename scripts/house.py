@@ -38,7 +38,7 @@ The floors, from the bottom (a module may import its own floor and the floors be
    ``weftsim.checks.plausibility`` -> ``weftsim.post.results``, is the one arrow back up between them);
 6. ``reference``, ``exudyn_engine``: the two engines (neither imports the other);
 7. ``engines``: the registry that names the engines, and ``simulate``, the one door into them;
-8. ``sweep``, ``studies``, ``wear``, ``bench``: what runs many simulations through the door;
+8. ``sweep``, ``studies``, ``wear``, ``bench``, ``optimize``: what runs many simulations through the door;
 9. ``api``: the Python interface (``simulate`` re-exported, ``sweep``, ``wear``, ``compare``, ...);
 10. ``cli``, ``__main__``, the package ``__init__``: the command line and the package's exports.
 
@@ -67,7 +67,7 @@ FLOORS: dict[str, int] = {
     "post": 5,
     "reference": 6, "exudyn_engine": 6,
     "engines": 7,
-    "sweep": 8, "studies": 8, "wear": 8, "bench": 8,
+    "sweep": 8, "studies": 8, "wear": 8, "bench": 8, "optimize": 8,
     "api": 9,
     "cli": 10, "__main__": 10, "": 10,  # "" is the package's __init__
 }

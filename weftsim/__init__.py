@@ -29,6 +29,8 @@ load_sweep(directory)
 kinematics(scene), compare(scene, outdir), sweep(scene, vary, outdir), wear(scene, hours, outdir)
     The commands ``weftsim kinematics | compare | sweep | wear`` as functions (the commands are thin shells
     over them).
+optimize(scene, vary, objectives, outdir, constraints=...)
+    ``weftsim optimize``: the design keys that minimise one or two objectives under the loom's constraints.
 bundled_scenes()
     Names of the scenes installed with weftsim.
 WeftsimError
@@ -59,6 +61,7 @@ from weftsim.api import (
     load_result,
     load_scene,
     load_sweep,
+    optimize,
     plausibility_checks,
     save_result,
     select_path,
@@ -70,6 +73,7 @@ from weftsim.errors import (  # noqa: E402
     ArgumentError,
     EngineError,
     MissingExtra,
+    OptimizeError,
     OutputError,
     PlausibilityWarning,
     RunFailed,
@@ -89,6 +93,7 @@ __all__ = [
     "ENGINE_NAMES",
     "EngineError",
     "MissingExtra",
+    "OptimizeError",
     "OutputError",
     "PlausibilityWarning",
     "RunFailed",
@@ -107,6 +112,7 @@ __all__ = [
     "load_result",
     "load_scene",
     "load_sweep",
+    "optimize",
     "plausibility_checks",
     "save_result",
     "select_path",

@@ -366,6 +366,15 @@ def sweep(scene: str | os.PathLike, vary: list[str], outdir: str | os.PathLike, 
     return run(Path(scene) if not isinstance(scene, str) else scene, vary, Path(outdir), **options)
 
 
+def optimize(scene: str | os.PathLike, vary: list[str], objectives: list[str], outdir: str | os.PathLike,
+             **options: Any) -> Any:
+    """A design optimisation (``weftsim optimize``): :func:`weftsim.optimize.optimize` (``weftsim.optimize`` is that
+    function too: the subpackage is callable)."""
+    from weftsim.optimize import optimize as run
+
+    return run(Path(scene) if not isinstance(scene, str) else scene, vary, objectives, Path(outdir), **options)
+
+
 def wear(scene: Scene | str | os.PathLike, hours: float, outdir: str | os.PathLike, **options: Any) -> dict:
     """The wear of the scene's worn joint(s) over ``hours`` (``weftsim wear``): :func:`weftsim.wear.wear`
     (``weftsim.wear`` is that function too: the subpackage is callable)."""

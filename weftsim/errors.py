@@ -73,6 +73,11 @@ class SweepError(WeftsimError, ValueError):
     """A sweep cannot be set up: bad --vary text, unknown key, invalid cell, incompatible directory."""
 
 
+class OptimizeError(WeftsimError, ValueError):
+    """An optimisation cannot be set up: unknown design key, bad bounds, unknown objective or constraint, a
+    directory holding another problem."""
+
+
 class StudyError(WeftsimError, ValueError):
     """A study cannot run: unknown name, missing scene file or bad setting."""
 

@@ -1,4 +1,5 @@
-"""Command line: ``weftsim scenes | kinematics | run | animate | compare | sweep | study | bench | wear | bearing``.  Thin: parse,
+"""Command line: ``weftsim scenes | kinematics | run | animate | compare | sweep | optimize | study | bench | wear |
+bearing``.  Thin: parse,
 call the Python interface (:mod:`weftsim.api`), report.
 
 One grammar for the scene of every command: ``SCENE`` is a file or the name of a bundled scene,
@@ -116,6 +117,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--cell-figures", action="store_true", help="also draw each cell's channels.png")
     p.add_argument("--yes", action="store_true", help="run a grid of more than 2000 cells (refused without it)")
 
+    p = sub.add_parser("optimize", help=OPTIMIZE_HELP,
+                       description="Differential evolution over the --vary keys (scipy), each design's runs on the "
+                       "sweep's pool (or a Dask cluster), resumable: rerunning the same command continues.  "
+                       "See docs/optimize.md.")
+    _add_optimize_flags(p)
+
     p = sub.add_parser("study", help="one of the paper's studies: figures, CSV and JSON (docs/paper-comparison.md)",
                        description="Run a study of the paper: contact-law (Fig. 7-9), clearance (Fig. 12), "
                        "speed (Fig. 13, with the acceleration spectrum), engines (Fig. 16), regime (the lubricated "
@@ -167,6 +174,26 @@ def build_parser() -> argparse.ArgumentParser:
 # both joints and the ensemble, as the command does).
 WEAR_HELP = ("predict the wear of the clearance joints (E, F, or both) over operating hours, or with --uncertain "
              "the hours to a clearance limit as a distribution (docs/wear.md)")
+
+
+OPTIMIZE_HELP = ("find the design keys that minimise one or two objectives (peak joint force of a worn joint, ...) "
+                 "under the loom's constraints (docs/optimize.md)")
+
+
+def _add_optimize_flags(p: argparse.ArgumentParser) -> None:
+    from weftsim.cli.optimize import add_flags
+
+    add_flags(p, positive, add_scene_flags)
+
+
+def cmd_optimize(args: argparse.Namespace) -> int:
+    from weftsim.api import SCENE_FLAGS, scene_overrides
+    from weftsim.cli.optimize import run
+
+    scene_overrides(set_overrides(args), where="command line", **shorthand_values(args))  # a key given twice
+    fixed = list(args.set) + [f"{SCENE_FLAGS[flag]}={value!r}" if isinstance(value, float) else
+                              f"{SCENE_FLAGS[flag]}={value}" for flag, value in shorthand_values(args).items()]
+    return run(args, fixed)
 
 
 def _add_wear_flags(p: argparse.ArgumentParser) -> None:
@@ -635,7 +662,7 @@ def cmd_scenes(args: argparse.Namespace) -> int:
 
 COMMANDS = {"scenes": cmd_scenes, "kinematics": cmd_kinematics, "run": cmd_run, "animate": cmd_animate,
             "compare": cmd_compare,
-            "sweep": cmd_sweep, "study": cmd_study, "bench": cmd_bench, "wear": cmd_wear, "bearing": cmd_bearing}
+            "sweep": cmd_sweep, "optimize": cmd_optimize, "study": cmd_study, "bench": cmd_bench, "wear": cmd_wear, "bearing": cmd_bearing}
 
 
 def _one_line(text: object) -> str:

@@ -135,7 +135,7 @@ def _shown(value: Any) -> str:
 # The command that writes each kind of output directory (the manifest's "kind"), for the refusal below.
 COMMAND_OF_KIND = {"run": "weftsim run", "compare": "weftsim compare", "kinematics": "weftsim kinematics",
                    "wear": "weftsim wear", "wear ensemble": "weftsim wear --uncertain", "study": "weftsim study",
-                   "bench": "weftsim bench"}
+                   "bench": "weftsim bench", "optimize": "weftsim optimize"}
 
 
 def recorded_kind(outdir: str | Path) -> str | None:

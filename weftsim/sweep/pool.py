@@ -66,11 +66,15 @@ def _dask_executor(scheduler: str):
 
 
 class SweepProgress:
-    """Cells done, failed and time left on stderr: one refreshed line on a terminal, else every ``interval`` s."""
+    """Cells done, failed and time left on stderr: one refreshed line on a terminal, else every ``interval`` s.
+
+    ``what`` and ``unit`` name the command and what it counts (``weftsim optimize`` counts designs evaluated).
+    """
 
     def __init__(self, total: int, skipped: int, stream=None, interval: float = 1.0,
-                 clock: Callable[[], float] = time.perf_counter):
+                 clock: Callable[[], float] = time.perf_counter, what: str = "sweep", unit: str = "cells"):
         self.total, self.skipped = total, skipped
+        self.what, self.unit = what, unit
         self.stream = stream if stream is not None else sys.stderr
         self.tty = hasattr(self.stream, "isatty") and self.stream.isatty()
         self.interval = interval if self.tty else max(interval, 10.0)
@@ -96,7 +100,8 @@ class SweepProgress:
         elapsed = now - self.start
         left = self.rate.left(now, done / max(run, 1)) if self.rate_started else float("nan")
         shown = f", left ~{left:.0f} s" if math.isfinite(left) else ", left: measuring"
-        text = (f"sweep: {done}/{run} cells done, {failed} failed"
+        text = (f"{self.what}: {done}/{run} {self.unit}" + (" done" if self.unit == "cells" else "")
+                + f", {failed} failed"
                 + (f", {self.skipped} already finished" if self.skipped else "")
                 + f", elapsed {elapsed:.0f} s" + ("" if final else shown))
         self.stream.write(("\r" + text + ("\n" if final else "")) if self.tty else text + "\n")
