@@ -18,7 +18,8 @@ MAX_COLUMNS = 2  # the first transfer (start-up) and the last
 def plot_exchange(result: RunResult) -> Figure:
     """One column per transfer window shown (the first and the last the run covers): both heads' positions in
     the shed (from the giver's outermost position) against the ideal mechanism's, their overlap, their relative
-    speed's departure from the ideal and each head's position error against the ideal mechanism, over the window's crank angle."""
+    speed's departure from the ideal and each head's position error against the ideal mechanism, over the
+    window's crank angle."""
     from weftsim.mechanism.kinematics import linkage_state
     from weftsim.model.exchange import gap, head, transfers
     from weftsim.post.plots import clearance_label, figure
