@@ -179,3 +179,24 @@ def test_an_ideal_taker_of_a_flexible_tape_is_refused_by_the_command_line():
     assert done.returncode == 2 and done.stdout == ""
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and "exchange.taker_clearance_mm" in lines[0] and "Traceback" not in done.stderr
+
+
+def test_the_exchange_study_runs_its_cells_on_the_sweep(tmp_path, monkeypatch):
+    """One cell of the study (600 rpm, a worn giver at c = 0.25 mm) through the sweep: its taker is the loom's own
+    new joint (c = 0.02 mm), run in the cell, as a run of that joint alone gives it."""
+    from weftsim.studies import StudyError, exchange, run_study
+
+    with pytest.raises(StudyError, match="sets joint_e.clearance_mm itself"):
+        run_study("exchange", tmp_path / "no", overrides={"joint_e.clearance_mm": 0.1})
+    monkeypatch.setattr(exchange, "SPEEDS_RPM", (600.0,))
+    monkeypatch.setattr(exchange, "CLEARANCES_MM", (0.25,))
+    report = run_study("exchange", tmp_path / "study", revolutions=0.56, progress=False, scene="loom")
+    for name in report["files"] + ["cells"]:
+        assert (tmp_path / "study" / name).exists(), name
+    (worn,) = report["rows"]
+    assert worn["transfer"] == 1 and report["taker_clearance_mm"] == 0.02 and report["cells_failed"] == 0
+    new = _run("loom", {"exchange.enabled": True, "drive.revolutions": 0.56})
+    (first,) = summary(new)["exchange"]["transfers"]
+    # The cell's taker is the new joint's run, interpolated onto the worn giver's steps: measured to 5e-11 m.
+    assert worn["taker_error_at_dead_centre_m"] == pytest.approx(first["giver_error_at_dead_centre_m"], abs=1e-9)
+    assert worn["giver_error_at_dead_centre_m"] > 10 * first["giver_error_at_dead_centre_m"] > 0
