@@ -200,3 +200,16 @@ def test_the_exchange_study_runs_its_cells_on_the_sweep(tmp_path, monkeypatch):
     # The cell's taker is the new joint's run, interpolated onto the worn giver's steps: measured to 5e-11 m.
     assert worn["taker_error_at_dead_centre_m"] == pytest.approx(first["giver_error_at_dead_centre_m"], abs=1e-9)
     assert worn["giver_error_at_dead_centre_m"] > 10 * first["giver_error_at_dead_centre_m"] > 0
+
+
+def test_both_engines_give_the_worn_givers_exchange(worn):
+    """The Exudyn engine on the worn giver's scene (its own run; the ideal taker the closed form): the overlap and
+    the giver's error at the dead centre agree with the reference engine's.  Measured at 600 rpm, 2 revolutions:
+    overlap 51.5812 / 51.5799 mm (2.5e-5), error 1.45222 / 1.45087 mm (9e-4); 1e-2 of the error is ten times that
+    (the issue asks 1 % of the overlap)."""
+    exudyn = simulate(worn.scene, "exudyn", on_warning=lambda text: None)
+    assert exudyn.ok, exudyn.message
+    (ours,), (theirs,) = summary(worn)["exchange"]["transfers"], summary(exudyn)["exchange"]["transfers"]
+    error = ours["giver_error_at_dead_centre_m"]
+    assert theirs["giver_error_at_dead_centre_m"] == pytest.approx(error, rel=1e-2)
+    assert theirs["overlap_at_dead_centre_m"] == pytest.approx(ours["overlap_at_dead_centre_m"], abs=1e-2 * error)
