@@ -72,6 +72,7 @@ SECTIONS: tuple[tuple[str, str, str], ...] = (
      "physics §2"),
     ("limits.", "hard-cases.md#2-failure-detection", "hard cases §2"),
     ("rapier_tape.", "rapier-tape.md", "rapier tape"),
+    ("exchange.", "rapier-tape.md#7-the-weft-exchange", "weft exchange"),
 )
 
 # One paragraph per table of the scene file, in the order of the schema.
@@ -104,6 +105,9 @@ TABLES: dict[str, str] = {
     "rapier_tape": "The flexible rapier tape and its head ([The rapier tape](rapier-tape.md)), optional: absent, "
                    "the rigid rapier of mass `inertia.rapier_mass_kg`; given (even empty), the tape with these "
                    "keys' defaults, and `inertia.rapier_mass_kg` is not used.",
+    "exchange": "The weft exchange with a taker head ([The weft exchange](rapier-tape.md#7-the-weft-exchange)), "
+                "optional: absent, nothing is computed; given (even empty), the taker runs with these keys' "
+                "defaults.",
 }
 
 

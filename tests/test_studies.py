@@ -234,7 +234,7 @@ def test_unknown_study_and_missing_scenes_are_errors(tmp_path):
         run_study("fig99", tmp_path)
     with pytest.raises(StudyError, match="not found"):
         run_study("clearance", tmp_path / "out", tmp_path, revolutions=0.05, progress=False)
-    assert set(STUDIES) == {"contact-law", "clearance", "speed", "engines", "regime"}
+    assert set(STUDIES) == {"contact-law", "clearance", "speed", "engines", "regime", "exchange"}
 
 
 def test_cli_study_command(tmp_path, capsys):

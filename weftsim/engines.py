@@ -278,9 +278,60 @@ def simulate(scene: Scene | str | os.PathLike, engine: str = "auto", *,
             warnings.warn(text, PlausibilityWarning, stacklevel=2)
         else:
             on_warning(text)
+    from weftsim.model.exchange import exchange_of, taker_source
+
+    second = exchange_of(scene) is not None and taker_source(scene) == "run"  # the taker's own run
     # The engine's pure solve, then the post-run criteria (energy balance, ...) that no single step shows,
     # once, for every engine.
-    result = vet_result(chosen.solve(scene, progress=progress, observe=observe))
+    result = vet_result(chosen.solve(scene, progress=_part(progress, 0.0, 0.5 if second else 1.0), observe=observe))
+    if exchange_of(scene) is not None:
+        result = _with_exchange(result, chosen, _part(progress, 0.5, 1.0))
     if raise_on_failure and not result.ok:
         raise RunFailed(f"simulation failed: {result.message}", result)
     return result
+
+
+def _part(progress: Callable[[float], None] | None, start: float, end: float) -> Callable[[float], None] | None:
+    """``progress`` of one of the runs of a scene, mapped onto [start, end] of the whole."""
+    if progress is None or (start, end) == (0.0, 1.0):
+        return progress
+    return lambda fraction: progress(start + (end - start) * fraction)
+
+
+def _with_exchange(result: RunResult, chosen: Engine, progress: Callable[[float], None] | None) -> RunResult:
+    """``result`` of the giver with the weft exchange's channels (:mod:`weftsim.model.exchange`): the taker from
+    the giver's run, the closed form or its own run on the same engine (vetted as every run is).
+
+    A taker run that fails fails the result, which keeps everything: the taker's channels hold its head up to
+    where it stopped (NaN after), and the message names the taker.
+    """
+    from dataclasses import replace
+
+    import numpy as np
+
+    from weftsim.checks.guards import vet_result
+    from weftsim.model.exchange import exchange_channels, taker_scene, taker_source
+    from weftsim.model.channels import EXCHANGE_CHANNELS
+
+    scene = result.scene
+    source = taker_source(scene)
+    samples = {k: v for k, v in result.samples.items() if k not in EXCHANGE_CHANNELS}
+    steps = {k: v for k, v in result.steps.items() if k not in EXCHANGE_CHANNELS}
+    taker = None
+    if source == "run" and result.ok:
+        taker = vet_result(chosen.solve(taker_scene(scene), progress=progress))
+    tables = {}
+    for name, table in (("samples", samples), ("steps", steps)):
+        other = None if taker is None else getattr(taker, name)
+        if source == "run" and taker is None:  # the giver failed: no taker run, no taker head (NaN)
+            other = {key: np.zeros(0) for key in ("time_s", "rapier_displacement_m", "rapier_velocity_m_s")}
+        tables[name] = {**table, **exchange_channels(scene, table, table if source == "giver" else other)}
+    stats = {**result.solver_stats, "exchange_taker": source}
+    changes: dict[str, Any] = {}
+    if taker is not None:
+        stats |= {"taker_steps": taker.solver_stats.get("steps"), "taker_wall_time_s": taker.wall_time_s,
+                  "wall_time_s": result.wall_time_s + taker.wall_time_s}
+        if not taker.ok and result.ok:
+            changes = {"status": "failed", "message": f"the taker head's run (exchange.taker_clearance_mm) failed: "
+                                                      f"{taker.message}"}
+    return replace(result, samples=tables["samples"], steps=tables["steps"], solver_stats=stats, **changes)

@@ -126,12 +126,14 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("study", help="one of the paper's studies: figures, CSV and JSON (docs/paper-comparison.md)",
                        description="Run a study of the paper: contact-law (Fig. 7-9), clearance (Fig. 12), "
                        "speed (Fig. 13, with the acceleration spectrum), engines (Fig. 16), regime (the lubricated "
-                       "joint's film ratio and peak force over speed x clearance x viscosity), or all of them.  "
+                       "joint's film ratio and peak force over speed x clearance x viscosity), exchange (the weft exchange's "
+                       "overlap, relative speed and head errors over clearance x speed, docs/rapier-tape.md), or all "
+                       "of them.  "
                        "Each study sets its own scenes; --set and the shorthands apply to every run of it, "
                        "except what the study sets itself (the clearance of 'clearance', the speed of 'speed', "
                        "the speed and clearance of 'contact-law': refused).  With SCENE each case runs on that "
                        "scene (e.g. 'weftsim study clearance loom': the loom at c = 0 (ideal), 0.01, 0.25, 0.50 mm).")
-    p.add_argument("name", help="contact-law, clearance, speed, engines, regime or all")
+    p.add_argument("name", help="contact-law, clearance, speed, engines, regime, exchange or all")
     p.add_argument("scene", nargs="?", default=None,
                    help="the scene to run the study's cases on: a scene file (TOML) or the name of a bundled scene "
                    "(default: the paper's reference scene and its cases in models/paper)")

@@ -585,6 +585,36 @@ class RapierTape:
 
 
 @dataclass(frozen=True)
+class Exchange:
+    """The weft exchange at mid-shed (docs/rapier-tape.md section 7), the scene's ``[exchange]`` table.
+
+    The giver head is this scene's mechanism; the taker head is the same mechanism mirrored on the other side
+    of the shed, on the same crank (both heads reach their deepest position, the dead centre, together), with
+    its own radial clearance at E and everything else the giver's.  Neither value below is published loom data
+    (none was found): both are assumptions, named as such.
+
+    Attributes
+    ----------
+    enabled : bool
+        False: the table describes an exchange that is not computed (the run is the scene's without it).
+    taker_clearance : float or None
+        The taker's radial clearance at E, m; 0 = an ideal joint; None = the giver's (a symmetric machine).
+    overlap : float
+        How far the heads of the ideal mechanism pass each other at the dead centre, m (assumed 50 mm: the
+        taker's hook reaches into the giver head).  It places the two mechanisms: their outermost head
+        positions are 2 x stroke - overlap apart.
+    window : float or None
+        Full width of the transfer window in crank angle, centred on the dead centre, rad; None = the crank
+        angles over which the ideal heads overlap.
+    """
+
+    enabled: bool = True
+    taker_clearance: float | None = None
+    overlap: float = 0.050
+    window: float | None = None
+
+
+@dataclass(frozen=True)
 class Drive:
     """Crank speed and run length; the drive law of a stop-start's transient (:func:`weftsim.physics.chain.crank_motion`).
 
@@ -781,6 +811,8 @@ class Scene:
     limits: Limits = field(default_factory=Limits)
     # The flexible rapier tape ([rapier_tape], docs/rapier-tape.md); None: the rigid rapier of mass m8.
     rapier_tape: RapierTape | None = None
+    # The weft exchange with a taker head ([exchange], docs/rapier-tape.md section 7); None: no taker.
+    exchange: Exchange | None = None
     source: str = ""
     # Keys of [joint_f] (without the table name) that F takes from [joint_e] because the scene does not
     # give them (weftsim.input.joint_keys); bookkeeping of how the scene was written, not part of the machine.

@@ -63,6 +63,8 @@ MAX_SCENE_BYTES = 1 << 20
 MAX_EXTENDS_DEPTH = 64
 # The optional table of the flexible rapier tape (docs/rapier-tape.md): given even empty, the scene has a tape.
 TAPE_TABLE = "rapier_tape"
+# The optional tables that mean something given empty: the tape, the exchange (docs/rapier-tape.md), with defaults.
+OPTIONAL_TABLES = {TAPE_TABLE: ("rapier_tape", params.RapierTape), "exchange": ("exchange", params.Exchange)}
 
 
 def _spelling(table: tuple[str, ...], name: str) -> str:
@@ -80,7 +82,7 @@ def _flatten(table: dict, where: str, prefix: tuple[str, ...] = (),
     for name, value in table.items():
         path = ".".join(prefix + (name,))
         if isinstance(value, dict):
-            if not value and path == TAPE_TABLE:  # an empty [rapier_tape]: the tape with its defaults
+            if not value and path in OPTIONAL_TABLES:  # an empty [rapier_tape] / [exchange]: its defaults
                 flat[path] = {}
             elif not value:
                 _check_empty_table(path, where)
@@ -415,6 +417,13 @@ def _check_scene(scene: params.Scene, where: str, origin: dict[str, Path]) -> No
             "(the four-bar O-E-F-G does not close: check mechanism.l_oe_mm, l_ef_mm, l_fg_mm, l_og_mm "
             "and rocker_arm_angle_deg)"
         )
+    if scene.exchange is not None:
+        from weftsim.model.exchange import exchange_problem
+
+        problem = exchange_problem(scene)
+        if problem:
+            key = problem.split("'")[1]
+            raise SceneError(f"{at(key)}: {problem}")
     if scene.rapier_tape is not None:
         from weftsim.mechanism.kinematics import rapier_stroke
 
@@ -458,15 +467,16 @@ def scene_from_keys(flat: dict[str, Any], where: str = "scene", origin: dict[str
     # named as that (oil.nu40_mm2_s = 1e6 beside a viscosity_mpa_s was reported as "both given").
     converted = {}
     for path, value in flat.items():
-        if path in TOP_LEVEL or path == TAPE_TABLE:
+        if path in TOP_LEVEL or path in OPTIONAL_TABLES:
             continue
         src = str(origin.get(path, where))
         key = _known(path, src)
         converted[path] = key, _convert(key, value, src), src
     _check_lubrication_given(flat, where)
     for path in flat:
-        if path == TAPE_TABLE:  # an empty [rapier_tape] table (_flatten)
-            scene = replace(scene, rapier_tape=scene.rapier_tape or params.RapierTape())
+        if path in OPTIONAL_TABLES:  # an empty [rapier_tape] or [exchange] table (_flatten)
+            attribute, table = OPTIONAL_TABLES[path]
+            scene = replace(scene, **{attribute: getattr(scene, attribute) or table()})
             continue
         if path not in converted:
             continue
@@ -530,7 +540,7 @@ def load_scene(path: str | os.PathLike, overrides: dict[str, Any] | None = None,
         flat[dotted] = value
         origin[dotted] = Path(overrides_from)
     for dotted in flat:  # a misspelt key is reported as such, not as the missing one it stands for
-        if dotted not in TOP_LEVEL and dotted != TAPE_TABLE:
+        if dotted not in TOP_LEVEL and dotted not in OPTIONAL_TABLES:
             _known(dotted, str(origin.get(dotted, path)))
     if "joint_f.clearance_mm" not in flat:  # a [joint_f] table without a clearance describes an ideal joint
         stray = [key for key in flat if key.startswith("joint_f.") and describes_joint(key)

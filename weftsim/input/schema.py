@@ -200,6 +200,20 @@ RAPIER_TAPE_KEYS: tuple[Key, ...] = (
 )
 
 
+# [exchange] (docs/rapier-tape.md section 7): optional as a whole (absent: no taker head, nothing computed); given,
+# every key defaults (params.Exchange names its assumptions).  The taker's clearance is bounded as joint E's.
+EXCHANGE_KEYS: tuple[Key, ...] = (
+    Key("exchange.enabled", "exchange.enabled", "bool",
+        doc="compute the exchange with the taker head (default true once the table is given)"),
+    Key("exchange.taker_clearance_mm", "exchange.taker_clearance", "float", MM, 0, PIN_MM, False,
+        doc="the taker's radial clearance at E, 0 = ideal (default: the giver's, joint_e.clearance_mm)"),
+    Key("exchange.overlap_mm", "exchange.overlap", "float", MM, 0, LENGTH_MM,
+        doc="how far the ideal heads pass each other at the dead centre (default 50, assumed)"),
+    Key("exchange.window_deg", "exchange.window", "float", DEG, 0, 360,
+        doc="full width of the transfer window in crank angle about the dead centre (default: where the "
+            "ideal heads overlap)"),
+)
+
 SCHEMA: tuple[Key, ...] = (
     Key("mechanism.crank_inclination_deg", "geometry.crank_inclination", "float", DEG, 0, 90, True, True,
         doc="beta, arc A-B of the spherical 4R"),
@@ -357,7 +371,7 @@ def _joint_f_keys() -> tuple[Key, ...]:
     return tuple(out)
 
 
-SCHEMA = SCHEMA + _joint_f_keys() + RAPIER_TAPE_KEYS
+SCHEMA = SCHEMA + _joint_f_keys() + RAPIER_TAPE_KEYS + EXCHANGE_KEYS
 _BY_PATH = {key.path: key for key in SCHEMA}
 TOP_LEVEL = ("name", "description", "extends")
 # Sections that describe the machine: a scene must give all their keys, itself or through
@@ -397,4 +411,6 @@ def _set(scene: Any, target: str, value: Any) -> Any:
         inner = params.Lubrication(viscosity=0.0)
     if inner is None and head == "rapier_tape":  # the table's first key: the tape starts from the defaults
         inner = params.RapierTape()
+    if inner is None and head == "exchange":  # the table's first key: the exchange starts from the defaults
+        inner = params.Exchange()
     return replace(scene, **{head: _set(inner, rest, value)})

@@ -82,6 +82,19 @@ TAPE_CHANNELS: tuple[str, ...] = (
     "tape_strain_energy_J",
 )
 
+# Channels of the weft exchange (weftsim.model.exchange, docs/rapier-tape.md section 7), present exactly when the
+# scene has an [exchange] that is on: the taker head's position and velocity into the shed from its side, the
+# heads' overlap (how far they have passed each other) and relative speed, and each head's position error against
+# the ideal rigid mechanism.  The giver's head is head_displacement_m (flexible tape) or rapier_displacement_m.
+EXCHANGE_CHANNELS: tuple[str, ...] = (
+    "taker_head_displacement_m",
+    "taker_head_velocity_m_s",
+    "exchange_overlap_m",
+    "exchange_relative_speed_m_s",
+    "giver_head_error_m",
+    "taker_head_error_m",
+)
+
 # Joint E's channel of each joint-F channel (same quantity at the other joint).
 JOINT_E_NAME = dict(zip(JOINT_F_CHANNELS, ("contact_force_N", "penetration_m", "eccentricity_y_m",
                                            "eccentricity_z_m", "impact_velocity_m_s", "in_contact",
@@ -120,7 +133,7 @@ PEAK_CHANNELS_TAPE: tuple[str, ...] = ("head_displacement_m", "head_velocity_m_s
 
 
 OPTIONAL_GROUPS = (JOINT_F_CHANNELS, LUBRICATION_CHANNELS, LUBRICATION_CHANNELS_F, JOINT_FORCE_CHANNELS,
-                   JOINT_FORCE_CHANNELS_F, TAPE_CHANNELS)
+                   JOINT_FORCE_CHANNELS_F, TAPE_CHANNELS, EXCHANGE_CHANNELS)
 
 
 def optional_channels(names) -> tuple[str, ...]:

@@ -142,6 +142,7 @@ def summary(result: RunResult) -> dict:
     """The content of ``summary.json`` (see the README's output reference)."""
     from weftsim.post.provenance import commit, versions
     from weftsim.input.scene import to_file_keys
+    from weftsim.model.exchange import exchange_summary
 
     n = complete_revolutions(result)
     per_revolution = []
@@ -163,6 +164,8 @@ def summary(result: RunResult) -> dict:
         "statistics": statistics(result),
         "first_contact_crank_angle_deg": result.first_contact_angle_deg,
         "energy_balance": energy_balance(result) if result.steps["time_s"].size else None,
+        # The weft exchange with the taker head (weftsim.model.exchange; None without an [exchange] that is on).
+        "exchange": exchange_summary(result.scene, result.steps, result.solver_stats.get("exchange_taker")),
         # Counts of a broken contact history and the law-range warnings (weftsim.checks.plausibility; not for
         # the ideal mechanism) and the design checks with their verdicts (weftsim.checks.design_checks).
         "plausibility": dict(result.plausibility) or None,

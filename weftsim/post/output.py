@@ -404,8 +404,8 @@ def output_rows(scene: Scene) -> float:
 
 def write_run(result: RunResult, outdir: str | Path, figure: bool = True, force: bool = False,
               npz: bool = False, on_write: Callable[[Path], None] | None = None) -> dict[str, Path]:
-    """Write ``channels.csv``, ``summary.json``, ``channels.png`` and (clearance joint) ``orbit.png``
-    for one run, atomically each.
+    """Write ``channels.csv``, ``summary.json``, ``channels.png``, (clearance joint) ``orbit.png`` and (an
+    ``[exchange]``) ``exchange.png`` for one run, atomically each.
 
     With ``npz`` also ``result.npz``: the whole result, per-step data included, losslessly
     (:func:`weftsim.post.results.save_npz`; ``weftsim.load_result`` reads it).  ``weftsim run`` asks for
@@ -429,4 +429,8 @@ def write_run(result: RunResult, outdir: str | Path, figure: bool = True, force:
         files["figure"] = ("channels.png", lambda target: write_figure(target, plot_channels([result])))
         if result.scene.loose_joints:  # one orbit panel per joint with a clearance (E, F)
             files["orbit"] = ("orbit.png", lambda target: write_figure(target, plot_orbit(result)))
+        if "exchange_overlap_m" in result.steps:  # the weft exchange (weftsim.model.exchange)
+            from weftsim.post.exchange_plot import plot_exchange
+
+            files["exchange"] = ("exchange.png", lambda target: write_figure(target, plot_exchange(result)))
     return write_files(outdir, what, files, scene=result.scene, on_write=on_write)

@@ -28,7 +28,8 @@ from weftsim.input.params import Scene
 # The channel tables live in weftsim.model.channels (below the joint modules that compute them); re-exported here.
 from weftsim.model.channels import (  # noqa: F401
     CHANNELS, JOINT_F_CHANNELS, LUBRICATION_CHANNELS, LUBRICATION_CHANNELS_F, JOINT_FORCE_CHANNELS,
-    JOINT_FORCE_CHANNELS_F, LOAD_FALLBACK, TAPE_CHANNELS, JOINT_E_NAME, CONTACT_CHANNELS, PEAK_CHANNELS,
+    JOINT_FORCE_CHANNELS_F, LOAD_FALLBACK, TAPE_CHANNELS, EXCHANGE_CHANNELS, JOINT_E_NAME, CONTACT_CHANNELS,
+    PEAK_CHANNELS,
     PEAK_CHANNELS_F, PEAK_CHANNELS_LUBRICATION, PEAK_CHANNELS_LUBRICATION_F, PEAK_CHANNELS_TAPE,
     OPTIONAL_GROUPS, optional_channels,
 )
@@ -47,7 +48,8 @@ def _as_channels(data: dict[str, np.ndarray], what: str) -> dict[str, np.ndarray
     names = CHANNELS
     for group, label in ((JOINT_F_CHANNELS, "joint F"), (LUBRICATION_CHANNELS, "lubrication"),
                          (LUBRICATION_CHANNELS_F, "joint F lubrication"), (JOINT_FORCE_CHANNELS, "joint E load"),
-                         (JOINT_FORCE_CHANNELS_F, "joint F load"), (TAPE_CHANNELS, "rapier tape")):
+                         (JOINT_FORCE_CHANNELS_F, "joint F load"), (TAPE_CHANNELS, "rapier tape"),
+                         (EXCHANGE_CHANNELS, "weft exchange")):
         given = [name for name in group if name in data]
         if given:
             if len(given) != len(group):
@@ -210,6 +212,8 @@ def scene_channels(scene: Scene) -> tuple[str, ...]:
 
         if tape_model(scene) == "flexible":
             names += TAPE_CHANNELS
+    if scene.exchange is not None and scene.exchange.enabled:  # the weft exchange (weftsim.model.exchange)
+        names += EXCHANGE_CHANNELS
     return names
 
 

@@ -8,6 +8,7 @@ name             what                                                           
 ``speed``        300, 500, 800 rpm at c = 0.25 mm; amplitude ratios; spectrum           Fig. 13
 ``engines``      reference vs exudyn, c = 0.50 mm at 400 rpm                            Fig. 16
 ``regime``       lubricated E: min film ratio, peak force over speed x clearance x oil  -
+``exchange``     weft exchange: overlap, relative speed, head errors over clearance x speed  -
 ===============  =====================================================================  ========
 
 Each writes into its output directory PNG figures named ``study-*.png``, CSV files of
@@ -23,7 +24,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Callable
 
-from weftsim.studies import clearance, common, contact_law, engines, regime, speed
+from weftsim.studies import clearance, common, contact_law, engines, exchange, regime, speed
 from weftsim.studies.common import SimulationFailed, StudyError
 from weftsim.studies.spectrum import Spectrum, acceleration_spectrum, amplitude_spectrum
 
@@ -37,10 +38,11 @@ STUDIES: dict[str, tuple[Callable[..., dict], Callable[[dict], str]]] = {
     "speed": (speed.run, speed.format_report),
     "engines": (engines.run, engines.format_report),
     "regime": (regime.run, regime.format_report),
+    "exchange": (exchange.run, exchange.format_report),
 }
 # name -> the scene keys the study sets itself (refused as overrides), with why
 SETS: dict[str, dict[str, str]] = {"contact-law": contact_law.SETS, "clearance": clearance.SETS, "speed": speed.SETS,
-                                   "engines": engines.SETS, "regime": regime.SETS}
+                                   "engines": engines.SETS, "regime": regime.SETS, "exchange": exchange.SETS}
 
 
 def check_overrides(name: str, overrides: dict | None = None, revolutions: float | None = None) -> None:
