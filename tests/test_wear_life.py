@@ -75,6 +75,20 @@ def test_the_how_to_scene_ends_at_the_limit(tmp_path):
     assert f"{hours:.6g} h of running" in run.stdout.strip().splitlines()[-1]
 
 
+def test_the_loom_ends_at_the_limit_and_goes_past_it_when_asked(tmp_path):
+    """The bundled loom ends at a limit a few updates in, cut at it; with past_limit the same prediction goes on to
+    the hours asked, beyond the limit, and still reports the hours to it.  (loom_dry differs from it in k alone,
+    which never enters the dynamics: the 1/k tests below; loom_oiled does not reach a limit: section 12.)"""
+    scene = load_scene("loom")
+    ended = predict_to_directory(scene, 1e4, tmp_path / "a", limit=0.0205e-3, figures=False)
+    hours = ended["hours_to_limit"]
+    assert ended["hours_reached"] == pytest.approx(hours, rel=1e-9) and hours < 1e4
+    assert ended["final_effective_clearance_e_mm"] == pytest.approx(0.0205, rel=1e-9)
+    past = predict_to_directory(scene, 1.5 * hours, tmp_path / "b", limit=0.0205e-3, figures=False, past_limit=True)
+    assert past["hours_reached"] == pytest.approx(1.5 * hours) and past["final_effective_clearance_e_mm"] > 0.0205
+    assert past["hours_to_limit"] == pytest.approx(hours, rel=1e-6)  # linear between the same updates
+
+
 # --- the regimes ----------------------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("regime, key", [("boundary", "boundary_wear_coefficient"), ("dry", "dry_wear_coefficient")])
@@ -98,6 +112,22 @@ def test_the_other_regimes_key_changes_nothing():
     b = predict(_wear(scene, dry_wear_coefficient=3e-3, mixed_wear_coefficient=4e-7), 1.0)
     assert [u.hours for u in a] == [u.hours for u in b]
     np.testing.assert_array_equal(a[-1].bearing, b[-1].bearing)
+
+
+def test_hours_scale_as_one_over_k_in_the_mixed_regime():
+    """An oiled pin whose film never lets the journal reach the wall (25 mPa s, c0 = 0.02 mm: film ratio min 2.2,
+    the asperities carry load) wears with mixed_wear_coefficient alone: 4 k gives the same geometries, to the bit
+    (measured), in a quarter of the hours."""
+    scene = load_scene("loom", {"joint_e.lubrication.viscosity_mpa_s": 25.0,
+                                "joint_e.wear.revolutions_per_update": 1})
+    base = predict(scene, 2500.0)
+    assert len(base) >= 2 and base[-1].bearing.max() > 0.0
+    fast = predict(_wear(scene, mixed_wear_coefficient=4.0 * scene.joint.wear.mixed_wear_coefficient),
+                   base[-1].hours / 4.0)
+    assert len(fast) == len(base)
+    for a, b in zip(base, fast):
+        assert b.hours == pytest.approx(a.hours / 4.0, rel=1e-12)
+        np.testing.assert_allclose(b.bearing, a.bearing, rtol=1e-12, atol=0.0)
 
 
 @pytest.fixture(scope="module")
