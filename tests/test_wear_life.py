@@ -314,7 +314,7 @@ def test_the_life_report_turns_each_sample_s_hours_into_its_own_calendar_days():
     prediction is the N-weighted share of its updates."""
     from types import SimpleNamespace
 
-    from weftsim.wear.life import prediction_stop_share, sample_days
+    from weftsim.wear.life import horizon_days, prediction_stop_share, sample_days, shift_days
 
     scene = load_scene("loom_oiled")
     hours = np.array([[10.0, 20.0], [100.0, np.inf], [1.0, 2.0]])
@@ -327,6 +327,17 @@ def test_the_life_report_turns_each_sample_s_hours_into_its_own_calendar_days():
         assert dc.replace(d, stops_per_hour=s).calendar_days(10.0) == pytest.approx(
             10.0 * (1.0 + s * d.stop_minutes / 60.0) / d.hours_per_day * 7.0 / d.days_per_week, rel=1e-15)
     assert np.isinf(days[1, 1])
+    # one, two and three shifts: the same samples' days at 8, 16 and 24 h a day (the scene's 24 h: the days above)
+    shifts = shift_days(scene, {"duty.stops_per_hour": stops}, hours)
+    assert list(shifts) == [8.0, 16.0, 24.0]
+    np.testing.assert_array_equal(shifts[24.0], days)
+    np.testing.assert_allclose(shifts[8.0], 3.0 * days, rtol=1e-15)
+    assert shift_days(scene, {"duty.hours_per_day": stops}, hours) is None  # drawn: the samples' own
+    # a censored sample lies beyond its own horizon's days: the least of them (5 stops an hour) bounds them all
+    least = 1e5 * (1.0 + 5.0 * d.stop_minutes / 60.0) / d.hours_per_day * 7.0 / d.days_per_week
+    assert horizon_days(scene, {"duty.stops_per_hour": stops}, 1e5) == pytest.approx(least, rel=1e-15)
+    assert horizon_days(scene, {"duty.stops_per_hour": stops}, 1e5, 8.0) == pytest.approx(3.0 * least, rel=1e-15)
+    assert horizon_days(scene, {}, 1e5) == pytest.approx(d.calendar_days(1e5), rel=1e-15)
 
     def update(n, volume, share):
         return SimpleNamespace(step_revolutions=n, part=lambda j: SimpleNamespace(volume_rate=volume),
