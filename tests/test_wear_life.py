@@ -314,7 +314,7 @@ def test_the_life_report_turns_each_sample_s_hours_into_its_own_calendar_days():
     prediction is the N-weighted share of its updates."""
     from types import SimpleNamespace
 
-    from weftsim.wear.life import horizon_days, prediction_stop_share, sample_days, shift_days
+    from weftsim.wear.life import horizon_days, prediction_stop_share, sample_days, shift_days, stop_share_summary
 
     scene = load_scene("loom_oiled")
     hours = np.array([[10.0, 20.0], [100.0, np.inf], [1.0, 2.0]])
@@ -346,3 +346,7 @@ def test_the_life_report_turns_each_sample_s_hours_into_its_own_calendar_days():
     assert prediction_stop_share([update(10.0, 1.0, 0.5), update(30.0, 1.0, 0.1), update(0.0, 5.0, 0.9)]) == \
         pytest.approx((10 * 0.5 + 30 * 0.1) / 40)
     assert prediction_stop_share([update(10.0, 0.0, 0.5)]) is None
+    # the summary over the design points names the centre design point's share (a job named node_1_1, not centre)
+    summary = stop_share_summary({"node_0_1": {"stop_start_share": 0.1}, "node_1_1": {"stop_start_share": 0.3},
+                                  "node_2_1": {"stop_start_share": 0.9}}, "node_1_1")
+    assert (summary["centre"], summary["min"], summary["median"], summary["max"]) == (0.3, 0.1, 0.3, 0.9)

@@ -320,7 +320,7 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
             f"{h:g}": {key: quantile_table(d[:, i], shift_beyond[h]) for key, i in level_index.items()}
             for h, d in shifts.items()},
         "horizon_calendar_days_by_shift": None if shifts is None else {f"{h:g}": b for h, b in shift_beyond.items()},
-        "stop_start_share": stop_share_summary(results),
+        "stop_start_share": stop_share_summary(results, centre_name(nodes, dynamic)),
         "shares": {k: {"rank_correlation": r, "share": s} for k, (r, s) in ens["shares"].items()},
         "jobs": {n: {"wall_s": r.get("wall_s"), "cpu_s": r.get("cpu_s"), "updates": r.get("updates"),
                      "error": r.get("error"),

@@ -73,13 +73,14 @@ def prediction_stop_share(updates: list, joint: str = "e") -> float | None:
     return share / volume if volume > 0.0 else None
 
 
-def stop_share_summary(results: dict) -> dict | None:
-    """{"centre", "min", "median", "max"} of the design predictions' stop-start shares (None without stops)."""
+def stop_share_summary(results: dict, centre: str = "centre") -> dict | None:
+    """{"centre", "min", "median", "max"} of the design predictions' stop-start shares (None without stops);
+    ``centre``: the job name of the centre design point (:func:`weftsim.wear.ensemble_design.centre_name`)."""
     shares = {n: r.get("stop_start_share") for n, r in results.items() if r.get("stop_start_share") is not None}
     if not shares:
         return None
     values = np.array(list(shares.values()), dtype=float)
-    return {"centre": shares.get("centre"), "min": float(values.min()), "median": float(np.median(values)),
+    return {"centre": shares.get(centre), "min": float(values.min()), "median": float(np.median(values)),
             "max": float(values.max()), "by_design_point": dict(sorted(shares.items()))}
 
 
