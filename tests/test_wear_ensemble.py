@@ -146,8 +146,15 @@ def test_cli_ensemble_writes_and_resumes(tmp_path):
     assert q["p10"]["hours"] < q["p50"]["hours"] < q["p90"]["hours"]
     assert q["p50"]["low"] <= q["p50"]["hours"] <= q["p50"]["high"]
     assert sum(v["share"] for v in data["shares"].values()) == pytest.approx(1.0)
-    for name in ("ensemble.csv", "ensemble_band.csv", "ensemble_cdf.png", "ensemble_band.png", "ensemble_shares.png"):
+    for name in ("ensemble.csv", "ensemble_band.csv", "ensemble_cdf.png", "ensemble_band.png", "ensemble_shares.png",
+                 "ensemble_life.png"):
         assert (out / name).is_file()
+    # the life report: calendar days (24 h a day, 7 days a week, no stops: hours / 24) and at 8 / 16 / 24 h a day
+    days = data["calendar_days_to_limit"]["p50"]["hours"]
+    assert days == pytest.approx(q["p50"]["hours"] / 24.0, rel=1e-12)
+    by_shift = data["calendar_days_by_shift"]
+    assert [by_shift[h]["0.26"]["p50"]["hours"] / days for h in ("8", "16", "24")] == pytest.approx([3.0, 1.5, 1.0])
+    assert f"8 h a day {by_shift['8']['0.26']['p10']['hours']:.4g} / " in first.stdout, first.stdout
     second = subprocess.run(cmd + ["--force"], capture_output=True, text=True, timeout=600)
     assert second.returncode == 0, second.stderr
     again = json.loads((out / "ensemble.json").read_text())

@@ -75,6 +75,20 @@ def test_the_how_to_scene_ends_at_the_limit(tmp_path):
     assert f"{hours:.6g} h of running" in run.stdout.strip().splitlines()[-1]
 
 
+def test_the_loom_ends_at_the_limit_and_goes_past_it_when_asked(tmp_path):
+    """The bundled loom ends at a limit a few updates in, cut at it; with past_limit the same prediction goes on to
+    the hours asked, beyond the limit, and still reports the hours to it.  (loom_dry differs from it in k alone,
+    which never enters the dynamics: the 1/k tests below; loom_oiled does not reach a limit: section 12.)"""
+    scene = load_scene("loom")
+    ended = predict_to_directory(scene, 1e4, tmp_path / "a", limit=0.0205e-3, figures=False)
+    hours = ended["hours_to_limit"]
+    assert ended["hours_reached"] == pytest.approx(hours, rel=1e-9) and hours < 1e4
+    assert ended["final_effective_clearance_e_mm"] == pytest.approx(0.0205, rel=1e-9)
+    past = predict_to_directory(scene, 1.5 * hours, tmp_path / "b", limit=0.0205e-3, figures=False, past_limit=True)
+    assert past["hours_reached"] == pytest.approx(1.5 * hours) and past["final_effective_clearance_e_mm"] > 0.0205
+    assert past["hours_to_limit"] == pytest.approx(hours, rel=1e-6)  # linear between the same updates
+
+
 # --- the regimes ----------------------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("regime, key", [("boundary", "boundary_wear_coefficient"), ("dry", "dry_wear_coefficient")])
@@ -98,6 +112,22 @@ def test_the_other_regimes_key_changes_nothing():
     b = predict(_wear(scene, dry_wear_coefficient=3e-3, mixed_wear_coefficient=4e-7), 1.0)
     assert [u.hours for u in a] == [u.hours for u in b]
     np.testing.assert_array_equal(a[-1].bearing, b[-1].bearing)
+
+
+def test_hours_scale_as_one_over_k_in_the_mixed_regime():
+    """An oiled pin whose film never lets the journal reach the wall (25 mPa s, c0 = 0.02 mm: film ratio min 2.2,
+    the asperities carry load) wears with mixed_wear_coefficient alone: 4 k gives the same geometries, to the bit
+    (measured), in a quarter of the hours."""
+    scene = load_scene("loom", {"joint_e.lubrication.viscosity_mpa_s": 25.0,
+                                "joint_e.wear.revolutions_per_update": 1})
+    base = predict(scene, 2500.0)
+    assert len(base) >= 2 and base[-1].bearing.max() > 0.0
+    fast = predict(_wear(scene, mixed_wear_coefficient=4.0 * scene.joint.wear.mixed_wear_coefficient),
+                   base[-1].hours / 4.0)
+    assert len(fast) == len(base)
+    for a, b in zip(base, fast):
+        assert b.hours == pytest.approx(a.hours / 4.0, rel=1e-12)
+        np.testing.assert_allclose(b.bearing, a.bearing, rtol=1e-12, atol=0.0)
 
 
 @pytest.fixture(scope="module")
@@ -284,7 +314,7 @@ def test_the_life_report_turns_each_sample_s_hours_into_its_own_calendar_days():
     prediction is the N-weighted share of its updates."""
     from types import SimpleNamespace
 
-    from weftsim.wear.life import prediction_stop_share, sample_days
+    from weftsim.wear.life import horizon_days, prediction_stop_share, sample_days, shift_days, stop_share_summary
 
     scene = load_scene("loom_oiled")
     hours = np.array([[10.0, 20.0], [100.0, np.inf], [1.0, 2.0]])
@@ -297,6 +327,17 @@ def test_the_life_report_turns_each_sample_s_hours_into_its_own_calendar_days():
         assert dc.replace(d, stops_per_hour=s).calendar_days(10.0) == pytest.approx(
             10.0 * (1.0 + s * d.stop_minutes / 60.0) / d.hours_per_day * 7.0 / d.days_per_week, rel=1e-15)
     assert np.isinf(days[1, 1])
+    # one, two and three shifts: the same samples' days at 8, 16 and 24 h a day (the scene's 24 h: the days above)
+    shifts = shift_days(scene, {"duty.stops_per_hour": stops}, hours)
+    assert list(shifts) == [8.0, 16.0, 24.0]
+    np.testing.assert_array_equal(shifts[24.0], days)
+    np.testing.assert_allclose(shifts[8.0], 3.0 * days, rtol=1e-15)
+    assert shift_days(scene, {"duty.hours_per_day": stops}, hours) is None  # drawn: the samples' own
+    # a censored sample lies beyond its own horizon's days: the least of them (5 stops an hour) bounds them all
+    least = 1e5 * (1.0 + 5.0 * d.stop_minutes / 60.0) / d.hours_per_day * 7.0 / d.days_per_week
+    assert horizon_days(scene, {"duty.stops_per_hour": stops}, 1e5) == pytest.approx(least, rel=1e-15)
+    assert horizon_days(scene, {"duty.stops_per_hour": stops}, 1e5, 8.0) == pytest.approx(3.0 * least, rel=1e-15)
+    assert horizon_days(scene, {}, 1e5) == pytest.approx(d.calendar_days(1e5), rel=1e-15)
 
     def update(n, volume, share):
         return SimpleNamespace(step_revolutions=n, part=lambda j: SimpleNamespace(volume_rate=volume),
@@ -305,3 +346,7 @@ def test_the_life_report_turns_each_sample_s_hours_into_its_own_calendar_days():
     assert prediction_stop_share([update(10.0, 1.0, 0.5), update(30.0, 1.0, 0.1), update(0.0, 5.0, 0.9)]) == \
         pytest.approx((10 * 0.5 + 30 * 0.1) / 40)
     assert prediction_stop_share([update(10.0, 0.0, 0.5)]) is None
+    # the summary over the design points names the centre design point's share (a job named node_1_1, not centre)
+    summary = stop_share_summary({"node_0_1": {"stop_start_share": 0.1}, "node_1_1": {"stop_start_share": 0.3},
+                                  "node_2_1": {"stop_start_share": 0.9}}, "node_1_1")
+    assert (summary["centre"], summary["min"], summary["median"], summary["max"]) == (0.3, 0.1, 0.3, 0.9)

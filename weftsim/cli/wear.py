@@ -275,11 +275,24 @@ def run_ensemble(args: argparse.Namespace, scene: Scene, outdir: str | Path,
     days = data["calendar_days_to_limit"]
     print(f"  calendar days to {args.limit_clearance_mm:g} mm ({data['duty_text']}): " + ", ".join(
         f"{name} {text_hours(days[name]['hours'], data['horizon_calendar_days'])[:-2]} d" for name in ("p10", "p50", "p90")))
+    by_shift = data.get("calendar_days_by_shift")
+    if by_shift:
+        at_limit = f"{args.limit_clearance_mm:.6g}"
+
+        def shift(h: str, table: dict) -> str:
+            beyond = data["horizon_calendar_days_by_shift"][h]
+            return f"{h} h a day " + " / ".join(text_hours(table[at_limit][name]["hours"], beyond)[:-2]
+                                               for name in ("p10", "p50", "p90")) + " d"
+
+        print(f"  calendar days to {args.limit_clearance_mm:g} mm by shifts (p10 / p50 / p90): "
+              + ", ".join(shift(h, t) for h, t in by_shift.items()))
     stops = data.get("stop_start_share")
     if stops:
-        print(f"  wear from stop-starts: {100 * stops['median']:.3g} % of the worn volume at the median design point "
-              f"({100 * stops['min']:.3g} - {100 * stops['max']:.3g} % over the {len(stops['by_design_point'])} "
-              "simulated predictions)")
+        centre = stops["centre"] is not None
+        at = "the centre design point" if centre else "the median of the design points"
+        print(f"  wear from stop-starts: {100 * (stops['centre'] if centre else stops['median']):.3g}"
+              f" % of the worn volume at {at} ({100 * stops['min']:.3g} - {100 * stops['max']:.3g} % over the "
+              f"{len(stops['by_design_point'])} simulated predictions)")
     if reach["fraction"] == 0.0:
         print(f"  shares of the spread: none (no sample reaches {args.limit_clearance_mm:g} mm within {horizon:g} h: "
               "the ranks are all tied)")

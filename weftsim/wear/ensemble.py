@@ -36,7 +36,7 @@ from weftsim.wear.censored import censored_quantile, fraction_interval, interval
 from weftsim.wear.ensemble_design import (DESIGN_QUANTILES, RESCALED, k_scale, _lagrange, centre_name,  # noqa: F401
                                           interpolate, plan)
 from weftsim.wear.jobs import hours_at, run_job
-from weftsim.wear.life import duty_text, horizon_days, life_figure, sample_days, stop_share_summary
+from weftsim.wear.life import duty_text, horizon_days, life_figure, sample_days, shift_days, stop_share_summary
 from weftsim.wear.uncertain import Uncertain, latin_hypercube, parse_uncertain, rank_shares
 
 if TYPE_CHECKING:
@@ -277,6 +277,9 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
     by_level = {key: {**quantile_table(hours[:, i], horizon), "reaching": reaching(hours[:, i], horizon)}
                 for key, i in level_index.items()}
     days = sample_days(scene, ens["values"], hours)
+    shifts = shift_days(scene, ens["values"], hours)
+    beyond = horizon_days(scene, ens["values"], horizon)  # a censored sample's days lie beyond this
+    shift_beyond = {h: horizon_days(scene, ens["values"], horizon, h) for h in shifts or ()}
     data = {
         "scene": scene.name,
         "joint": "E",  # wear at joint E (the wear prediction's joint so far)
@@ -309,11 +312,15 @@ def wear_ensemble(scene: Scene, uncertain: dict[str, str] | list[str], samples: 
         "hours_by_clearance_mm": by_level,
         # calendar time (each sample's own duty, weftsim.wear.life) and the stop-starts' share of the wear
         "duty_text": duty_text(scene, ens["values"]),
-        "horizon_calendar_days": horizon_days(scene, horizon),
-        "calendar_days_to_limit": quantile_table(days[:, -1], horizon_days(scene, horizon)),
-        "calendar_days_by_clearance_mm": {key: quantile_table(days[:, i], horizon_days(scene, horizon))
-                                          for key, i in level_index.items()},
-        "stop_start_share": stop_share_summary(results),
+        "horizon_calendar_days": beyond,
+        "calendar_days_to_limit": quantile_table(days[:, -1], beyond),
+        "calendar_days_by_clearance_mm": {key: quantile_table(days[:, i], beyond) for key, i in level_index.items()},
+        # the same at one, two and three shifts (8, 16, 24 h a day; None where the hours a day are drawn)
+        "calendar_days_by_shift": None if shifts is None else {
+            f"{h:g}": {key: quantile_table(d[:, i], shift_beyond[h]) for key, i in level_index.items()}
+            for h, d in shifts.items()},
+        "horizon_calendar_days_by_shift": None if shifts is None else {f"{h:g}": b for h, b in shift_beyond.items()},
+        "stop_start_share": stop_share_summary(results, centre_name(nodes, dynamic)),
         "shares": {k: {"rank_correlation": r, "share": s} for k, (r, s) in ens["shares"].items()},
         "jobs": {n: {"wall_s": r.get("wall_s"), "cpu_s": r.get("cpu_s"), "updates": r.get("updates"),
                      "error": r.get("error"),

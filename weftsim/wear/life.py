@@ -22,6 +22,7 @@ if TYPE_CHECKING:
     from weftsim.input.params import Scene
 
 DUTY_KEYS = ("stops_per_hour", "stop_minutes", "hours_per_day", "days_per_week")
+SHIFTS = (8.0, 16.0, 24.0)  # hours a day of one, two and three shifts
 
 
 def sample_days(scene: Scene, values: dict[str, np.ndarray], hours: np.ndarray) -> np.ndarray:
@@ -36,9 +37,27 @@ def sample_days(scene: Scene, values: dict[str, np.ndarray], hours: np.ndarray) 
     return hours * factor[:, None]
 
 
-def horizon_days(scene: Scene, horizon: float) -> float:
-    """The horizon in calendar days at the scene's duty (what a censored calendar quantile lies beyond)."""
-    return scene.duty.calendar_days(horizon)
+def shift_days(scene: Scene, values: dict[str, np.ndarray], hours: np.ndarray) -> dict[float, np.ndarray] | None:
+    """{hours a day: calendar days of each sample's ``hours``} at one, two and three shifts (:data:`SHIFTS`), the
+    other duty keys as in :func:`sample_days`; None where ``duty.hours_per_day`` is drawn (the samples' own
+    shifts are then the report's calendar days)."""
+    if "duty.hours_per_day" in values:
+        return None
+    n = hours.shape[0]
+    return {h: sample_days(scene, {**values, "duty.hours_per_day": np.full(n, h)}, hours) for h in SHIFTS}
+
+
+def horizon_days(scene: Scene, values: dict[str, np.ndarray], horizon: float, hours_per_day: float | None = None
+                 ) -> float:
+    """The horizon in calendar days, what a censored calendar quantile lies beyond: the least of the samples'
+    days at ``horizon`` running hours (each sample's own duty, as :func:`sample_days`; at ``hours_per_day``
+    where given).  A sample that does not reach a level within the horizon is beyond its own horizon's days, and
+    these differ where ``duty.*`` keys are drawn (15 stops an hour at 2.87 min each make an hour of running 1.72
+    scheduled hours, 5 stops 1.24): only the least of them bounds every censored sample."""
+    if hours_per_day is not None:
+        values = {**values, "duty.hours_per_day": np.full(1, hours_per_day)}
+    n = max([1] + [np.size(v) for v in values.values()])
+    return float(np.min(sample_days(scene, values, np.full((n, 1), horizon))))
 
 
 def prediction_stop_share(updates: list, joint: str = "e") -> float | None:
@@ -54,13 +73,14 @@ def prediction_stop_share(updates: list, joint: str = "e") -> float | None:
     return share / volume if volume > 0.0 else None
 
 
-def stop_share_summary(results: dict) -> dict | None:
-    """{"centre", "min", "median", "max"} of the design predictions' stop-start shares (None without stops)."""
+def stop_share_summary(results: dict, centre: str = "centre") -> dict | None:
+    """{"centre", "min", "median", "max"} of the design predictions' stop-start shares (None without stops);
+    ``centre``: the job name of the centre design point (:func:`weftsim.wear.ensemble_design.centre_name`)."""
     shares = {n: r.get("stop_start_share") for n, r in results.items() if r.get("stop_start_share") is not None}
     if not shares:
         return None
     values = np.array(list(shares.values()), dtype=float)
-    return {"centre": shares.get("centre"), "min": float(values.min()), "median": float(np.median(values)),
+    return {"centre": shares.get(centre), "min": float(values.min()), "median": float(np.median(values)),
             "max": float(values.max()), "by_design_point": dict(sorted(shares.items()))}
 
 
@@ -109,5 +129,5 @@ def duty_text(scene: Scene, values: dict) -> str:
     return ", ".join(parts)
 
 
-__all__ = ["DUTY_KEYS", "duty_text", "horizon_days", "life_figure", "prediction_stop_share", "sample_days",
-           "stop_share_summary"]
+__all__ = ["DUTY_KEYS", "SHIFTS", "duty_text", "horizon_days", "life_figure", "prediction_stop_share", "sample_days",
+           "shift_days", "stop_share_summary"]
