@@ -206,9 +206,6 @@ def _loom_report():
     return scene, weftsim.bearing(scene)
 
 
-@pytest.mark.xfail(strict=True, reason="the kernel's hand-over of the asperities' load to the dry law (issue 30, "
-                   "point 3) drops the boundary friction: beyond e = c the loom's frictionless dry law (friction_"
-                   "coefficient 0) carries the load, so f falls to the film's shear (6e-6 at 0.2 rpm)")
 def test_boundary_friction_is_the_boundary_coefficient():
     """At the foot of the Stribeck curve the solids carry the load: f is their boundary friction, mu_b = 0.1."""
     _, report = _loom_report()
