@@ -108,7 +108,9 @@ def test_dry_scene_is_bit_for_bit_the_former_joint():
 
 def test_no_film_and_no_asperities_is_the_dry_joint_exactly():
     off = {**OIL, "joint_e.lubrication.viscosity_mpa_s": 0.0,
-           "joint_e.lubrication.asperity_density_radius_roughness": 0.0, **EXPLICIT}  # the integrator of the dry run ("auto" takes an implicit one for a lubricated joint)
+           "joint_e.lubrication.asperity_density_radius_roughness": 0.0,
+           "joint_e.lubrication.boundary_friction_coefficient": 0.0,  # the solids' contact as frictionless as dry
+           **EXPLICIT}  # the integrator of the dry run ("auto" takes an implicit one for a lubricated joint)
     dry, lubricated = solve(_scene()), solve(_scene(**off))
     for name in ("driving_torque_Nm", "contact_force_N", "eccentricity_y_m", "dissipated_energy_J"):
         np.testing.assert_array_equal(lubricated.steps[name], dry.steps[name])  # the added terms are exact zeros
@@ -236,7 +238,9 @@ def test_vanishing_viscosity_gives_the_dry_joint(runs):
     gaps = []
     for viscosity in (1e-4, 1e-5, 1e-6):  # mPa s; asperities off, so only the film separates it from dry
         keys = {"joint_e.lubrication.viscosity_mpa_s": viscosity,
-                "joint_e.lubrication.asperity_density_radius_roughness": 0.0, **EXPLICIT}
+                "joint_e.lubrication.asperity_density_radius_roughness": 0.0,
+           "joint_e.lubrication.boundary_friction_coefficient": 0.0,  # the solids' contact as frictionless as dry
+           **EXPLICIT}
         steps = solve(_scene(**keys)).steps
         gaps.append(abs(steps["contact_force_N"].max() - dry["contact_force_N"].max()) / dry["contact_force_N"].max())
     assert gaps[0] > gaps[1] > gaps[2]
