@@ -227,9 +227,9 @@ def _floor_points(floor: float) -> list:
 
 
 def test_the_rough_film_carries_the_mixed_regime_whatever_its_floor_below_it():
-    """Patir and Cheng's rough film carries the load down to h_min = 0.5 sigma: floors 0.25 and 0.5 sigma give the
+    """The film carries the load down to h_min = 0.5 sigma: floors 0.25 and 0.5 sigma, both below the film, give the
     same low-speed friction (measured: equal to 1e-12, f = 0.00492, 0.00364, 0.00274), the film carrying > 95 % of
-    the load and the asperities the rest with their boundary friction."""
+    the load and the asperities the rest with their boundary friction: the floor acts only below itself."""
     low, mid = _floor_points(0.25), _floor_points(0.5)
     for a, b in zip(low, mid):
         assert a.film_ratio >= 0.5 and a.dry_force_n == 0.0
@@ -240,8 +240,9 @@ def test_the_rough_film_carries_the_mixed_regime_whatever_its_floor_below_it():
 @pytest.mark.xfail(strict=True, reason="a floor above the operating film decides the friction: held at h = sigma "
                    "the film cannot carry the load and the Greenwood-Tripp asperities (at most ~0.5-1 kN at h = 0 on "
                    "the loom's pin) cannot make up the rest, so the journal falls through to the dry law (f = 0.051, "
-                   "0.034, 0.017 at 15, 20, 25 rpm against 0.0049, 0.0036, 0.0027); the rough film's table ends at "
-                   "sigma / 4 and its nominal gap still closes at contact (issue 30, point 2)")
+                   "0.034, 0.017 at 15, 20, 25 rpm against 0.0049, 0.0036, 0.0027).  The kernel's film is smooth (the "
+                   "table's roughness axis was never built); Patir and Cheng's film, solved directly, would put 20 rpm "
+                   "at 0.86 sigma (smooth 0.71): still below a floor of sigma (issue 30, point 2)")
 def test_the_low_speed_friction_does_not_depend_on_a_floor_of_one_sigma():
     """The issue's check: floors 0.25-1 sigma give the low-speed friction within 2 %."""
     for a, b in zip(_floor_points(0.25), _floor_points(1.0)):

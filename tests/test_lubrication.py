@@ -67,6 +67,8 @@ def test_lubrication_table_sets_the_film_and_its_defaults():
     # past the bound, is refused as such by the schema: tests/test_hostile_input.py.)
     ({**OIL, "joint_e.clearance_mm": 0.05, "joint_e.lubrication.roughness_um": 60.0}, "smaller than the clearance"),
     ({**OIL, "joint_e.lubrication.viscosity": 80.0}, "unknown key"),
+    # In oil the solids' contact carries the boundary coefficient: a dry friction coefficient would do nothing.
+    ({**OIL, "joint_e.friction_coefficient": 0.15}, "boundary_friction_coefficient"),
 ])
 def test_bad_lubrication_keys_give_one_line(keys, words):
     with pytest.raises(SceneError) as info:
