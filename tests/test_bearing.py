@@ -238,8 +238,8 @@ def test_the_rough_film_carries_the_mixed_regime_whatever_its_floor_below_it():
 
 
 @pytest.mark.xfail(strict=True, reason="a floor above the operating film decides the friction: held at h = sigma "
-                   "the film cannot carry the load and the Greenwood-Tripp asperities (at most ~0.5-1 kN at h = 0 on "
-                   "the loom's pin) cannot make up the rest, so the journal falls through to the dry law (f = 0.051, "
+                   "the film cannot carry the load and the Greenwood-Tripp asperities (0.46 kN at h = sigma / 2, "
+                   "1.2 kN at h = 0 on the loom's pin) cannot make up the rest, so the journal falls through to the dry law (f = 0.051, "
                    "0.034, 0.017 at 15, 20, 25 rpm against 0.0049, 0.0036, 0.0027).  The kernel's film is smooth (the "
                    "table's roughness axis was never built); Patir and Cheng's film, solved directly, would put 20 rpm "
                    "at 0.86 sigma (smooth 0.71): still below a floor of sigma (issue 30, point 2)")

@@ -273,7 +273,7 @@ def test_engines_agree_on_a_lubricated_run(runs):
 def test_engines_agree_on_the_lubricated_loom(clearance_mm, viscosity):
     """`weftsim run loom` with oil on both engines (the reference engine's RODAS4, the Exudyn tree's
     generalized-alpha), a quarter revolution at 600 rpm: a full film at 0.02 mm, a film gone at the floor with
-    asperities carrying at 0.1 mm, and the mixed regime of thin oil (10 mPa s at 0.02 mm: the rough film and the
+    asperities carrying at 0.1 mm, and the mixed regime of thin oil (10 mPa s at 0.02 mm: the film and the
     dissipating asperities share the load).  Within the dry runs' first-revolution tolerance (measured over one
     revolution: maxima within 1.3e-3, the smallest film ratio 8.7988 against 8.8058 at 0.02 mm); the mixed
     regime's asperity peak at tolerances that resolve it (below)."""
