@@ -334,3 +334,13 @@ def test_a_bound_too_few_samples_give_is_not_called_censored():
     censored = quantile_table(np.r_[np.arange(1.0, 81.0), [np.inf] * 20], 1e5)["p90"]
     assert censored["censored"] and censored["low_beyond_hours"] == censored["high_beyond_hours"] == 1e5
     assert text_interval(censored, 100) == "> 1e+05 h - > 1e+05 h"
+
+
+def test_the_dry_friction_of_an_oiled_joint_is_refused():
+    """In oil the solids' contact carries the boundary coefficient (weftsim.physics.joint): the dry joint's
+    friction coefficient is not read, so it cannot spread the wear; the boundary coefficient may."""
+    scene = SCENES["loom-oiled"]()
+    with pytest.raises(WearError) as err:
+        check_uncertain_key("joint_e.friction_coefficient", scene)
+    assert "boundary_friction_coefficient" in str(err.value) and "\n" not in str(err.value)
+    assert uncertain_key_problem("joint_e.lubrication.boundary_friction_coefficient", scene) is None

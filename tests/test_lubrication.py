@@ -67,6 +67,8 @@ def test_lubrication_table_sets_the_film_and_its_defaults():
     # past the bound, is refused as such by the schema: tests/test_hostile_input.py.)
     ({**OIL, "joint_e.clearance_mm": 0.05, "joint_e.lubrication.roughness_um": 60.0}, "smaller than the clearance"),
     ({**OIL, "joint_e.lubrication.viscosity": 80.0}, "unknown key"),
+    # In oil the solids' contact carries the boundary coefficient: a dry friction coefficient would do nothing.
+    ({**OIL, "joint_e.friction_coefficient": 0.15}, "boundary_friction_coefficient"),
 ])
 def test_bad_lubrication_keys_give_one_line(keys, words):
     with pytest.raises(SceneError) as info:
@@ -108,7 +110,9 @@ def test_dry_scene_is_bit_for_bit_the_former_joint():
 
 def test_no_film_and_no_asperities_is_the_dry_joint_exactly():
     off = {**OIL, "joint_e.lubrication.viscosity_mpa_s": 0.0,
-           "joint_e.lubrication.asperity_density_radius_roughness": 0.0, **EXPLICIT}  # the integrator of the dry run ("auto" takes an implicit one for a lubricated joint)
+           "joint_e.lubrication.asperity_density_radius_roughness": 0.0,
+           "joint_e.lubrication.boundary_friction_coefficient": 0.0,  # the solids' contact as frictionless as dry
+           **EXPLICIT}  # the integrator of the dry run ("auto" takes an implicit one for a lubricated joint)
     dry, lubricated = solve(_scene()), solve(_scene(**off))
     for name in ("driving_torque_Nm", "contact_force_N", "eccentricity_y_m", "dissipated_energy_J"):
         np.testing.assert_array_equal(lubricated.steps[name], dry.steps[name])  # the added terms are exact zeros
@@ -236,7 +240,9 @@ def test_vanishing_viscosity_gives_the_dry_joint(runs):
     gaps = []
     for viscosity in (1e-4, 1e-5, 1e-6):  # mPa s; asperities off, so only the film separates it from dry
         keys = {"joint_e.lubrication.viscosity_mpa_s": viscosity,
-                "joint_e.lubrication.asperity_density_radius_roughness": 0.0, **EXPLICIT}
+                "joint_e.lubrication.asperity_density_radius_roughness": 0.0,
+           "joint_e.lubrication.boundary_friction_coefficient": 0.0,  # the solids' contact as frictionless as dry
+           **EXPLICIT}
         steps = solve(_scene(**keys)).steps
         gaps.append(abs(steps["contact_force_N"].max() - dry["contact_force_N"].max()) / dry["contact_force_N"].max())
     assert gaps[0] > gaps[1] > gaps[2]
@@ -267,7 +273,7 @@ def test_engines_agree_on_a_lubricated_run(runs):
 def test_engines_agree_on_the_lubricated_loom(clearance_mm, viscosity):
     """`weftsim run loom` with oil on both engines (the reference engine's RODAS4, the Exudyn tree's
     generalized-alpha), a quarter revolution at 600 rpm: a full film at 0.02 mm, a film gone at the floor with
-    asperities carrying at 0.1 mm, and the mixed regime of thin oil (10 mPa s at 0.02 mm: the rough film and the
+    asperities carrying at 0.1 mm, and the mixed regime of thin oil (10 mPa s at 0.02 mm: the film and the
     dissipating asperities share the load).  Within the dry runs' first-revolution tolerance (measured over one
     revolution: maxima within 1.3e-3, the smallest film ratio 8.7988 against 8.8058 at 0.02 mm); the mixed
     regime's asperity peak at tolerances that resolve it (below)."""

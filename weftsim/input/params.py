@@ -505,6 +505,9 @@ def joint_problem(joint: ClearanceJoint) -> str | None:
     if lub is not None:
         if not isinstance(lub, Lubrication):
             return f"`lubrication` must be a weftsim.input.params.Lubrication or None, got {type(lub).__name__}"
+        if joint.friction_coefficient > 0.0:
+            return (f"`friction_coefficient` ({joint.friction_coefficient:g}) is the dry joint's: in oil the solids' "
+                    f"contact carries `lubrication.boundary_friction_coefficient`; set friction_coefficient = 0")
         if c > 0.0 and lub.film_floor_ratio * lub.roughness >= c:
             return (f"`lubrication.roughness` x `film_floor_ratio` ({lub.film_floor_ratio * lub.roughness:.3g} m) "
                     f"must be smaller than the clearance {c:.3g} m (the film needs room between the surfaces)")

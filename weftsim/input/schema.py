@@ -139,10 +139,10 @@ def LUBRICATION_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 -
         Key(at + "roughness_radius_ratio", to + "roughness_radius_ratio", "float", 1, 0, 1,
             doc="Greenwood-Tripp sigma / beta, RMS roughness over asperity summit radius (default 1e-3)"),
         Key(at + "boundary_friction_coefficient", to + "boundary_friction_coefficient", "float", 1, 0, 2, False,
-            doc="friction coefficient on the asperity load (default 0.1)"),
+            doc="friction coefficient of the solids' contact in oil, asperities and dry law (default 0.1)"),
         Key(at + "film_floor_ratio", to + "film_floor_ratio", "float", 1, 0.25, 4, False,
-            doc="numerical guard: the film force is evaluated no closer than this many RMS roughnesses (default 1; "
-                "the rough film's table reaches 0.25)"),
+            doc="the film force is evaluated no closer than this many RMS roughnesses (default 1); a floor above the "
+                "operating film decides the mixed regime's friction (docs/lubricated-joint.md)"),
         # The oil and the heat balance (weftsim.physics.oil, weftsim.joint.heat): instead of viscosity_mpa_s.
         Key(at + "oil", to + "oil", "str",
             doc="an ISO 3448 grade (\"ISO VG 220\"): the viscosity follows from the film temperature of the "

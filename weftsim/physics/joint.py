@@ -46,7 +46,8 @@ def joint_parameters(joint: ClearanceJoint, law: _Law) -> np.ndarray:
     """The joint block: the law's (kind, coef, c, xi), R_b, mu, friction ramp, v_min, rule flag, dead zone,
     then the lubrication (flag, viscosity, film model, roughness, Greenwood-Tripp K E*, boundary mu, film
     floor, R_j, L_b, the asperities' hysteresis kappa = (1 - e^2) / (1 + e^2) from the joint's restitution e;
-    zeros for a dry joint).
+    zeros for a dry joint).  A lubricated joint's mu is its boundary mu: the dry law's contact is the solids'
+    boundary-lubricated contact.
 
     ``joint``: a :class:`weftsim.input.params.ClearanceJoint`; ``law``: a law of :mod:`weftsim.joint.contact`
     (its ``parameters``).  ``TRACK_MAX`` is 1.0 under the "max_approach" rule, 0.0 under "onset";
@@ -72,6 +73,11 @@ def joint_parameters(joint: ClearanceJoint, law: _Law) -> np.ndarray:
         out[ASPERITY_COEF] = greenwood_tripp_coefficient(lub.asperity_density_radius_roughness,
                                                          lub.roughness_radius_ratio, joint.effective_modulus)
         out[BOUNDARY_MU] = lub.boundary_friction_coefficient
+        # The solids' contact in oil is boundary-lubricated: beyond abs(e) = c, where the dry law takes the
+        # asperities' load over (weftsim.physics.lubricated.asperity_share), its friction is mu_b too, so the
+        # solids carry mu_b on their whole load in every engine (the dry joint's `friction_coefficient` is the
+        # unlubricated contact's; a lubricated joint refuses one > 0, weftsim.input.params).
+        out[MU] = lub.boundary_friction_coefficient
         out[FILM_FLOOR] = lub.film_floor_ratio
         out[JOURNAL_RADIUS] = joint.journal_radius
         out[BEARING_LENGTH] = joint.bearing_length

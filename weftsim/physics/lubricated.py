@@ -23,8 +23,10 @@ at every eccentricity, in contact or not::
   friction F_Ta = -mu_b c_d(v_T) F_a sign(v_T) acts at the contact point Q = P_b + R_b n with the moments
   of the dry friction, M_j = (R_b - |e|) F_Ta, M_b = -R_b F_Ta (:func:`weftsim.physics.joint.friction_force`
   with mu_b and the joint's friction ramp).
-- **Dry law.** Unchanged (:func:`weftsim.physics.joint.clearance_force_at`): zero at |e| = c and growing
-  from there, so the total radial force is continuous in |e| (the film term is continuous and held
+- **Dry law.** :func:`weftsim.physics.joint.clearance_force_at`, its friction coefficient the boundary mu_b (a
+  lubricated joint's block carries mu_b as its mu, :func:`weftsim.physics.joint.joint_parameters`: the solids'
+  contact in oil is boundary-lubricated, so the load the asperities hand over keeps its friction): zero at
+  |e| = c and growing from there, so the total radial force is continuous in |e| (the film term is continuous and held
   constant in |e| beyond its floor, the asperity share is continuous and falls as the dry law rises).
 
 Dissipated power of the film, the boundary friction and the asperities' hysteresis, the part of the power the

@@ -25,6 +25,7 @@ or would change what is modelled instead of a value of it:
   joint does not wear in (``dry_wear_coefficient`` in the boundary regime, ``mixed_wear_coefficient`` on a dry
   joint, any regime's k under a given ``wear_coefficient``); running-in on a dry joint, or its depth without
   ``run_in_roughness_um``; the oil's properties and the heat balance under a fixed ``viscosity_mpa_s``;
+  the dry ``friction_coefficient`` of a joint in oil (its solids carry the boundary coefficient);
   a stop's ``stop_minutes``, ``startup_revolutions`` or ``rundown_revolutions`` on a loom that does not stop
   (``stops_per_hour = 0``, unless that is uncertain too);
 - it would change the lubricant's model: a grade's ``oil.nu40_mm2_s`` / ``oil.nu100_mm2_s``, a fixed
@@ -159,6 +160,10 @@ def _joint_e_problem(key: str, scene: Scene, others: tuple[str, ...]) -> str | N
         if regime != "mixed" and wear.regime != regime:
             return (f"joint E's solid contact wears in the {wear.regime!r} regime ([joint_e.wear] regime): the "
                     f"{regime} k does not change the wear")
+    if name == "friction_coefficient" and joint.is_lubricated:
+        return ("joint E runs in oil, whose solids' contact carries the lubrication's boundary_friction_coefficient: "
+                "the dry joint's friction coefficient is not read and does not change the wear; make "
+                "joint_e.lubrication.boundary_friction_coefficient uncertain instead")
     if name in ("wear.run_in_roughness_um", "wear.run_in_depth_um") and not joint.is_lubricated:
         return "running-in lowers an oil film's roughness, and joint E is dry: it does not change the wear"
     if name == "wear.run_in_depth_um" and wear.run_in_roughness is None \
