@@ -102,9 +102,12 @@ def select_path(scene: Scene) -> dict:
         from weftsim.model.tape_selection import rigid_scene, tape_check
 
         check = tape_check(scene)
-        if check["model"] == "flexible":
-            return {"model": "none", "method": "none", "reason": "no flexible rapier tape in the Exudyn engine yet",
-                    "rapier": check["reason"]}
+        if check["model"] == "flexible":  # the tape on the tree of the linkage (weftsim.exudyn_engine.tape_tree)
+            from weftsim.model.tape import massless_rapier
+
+            path = select_path(massless_rapier(scene))
+            return dict(path, method=path["method"] + f", tape of {scene.rapier_tape.modes} Ritz functions",
+                        rapier=check["reason"])
         return dict(select_path(rigid_scene(scene)), rapier=check["reason"])
     s = scene.exudyn_solver
     model, reason = select_model(scene)
