@@ -21,6 +21,9 @@
   flexible body anywhere in members 1-3 would need the rigid-body model (members 1-3 no longer move
   in closed form); weftsim's scenes have neither yet.
 
+A flexible rapier tape (``[rapier_tape]`` run flexible) rides on the kinematic tree of its linkage with a
+massless rapier (:mod:`.tape_tree`); the rigid-body model does not carry it.
+
 ``"rigid_body"`` and ``"kinematic_tree"`` stay explicit choices.  :func:`weftsim.exudyn_engine.solve`
 runs exactly the model this module names, with the steps it plans (:func:`adaptive`, :func:`step_plan`:
 the error-controlled or the fixed step of the rigid-body model).  Plain arithmetic on the scene: this module
