@@ -311,8 +311,8 @@ def test_without_the_table_the_rigid_rapier_is_untouched():
 
 
 def test_the_automatic_engine_of_a_flexible_tape_is_the_reference_engine():
-    """engine 'auto' is the Exudyn engine, which has no flexible tape yet: a scene whose tape runs flexible
-    goes to the reference engine instead; a tape run as the rigid rapier stays on the default."""
+    """engine 'auto' is the Exudyn engine, but a scene whose tape runs flexible goes to the reference engine
+    (both model it, tests/test_exudyn_tape.py); a tape run as the rigid rapier stays on the default."""
     from weftsim import engines
 
     flexible = load_scene("loom_tape", {"drive.revolutions": 0.01})

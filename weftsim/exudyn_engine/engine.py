@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 from weftsim.exudyn_engine.selection import adaptive, select_model, select_path, step_plan, tree_solver
 from weftsim.errors import SceneError
-from weftsim.exudyn_engine.solver import check_settings, solve
+from weftsim.exudyn_engine.solver import check_settings, solve, tape_problem
 from weftsim.model.stiffness import stiff_joints
 from weftsim.checks.contract import Estimate
 from weftsim.checks.progress import NPZ_BYTES_PER_ROW, STEP_ROWS_PER_REVOLUTION
@@ -35,6 +35,10 @@ EXUDYN_RIGID_BODY_STIFF_FACTOR = 25.0
 # The rigid-body model takes fixed steps: its cost is per step (5.5 s for the 75 000 steps of one revolution
 # at 400 rpm with h = 2e-6 s, 73 us a step; 16.6 s for 3 revolutions).
 EXUDYN_SECONDS_PER_STEP = 7.3e-5
+# The flexible tape on the tree (DOPRI5 at the tape's stability limit through the impacts): loom_tape at 600 rpm,
+# c = 0.02 mm, two revolutions: 19.2 s of CPU and 82 531 stored steps (docs/rapier-tape.md section 6), per revolution.
+TAPE_SECONDS_PER_REVOLUTION = 9.6
+TAPE_STEP_ROWS_PER_REVOLUTION = 41_300
 
 
 def tree_explicit(scene: Scene) -> bool:
@@ -64,10 +68,20 @@ def estimate(scene: Scene) -> Estimate:
     round-off): the command line asks for the estimate before the run, so such a scene is refused there in
     one line (exit 2) instead of being estimated (a 1e-9 s step: ~73 s and ~829 MB announced) and then
     failing at its first step with incomplete result files.  ``solve`` still returns the same failure."""
-    if scene.rapier_tape is None:  # the tape's scenes are solved through their own model (solver.solve)
-        problem = check_settings(scene)
-        if problem is not None:
-            raise SceneError(problem)
+    if scene.rapier_tape is not None:
+        from weftsim.model.tape_selection import rigid_scene
+
+        if rigid_scene(scene).rapier_tape is not None:  # the flexible tape on the tree (solver._solve_tape_scene)
+            problem = tape_problem(scene)
+            if problem is not None:
+                raise SceneError(problem)
+            revolutions = scene.drive.revolutions
+            return Estimate(revolutions * TAPE_SECONDS_PER_REVOLUTION,
+                            revolutions * TAPE_STEP_ROWS_PER_REVOLUTION * NPZ_BYTES_PER_ROW, False)
+        scene = rigid_scene(scene)  # the tape as the rigid rapier: the rigid loom's run
+    problem = check_settings(scene)
+    if problem is not None:
+        raise SceneError(problem)
     seconds = run_time(scene)
     rows = STEP_ROWS_PER_REVOLUTION * seconds / SECONDS_PER_REVOLUTION["exudyn kinematic_tree"]
     return Estimate(seconds, rows * NPZ_BYTES_PER_ROW, bool(stiff_joints(scene)) and tree_explicit(scene))

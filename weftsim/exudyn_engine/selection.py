@@ -21,6 +21,9 @@
   flexible body anywhere in members 1-3 would need the rigid-body model (members 1-3 no longer move
   in closed form); weftsim's scenes have neither yet.
 
+A flexible rapier tape (``[rapier_tape]`` run flexible) rides on the kinematic tree of its linkage with a
+massless rapier (:mod:`.tape_tree`); the rigid-body model does not carry it.
+
 ``"rigid_body"`` and ``"kinematic_tree"`` stay explicit choices.  :func:`weftsim.exudyn_engine.solve`
 runs exactly the model this module names, with the steps it plans (:func:`adaptive`, :func:`step_plan`:
 the error-controlled or the fixed step of the rigid-body model).  Plain arithmetic on the scene: this module
@@ -102,9 +105,12 @@ def select_path(scene: Scene) -> dict:
         from weftsim.model.tape_selection import rigid_scene, tape_check
 
         check = tape_check(scene)
-        if check["model"] == "flexible":
-            return {"model": "none", "method": "none", "reason": "no flexible rapier tape in the Exudyn engine yet",
-                    "rapier": check["reason"]}
+        if check["model"] == "flexible":  # the tape on the tree of the linkage (weftsim.exudyn_engine.tape_tree)
+            from weftsim.model.tape import massless_rapier
+
+            path = select_path(massless_rapier(scene))
+            return dict(path, method=path["method"] + f", tape of {scene.rapier_tape.modes} Ritz functions",
+                        rapier=check["reason"])
         return dict(select_path(rigid_scene(scene)), rapier=check["reason"])
     s = scene.exudyn_solver
     model, reason = select_model(scene)

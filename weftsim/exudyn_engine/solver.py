@@ -199,15 +199,45 @@ def solve(scene: Scene, progress: Callable[[float], None] | None = None, callbac
     return result
 
 
+def tape_problem(scene: Scene) -> str | None:
+    """Why the Exudyn engine cannot run the flexible tape of ``scene`` (one line), or None.
+
+    The tape rides on the kinematic tree (:mod:`.tape_tree`): it needs what the reference engine's tape needs
+    (:func:`weftsim.model.tape_selection.flexible_problem`), the settings of the linkage it drives, and the
+    tree."""
+    from weftsim.model.tape import massless_rapier
+    from weftsim.model.tape_selection import flexible_problem
+
+    problem = flexible_problem(scene) or check_settings(massless_rapier(scene))
+    if problem is not None:
+        return problem
+    if select_model(scene)[0] != "kinematic_tree":
+        return ("the Exudyn engine runs the flexible rapier tape on the kinematic tree only; set "
+                "`solver.exudyn.model` = 'auto' or 'kinematic_tree', or rapier_tape.model = 'rigid'")
+    return None
+
+
 def _solve_tape_scene(scene: Scene, progress, callback, observe) -> RunResult:
     """A scene with a ``[rapier_tape]``: its rigid equivalent when the tape runs as the rigid rapier
-    (:func:`weftsim.model.tape_selection.tape_model`), else a failed result (this engine has no flexible tape yet)."""
+    (:func:`weftsim.model.tape_selection.tape_model`), else the flexible tape on the kinematic tree
+    (:mod:`.tape_tree`)."""
     from weftsim.model.tape_selection import rigid_scene, tape_check
 
     check = tape_check(scene)
     if check["model"] == "flexible":
-        return _failed(scene, "the Exudyn engine does not model the flexible rapier tape yet (docs/rapier-tape.md); "
-                              "run it on engine 'reference', or set rapier_tape.model = 'rigid'", 0.0)
+        wall0 = _time.perf_counter()
+        if callback is not None:
+            scene = dataclasses.replace(scene, exudyn_solver=dataclasses.replace(scene.exudyn_solver,
+                                                                                 callback=callback))
+        problem = tape_problem(scene)
+        if problem is not None:
+            return _failed(scene, problem, 0.0)
+        from weftsim.exudyn_engine.tree_solve import solve_tree
+
+        result = solve_tree(scene, progress, None, observe)
+        object.__setattr__(result, "path", select_path(scene))
+        result.solver_stats["wall_time_s"] = _time.perf_counter() - wall0
+        return result
     result = solve(rigid_scene(scene), progress, callback, observe)
     object.__setattr__(result, "path", dict(result.path, rapier=check["reason"]))
     object.__setattr__(result, "scene", scene)

@@ -11,9 +11,8 @@ two within 3.5e-8, four within 8e-10 (0.25-1.49 m, the default tape).
 
 :func:`driven_head_acceleration` drives the root along the guide with a prescribed wheel motion s(t) (a coordinate
 constraint with an offset user function) at a fixed free length: the Exudyn side of the engines' agreement on the
-head's acceleration (tests/test_rapier_tape.py).  Not built yet: the tape driven by the linkage's rapier wheel
-with a growing free length (an ALE cable or a sliding joint at the wheel), so the Exudyn engine runs a tape
-scene only as the rigid rapier.
+head's acceleration (tests/test_rapier_tape.py).  The tape driven by the linkage's rapier wheel over a growing
+free length is :mod:`.tape_tree` (the variable-length Ritz bar on the kinematic tree).
 """
 
 from __future__ import annotations

@@ -51,12 +51,14 @@ from weftsim.exudyn_engine.selection import (  # noqa: F401 (re-exported: the tr
     tree_relative_tolerance,
     tree_solver,
 )
+from weftsim.exudyn_engine.tape_tree import add_tape, tape_sensors, with_tape
 from weftsim.exudyn_engine.tree_implicit import ImplicitTree
 from weftsim.exudyn_engine.step_control import failure_reason as implicit_failure
 from weftsim.checks.guards import RunGuard, failure_message, non_finite_breach
 from weftsim.input.params import Scene
 from weftsim.model.dynamics import NUMPY, ChainConstants, chain_energy, eccentricity, initial_state
 from weftsim.model.ideal import crank_side_inertia, crank_side_potential
+from weftsim.model.tape import massless_rapier
 from weftsim.post.results import RunResult, angle_grid, empty_channels
 
 if TYPE_CHECKING:
@@ -167,9 +169,11 @@ def worn_channels(scene: Scene, t: np.ndarray, a: np.ndarray, psi: np.ndarray, d
 MOTION_SHARE = math.sqrt(2.0 / (2.0 + POWER_JOINTS))
 
 
-def tree_settings(scene: Scene) -> exu.SimulationSettings:
+def tree_settings(scene: Scene, tape_coordinates: int = 0) -> exu.SimulationSettings:
     """Explicit solver with automatic step size; no files, no console output.  The tolerances are the scene's
-    times :data:`MOTION_SHARE`: the explicit tree carries the power joints (:func:`solve_tree`)."""
+    times :data:`MOTION_SHARE`: the explicit tree carries the power joints (:func:`solve_tree`).  With a
+    flexible tape's ``tape_coordinates`` (its Ritz coordinates, motion too) the share is
+    sqrt((2 + n) / (2 + n + POWER_JOINTS))."""
     s = scene.exudyn_solver
     omega, t_end = scene.drive.speed, scene.drive.end_time
     ss = exu.SimulationSettings()
@@ -179,8 +183,10 @@ def tree_settings(scene: Scene) -> exu.SimulationSettings:
     ti.numberOfSteps = STEPS_PER_SAMPLE * max(1, math.ceil(t_end / (scene.output.sample_angle / omega) * (1.0 - 1e-12)))
     ti.numberOfSteps = max(ti.numberOfSteps, math.ceil(t_end / largest_step(scene) * (1.0 - 1e-12)))
     ti.automaticStepSize = True
-    ti.relativeTolerance = tree_relative_tolerance(scene) * MOTION_SHARE
-    ti.absoluteTolerance = s.absolute_tolerance * MOTION_SHARE
+    motion = 2 + tape_coordinates
+    share = math.sqrt(motion / (motion + POWER_JOINTS))
+    ti.relativeTolerance = tree_relative_tolerance(scene) * share
+    ti.absoluteTolerance = s.absolute_tolerance * share
     ti.minimumStepSize = scene.limits.min_step
     ti.explicit.computeEndOfStepAccelerations = END_OF_STEP_ACCELERATIONS
     silence(ss)
@@ -322,13 +328,21 @@ def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, ca
     # after ~230 revolutions), with them 4e-4 J, at 40 % more CPU time (two more Jacobian columns).  With an oil
     # film they changed nothing (3.9e-3 and 4.3e-3 J in 3 revolutions) and cost 47 %: the quadrature stays.
     powers = not implicit or (scene.joint.friction_coefficient > 0.0 and not scene.joint.is_lubricated)
-    model = build_tree(mbs, scene, scene.exudyn_solver.callback if callback is None else callback, powers=powers)
+    # A flexible rapier tape: the tree of the linkage with a massless rapier, the tape and head on its wheel
+    # (:mod:`.tape_tree`; its damping enters the power joint of D, so it needs the power joints).
+    tape_scene = scene.rapier_tape is not None
+    linkage = massless_rapier(scene) if tape_scene else scene
+    powers = powers or tape_scene
+    model = build_tree(mbs, linkage, scene.exudyn_solver.callback if callback is None else callback, powers=powers)
     store = {"storeInternal": True, "writeToFile": False}
     sensors = {
         "q": mbs.AddSensor(SensorNode(nodeNumber=model.node, outputVariableType=OVT.Coordinates, **store)),
         "q_t": mbs.AddSensor(SensorNode(nodeNumber=model.node, outputVariableType=OVT.Coordinates_t, **store)),
         "q_tt": mbs.AddSensor(SensorNode(nodeNumber=model.node, outputVariableType=OVT.Coordinates_tt, **store)),
     }
+    tape = add_tape(mbs, scene, model.node) if tape_scene else None
+    if tape is not None:
+        sensors |= tape_sensors(mbs, tape, store)
     guard = RunGuard(scene)
     breach = []
     state = {"t": 0.0, "next_report": _PROGRESS_EVERY, "min_step": math.inf}
@@ -362,7 +376,7 @@ def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, ca
     mbs.Assemble()
     if progress is not None:
         progress(0.0)
-    settings = tree_settings(scene)
+    settings = tree_settings(scene, tape.modes if tape is not None else 0)
     if implicit:
         stepper.settings(settings)
     status, message, kind = "success", "", None
@@ -384,6 +398,8 @@ def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, ca
     data = {k: np.asarray(mbs.GetSensorStoredData(v)) for k, v in sensors.items()}  # the stub says ArrayLike
     data["force"] = np.array(model.bearing_force).reshape(-1, RECORD_COLUMNS)
     steps = tree_channels(model, data) if min(len(v) for v in data.values()) else empty_channels()
+    if tape is not None:
+        steps = with_tape(steps, tape, scene, data) if len(steps["time_s"]) else empty_channels(scene=scene)
     if observe is not None:
         observe(*tree_states(data, len(steps["time_s"])))
     bad = first_nonfinite_row(steps)
