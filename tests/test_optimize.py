@@ -178,3 +178,15 @@ def test_worn_joint_objective_on_the_pool_matches_a_direct_run(tmp_path, capsys)
     direct = cell_metrics(result)["joint_force_N_last_peak"]
     assert math.isclose(best["objectives"]["peak_joint_force"], direct, rel_tol=1e-12)  # the same deterministic run
     assert best["objectives"]["peak_joint_force"] <= data["start"]["objectives"]["peak_joint_force"]
+
+
+def test_objectives_read_the_runs_they_name():
+    """clearance_sensitivity is worn / new - 1 of the peak joint force; the worn-joint ones read the worn run."""
+    from weftsim.optimize.objectives import objective_values
+
+    runs = {"worn": {"joint_force_n": 150.0, "rapier_acceleration_m_s2": 7.0, "pin_pressure_pa": 3.0,
+                     "pv_pa_m_s": 4.0}, "new": {"joint_force_n": 100.0}}
+    names = ("clearance_sensitivity", "peak_joint_force", "peak_rapier_acceleration", "pin_pressure", "pv")
+    assert objective_values(names, {}, runs) == {"clearance_sensitivity": 0.5, "peak_joint_force": 150.0,
+                                                 "peak_rapier_acceleration": 7.0, "pin_pressure": 3.0, "pv": 4.0}
+    assert objective_values(("clearance_sensitivity",), {}, {"worn": runs["worn"]}) == {"clearance_sensitivity": None}
