@@ -1,9 +1,9 @@
 """The bundled loom's life in its three regimes, one figure (docs/wear.md section 12, docs/img/loom_life.png).
 
-    python scripts/loom_life.py GREASED DRY OILED [OILED ...] [-o docs/img/loom_life.png]
+    python scripts/loom_life.py LABEL=DIR [LABEL=DIR ...] [-o docs/img/loom_life.png]
 
-Each argument is the output directory of a ``weftsim wear ... --uncertain ...`` ensemble (the commands of
-docs/wear.md section 12); nothing is simulated here.  Left: the distribution of the running hours to the limit
+Each DIR is the output directory of a ``weftsim wear ... --uncertain ...`` ensemble (the commands of
+docs/wear.md section 12), LABEL its name in the figure; nothing is simulated here.  Left: the distribution of the running hours to the limit
 (each curve ends at the fraction of the samples that reach it within the ensemble's horizon).  Right: p10 - p90
 of the calendar days to the limit at one, two and three shifts (8, 16, 24 h a day), p50 marked.  No published
 bushing replacement interval of a loom was found to draw beside them (section 12 says where it was looked for).
@@ -36,14 +36,14 @@ def main() -> None:
     from weftsim.post.plots import figure
 
     ap = argparse.ArgumentParser()
-    ap.add_argument("ensembles", nargs="+", type=Path)
+    ap.add_argument("ensembles", nargs="+", help="LABEL=DIR")
     ap.add_argument("-o", "--output", type=Path, default=ROOT / "docs" / "img" / "loom_life.png")
     args = ap.parse_args()
     cases = []
-    for directory in args.ensembles:
-        data, hours = _read(directory)
-        label = data["scene"] + (f" ({data['uncertain'][0].split('=')[1]})" if data["scene"] == "loom" else "")
-        cases.append((label, data, hours))
+    for text in args.ensembles:
+        label, _, directory = text.rpartition("=")
+        data, hours = _read(Path(directory))
+        cases.append((label or data["scene"], data, hours))
     limit = cases[0][1]["limit_clearance_mm"]
     fig = figure(figsize=(11, 4.4))
     ax = fig.add_subplot(1, 2, 1)
@@ -63,7 +63,7 @@ def main() -> None:
     ax = fig.add_subplot(1, 2, 2)
     key = f"{limit:.6g}"
     y = 0
-    ticks, names = [], []
+    ticks, names, right = [], [], 0.0
     for i, (label, data, _) in enumerate(cases):
         for shift, table in (data.get("calendar_days_by_shift") or {}).items():
             q = {p: table[key][p]["hours"] for p in ("p10", "p50", "p90")}
@@ -75,15 +75,17 @@ def main() -> None:
                 ax.plot([q["p50"]], [y], "k|", ms=12)
             if q["p90"] is None:
                 ax.annotate("", xy=(high * 3.0, y), xytext=(high, y), arrowprops={"arrowstyle": "->", "color": f"C{i}"})
+            right = max(right, 10.0 * high)
             ticks.append(y)
-            names.append(f"{data['scene']}, {shift} h a day")
+            names.append(f"{label}, {shift} h a day")
             y -= 1
         y -= 0.5
     ax.set_yticks(ticks, names, fontsize=7)
     ax.set_xscale("log")
-    ax.set_xlabel(f"calendar days to {limit:g} mm: p10 - p90, p50 marked (arrow: beyond the horizon)")
+    ax.set_xlim(right=right)
+    ax.set_xlabel(f"calendar days to {limit:g} mm, 6 days a week: p10-p90, p50 |\n(arrow: beyond the horizon)")
     ax.grid(True, axis="x", alpha=0.3)
-    ax.text(0.02, 0.02, "published replacement intervals of loom bushings:\nnone found (docs/wear.md section 12)",
+    ax.text(0.02, 0.30, "published replacement intervals of loom bushings:\nnone found (docs/wear.md section 12)",
             transform=ax.transAxes, fontsize=7, va="bottom")
     fig.suptitle("The bundled loom's pin at E, 600 rpm nominal: greased, truly dry and oiled")
     fig.tight_layout()
