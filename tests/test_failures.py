@@ -262,6 +262,27 @@ def test_reference_step_size_floor_from_limits():
     r = door("reference")(scene(min_step=1e-5))
     assert_failed(r, "step_size", "below limits.min_step_s = 1e-05 s")
     assert r.steps["time_s"][-1] > 0.0
+    # The hint names the raised floor first, then the reference engine's own keys (issue 35).
+    assert "a smaller limits.min_step_s (it is 1e-05 s, raised from its default 1e-12 s" in r.message, r.message
+    assert "solver.reference.method" in r.message and "solver.exudyn" not in r.message
+
+
+@pytest.mark.parametrize("implicit", [False, True])
+def test_the_step_collapse_hint_names_the_keys_of_the_engine_that_ran(implicit):
+    """The kinematic tree's guard (the Exudyn default path) says what to try in solver.exudyn.* keys, never the
+    reference engine's solver.reference.method (issue 35: it did), and a raised limits.min_step_s first; at the
+    default floor it does not mention it."""
+    from weftsim.checks.guards import RunGuard
+    from weftsim.exudyn_engine.tree_solve import step_advice
+
+    for min_step, raised in ((1e-12, False), (1e-5, True)):
+        s = scene(min_step=min_step)
+        breach = RunGuard(s, step_advice=step_advice(s, implicit)).check(step_size=0.5 * min_step)
+        assert breach is not None and breach.kind == "step_size"
+        assert "solver.reference" not in breach.hint and "solver.exudyn." in breach.hint, breach.hint
+        assert ("solver.exudyn.local_error_m" in breach.hint) == implicit, breach.hint
+        assert ("solver.exudyn.relative_tolerance" in breach.hint) == (not implicit), breach.hint
+        assert ("limits.min_step_s (it is 1e-05 s, raised from its default 1e-12 s" in breach.hint) == raised
 
 
 def test_exudyn_newton_non_convergence():
@@ -271,6 +292,7 @@ def test_exudyn_newton_non_convergence():
     r = door("exudyn")(scene(exudyn=settings))
     assert_failed(r, "newton", "Newton did not converge", "step-size collapse", "solver.exudyn.step_size_s",
                   "solver.exudyn.newton_max_iterations")  # fmt: skip
+    assert "solver.reference" not in r.message and "raised from its default" not in r.message  # floor not raised
 
 
 # --- NaN and inf -------------------------------------------------------------------------

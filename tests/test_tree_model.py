@@ -18,6 +18,7 @@ from weftsim.exudyn_engine.tree_solve import contact_work  # noqa: E402
 from weftsim.model.dynamics import ChainConstants, eccentricity, initial_state, pack_parameters  # noqa: E402
 from weftsim.model.dynamics import NUMPY  # noqa: E402
 from weftsim.input.scene import load_scene  # noqa: E402
+from weftsim.checks.guards import energy_residual  # noqa: E402
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 
@@ -104,8 +105,8 @@ def test_accelerations_are_those_of_the_accepted_states():
 
 @pytest.mark.parametrize("scene_name, clearance_mm, revolutions, mu", [
     ("reference", 0.5, 6.0, 0.0),  # the reference scene's worst drift under quadrature
-    ("loom", 0.1, 3.0, 0.0),  # the worn loom, in lasting contact (95 % of the steps)
-    ("loom", 0.25, 3.0, 0.0),
+    # the worn loom without friction, in lasting contact (95 % of the steps): over 10 revolutions in
+    # test_the_worn_looms_long_run_holds_on_the_default_exudyn_path
     ("loom", 0.1, 3.0, 0.15),  # friction: the implicit tree, with the power joints too
 ])
 def test_energy_balance_closes_over_revolutions_on_the_default_path(scene_name, clearance_mm, revolutions, mu):
@@ -124,9 +125,7 @@ def test_energy_balance_closes_over_revolutions_on_the_default_path(scene_name, 
     r = solve(scene)
     assert r.ok and r.path["model"] == "kinematic_tree", r.message
     st = r.steps
-    residual = (st["driving_work_J"] - (st["kinetic_energy_J"] - st["kinetic_energy_J"][0])
-                - (st["potential_energy_J"] - st["potential_energy_J"][0]) - st["contact_energy_J"]
-                - st["dissipated_energy_J"])  # fmt: skip
+    residual = energy_residual(st)
     assert np.abs(residual).max() < 2e-5 * st["kinetic_energy_J"].max()
     # D' >= 0 at every state; the integrated D falls by the solver's local error in a few steps (loom at
     # 0.1 mm: 8 steps of 5766, -1.2e-7 J in all, against 5.09 J dissipated).
@@ -171,3 +170,52 @@ def test_no_light_impact_falls_inside_one_free_flight_step(clearance_mm, rpm, pe
     r = solve(scene)
     assert r.ok, r.message
     assert r.plausibility["nonpositive_onsets"] == 0
+
+
+# The reference engine's peaks over revolutions 2-10 of the worn loom (600 rpm, its defaults: numba_DOP853 at
+# rtol 1e-5), measured with 'weftsim run loom --clearance-mm C --revolutions 10 --engine reference' (summary.json's
+# revolutions 2-10; 68 s and 50 s of CPU, too long for the suite): the largest abs(rapier acceleration), the most
+# negative driving torque and the largest contact force.
+WORN_LOOM_REFERENCE_PEAKS = {
+    0.1: {"rapier_acceleration_m_s2": 13924.0, "driving_torque_Nm": -8992.2, "contact_force_N": 69968.0},
+    0.25: {"rapier_acceleration_m_s2": 23725.0, "driving_torque_Nm": -15464.0, "contact_force_N": 120990.0},
+}
+
+
+@pytest.fixture(scope="module", params=sorted(WORN_LOOM_REFERENCE_PEAKS))
+def worn_loom_long_run(request):
+    """The worn loom's 10-revolution run on the default Exudyn path, as 'weftsim run loom --clearance-mm C
+    --revolutions 10 --engine exudyn' runs it (the door, with its energy guard): ~2 s of CPU each."""
+    import weftsim
+
+    scene = load_scene("loom", {"drive.revolutions": 10.0, "joint_e.clearance_mm": request.param})
+    with pytest.warns(Warning):  # the clearance is outside the design range: the worn joint's warning
+        return request.param, weftsim.simulate(scene, "exudyn")
+
+
+def test_the_worn_looms_long_run_holds_on_the_default_exudyn_path(worn_loom_long_run):
+    """Issue 35: 'weftsim run loom --clearance-mm 0.1 --revolutions 10 --engine exudyn' failed the energy guard at
+    revolution 8 (-9.76 J, 1 % of the largest kinetic energy), at 0.25 mm at revolution 6.4: the drawn and
+    dissipated works were a quadrature over the steps, which missed ~1 J a revolution of the ~1000 J the lasting
+    contact moves in and out of the chain.  The whole 10 revolutions are the test (2 s of CPU): the error was a
+    drift, so only a long run shows it at its size.  Measured now: residual 2.6e-6 (0.1 mm) and 2.3e-6 (0.25 mm)
+    of the largest kinetic energy at the end, the largest over the run the same; with the quadrature put back
+    (build_tree(powers=False)) 8.0e-3 and 1.1e-3.  The bound 2e-5 is test_energy_balance_closes_over_revolutions'.
+
+    Revolutions 2-10's peaks against the reference engine's: measured within 0.22 % (0.1 mm: acceleration 13955
+    against 13924 m/s2, torque -8975 against -8992 N m, contact force 70078 against 69968 N) and 0.09 % (0.25 mm);
+    the peaks of single revolutions scatter by ~3 % about them (the impacts' sequence), so 1 % holds the engines'
+    agreement, not one revolution's draw."""
+    clearance, r = worn_loom_long_run
+    assert r.ok and r.path["model"] == "kinematic_tree", r.message
+    st = r.steps
+    residual = energy_residual(st)
+    assert np.abs(residual).max() < 2e-5 * st["kinetic_energy_J"].max()
+    assert st["dissipated_energy_J"][-1] > 0.0 and np.all(np.diff(st["dissipated_energy_J"]) > -1e-6)
+    late = st["time_s"] >= r.scene.drive.period  # revolutions 2-10
+    expected = WORN_LOOM_REFERENCE_PEAKS[clearance]
+    got = {"rapier_acceleration_m_s2": np.abs(st["rapier_acceleration_m_s2"][late]).max(),
+           "driving_torque_Nm": st["driving_torque_Nm"][late].min(),
+           "contact_force_N": st["contact_force_N"][late].max()}
+    for name, value in got.items():
+        assert value == pytest.approx(expected[name], rel=1e-2), (name, value, expected[name])

@@ -41,7 +41,7 @@ from typing import Callable, TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.input.params import Scene
+from weftsim.input.params import Limits, Scene
 
 if TYPE_CHECKING:
     from weftsim.checks.plausibility import Plausibility
@@ -112,6 +112,29 @@ def non_finite_breach(what: str = "the state became non-finite (NaN or inf)") ->
     )  # fmt: skip
 
 
+# What to try after a step collapse on the reference engine (the default of RunGuard's step_advice): the
+# engines pass their own, naming their own solver keys.
+REFERENCE_STEP_ADVICE = ("another method (solver.reference.method = 'Radau' or 'LSODA' for stiff contact) or a "
+                         "looser solver.reference.rtol / atol")
+
+
+def raised_min_step(scene: Scene) -> str:
+    """``"a smaller limits.min_step_s (...), "`` when the scene raised it above its default, else ``""``: after a
+    step collapse the floor, not the equations, may be what stopped the run."""
+    default = Limits().min_step
+    if scene.limits.min_step <= default:
+        return ""
+    return (f"a smaller limits.min_step_s (it is {scene.limits.min_step:.3g} s, raised from its default "
+            f"{default:.3g} s: the impacts may need shorter steps), ")
+
+
+def step_collapse_hint(scene: Scene, step_advice: str) -> str:
+    """What to try after a step collapse: a raised ``limits.min_step_s`` first, then the engine's own
+    ``step_advice``."""
+    return (f"the equations became too stiff or discontinuous for the step control: try {raised_min_step(scene)}"
+            f"{step_advice}, or check the joint's stiffness and the contact law")
+
+
 class RunGuard:
     """The ``[limits]`` of one run, checked step by step.
 
@@ -121,9 +144,13 @@ class RunGuard:
         Its ``limits`` and journal radius set the bounds.
     clock : callable, optional
         Wall clock in seconds (tests pass a fake one); started here.
+    step_advice : str
+        What the engine that runs suggests after a step collapse, naming its solver keys
+        (:data:`REFERENCE_STEP_ADVICE` for the reference engine).
     """
 
-    def __init__(self, scene: Scene, clock: Callable[[], float] = time.perf_counter):
+    def __init__(self, scene: Scene, clock: Callable[[], float] = time.perf_counter,
+                 step_advice: str = REFERENCE_STEP_ADVICE):
         limits = scene.limits
         self.clock = clock
         self.start = clock()
@@ -136,6 +163,7 @@ class RunGuard:
         # Joint F's bound, against its own journal radius (docs/clearance-f.md).
         self.max_penetration_f = limits.max_penetration * scene.joint_f.journal_radius
         self.min_step = limits.min_step
+        self.step_hint = step_collapse_hint(scene, step_advice)
 
     @property
     def elapsed(self) -> float:
@@ -186,10 +214,8 @@ class RunGuard:
             return Breach(
                 "step_size",
                 f"the step size collapsed to {step_size:.3g} s (below limits.min_step_s = {self.min_step:.3g} s)",
-                "the equations became too stiff or discontinuous for the method: try another method "
-                "(solver.reference.method = 'Radau' or 'LSODA' for stiff contact), a looser tolerance, or check "
-                "the joint's stiffness and the contact law",
-            )  # fmt: skip
+                self.step_hint,
+            )
         if self.max_steps is not None and self.steps > self.max_steps:
             return Breach(
                 "steps",

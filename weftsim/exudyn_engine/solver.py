@@ -35,7 +35,7 @@ from weftsim.exudyn_engine.selection import (  # noqa: F401 (IDEAL_JOINT_STEP_AN
 )
 from weftsim.exudyn_engine.step_control import StepController, failure_reason
 from weftsim.exudyn_engine.sensors import add_sensors, first_nonfinite_row, sample_channels, silence, step_channels
-from weftsim.checks.guards import RunGuard, failure_message, non_finite_breach
+from weftsim.checks.guards import RunGuard, failure_message, non_finite_breach, raised_min_step
 from weftsim.input.params import Scene
 from weftsim.input.scene import IMPACT_VELOCITY_RULES, STEP_CONTROLS
 from weftsim.post.results import RunResult, angle_grid, empty_channels
@@ -143,14 +143,15 @@ def _failed(scene: Scene, message: str, wall: float) -> RunResult:
                      {"wall_time_s": wall}, {"first_contact_time_s": None})  # fmt: skip
 
 
-def _what_to_try(scene: Scene, h: float) -> str:
+def _what_to_try(scene: Scene, h: float, collapsed: bool = False) -> str:
     s = scene.exudyn_solver
+    floor = raised_min_step(scene) if collapsed else ""  # Newton's step reduction stopped at limits.min_step_s
     if adaptive(scene):
-        return (f"try a smaller `solver.exudyn.local_error_m` (now {s.local_error:.3g} m), or "
+        return (f"try {floor}a smaller `solver.exudyn.local_error_m` (now {s.local_error:.3g} m), or "
                 f"`solver.exudyn.step_control` = 'fixed' with a small `solver.exudyn.step_size_s`, a "
                 f"`solver.exudyn.spectral_radius` below {s.spectral_radius} or more "
                 f"`solver.exudyn.newton_max_iterations` (now {s.newton_max_iterations})")  # fmt: skip
-    return (f"try a smaller `solver.exudyn.step_size_s` (now {h:.3g} s), a `solver.exudyn.spectral_radius` below "
+    return (f"try {floor}a smaller `solver.exudyn.step_size_s` (now {h:.3g} s), a `solver.exudyn.spectral_radius` below "
             f"{s.spectral_radius} or more `solver.exudyn.newton_max_iterations` "
             f"(now {s.newton_max_iterations})")  # fmt: skip
 
@@ -315,7 +316,7 @@ def _solve_model(scene: Scene, path_model: str, progress, callback: str | None, 
         status, kind = "failed", breach[0].kind
         message = failure_message("Exudyn engine", t_last, omega, breach[0].what, breach[0].hint)
     elif status == "failed":
-        message = failure_message("Exudyn engine", t_last, omega, message, _what_to_try(scene, h))
+        message = failure_message("Exudyn engine", t_last, omega, message, _what_to_try(scene, h, "step-size collapse" in message))
     elif len(steps["time_s"]) and scene.drive.end_time - steps["time_s"][-1] > 0.5 * h:
         # Fixed steps: a premature stop misses at least one whole step; the time sum itself
         # drifts by ~n_steps * eps * t_end (2.5e-10 s after 10 revolutions), far above 1e-6 h.

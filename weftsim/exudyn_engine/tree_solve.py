@@ -54,7 +54,7 @@ from weftsim.exudyn_engine.selection import (  # noqa: F401 (re-exported: the tr
 from weftsim.exudyn_engine.tape_tree import add_tape, tape_sensors, with_tape
 from weftsim.exudyn_engine.tree_implicit import ImplicitTree
 from weftsim.exudyn_engine.step_control import failure_reason as implicit_failure
-from weftsim.checks.guards import RunGuard, failure_message, non_finite_breach
+from weftsim.checks.guards import RunGuard, failure_message, non_finite_breach, raised_min_step
 from weftsim.input.params import Scene
 from weftsim.model.dynamics import NUMPY, ChainConstants, chain_energy, eccentricity, initial_state
 from weftsim.model.ideal import crank_side_inertia, crank_side_potential
@@ -93,6 +93,16 @@ def check_tree_settings(scene: Scene) -> str | None:
         if not (value > 0.0 and math.isfinite(value)):
             return f"`solver.exudyn.{name}` must be > 0, got {value}"
     return None
+
+
+def step_advice(scene: Scene, implicit: bool) -> str:
+    """What to try after a step collapse of the kinematic tree, naming its own solver keys (the guard's hint)."""
+    if implicit:
+        return (f"a looser solver.exudyn.local_error_m (now {scene.exudyn_solver.local_error:.3g} m) or "
+                "solver.exudyn.tree_solver = 'explicit'")
+    other = next(name for name in EXPLICIT_METHODS if name != scene.exudyn_solver.explicit_method)
+    return (f"a looser solver.exudyn.relative_tolerance / absolute_tolerance, solver.exudyn.explicit_method = "
+            f"{other!r}, or solver.exudyn.tree_solver = 'implicit'")
 
 
 def contact_work(y: np.ndarray, t: np.ndarray, delta: np.ndarray) -> np.ndarray:
@@ -343,7 +353,7 @@ def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, ca
     tape = add_tape(mbs, scene, model.node) if tape_scene else None
     if tape is not None:
         sensors |= tape_sensors(mbs, tape, store)
-    guard = RunGuard(scene)
+    guard = RunGuard(scene, step_advice=step_advice(scene, implicit))
     breach = []
     state = {"t": 0.0, "next_report": _PROGRESS_EVERY, "min_step": math.inf}
 
@@ -409,8 +419,9 @@ def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, ca
             found = non_finite_breach("non-finite values (NaN or inf) in the results (explicit solvers do not stop on NaN)")
             status, message, kind = "failed", found.what, found.kind
     t_last = float(steps["time_s"][-1]) if len(steps["time_s"]) else 0.0
+    floor = raised_min_step(scene) if "step-size collapse" in message else ""  # the step reduction's floor
     if implicit:
-        hint = ("try a smaller `solver.exudyn.local_error_m`, `solver.exudyn.tree_solver` = 'explicit', "
+        hint = (f"try {floor}a smaller `solver.exudyn.local_error_m`, `solver.exudyn.tree_solver` = 'explicit', "
                 "or the reference engine")  # fmt: skip
     else:
         hint = ("try a tighter `solver.exudyn.relative_tolerance`, the 'rigid_body' model, or the reference engine")
