@@ -293,7 +293,7 @@ def test_foreign_directory_is_used_only_with_force_and_its_files_stay(tmp_path):
     out = tmp_path / "thesis"
     out.mkdir()
     (out / "chapter1.tex").write_text("mine")
-    done = cli("run", REFERENCE, "-o", out, "--revolutions", "0.01", "--no-plot", "--force")
+    done = cli_in_process("run", REFERENCE, "-o", out, "--revolutions", "0.01", "--no-plot", "--force", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     assert (out / "chapter1.tex").read_text() == "mine"  # --force writes beside, never deletes others' files
     assert {"channels.csv", "summary.json", "chapter1.tex"} <= {p.name for p in out.iterdir()}
@@ -301,13 +301,13 @@ def test_foreign_directory_is_used_only_with_force_and_its_files_stay(tmp_path):
 
 def test_rerun_replaces_the_previous_run_and_drops_its_stale_files(tmp_path):
     out = tmp_path / "run"
-    first = cli("run", REFERENCE, "-o", out, "--revolutions", "0.01")
+    first = cli_in_process("run", REFERENCE, "-o", out, "--revolutions", "0.01", cwd=tmp_path)
     assert first.returncode == 0, first.stderr
     assert (out / "channels.png").exists()
     # Another scene (0.02 revolutions) into the same directory: refused unless --force (issue 25).
-    refused = cli("run", REFERENCE, "-o", out, "--revolutions", "0.02", "--no-plot")
+    refused = cli_in_process("run", REFERENCE, "-o", out, "--revolutions", "0.02", "--no-plot", cwd=tmp_path)
     assert refused.returncode == 2 and "drive.revolutions 0.01 -> 0.02" in refused.stderr
-    second = cli("run", REFERENCE, "-o", out, "--revolutions", "0.02", "--no-plot", "--force")
+    second = cli_in_process("run", REFERENCE, "-o", out, "--revolutions", "0.02", "--no-plot", "--force", cwd=tmp_path)
     assert second.returncode == 0, second.stderr
     # The figure of the first run would describe other data: it is gone, and the manifest lists
     # exactly this run's files.

@@ -8,7 +8,6 @@ from __future__ import annotations
 import json
 import math
 import subprocess
-import sys
 from dataclasses import replace
 
 import numpy as np
@@ -24,6 +23,16 @@ from weftsim.wear import WearError, check_request
 from weftsim.wear.engines import engine_update, exudyn_update
 from weftsim.wear.extrapolate import worn_scene
 from conftest import door
+
+
+def _weftsim(capsys, *args: str) -> subprocess.CompletedProcess:
+    """``weftsim ARGS`` through weftsim.cli.main in this process (the console script's function): its status, stdout
+    and stderr (no new process: its imports and the compiled kernels' loading are this process's)."""
+    from weftsim.cli.commands import main
+
+    status = main(list(args))
+    captured = capsys.readouterr()
+    return subprocess.CompletedProcess(["weftsim", *args], status, captured.out, captured.err)
 
 
 def _profiles(n: int, c0: float) -> tuple[np.ndarray, np.ndarray]:
@@ -228,7 +237,7 @@ def test_both_engines_agree_on_the_hours_to_a_limit_within_the_chaotic_scatter()
     assert np.all(np.abs(exu - ref.mean()) <= spread), (ref, exu)
 
 
-def test_cli_wear_on_exudyn_writes_its_prediction_and_agrees_on_the_first_update(tmp_path):
+def test_cli_wear_on_exudyn_writes_its_prediction_and_agrees_on_the_first_update(tmp_path, capsys):
     """``weftsim wear --engine exudyn`` runs (its own default directory, the engine in wear.json), and its first
     update (the unworn joint, before any chaos from the wear) agrees with the reference engine's."""
     out = {}
@@ -239,9 +248,8 @@ def test_cli_wear_on_exudyn_writes_its_prediction_and_agrees_on_the_first_update
     # at its default rtol 1e-5 and 0.0911807 at 1e-9
     tighter = {"exudyn": ["--set", "solver.exudyn.relative_tolerance=1e-9"], "reference": []}
     for engine in ("reference", "exudyn"):
-        run = subprocess.run([sys.executable, "-m", "weftsim.cli", "wear", "loom", "--engine", engine, "--hours", "0.3",
-                              "--limit-clearance-mm", "0.0201", "--no-plot", "-o", str(tmp_path / engine),
-                              *tighter[engine]], capture_output=True, text=True)  # fmt: skip
+        run = _weftsim(capsys, "wear", "loom", "--engine", engine, "--hours", "0.3", "--limit-clearance-mm", "0.0201",
+                       "--no-plot", "-o", str(tmp_path / engine), *tighter[engine])  # fmt: skip
         assert run.returncode == 0, run.stderr
         assert f"on the {engine} engine" in run.stderr
         out[engine] = json.loads((tmp_path / engine / "wear.json").read_text())
@@ -276,15 +284,14 @@ def test_a_worn_lubricated_joint_agrees_between_the_engines():
     assert door("reference")(round_scene).steps["film_ratio"].min() < 0.995 * out["reference"][0]
 
 
-def test_cli_wear_to_the_limit_without_hours_ends_exactly_at_it(tmp_path):
+def test_cli_wear_to_the_limit_without_hours_ends_exactly_at_it(tmp_path, capsys):
     """``weftsim wear SCENE --limit-clearance-mm X`` (no --hours) predicts until the effective clearance reaches
     X: the crossing update is cut there, so the final clearance is X and the hours at the limit are the hours
     reached; run again, it resumes and ends at the same point."""
     out = tmp_path / "w"
     runs = []
     for _ in range(2):
-        run = subprocess.run([sys.executable, "-m", "weftsim.cli", "wear", "reference", "--limit-clearance-mm", "0.26",
-                              "--no-plot", "-o", str(out)], capture_output=True, text=True)  # fmt: skip
+        run = _weftsim(capsys, "wear", "reference", "--limit-clearance-mm", "0.26", "--no-plot", "-o", str(out))
         assert run.returncode == 0, run.stderr
         assert "until the clearance reaches 0.26 mm" in run.stderr
         runs.append(json.loads((out / "wear.json").read_text()))
@@ -296,13 +303,11 @@ def test_cli_wear_to_the_limit_without_hours_ends_exactly_at_it(tmp_path):
     assert runs[1]["hours_reached"] == runs[0]["hours_reached"]  # the resume re-simulates the last update
 
 
-def test_a_state_of_one_engine_is_not_resumed_on_the_other(tmp_path):
+def test_a_state_of_one_engine_is_not_resumed_on_the_other(tmp_path, capsys):
     out = tmp_path / "w"
-    first = subprocess.run([sys.executable, "-m", "weftsim.cli", "wear", "reference", "--hours", "0.5", "--no-plot",
-                            "-o", str(out)], capture_output=True, text=True)  # fmt: skip
+    first = _weftsim(capsys, "wear", "reference", "--hours", "0.5", "--no-plot", "-o", str(out))
     assert first.returncode == 0, first.stderr
-    other = subprocess.run([sys.executable, "-m", "weftsim.cli", "wear", "reference", "--hours", "1", "--engine",
-                            "exudyn", "--no-plot", "-o", str(out)], capture_output=True, text=True)  # fmt: skip
+    other = _weftsim(capsys, "wear", "reference", "--hours", "1", "--engine", "exudyn", "--no-plot", "-o", str(out))
     assert other.returncode == 2 and "on the reference engine" in other.stderr and "--engine reference" in other.stderr
     assert len(other.stderr.strip().splitlines()) == 1 and "Traceback" not in other.stderr
 
