@@ -27,7 +27,7 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from weftsim.bench.measure import LOOM_CASES, Setting, _ref, _rigid, converged_solution, measure
+from weftsim.bench.measure import LOOM_CASES, OILED_CASES, Setting, _ref, _rigid, converged_solution, measure
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -162,6 +162,34 @@ def loom_friction_items(models: str | Path, repeats: int, log: Callable[[str], N
     return items
 
 
+OILED_RATIO_AT_MOST = 3.0  # issue 36: the oiled loom on Exudyn at most 3x the reference engine's time
+
+
+def loom_oiled_items(models: str | Path, repeats: int, log: Callable[[str], None] = print) -> dict:
+    """Issue 36: the oiled loom (one revolution) on both engines' default paths, Exudyn's time against the
+    reference engine's; the peaks of each against the reference engine's converged run (RODAS4 rtol 1e-10)."""
+    items = {}
+    for case in OILED_CASES:
+        ref = converged_solution(case, models, LOOM_FRICTION_REVOLUTIONS, log)
+        rows = {engine: measure(case, Setting(engine, engine, "default", {}), ref, models, LOOM_FRICTION_REVOLUTIONS,
+                                repeats, 8.0, 1.0) for engine in ("reference", "exudyn")}  # fmt: skip
+        for engine, row in rows.items():
+            items[f"{engine} default, {case}"] = row
+        fast, slow = rows["reference"], rows["exudyn"]
+        ratio = fast["realtime_ratio"] / slow["realtime_ratio"]
+        cpu = fast["realtime_ratio_cpu"] / slow["realtime_ratio_cpu"]
+        peak = (slow.get("errors") or {}).get("peak_max")
+        ok = fast["status"] == slow["status"] == "success"
+        items[f"exudyn / reference, default, {case}"] = {
+            "status": "success" if ok else "failed", "ratio": ratio, "cpu_ratio": cpu, "peak_error": peak,
+            "steps": [fast["steps"], slow["steps"]],
+            "met": ok and ratio <= OILED_RATIO_AT_MOST and peak is not None and peak <= LOOM_PEAK_TARGET,
+            "target_text": f"<= {OILED_RATIO_AT_MOST:g}x, peaks within {LOOM_PEAK_TARGET:.1%}"}
+        log(f"  exudyn / reference, {case}: {ratio:.2f}x wall, {cpu:.2f}x CPU, steps {fast['steps']} / "
+            f"{slow['steps']}, peak error {peak}")
+    return items
+
+
 def _ratio_item(case: str, overrides: dict, refs: dict, dry: dict, models, repeats: int) -> dict:
     """The lubricated run's time against the dry one's; its errors are against the dry solution (a film changes
     the peaks), so only the ratio is judged here; its accuracy needs a converged lubricated ensemble."""
@@ -199,6 +227,7 @@ def run_targets(models: str | Path = "models", repeats: int = 5, jobs: int = 2, 
             f"{(row['errors'] or {}).get('peak_max')}, stats err {(row['errors'] or {}).get('stats_max')}")
     report["items"].update(stiff_items(models, repeats, log))
     report["items"].update(loom_friction_items(models, repeats, log))
+    report["items"].update(loom_oiled_items(models, repeats, log))
     with tempfile.TemporaryDirectory(prefix="weftsim-targets-") as tmp:
         for engine in ("reference", "exudyn"):
             name = f"weftsim run {engine}, new process, 2 rev"
