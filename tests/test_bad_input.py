@@ -124,6 +124,8 @@ SCENES = [
      ["rapier_tape.length_mm", "at least free_length_mm + the stroke"]),
     ("tape-unknown-model", EXTENDS + '[rapier_tape]\nmodel = "elastic"\n', ["rapier_tape.model", "'elastic'", "'flexible'"]),
     ("tape-modes-not-whole", EXTENDS + "[rapier_tape]\nmodes = 4.5\n", ["rapier_tape.modes", "whole number"]),
+    ("exchange-ideal-taker-of-a-tape", EXTENDS + '[rapier_tape]\nmodel = "flexible"\n[exchange]\ntaker_clearance_mm = 0\n',
+     ["exchange.taker_clearance_mm", "ideal joints", "needs a clearance at E"]),
     ("duty-day-longer-than-24-h", EXTENDS + "[duty]\nhours_per_day = 25\n", ["duty.hours_per_day", "25", "<= 24"]),
     ("duty-negative-stops", EXTENDS + "[duty]\nstops_per_hour = -2\n", ["duty.stops_per_hour", "-2", ">= 0"]),
     ("unknown-method", EXTENDS + '[solver.reference]\nmethod = "Euler"\n', ["solver.reference.method", "'Euler'"]),

@@ -9,8 +9,6 @@ keys are refused in one line; absent or off, nothing changes.
 from __future__ import annotations
 
 import math
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -93,7 +91,8 @@ def test_a_worn_giver_errs_as_its_journals_eccentricity_moves_the_head(worn):
     predicted = _head_from_eccentricity(worn.scene, theta, steps["eccentricity_y_m"], steps["eccentricity_z_m"]) - s_i
     assert np.max(np.abs(steps["giver_head_error_m"] - predicted)) < 1e-9
     (first,) = summary(worn)["exchange"]["transfers"]
-    # Nonzero, beyond the clearance itself (the sector arm's lever: d5 d7 / (d6 L_FG) = 12.4 m per m at F), and
+    # Nonzero, beyond the clearance itself (measured 5.8 mm of head per mm of clearance: the gear train's
+    # d5 d7 / (d6 L_FG) = 4.9 and the rod's transmission angle), and
     # the head runs further into the shed (the decelerating rapier pulls the journal to the bearing's far side).
     assert first["giver_error_at_dead_centre_m"] > 0.25e-3
     assert first["taker_error_min_m"] == first["taker_error_max_m"] == 0.0
@@ -166,19 +165,12 @@ def test_an_exchange_result_file_reads_back(worn, tmp_path):
     ({"exchange.window_deg": 400.0}, "'exchange.window_deg' must be > 0 and <= 360"),
     ({"exchange.enabled": "yes"}, "'exchange.enabled' must be true or false"),
     ({"exchange.taker": 1.0}, "unknown key 'exchange.taker'"),
+    ({"exchange.taker_clearance_mm": 0.0, "rapier_tape.model": "flexible"}, "the flexible rapier tape cannot run"),
 ])
 def test_bad_exchange_keys_are_one_line(keys, words):
     with pytest.raises(SceneError) as caught:
         load_scene("loom", keys)
     assert words in str(caught.value) and "\n" not in str(caught.value)
-
-
-def test_an_ideal_taker_of_a_flexible_tape_is_refused_by_the_command_line():
-    done = subprocess.run([sys.executable, "-m", "weftsim", "run", "loom_tape", "--engine", "reference",
-                           "--set", "exchange.taker_clearance_mm=0", "-o", "unused"], capture_output=True, text=True)
-    assert done.returncode == 2 and done.stdout == ""
-    lines = done.stderr.strip().splitlines()
-    assert len(lines) == 1 and "exchange.taker_clearance_mm" in lines[0] and "Traceback" not in done.stderr
 
 
 def test_the_exchange_study_runs_its_cells_on_the_sweep(tmp_path, monkeypatch):

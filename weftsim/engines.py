@@ -267,6 +267,11 @@ def simulate(scene: Scene | str | os.PathLike, engine: str = "auto", *,
         raise ArgumentError(f"simulate: progress must be None or a function called with the completed fraction "
                             f"(e.g. lambda f: print(f)), got {type(progress).__name__} {progress!r:.40}")
     scene = _as_scene(scene)
+    from weftsim.model.exchange import exchange_of, exchange_problem, taker_source
+
+    problem = exchange_problem(scene)  # e.g. an ideal taker of a tape that rapier_tape.model = 'auto' runs flexible
+    if problem:
+        raise SceneError(f"scene {scene.name}: {problem}")
     if engine == AUTO:  # a flexible rapier tape runs on the reference engine (resolve)
         chosen = get(resolve(engine, scene))
     if any(getattr(scene, attr).lubrication is not None and getattr(scene, attr).lubrication.has_oil
@@ -279,8 +284,6 @@ def simulate(scene: Scene | str | os.PathLike, engine: str = "auto", *,
             warnings.warn(text, PlausibilityWarning, stacklevel=2)
         else:
             on_warning(text)
-    from weftsim.model.exchange import exchange_of, taker_source
-
     second = exchange_of(scene) is not None and taker_source(scene) == "run"  # the taker's own run
     # The engine's pure solve, then the post-run criteria (energy balance, ...) that no single step shows,
     # once, for every engine.

@@ -617,6 +617,28 @@ class Exchange:
     window: float | None = None
 
 
+def exchange_problem(scene: Scene, stroke: float, flexible_tape: bool) -> str:
+    """Why the scene's ``[exchange]`` cannot be computed ('' when it can, or when it is absent or off): one line
+    naming the key.  ``stroke``: the ideal head's deepest position, m; ``flexible_tape``: the scene's tape runs
+    flexible (the scene reader passes its explicit ``rapier_tape.model``, :func:`weftsim.model.exchange.
+    exchange_problem` the automatic choice too)."""
+    exchange = scene.exchange
+    if exchange is None or not exchange.enabled:
+        return ""
+    c = scene.joint.clearance if exchange.taker_clearance is None else exchange.taker_clearance
+    if c >= scene.joint.journal_radius:
+        return (f"key 'exchange.taker_clearance_mm' must be smaller than the journal radius "
+                f"{scene.joint.journal_radius * 1e3:g} mm, got {c * 1e3:g}")
+    if exchange.overlap >= 2.0 * stroke:
+        return (f"key 'exchange.overlap_mm' must be smaller than twice the stroke, {2e3 * stroke:.1f} mm (the heads "
+                f"start apart), got {exchange.overlap * 1e3:g}")
+    if c == 0.0 and flexible_tape:
+        return ("key 'exchange.taker_clearance_mm' = 0 gives the taker ideal joints, which the flexible rapier tape "
+                "cannot run (it needs a clearance at E): give the taker a clearance > 0, or set rapier_tape.model = "
+                "'rigid'")
+    return ""
+
+
 @dataclass(frozen=True)
 class Drive:
     """Crank speed and run length; the drive law of a stop-start's transient (:func:`weftsim.physics.chain.crank_motion`).

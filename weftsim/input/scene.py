@@ -418,9 +418,11 @@ def _check_scene(scene: params.Scene, where: str, origin: dict[str, Path]) -> No
             "and rocker_arm_angle_deg)"
         )
     if scene.exchange is not None:
-        from weftsim.model.exchange import exchange_problem
+        from weftsim.mechanism.kinematics import linkage_state
 
-        problem = exchange_problem(scene)
+        explicit = scene.rapier_tape is not None and scene.rapier_tape.model == "flexible"  # "auto": at the run
+        problem = params.exchange_problem(scene, float(linkage_state(math.pi, scene.geometry).rapier_displacement),
+                                          explicit)
         if problem:
             key = problem.split("'")[1]
             raise SceneError(f"{at(key)}: {problem}")

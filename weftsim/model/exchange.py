@@ -86,23 +86,14 @@ def taker_source(scene: Scene) -> str:
 
 
 def exchange_problem(scene: Scene) -> str:
-    """Why the scene's exchange cannot be computed ('' when it can): one line naming the key."""
-    exchange = exchange_of(scene)
-    if exchange is None:
+    """Why the scene's exchange cannot be computed ('' when it can): one line naming the key
+    (:func:`weftsim.input.params.exchange_problem`, with the tape's automatic choice of model)."""
+    from weftsim.input.params import exchange_problem as problem
+
+    if exchange_of(scene) is None:
         return ""
-    c = taker_clearance(scene)
-    if c >= scene.joint.journal_radius:
-        return (f"key 'exchange.taker_clearance_mm' must be smaller than the journal radius "
-                f"{scene.joint.journal_radius * 1e3:g} mm, got {c * 1e3:g}")
-    reach = 2.0 * ideal_displacement(scene, DEAD_CENTRE)
-    if exchange.overlap >= reach:
-        return (f"key 'exchange.overlap_mm' must be smaller than twice the stroke, {reach * 1e3:.1f} mm (the heads "
-                f"start apart), got {exchange.overlap * 1e3:g}")
-    if c == 0.0 and taker_source(scene) == "run" and _flexible(taker_scene(scene)):
-        return ("key 'exchange.taker_clearance_mm' = 0 gives the taker ideal joints, which the flexible rapier tape "
-                "cannot run (it needs a clearance at E): give the taker a clearance > 0, or set rapier_tape.model = "
-                "'rigid'")
-    return ""
+    stroke = float(ideal_displacement(scene, DEAD_CENTRE))
+    return problem(scene, stroke, _flexible(scene))
 
 
 def ideal_displacement(scene: Scene, theta) -> np.ndarray:

@@ -8,7 +8,7 @@ name             what                                                           
 ``speed``        300, 500, 800 rpm at c = 0.25 mm; amplitude ratios; spectrum           Fig. 13
 ``engines``      reference vs exudyn, c = 0.50 mm at 400 rpm                            Fig. 16
 ``regime``       lubricated E: min film ratio, peak force over speed x clearance x oil  -
-``exchange``     weft exchange: overlap, relative speed, head errors over clearance x speed  -
+``exchange``     weft exchange: overlap, speed, head errors over clearance x speed      -
 ===============  =====================================================================  ========
 
 Each writes into its output directory PNG figures named ``study-*.png``, CSV files of
