@@ -233,6 +233,22 @@ def _table_cells(eps: float, xi: float, width: float):
     return factor / table_scale(eps, w), sign, iw, iu, ix, _catmull_rom(tw), _catmull_rom(tu), _catmull_rom(tx)
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _tricubic(table, iw: int, iu: int, ix: int, ww, wu, wx):
+    """Both components of the 4 x 4 x 4 Catmull-Rom sum of ``table`` (B/D x u x xi x 2, padded) from node
+    (iw, iu, ix) on."""
+    g0 = 0.0
+    g1 = 0.0
+    for a in range(4):
+        for b in range(4):
+            wab = ww[a] * wu[b]
+            for d in range(4):
+                weight = wab * wx[d]
+                g0 += weight * table[iw + a, iu + b, ix + d, 0]
+                g1 += weight * table[iw + a, iu + b, ix + d, 1]
+    return g0, g1
+
+
 @njit(cache=True, error_model="numpy")
 def finite_force(eps: float, xi: float, width: float):
     """Dimensionless film force (f_along_e, f_ahead) of the finite bearing, smooth surfaces: the table's s = 0
@@ -243,15 +259,7 @@ def finite_force(eps: float, xi: float, width: float):
     bearing's (B/D)^3, above B/D = 4 as the long bearing's B/D.
     """
     scale, sign, iw, iu, ix, ww, wu, wx = _table_cells(eps, xi, width)
-    g0 = 0.0
-    g1 = 0.0
-    for a in range(4):
-        for b in range(4):
-            wab = ww[a] * wu[b]
-            for d in range(4):
-                weight = wab * wx[d]
-                g0 += weight * FINITE_TABLE[iw + a, iu + b, ix + d, 0]
-                g1 += weight * FINITE_TABLE[iw + a, iu + b, ix + d, 1]
+    g0, g1 = _tricubic(FINITE_TABLE, iw, iu, ix, ww, wu, wx)
     return g0 * scale, sign * g1 * scale
 
 
@@ -282,14 +290,9 @@ def rough_finite_force(eps: float, xi: float, width: float, roughness: float):
     g0 = 0.0
     g1 = 0.0
     for m in range(4):
-        for a in range(4):
-            wma = wr[m] * ww[a]
-            for b in range(4):
-                wab = wma * wu[b]
-                for d in range(4):
-                    weight = wab * wx[d]
-                    g0 += weight * ROUGH_TABLE[ir + m, iw + a, iu + b, ix + d, 0]
-                    g1 += weight * ROUGH_TABLE[ir + m, iw + a, iu + b, ix + d, 1]
+        h0, h1 = _tricubic(ROUGH_TABLE[ir + m], iw, iu, ix, ww, wu, wx)
+        g0 += wr[m] * h0
+        g1 += wr[m] * h1
     return f_along + g0 * scale, f_ahead + sign * g1 * scale
 
 
