@@ -73,6 +73,8 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
+from weftsim.physics.flow_factors import couette_factor_at
+
 MODEL_FINITE, MODEL_SHORT, MODEL_LONG, MODEL_SHORT_HALF = 0, 1, 2, 3
 # MODEL_SHORT_HALF: width in sin(xi) of the blend between the two half films (short_half_force).
 SHORT_HALF_BAND = 0.1
@@ -92,10 +94,13 @@ LOG_WIDTH_STEP = math.log(WIDTH_MAX / WIDTH_MIN) / (N_WIDTH - 1)
 # film is thick (nodes at h_min / sigma = inf, 2.73, 1.49, 0.76, 0.25).
 N_R, ROUGH_DECAY, RATIO_MIN = 5, 0.56, 0.25
 S_MAX = math.exp(-ROUGH_DECAY * RATIO_MIN)
+# Nodes of the rough film's Couette factor (the mean of phi_f over Sommerfeld's angle, trapezoid rule): against
+# 4096 nodes 4e-6 at h_min = sigma (c = 50 sigma), 1.5e-4 at h_min = sigma / 4 (32 nodes: 2e-3).
+COUETTE_POINTS = 64
 # First 16 hex digits of the SHA-256 of the stored table (scripts/make_film_table.py writes this
 # line).  numba freezes the table into the compiled code and keys its cache by this file, so a new
 # table must change this file; a table that does not match is not used (NaN forces).
-TABLE_DIGEST = "724a82af844b3486"
+TABLE_DIGEST = "83a888962a89feaf"
 
 
 def table_eccentricities() -> np.ndarray:
@@ -139,26 +144,36 @@ def table_digest(table: np.ndarray) -> str:
     return hashlib.sha256(np.ascontiguousarray(table, dtype=np.float64).tobytes()).hexdigest()[:16]
 
 
+def stored_table() -> np.ndarray | None:
+    """The stored table (s x B/D x eps x xi x 2, float64), or None if it is missing or is not the one of
+    ``TABLE_DIGEST`` (while scripts/make_film_table.py builds it)."""
+    path = Path(__file__).with_name("film_table.npz")
+    if not path.exists():
+        return None
+    with np.load(path) as data:
+        core = np.asarray(data["force"], dtype=np.float64)
+    if core.shape != (N_R, N_WIDTH, N_U, N_XI, 2) or table_digest(core) != TABLE_DIGEST:
+        return None
+    return core
+
+
 def _padded_table() -> np.ndarray:
     """The stored table with one ghost node on each side of each axis (Catmull-Rom needs four nodes).
 
     xi: mirror images (the component along e is even in xi about 0 and pi, the one ahead odd);
-    eps and B/D: linear extrapolation.  NaN if the stored table is missing or is not the one of
-    ``TABLE_DIGEST`` (while scripts/make_film_table.py builds it).
+    s, eps and B/D: linear extrapolation.  NaN if there is no table of ``TABLE_DIGEST``.
     """
-    path = Path(__file__).with_name("film_table.npz")
-    shape = (N_WIDTH, N_U, N_XI, 2)
-    if not path.exists():
-        return np.full((N_WIDTH + 2, N_U + 2, N_XI + 2, 2), np.nan)
-    with np.load(path) as data:
-        core = np.asarray(data["force"], dtype=np.float64)
-    if core.shape != shape or table_digest(core) != TABLE_DIGEST:
-        return np.full((N_WIDTH + 2, N_U + 2, N_XI + 2, 2), np.nan)
-    out = np.empty((N_WIDTH + 2, N_U + 2, N_XI + 2, 2))
-    out[1:-1, 1:-1, 1:-1] = core
+    core = stored_table()
+    padded = (N_R + 2, N_WIDTH + 2, N_U + 2, N_XI + 2, 2)
+    if core is None:
+        return np.full(padded, np.nan)
+    out = np.empty(padded)
+    out[1:-1, 1:-1, 1:-1, 1:-1] = core
     mirror = np.array([1.0, -1.0])
-    out[1:-1, 1:-1, 0] = core[:, :, 1] * mirror
-    out[1:-1, 1:-1, -1] = core[:, :, -2] * mirror
+    out[1:-1, 1:-1, 1:-1, 0] = core[:, :, :, 1] * mirror
+    out[1:-1, 1:-1, 1:-1, -1] = core[:, :, :, -2] * mirror
+    out[1:-1, 1:-1, 0] = 2.0 * out[1:-1, 1:-1, 1] - out[1:-1, 1:-1, 2]
+    out[1:-1, 1:-1, -1] = 2.0 * out[1:-1, 1:-1, -2] - out[1:-1, 1:-1, -3]
     out[1:-1, 0] = 2.0 * out[1:-1, 1] - out[1:-1, 2]
     out[1:-1, -1] = 2.0 * out[1:-1, -2] - out[1:-1, -3]
     out[0] = 2.0 * out[1] - out[2]
@@ -166,7 +181,13 @@ def _padded_table() -> np.ndarray:
     return out
 
 
-FINITE_TABLE = _padded_table()
+# numba freezes global arrays into the compiled code and caches it only for arrays under 1e6 bytes: the smooth
+# slice (padded, float64: the smooth film exactly as tabulated) and the rough slices as their difference from it in
+# float32 (973 kB; rounding 6e-8 of the roughness's share, far below the interpolation error; exactly 0 at s = 0).
+_PADDED = _padded_table()
+FINITE_TABLE = np.ascontiguousarray(_PADDED[1])
+ROUGH_TABLE = np.ascontiguousarray(_PADDED - _PADDED[1]).astype(np.float32)
+del _PADDED
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -189,14 +210,9 @@ def _cell(x: float, n: int):
     return i, x - i
 
 
-@njit(cache=True, error_model="numpy")
-def finite_force(eps: float, xi: float, width: float):
-    """Dimensionless film force (f_along_e, f_ahead) of the finite bearing: the table, tricubic.
-
-    Catmull-Rom in u = 1 - sqrt(1 - eps), in xi and in log(B/D).  Past eps = 0.99 the scaled force
-    of eps = 0.99 is kept (f grows as (1 - eps^2)^-1.5); below B/D = 1/4 the force scales as the short
-    bearing's (B/D)^3, above B/D = 4 as the long bearing's B/D.
-    """
+@njit(cache=True, error_model="numpy", inline="always")
+def _table_cells(eps: float, xi: float, width: float):
+    """(factor, sign, (iw, iu, ix), Catmull-Rom weights in B/D, u and xi) of the table's point (eps, xi, B/D)."""
     factor = 1.0
     w = width
     if w < WIDTH_MIN:
@@ -214,9 +230,13 @@ def finite_force(eps: float, xi: float, width: float):
     iu, tu = _cell(u / U_MAX * (N_U - 1), N_U)
     ix, tx = _cell(x / math.pi * (N_XI - 1), N_XI)
     iw, tw = _cell(math.log(w / WIDTH_MIN) / LOG_WIDTH_STEP, N_WIDTH)
-    wu = _catmull_rom(tu)
-    wx = _catmull_rom(tx)
-    ww = _catmull_rom(tw)
+    return factor / table_scale(eps, w), sign, iw, iu, ix, _catmull_rom(tw), _catmull_rom(tu), _catmull_rom(tx)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _tricubic(table, iw: int, iu: int, ix: int, ww, wu, wx):
+    """Both components of the 4 x 4 x 4 Catmull-Rom sum of ``table`` (B/D x u x xi x 2, padded) from node
+    (iw, iu, ix) on."""
     g0 = 0.0
     g1 = 0.0
     for a in range(4):
@@ -224,10 +244,56 @@ def finite_force(eps: float, xi: float, width: float):
             wab = ww[a] * wu[b]
             for d in range(4):
                 weight = wab * wx[d]
-                g0 += weight * FINITE_TABLE[iw + a, iu + b, ix + d, 0]
-                g1 += weight * FINITE_TABLE[iw + a, iu + b, ix + d, 1]
-    scale = factor / table_scale(eps, w)
+                g0 += weight * table[iw + a, iu + b, ix + d, 0]
+                g1 += weight * table[iw + a, iu + b, ix + d, 1]
+    return g0, g1
+
+
+@njit(cache=True, error_model="numpy")
+def finite_force(eps: float, xi: float, width: float):
+    """Dimensionless film force (f_along_e, f_ahead) of the finite bearing, smooth surfaces: the table's s = 0
+    slice, tricubic.
+
+    Catmull-Rom in u = 1 - sqrt(1 - eps), in xi and in log(B/D).  Past eps = 0.99 the scaled force
+    of eps = 0.99 is kept (f grows as (1 - eps^2)^-1.5); below B/D = 1/4 the force scales as the short
+    bearing's (B/D)^3, above B/D = 4 as the long bearing's B/D.
+    """
+    scale, sign, iw, iu, ix, ww, wu, wx = _table_cells(eps, xi, width)
+    g0, g1 = _tricubic(FINITE_TABLE, iw, iu, ix, ww, wu, wx)
     return g0 * scale, sign * g1 * scale
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def roughness_coordinate(eps: float, roughness: float) -> float:
+    """s = exp(-0.56 h_min / sigma) of the film at eccentricity ratio eps, ``roughness`` = sigma / c (0: smooth)."""
+    if roughness <= 0.0:
+        return 0.0
+    return math.exp(-ROUGH_DECAY * (1.0 - eps) / roughness)
+
+
+@njit(cache=True, error_model="numpy")
+def rough_finite_force(eps: float, xi: float, width: float, roughness: float):
+    """Dimensionless film force (f_along_e, f_ahead) of the finite bearing between rough surfaces (Patir and
+    Cheng's average flow), ``roughness`` = sigma / c: the smooth film plus the rough slices' difference from it,
+    Catmull-Rom in s as well.
+
+    s = 0 (smooth surfaces, or a film so thick that s underflows) is :func:`finite_force` exactly.  Beyond
+    s = S_MAX (h_min < sigma / 4, below the film floor's least value) the flow factors of sigma / 4 are kept.
+    """
+    s = roughness_coordinate(eps, roughness)
+    f_along, f_ahead = finite_force(eps, xi, width)
+    if s <= 0.0:
+        return f_along, f_ahead
+    scale, sign, iw, iu, ix, ww, wu, wx = _table_cells(eps, xi, width)
+    ir, tr = _cell(s / S_MAX * (N_R - 1), N_R)
+    wr = _catmull_rom(tr)
+    g0 = 0.0
+    g1 = 0.0
+    for m in range(4):
+        h0, h1 = _tricubic(ROUGH_TABLE[ir + m], iw, iu, ix, ww, wu, wx)
+        g0 += wr[m] * h0
+        g1 += wr[m] * h1
+    return f_along + g0 * scale, f_ahead + sign * g1 * scale
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -433,7 +499,7 @@ def long_force(eps: float, xi: float, half_width: float):
 @njit(cache=True, error_model="numpy")
 def film_force(ey: float, ez: float, vy: float, vz: float, omega_j: float, omega_b: float, c: float,
                radius: float, length: float, viscosity: float, model: int):
-    """Film force on the journal and film friction torques: (fy, fz, torque_j, torque_b).
+    """Film force on the journal and film friction torques between smooth surfaces: (fy, fz, torque_j, torque_b).
 
     Parameters
     ----------
@@ -457,6 +523,19 @@ def film_force(ey: float, ez: float, vy: float, vz: float, omega_j: float, omega
     torque_j, torque_b : float
         Film friction torques about +x on journal and bearing, N m.
     """
+    return rough_film_force(ey, ez, vy, vz, omega_j, omega_b, c, radius, length, viscosity, model, 0.0)
+
+
+@njit(cache=True, error_model="numpy")
+def rough_film_force(ey: float, ez: float, vy: float, vz: float, omega_j: float, omega_b: float, c: float,
+                     radius: float, length: float, viscosity: float, model: int, roughness: float):
+    """:func:`film_force` between rough surfaces of combined RMS roughness ``roughness`` (sigma, m; 0: smooth).
+
+    ``MODEL_FINITE``: Patir and Cheng's average-flow film (:func:`rough_finite_force`) and their shear factor on
+    the Couette torque (:func:`weftsim.physics.flow_factors.couette_factor_at`, COUETTE_POINTS nodes); the
+    pressure-gradient torque -(e x F)_x / 2 keeps its smooth form.  The other models stay smooth.  sigma = 0
+    is the smooth film bit for bit.
+    """
     omega_m = 0.5 * (omega_j + omega_b)
     # Booker's squeeze velocity V = e_dot - omega_m x e  (x e = (-ez, ey)).
     sy = vy + omega_m * ez
@@ -464,6 +543,7 @@ def film_force(ey: float, ez: float, vy: float, vz: float, omega_j: float, omega
     e = math.sqrt(ey * ey + ez * ez)
     speed = math.sqrt(sy * sy + sz * sz)
     eps = e / c
+    rough = model == MODEL_FINITE and roughness > 0.0
     fy = 0.0
     fz = 0.0
     if speed > 0.0 and viscosity > 0.0:
@@ -475,7 +555,9 @@ def film_force(ey: float, ez: float, vy: float, vz: float, omega_j: float, omega
             nz = sz / speed
         xi = math.atan2(ny * sz - nz * sy, ny * sy + nz * sz)
         half_width = 0.5 * length / radius
-        if model == MODEL_FINITE:
+        if rough:
+            f_along, f_ahead = rough_finite_force(eps, xi, half_width, roughness / c)
+        elif model == MODEL_FINITE:
             f_along, f_ahead = finite_force(eps, xi, half_width)
         elif model == MODEL_LONG:
             f_along, f_ahead = long_force(eps, xi, half_width)
@@ -488,5 +570,7 @@ def film_force(ey: float, ez: float, vy: float, vz: float, omega_j: float, omega
         fy = scale * (f_along * ny - f_ahead * nz)
         fz = scale * (f_along * nz + f_ahead * ny)
     couette = viscosity * radius ** 3 * length * (omega_b - omega_j) * TWO_PI / (c * math.sqrt(1.0 - eps * eps))
+    if rough:
+        couette *= couette_factor_at(eps, roughness / c, COUETTE_POINTS)
     pressure = -0.5 * (ey * fz - ez * fy)
     return fy, fz, couette + pressure, -couette + pressure

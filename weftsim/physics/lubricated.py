@@ -3,7 +3,7 @@
 A lubricated joint (``joint.lubrication``, the block of :mod:`.joint` from ``LUBRICATED`` on) is loaded
 at every eccentricity, in contact or not::
 
-    f_journal = f_film(e*, e_dot*, omega_j, omega_b)        oil film, :func:`weftsim.physics.film.film_force`
+    f_journal = f_film(e*, e_dot*, omega_j, omega_b)        oil film, :func:`weftsim.physics.film.rough_film_force`
               - F_a(|e|) n + F_Ta t                         asperities (Greenwood-Tripp, :mod:`.asperity`)
                                                             and boundary friction on their load
               + f_dry                                       the dry law beyond |e| = c (:mod:`.joint`)
@@ -40,7 +40,7 @@ import math
 from numba import njit
 
 from weftsim.physics.asperity import asperity_load
-from weftsim.physics.film import film_force
+from weftsim.physics.film import rough_film_force
 from weftsim.physics.joint import (
     ASPERITY_COEF, ASPERITY_HYSTERESIS, BEARING_LENGTH, BEARING_RADIUS, BOUNDARY_MU, CLEARANCE, COEF, FILM_FLOOR,
     FILM_MODEL, JOURNAL_RADIUS, KIND, LUBRICATED, ROUGHNESS, V0, V1, V_MIN, VISCOSITY, connector_friction_force_at,
@@ -75,8 +75,8 @@ def film_at_floor(prm, clearance: float, ex: float, ey: float, vx: float, vy: fl
         tx, ty = vx - radial * nx, vy - radial * ny
         ex, ey = cap * nx, cap * ny
         vx, vy = radial * nx + scale * tx, radial * ny + scale * ty
-    return film_force(ex, ey, vx, vy, w_j, w_b, clearance, prm[JOURNAL_RADIUS], prm[BEARING_LENGTH], viscosity,
-                      int(prm[FILM_MODEL]))  # fmt: skip
+    return rough_film_force(ex, ey, vx, vy, w_j, w_b, clearance, prm[JOURNAL_RADIUS], prm[BEARING_LENGTH], viscosity,
+                            int(prm[FILM_MODEL]), prm[ROUGHNESS])  # fmt: skip
 
 
 HANDOVER_TOL = 1e-13  # relative: the penetration at which the dry law's elastic force reaches F_a(c)

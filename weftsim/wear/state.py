@@ -58,7 +58,8 @@ def scene_identity(scene: Scene) -> str:
     An ideal joint F's ``[joint_f.wear]`` keys are left out: they change nothing, and a state written before F
     could wear (which did not know them) stays the same scene's; so are the oil's and its heat balance's keys of a
     joint that names no oil (a fixed viscosity or a dry joint), for a state written before they existed.  So are the
-    ``[rapier_tape]`` keys of a scene without a tape (all unset), for a state written before the tape existed, and
+    ``[rapier_tape]`` keys of a scene without a tape and the ``[exchange]`` keys of a scene without an exchange (all
+    unset), for a state written before the tape or the exchange existed, and
     an unset ``bushing_wall_mm`` (the cylindrical law's, which refuses a joint without it), for a state written
     before that key existed.
     """
@@ -84,8 +85,9 @@ def scene_identity(scene: Scene) -> str:
     for table, joint in (("joint_e", scene.joint), ("joint_f", scene.joint_f)):
         if joint.lubrication is None or not joint.lubrication.has_oil:  # the oil's keys change nothing without one
             keys = {k: v for k, v in keys.items() if k not in {f"{table}.lubrication.{name}" for name in HEAT_KEYS}}
-    if scene.rapier_tape is None:
-        keys = {k: v for k, v in keys.items() if not k.startswith("rapier_tape.")}
+    for attribute in ("rapier_tape", "exchange"):  # no tape / no exchange: their keys (all unset) change nothing
+        if getattr(scene, attribute) is None:
+            keys = {k: v for k, v in keys.items() if not k.startswith(attribute + ".")}
     for table in ("joint_e", "joint_f"):  # unset (None): only the cylindrical law reads it, and it refuses None
         if keys.get(f"{table}.bushing_wall_mm", 0.0) is None:
             keys.pop(f"{table}.bushing_wall_mm")
