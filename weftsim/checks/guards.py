@@ -171,7 +171,7 @@ class RunGuard:
         return self.clock() - self.start
 
     def check(self, penetration: float | None = None, step_size: float | None = None, steps: int = 1,
-              finite: bool = True, penetration_f: float | None = None) -> Breach | None:
+              finite: bool = True, penetration_f: float | None = None, floor_fails: bool = False) -> Breach | None:
         """Count ``steps`` accepted steps and check every criterion.
 
         Parameters
@@ -188,6 +188,10 @@ class RunGuard:
             False if the engine found a NaN or inf in the state.
         penetration_f : float, optional
             The same at joint F; None while F is ideal.
+        floor_fails : bool
+            True for a solver that accepts a step at its floor without meeting its tolerance (Exudyn's
+            explicit solvers print "reached minStepSize; integration continued" and go on at the floor,
+            never below it): a step at limits.min_step_s is then a breach too.
 
         Returns
         -------
@@ -214,6 +218,13 @@ class RunGuard:
             return Breach(
                 "step_size",
                 f"the step size collapsed to {step_size:.3g} s (below limits.min_step_s = {self.min_step:.3g} s)",
+                self.step_hint,
+            )
+        if floor_fails and step_size is not None and step_size <= self.min_step * (1.0 + 1e-9):
+            return Breach(
+                "step_size",
+                f"the error tolerance cannot be met with steps of limits.min_step_s = {self.min_step:.3g} s "
+                "(the solver reached its minimum step)",
                 self.step_hint,
             )
         if self.max_steps is not None and self.steps > self.max_steps:
