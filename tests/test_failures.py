@@ -281,6 +281,10 @@ def test_exudyn_tree_fails_at_its_step_floor_as_the_reference_engine_does():
     assert 0.0 < r.steps["time_s"][-1] < s.drive.end_time
     # A floor below the steps the impact takes (2.8e-6 s at the smallest) runs as at the default.
     assert door("exudyn")(dataclasses.replace(s, limits=Limits(min_step=1e-8))).ok
+    # The rigid-body model's own step control accepted steps at the floor above its tolerance too.
+    r = door("exudyn")(dataclasses.replace(s, exudyn_solver=ExudynSolver(model="rigid_body")))
+    assert_failed(r, "step_size", "limits.min_step_s = 1e-05 s", "solver.exudyn.local_error_m")
+    assert "solver.reference" not in r.message, r.message
 
 
 @pytest.mark.parametrize("implicit", [False, True])
