@@ -12,7 +12,8 @@ kind              fails when                                  limit (scene ``[li
 ================  ==========================================  ==============================
 ``non_finite``    a state or channel is NaN or inf            always on
 ``penetration``   delta > max_penetration_ratio * R_j         ``max_penetration_ratio`` (0.1)
-``step_size``     an accepted step h < min_step               ``min_step_s`` (1e-12 s)
+``step_size``     an accepted step h < min_step (or at it,    ``min_step_s`` (1e-12 s)
+                  for a solver that goes on there unchecked)
 ``steps``         more than max_steps accepted steps          ``max_steps`` (0 = none)
 ``wall_time``     wall-clock time since the start > budget    ``max_wall_time_s`` (0 = none)
 ``energy``        W - dKE - dPE - E_contact - E_diss > limit  ``max_energy_error`` (0.01)
