@@ -267,6 +267,26 @@ def test_reference_step_size_floor_from_limits():
     assert "solver.reference.method" in r.message and "solver.exudyn" not in r.message
 
 
+def test_exudyn_tree_fails_at_its_step_floor_as_the_reference_engine_does():
+    """limits.min_step_s = 1e-5 s on the Exudyn kinematic tree (its explicit solver): Exudyn prints "reached
+    minStepSize; integration continued" and goes on at exactly the floor, accepting steps whose error exceeds
+    the tolerance; the run took > 300 s for 20 deg (issue 35).  Measured: now it fails at 6.7 deg (the
+    start-up impact), names the floor and the tolerance keys, and keeps the free flight before, as the
+    reference engine does (test_reference_step_size_floor_from_limits)."""
+    s = scene(degrees=10.0, exudyn=ExudynSolver(), min_step=1e-5)
+    r = door("exudyn")(s)
+    assert_failed(r, "step_size", "limits.min_step_s = 1e-05 s")
+    assert "a smaller limits.min_step_s (it is 1e-05 s, raised" in r.message, r.message
+    assert "solver.exudyn.relative_tolerance / absolute_tolerance" in r.message, r.message
+    assert 0.0 < r.steps["time_s"][-1] < s.drive.end_time
+    # A floor below the steps the impact takes (2.8e-6 s at the smallest) runs as at the default.
+    assert door("exudyn")(dataclasses.replace(s, limits=Limits(min_step=1e-8))).ok
+    # The rigid-body model's own step control accepted steps at the floor above its tolerance too.
+    r = door("exudyn")(dataclasses.replace(s, exudyn_solver=ExudynSolver(model="rigid_body")))
+    assert_failed(r, "step_size", "limits.min_step_s = 1e-05 s", "solver.exudyn.local_error_m")
+    assert "solver.reference" not in r.message, r.message
+
+
 @pytest.mark.parametrize("implicit", [False, True])
 def test_the_step_collapse_hint_names_the_keys_of_the_engine_that_ran(implicit):
     """The kinematic tree's guard (the Exudyn default path) says what to try in solver.exudyn.* keys, never the

@@ -12,7 +12,8 @@ kind              fails when                                  limit (scene ``[li
 ================  ==========================================  ==============================
 ``non_finite``    a state or channel is NaN or inf            always on
 ``penetration``   delta > max_penetration_ratio * R_j         ``max_penetration_ratio`` (0.1)
-``step_size``     an accepted step h < min_step               ``min_step_s`` (1e-12 s)
+``step_size``     an accepted step h < min_step (or at it,    ``min_step_s`` (1e-12 s)
+                  for a solver that goes on there unchecked)
 ``steps``         more than max_steps accepted steps          ``max_steps`` (0 = none)
 ``wall_time``     wall-clock time since the start > budget    ``max_wall_time_s`` (0 = none)
 ``energy``        W - dKE - dPE - E_contact - E_diss > limit  ``max_energy_error`` (0.01)
@@ -171,7 +172,7 @@ class RunGuard:
         return self.clock() - self.start
 
     def check(self, penetration: float | None = None, step_size: float | None = None, steps: int = 1,
-              finite: bool = True, penetration_f: float | None = None) -> Breach | None:
+              finite: bool = True, penetration_f: float | None = None, floor_fails: bool = False) -> Breach | None:
         """Count ``steps`` accepted steps and check every criterion.
 
         Parameters
@@ -188,6 +189,10 @@ class RunGuard:
             False if the engine found a NaN or inf in the state.
         penetration_f : float, optional
             The same at joint F; None while F is ideal.
+        floor_fails : bool
+            True for a solver that accepts a step at its floor without meeting its tolerance (Exudyn's
+            explicit solvers print "reached minStepSize; integration continued" and go on at the floor,
+            never below it): a step at limits.min_step_s is then a breach too.
 
         Returns
         -------
@@ -214,6 +219,13 @@ class RunGuard:
             return Breach(
                 "step_size",
                 f"the step size collapsed to {step_size:.3g} s (below limits.min_step_s = {self.min_step:.3g} s)",
+                self.step_hint,
+            )
+        if floor_fails and step_size is not None and step_size <= self.min_step * (1.0 + 1e-9):
+            return Breach(
+                "step_size",
+                f"the error tolerance cannot be met with steps of limits.min_step_s = {self.min_step:.3g} s "
+                "(the solver reached its minimum step)",
                 self.step_hint,
             )
         if self.max_steps is not None and self.steps > self.max_steps:

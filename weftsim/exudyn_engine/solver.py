@@ -260,7 +260,7 @@ def _solve_model(scene: Scene, path_model: str, progress, callback: str | None, 
     counter = {"steps": 0}
     # The adaptive step takes about 1/3 of the fixed plan's steps (docs/performance.md).
     report_every = max(1, (n_steps // 3 if adaptive(scene) else n_steps) // _PROGRESS_CALLS)
-    guard = RunGuard(scene)
+    guard = RunGuard(scene, step_advice=f"a looser solver.exudyn.local_error_m (now {scene.exudyn_solver.local_error:.3g} m)")
     breach = []
 
     def count(mbs, t):
@@ -272,7 +272,9 @@ def _solve_model(scene: Scene, path_model: str, progress, callback: str | None, 
         # joint's own post-step hook, so the tracker holds this step's penetration.
         found = guard.check(penetration=model.clearance.tracker.delta if model.clearance else None,
                             penetration_f=model.clearance_f.tracker.delta if model.clearance_f else None,
-                            steps=1 if t > 0.0 else 0)  # fmt: skip
+                            steps=1 if t > 0.0 else 0,
+                            step_size=control.min_step if control is not None and control.floor_misses else None,
+                            floor_fails=True)  # fmt: skip
         if found is not None:
             breach.append(found)
             return False  # Exudyn stops after this step

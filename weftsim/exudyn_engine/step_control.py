@@ -97,6 +97,7 @@ class StepController:
         self.arm = arm
         self.tolerance = tolerance
         self.min_step = min_step
+        self.floor_misses = 0  # steps accepted at min_step with an estimate above REJECT_FACTOR * tolerance
         self.max_step = min(max_step, sample_period)
         self.sample_period = sample_period
         self.factor = abs(newmark_beta - 1.0 / 6.0)
@@ -157,6 +158,8 @@ class StepController:
             # Exudyn repeats the step with min(0.75 h, recommendation) from the start-of-step state.
             self.rejected += 1
             return [_REJECT, self.proposal(h, err)]
+        if err > REJECT_FACTOR * self.tolerance:  # at the floor: accepted above the tolerance (the run's guard fails it)
+            self.floor_misses += 1
         self.accel_trial, self.error_trial = a1, err
         return [_ACCEPT, _NO_RECOMMENDATION]
 

@@ -368,7 +368,8 @@ def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, ca
         if progress is not None and t >= state["next_report"] * t_end:
             progress(min(1.0, t / t_end))
             state["next_report"] = math.floor(t / t_end / _PROGRESS_EVERY + 1.0) * _PROGRESS_EVERY
-        found = guard.check(penetration=model.tracker.delta, step_size=h if t < t_end * (1.0 - 1e-12) else None)
+        found = guard.check(penetration=model.tracker.delta, step_size=h if t < t_end * (1.0 - 1e-12) else None,
+                            floor_fails=not implicit)  # the explicit solvers go on at the floor, unchecked
         if found is not None:
             breach.append(found)
             return False
