@@ -6,7 +6,7 @@ or would change what is modelled instead of a value of it:
 
 - it is not a number (``joint_e.law``, ``solver.exudyn.model``, ``name``): a distribution draws numbers;
   a whole-number key (``joint_e.wear.profile_points``) is a setting, not a measured value;
-- it has no physics (``output.*``, ``compare.*``, ``limits.*``, ``solver.*``, a material's
+- it has no physics (``output.*``, ``compare.*``, ``limits.*``, ``solver.*``, ``exchange.*``, a material's
   ``yield_strength_mpa``, ``max_pressure_mpa``, ``max_pv_mpa_m_s``): it sets what is written, checked or how
   closely it is solved, not the machine;
 - it is an inertia of members 1-3 (crank, coupler, rocker): driven at the crank's constant speed, their
@@ -53,6 +53,7 @@ NO_PHYSICS = {
     "compare.": "it sets the engines' agreement tolerances, not the machine",
     "limits.": "it sets a run's guard or warning threshold, not the machine",
     "solver.": "it sets how closely a run is solved, not the machine",
+    "exchange.": "it sets the weft exchange's outputs (the taker head beside the giver's), not joint E's wear",
 }
 # Members 1-3 (crank, coupler, rocker) are driven at the crank's constant speed through ideal joints: their
 # motion is the crank's, whatever their inertia, which sets the driving torque alone.  (Measured: the reference
