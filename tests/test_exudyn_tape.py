@@ -92,3 +92,17 @@ def test_the_tape_rides_on_the_implicit_tree_with_friction():
     s = exudyn.steps
     total = s["kinetic_energy_J"] + s["potential_energy_J"] + s["contact_energy_J"] + s["dissipated_energy_J"]
     assert np.abs(total - total[0] - s["driving_work_J"]).max() < 1e-4 * s["kinetic_energy_J"].max()
+
+
+def test_the_command_line_runs_a_flexible_tape_on_the_reference_engine_by_default(tmp_path):
+    """``weftsim run loom_tape`` without ``--engine`` takes the engine the automatic choice names for the scene (the
+    reference engine for a flexible tape, weftsim.engines.resolve), as weftsim.simulate does; the command line
+    resolved the engine before it read the scene and ran the tape on Exudyn."""
+    import json
+
+    from weftsim.cli.commands import main
+    from weftsim.engines import resolve
+
+    assert main(["run", "loom_tape", "--revolutions", "0.002", "--no-plot", "-o", str(tmp_path / "r")]) == 0
+    summary = json.loads((tmp_path / "r" / "summary.json").read_text())
+    assert summary["engine"] == resolve("auto", load_scene("loom_tape")) == "reference"

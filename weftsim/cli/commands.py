@@ -452,7 +452,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     from weftsim.checks.design_checks import report_lines
 
     scene = scene_from_args(args)
-    engine = resolve_engine(args.engine)
+    engine = resolve_engine(args.engine, scene)  # a flexible tape: the reference engine
     outdir = output_directory(args, scene, engine)
     _check_fits(scene, outdir)
     # Checked before the estimate, which may still refuse the run (the engine's settings); created after it, so a
@@ -482,7 +482,7 @@ def cmd_animate(args: argparse.Namespace) -> int:
     from weftsim.post.record import check_same_scene, scene_toml
 
     scene = scene_from_args(args)
-    engine = resolve_engine(args.engine)
+    engine = resolve_engine(args.engine, scene)  # a flexible tape: the reference engine
     if args.viewer:
         return _replay_in_viewer(args, scene, engine)
     target = Path(args.output) if args.output else output_directory(args, scene, engine) / "animation.gif"

@@ -72,8 +72,9 @@ def tape_check(scene: Scene) -> dict:
               f"drive's harmonics would move the head's acceleration by {error:.2e} of its peak "
               f"(limit {RIGID_SERVES_BELOW:g}), the rigid rapier {verdict}")
     if serves and not scene.joint.is_ideal:
-        # Measured on loom_tape (600 rpm, c = 0.02 mm, revolution 2): the head's acceleration peaks at -4311 and
-        # +3443 m/s^2 on the flexible tape against -2228 and +2225 on the rigid rapier (docs/rapier-tape.md).
+        # Measured on loom_tape (600 rpm, c = 0.02 mm, revolution 2, both engines): the head's acceleration peaks
+        # at -4941 and +5371 m/s^2 on the flexible tape against -5269 and +5236 on the rigid rapier, and -18344 /
+        # +20948 against -5227 / +12441 over the start-up (docs/rapier-tape.md section 5).
         reason += ("; the estimate covers the drive only: the clearance joint's impacts excite the tape beyond it "
                    "(rapier_tape.model = 'flexible' for the head's accelerations)")
     if tape.model == "auto":

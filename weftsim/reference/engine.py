@@ -41,11 +41,12 @@ EXPLICIT_STIFF_FACTOR = 1500.0
 # Recorded step rows per revolution of the implicit path with friction, ~13 000 (3 200 steps); the dry
 # default's is weftsim.checks.progress.STEP_ROWS_PER_REVOLUTION.
 IMPLICIT_STEP_ROWS_PER_REVOLUTION = 1.3e4
-# The flexible rapier tape (RODAS4 throughout): loom_tape, 600 rpm, two revolutions, 3.8 s of CPU and 92 300 steps
-# against 0.068 s and 2 670 steps of the rigid loom on numba_DOP853 (issue 33, one process, load average 12):
-# per revolution, 1.9 s and ~50 000 step rows (docs/rapier-tape.md, section 6).
-FLEXIBLE_TAPE_SECONDS_PER_REVOLUTION = 1.9
-FLEXIBLE_TAPE_STEP_ROWS_PER_REVOLUTION = 5e4
+# The flexible rapier tape (RODAS4 throughout): loom_tape, 600 rpm, c = 0.02 mm, two revolutions, 27.0 s of CPU and
+# 1 115 914 steps under the cylindrical contact law (its start-up impacts excite the tape's upper modes; 3 December
+# 2026, one process, load average 7-10; the worn joints' 17.3 s and 12.4 s at 0.1 and 0.25 mm take fewer steps):
+# per revolution, 13.5 s and ~6e5 step rows (docs/rapier-tape.md, section 6).
+FLEXIBLE_TAPE_SECONDS_PER_REVOLUTION = 13.5
+FLEXIBLE_TAPE_STEP_ROWS_PER_REVOLUTION = 6e5
 
 
 def _path(scene: Scene) -> tuple[str, bool]:
