@@ -87,7 +87,7 @@ def prepare_directory(path: str | Path, force: bool = False, scene: Scene | None
         except OSError as exc:
             raise OutputError(f"cannot create output directory {path}: {exc.strerror}") from None
     elif not (path.exists() or path.is_symlink()):
-        check_file_target(path / MANIFEST)  # to be created: its nearest existing ancestor a writable directory
+        _check_creatable(path)
         return path
     elif not path.is_dir():
         raise OutputError(f"output directory {path} exists and is not a directory")
@@ -98,6 +98,17 @@ def prepare_directory(path: str | Path, force: bool = False, scene: Scene | None
         raise OutputError(f"{manifest} is not weftsim's manifest file (a directory, a link or a device); "
                           "remove it, or choose another directory with -o")
     return path
+
+
+def _check_creatable(path: Path) -> None:
+    """A directory to be created: its nearest existing ancestor must be a writable directory (an OutputError)."""
+    for ancestor in path.parents:
+        if ancestor.exists() or ancestor.is_symlink():
+            if not ancestor.is_dir():
+                raise OutputError(f"cannot create output directory {path}: {ancestor} is a file, not a directory")
+            if not os.access(ancestor, os.W_OK | os.X_OK):
+                raise OutputError(f"cannot create output directory {path}: directory {ancestor} is not writable")
+            return
 
 
 def check_file_target(target: str | Path) -> Path:
