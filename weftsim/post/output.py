@@ -87,7 +87,7 @@ def prepare_directory(path: str | Path, force: bool = False, scene: Scene | None
         except OSError as exc:
             raise OutputError(f"cannot create output directory {path}: {exc.strerror}") from None
     elif not (path.exists() or path.is_symlink()):
-        _check_creatable(path)
+        _nearest_ancestor(path, f"cannot create output directory {path}")
         return path
     elif not path.is_dir():
         raise OutputError(f"output directory {path} exists and is not a directory")
@@ -100,15 +100,17 @@ def prepare_directory(path: str | Path, force: bool = False, scene: Scene | None
     return path
 
 
-def _check_creatable(path: Path) -> None:
-    """A directory to be created: its nearest existing ancestor must be a writable directory (an OutputError)."""
+def _nearest_ancestor(path: Path, what: str) -> Path | None:
+    """The nearest existing ancestor of ``path``, which must be a writable directory: an OutputError starting with
+    ``what`` (the thing that cannot be made) names the part of the path in the way; None if no ancestor exists."""
     for ancestor in path.parents:
         if ancestor.exists() or ancestor.is_symlink():
             if not ancestor.is_dir():
-                raise OutputError(f"cannot create output directory {path}: {ancestor} is a file, not a directory")
+                raise OutputError(f"{what}: {ancestor} is a file, not a directory")
             if not os.access(ancestor, os.W_OK | os.X_OK):
-                raise OutputError(f"cannot create output directory {path}: directory {ancestor} is not writable")
-            return
+                raise OutputError(f"{what}: directory {ancestor} is not writable")
+            return ancestor
+    return None
 
 
 def check_file_target(target: str | Path) -> Path:
@@ -120,20 +122,14 @@ def check_file_target(target: str | Path) -> Path:
     target = Path(target)
     if target.is_dir():
         raise OutputError(f"cannot write {target}: it is a directory; give a file name")
-    for ancestor in target.parents:
-        if ancestor.exists() or ancestor.is_symlink():
-            if not ancestor.is_dir():
-                raise OutputError(f"cannot write {target}: {ancestor} is a file, not a directory")
-            if not os.access(ancestor, os.W_OK | os.X_OK):
-                raise OutputError(f"cannot write {target}: directory {ancestor} is not writable")
-            if ancestor == target.parent:  # permissions do not tell all (a read-only mount, /proc): try a file
-                try:
-                    fd, probe = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=ancestor)
-                    os.close(fd)
-                    os.unlink(probe)
-                except OSError as exc:
-                    raise OutputError(f"cannot write {target}: {exc.strerror or exc}") from None
-            return target
+    ancestor = _nearest_ancestor(target, f"cannot write {target}")
+    if ancestor == target.parent:  # permissions do not tell all (a read-only mount, /proc): try a file
+        try:
+            fd, probe = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=ancestor)
+            os.close(fd)
+            os.unlink(probe)
+        except OSError as exc:
+            raise OutputError(f"cannot write {target}: {exc.strerror or exc}") from None
     return target
 
 
