@@ -188,14 +188,20 @@ def _add_optimize_flags(p: argparse.ArgumentParser) -> None:
     add_flags(p, positive, add_scene_flags)
 
 
-def cmd_optimize(args: argparse.Namespace) -> int:
+def _fixed_overrides(args: argparse.Namespace) -> list[str]:
+    """The --set overrides and the shorthand flags as KEY=VALUE texts, fixed for every design or cell; a key given
+    twice is refused first."""
     from weftsim.api import SCENE_FLAGS, scene_overrides
-    from weftsim.cli.optimize import run
 
     scene_overrides(set_overrides(args), where="command line", **shorthand_values(args))  # a key given twice
-    fixed = list(args.set) + [f"{SCENE_FLAGS[flag]}={value!r}" if isinstance(value, float) else
-                              f"{SCENE_FLAGS[flag]}={value}" for flag, value in shorthand_values(args).items()]
-    return run(args, fixed)
+    return list(args.set) + [f"{SCENE_FLAGS[flag]}={value!r}" if isinstance(value, float) else
+                             f"{SCENE_FLAGS[flag]}={value}" for flag, value in shorthand_values(args).items()]
+
+
+def cmd_optimize(args: argparse.Namespace) -> int:
+    from weftsim.cli.optimize import run
+
+    return run(args, _fixed_overrides(args))
 
 
 def _add_wear_flags(p: argparse.ArgumentParser) -> None:
@@ -568,14 +574,11 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
-    from weftsim.api import SCENE_FLAGS, resolve_engine, scene_overrides
+    from weftsim.api import resolve_engine
     from weftsim.sweep import format_report, plan_sweep, run_sweep
 
     engine = resolve_engine(args.engine) if args.engine in ENGINE_CHOICES else args.engine
-    scene_overrides(set_overrides(args), where="command line", **shorthand_values(args))  # a key given twice
-    # The shorthand flags are fixed overrides of every cell, as --set is.
-    fixed = list(args.set) + [f"{SCENE_FLAGS[flag]}={value!r}" if isinstance(value, float) else
-                              f"{SCENE_FLAGS[flag]}={value}" for flag, value in shorthand_values(args).items()]
+    fixed = _fixed_overrides(args)  # the shorthand flags are fixed overrides of every cell, as --set is
     with terminated_as_interrupt():
         return _run_sweep(args, engine, fixed)
 
