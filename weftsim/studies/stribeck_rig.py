@@ -17,8 +17,12 @@ import math
 import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from weftsim.errors import SceneError
+
+if TYPE_CHECKING:
+    from weftsim.input.params import ClearanceJoint
 
 BASE_SCENE = "loom"  # the bundled scene whose joint E takes each bearing's keys
 
@@ -28,7 +32,7 @@ class RigBearing:
     """One kind of bearing on the rig's shaft: ``count`` of them, each carrying ``load_share`` of the load."""
 
     name: str
-    joint: object  # weftsim.input.params.ClearanceJoint, lubricated
+    joint: ClearanceJoint  # lubricated
     count: int
     load_share: float
 
@@ -67,9 +71,12 @@ def load_rig(path: str | Path) -> Rig:
 
 def with_floor(rig: Rig, floor: float) -> Rig:
     """The rig with every bearing's ``film_floor_ratio`` set to ``floor`` (the numerical guard of the film)."""
-    return replace(rig, bearings=tuple(
-        replace(b, joint=replace(b.joint, lubrication=replace(b.joint.lubrication, film_floor_ratio=floor)))
-        for b in rig.bearings))
+    bearings = []
+    for b in rig.bearings:
+        lub = b.joint.lubrication
+        assert lub is not None  # load_rig gives every bearing the rig's [lubrication]
+        bearings.append(replace(b, joint=replace(b.joint, lubrication=replace(lub, film_floor_ratio=floor))))
+    return replace(rig, bearings=tuple(bearings))
 
 
 def rig_point(rig: Rig, load: float, rpm: float) -> dict:
