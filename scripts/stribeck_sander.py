@@ -33,18 +33,22 @@ def comparison_table(rig, rows: list[dict], floored: list[dict]) -> str:
     big_end = rig.bearings[0].joint
     mu, radius = big_end.lubrication.boundary_friction_coefficient, big_end.journal_radius
     lines = ["| load | rpm | published | weftsim | ratio | (floor sigma/4) | big end h_min (film ratio) | "
-             "asperity load | implied asperity load |", "|---|---|---|---|---|---|---|---|---|"]
+             "asperity load | asperity load that would close the gap | supports' share | supports' film ratio |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for case, low in zip(rows, floored):
         for k, rpm in enumerate(case["rpm"]):
             big = case["points"][k]["bearings"]["big_end"]
+            support = case["points"][k]["bearings"]["support"]
+            share = sum(b.count * case["points"][k]["bearings"][b.name]["friction_torque_nm"]
+                        for b in rig.bearings if b.name != "big_end") / case["weftsim_nm"][k]
             gap = case["torque_nm"][k] - case["weftsim_nm"][k]
             implied = f"{big['asperity_load_n'] + gap / (mu * radius):.0f} N" if gap > 0.0 else "-"
             lines.append(f"| {case['load_n'] / 1e3:g} kN | {rpm:g} | {case['torque_nm'][k]:.3f} | "
                          f"{case['weftsim_nm'][k]:.3f} | {case['ratio'][k]:.2f} | {low['ratio'][k]:.2f} | "
                          f"{1e6 * big['min_film_m']:.3f} um ({big['film_ratio']:.2f}) | "
-                         f"{big['asperity_load_n']:.0f} N | {implied} |")
+                         f"{big['asperity_load_n']:.0f} N | {implied} | {100 * share:.0f} % | {support['film_ratio']:.2f} |")
         lines.append(f"| {case['load_n'] / 1e3:g} kN | least torque at | {case['minimum_rpm']:g} rpm | "
-                     f"{case['weftsim_minimum_rpm']:g} rpm | | {low['weftsim_minimum_rpm']:g} rpm | | | |")
+                     f"{case['weftsim_minimum_rpm']:g} rpm | | {low['weftsim_minimum_rpm']:g} rpm | | | | | |")
     return "\n".join(lines)
 
 
@@ -56,6 +60,65 @@ def clearance_table(rig) -> str:
         cells = [" ".join(f"{n:g}:{q:.2f}" for n, q in zip(c["rpm"], c["ratio"])) for c in comparison(scaled)]
         lines.append(f"| {psi:g} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
+
+
+def variant_table(rig) -> str:
+    """weftsim / published torque with one surface input changed (each a check of a cause, not a fit)."""
+    big = rig.bearings[0].joint.lubrication
+    variants = (("as published", {}),
+                ("no asperity contact", {"asperity_density_radius_roughness": 0.0}),
+                (f"boundary mu 0.1 (5 x the source's {big.boundary_friction_coefficient:g})",
+                 {"boundary_friction_coefficient": 0.1}),
+                ("sigma = the surfaces' composite Rq, sqrt(0.20^2 + 0.34^2) = 0.394 um",
+                 {"roughness": math.hypot(0.20e-6, 0.34e-6)}))
+    lines = ["| inputs | " + " | ".join(f"{c['load_n'] / 1e3:g} kN (least torque at)" for c in rig.loads) + " |",
+             "|---|---|---|"]
+    for name, change in variants:
+        changed = replace(rig, bearings=tuple(replace(b, joint=replace(b.joint, lubrication=replace(
+            b.joint.lubrication, **change))) for b in rig.bearings))
+        cells = [" ".join(f"{n:g}:{q:.2f}" for n, q in zip(c["rpm"], c["ratio"])) + f" ({c['weftsim_minimum_rpm']:g})"
+                 for c in comparison(changed)]
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def summit_offset_check(rig, offset: float) -> str:
+    """The source's summit mean heights read as an offset of the contact's gap: Greenwood and Tripp's pressure at
+    h - offset, i.e. the asperity term of the kernel at clearance c - offset beside the film at c (the two terms of
+    weftsim.physics.lubricated.lubricated_force called apart and summed; equal to the kernel's sum at offset 0),
+    solved for the load as weftsim.joint.steady does.  A diagnostic, not weftsim's model."""
+    from scipy.optimize import brentq
+
+    from weftsim.joint.steady import joint_block
+    from weftsim.physics.joint import ASPERITY_COEF, VISCOSITY
+    from weftsim.physics.lubricated import L_FX, L_FY, L_MJ, lubricated_force
+
+    def torque(joint, load, omega):
+        prm = joint_block(joint)
+        film, contact = prm.copy(), prm.copy()
+        film[ASPERITY_COEF], contact[VISCOSITY] = 0.0, 0.0
+        c = joint.clearance
+
+        def force(ecc):
+            a = lubricated_force(film, c, ecc, 0.0, 0.0, 0.0, omega, 0.0)
+            b = lubricated_force(contact, c - offset, ecc, 0.0, 0.0, 0.0, omega, 0.0)
+            return a[L_FX] + b[L_FX], a[L_FY] + b[L_FY], a[L_MJ] + b[L_MJ]
+
+        top = (c - offset) * (1.0 - 1e-9)  # the summit planes touch at c - offset
+        if math.hypot(*force(top)[:2]) < load:
+            return math.nan
+        ecc = brentq(lambda e: math.hypot(*force(e)[:2]) - load, 1e-9 * c, top, xtol=1e-13 * c)
+        return -force(ecc)[2]
+
+    cells = []
+    for case in rig.loads:
+        row = []
+        for rpm, published in zip(case["rpm"], case["torque_nm"]):
+            omega = rpm * math.pi / 30.0
+            total = sum(b.count * torque(b.joint, b.load_share * case["load_n"], omega) for b in rig.bearings)
+            row.append(f"{rpm:g}:{total / published:.2f}" if math.isfinite(total) else f"{rpm:g}:no balance")
+        cells.append(" ".join(row))
+    return f"| summit offset {1e6 * offset:g} um | " + " | ".join(cells) + " |"
 
 
 def elastic_estimate(rig, load: float, rpm: float) -> str:
@@ -109,6 +172,8 @@ def figure(rig, floored, path: Path) -> None:
         ax.plot(case["rpm"], case["torque_nm"], "ko-", label="published (Sander et al. 2016)")
         for r, style, name in ((rig, "C0-", "weftsim, film floor sigma"), (floored, "C1--", "weftsim, floor sigma/4")):
             curve = [rig_point(r, case["load_n"], n)["torque_nm"] for n in CURVE_RPM]
+            print(f"{name}, {case['load_n'] / 1e3:g} kN: least torque {min(curve):.3f} N m at "
+                  f"{CURVE_RPM[int(np.argmin(curve))]:.0f} rpm (grid of {CURVE_RPM.size} speeds)")
             ax.plot(CURVE_RPM, curve, style, label=name)
         ax.axvline(case["minimum_rpm"], color="0.6", lw=0.8, ls=":")
         ax.set_xscale("log")
@@ -131,6 +196,14 @@ def main():
     print()
     print("weftsim / published torque, by relative clearance Psi (source's assumption 1e-3):")
     print(clearance_table(rig))
+    print()
+    print("weftsim / published torque with one input changed:")
+    print(variant_table(rig))
+    print(summit_offset_check(rig, 0.0))
+    print(summit_offset_check(rig, (0.21 + 0.39) * 1e-6))
+    floor_gap = max(abs(p["torque_nm"] - q["torque_nm"]) / p["torque_nm"] for a, b in zip(rows, low)
+                    for p, q in zip(a["points"], b["points"]) if p["bearings"]["big_end"]["film_ratio"] >= 1.0)
+    print(f"largest relative torque change, floor sigma -> sigma/4, where h_min >= sigma: {floor_gap:.1e}")
     print()
     print("| load | rpm | eps | film force (solve) | h_min | peak p (axial mean) | arc above p_max / 10 | "
           "elastic flattening |")
