@@ -46,7 +46,8 @@ def comparison_table(rig, rows: list[dict], floored: list[dict]) -> str:
             lines.append(f"| {case['load_n'] / 1e3:g} kN | {rpm:g} | {case['torque_nm'][k]:.3f} | "
                          f"{case['weftsim_nm'][k]:.3f} | {case['ratio'][k]:.2f} | {low['ratio'][k]:.2f} | "
                          f"{1e6 * big['min_film_m']:.3f} um ({big['film_ratio']:.2f}) | "
-                         f"{big['asperity_load_n']:.0f} N | {implied} | {100 * share:.0f} % | {support['film_ratio']:.2f} |")
+                         f"{big['asperity_load_n']:.0f} N | {implied} | {100 * share:.0f} % | "
+                         f"{support['film_ratio']:.2f} |")
         lines.append(f"| {case['load_n'] / 1e3:g} kN | least torque at | {case['minimum_rpm']:g} rpm | "
                      f"{case['weftsim_minimum_rpm']:g} rpm | | {low['weftsim_minimum_rpm']:g} rpm | | | | | |")
     return "\n".join(lines)

@@ -422,3 +422,17 @@ def test_the_stribeck_comparison_is_not_the_film_floors(sander):
         for rpm, torque, point in zip(case["rpm"], case["weftsim_nm"], case["points"]):
             if point["bearings"]["big_end"]["film_ratio"] >= 1.0:
                 assert rig_point(low, case["load_n"], rpm)["torque_nm"] == pytest.approx(torque, rel=1e-9)
+
+
+def test_a_bad_rig_file_is_one_line(tmp_path):
+    """The rig file is input: a missing table or a bad scene key is refused in one line naming the file."""
+    from weftsim.studies.stribeck_rig import load_rig
+
+    text = SANDER_RIG.read_text()
+    for name, broken in (("no_loads.toml", text.split("[[loads]]")[0].replace("[lubrication]", "[oil]")),
+                         ("bad_key.toml", text.replace("clearance_mm = 0.0239", "clearance_mm = -1.0"))):
+        path = tmp_path / name
+        path.write_text(broken)
+        with pytest.raises(SceneError) as error:
+            load_rig(path)
+        assert str(path) in str(error.value) and "\n" not in str(error.value)

@@ -58,15 +58,21 @@ def load_rig(path: str | Path) -> Rig:
         bearings = []
         for name, table in data["bearings"].items():
             keys = {f"joint_e.{key}": value for key, value in table["keys"].items()}
-            scene = load_scene(BASE_SCENE, overrides={**keys, **shared})
+            scene = load_scene(BASE_SCENE, overrides={**keys, **shared},
+                               overrides_from=f"rig file {path}, [bearings.{name}]")
             bearings.append(RigBearing(name, scene.joint, int(table["count"]), float(table["load_share"])))
         loads = tuple({"load_n": 1e3 * float(case["load_kn"]), "rpm": [float(n) for n in case["rpm"]],
                        "torque_nm": [float(m) for m in case["torque_nm"]], "minimum_rpm": float(case["minimum_rpm"]),
                        **({"min_film_rpm": case["min_film_rpm"], "min_film_um": case["min_film_um"]}
                           if "min_film_rpm" in case else {})} for case in data["loads"])
         return Rig(str(data["source"]), tuple(bearings), loads)
-    except (OSError, tomllib.TOMLDecodeError, KeyError, TypeError, ValueError) as exc:
-        raise SceneError(f"rig file {path}: {type(exc).__name__}: {exc}") from None
+    except SceneError:
+        raise  # a bearing's scene key, named with the file by load_scene
+    except KeyError as exc:
+        raise SceneError(f"rig file {path}: missing table or key {exc} "
+                         "(see tests/data/stribeck_sander2016.toml)") from None
+    except (OSError, tomllib.TOMLDecodeError, TypeError, ValueError) as exc:
+        raise SceneError(f"rig file {path}: {exc}") from None
 
 
 def with_floor(rig: Rig, floor: float) -> Rig:
