@@ -404,6 +404,7 @@ def test_the_published_stribeck_rig_where_the_film_is_full(sander):
             assert point["bearings"]["support"]["film_ratio"] > 2.0  # the supports stay hydrodynamic throughout
             assert point["bearings"]["big_end"]["dry_force_n"] == 0.0  # the journal never reaches the dry law
         # The published least torque is among the points held (measured 0.94 at 8 kN, 500 rpm; 0.91 at 4 kN, 300).
+        assert case["minimum_rpm"] == case["rpm"][int(np.argmin(case["torque_nm"]))]
         assert case["minimum_rpm"] in agrees
     full = rows[0]["points"][0]["bearings"]["big_end"]
     assert rows[0]["load_n"] == 8000.0 and rows[0]["rpm"][0] == 3000.0
