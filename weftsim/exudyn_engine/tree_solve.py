@@ -118,7 +118,7 @@ def step_trapezoids(power: np.ndarray, t: np.ndarray) -> np.ndarray:
 
     What generalized-alpha at spectral radius 1 (alpha_m = alpha_f = 1/2, gamma = 1/2) makes of a power joint
     q'' = P, unit mass, whose force does not depend on q: its algorithmic accelerations obey
-    a_n + a_(n+1) = P_n + P_(n+1), so q'_(n+1) - q'_n = h (a_n + a_(n+1)) / 2 = h (P_n + P_(n+1)) / 2, whatever
+    a[n] + a[n+1] = P[n] + P[n+1], so q'[n+1] - q'[n] = h (a[n] + a[n+1]) / 2 = h (P[n] + P[n+1]) / 2, whatever
     the starting acceleration.  P at the converged states is the callback's (its stash at each accepted step).
     """
     out = np.zeros_like(power)
