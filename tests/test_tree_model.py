@@ -120,7 +120,8 @@ def test_energy_balance_closes_over_revolutions_on_the_default_path(scene_name, 
     ~50 us steps missed 1.2 J a revolution, so a 10-revolution run failed the energy guard (1 %) at
     revolution 8 (c = 0.1 mm) and 6.4 (0.25 mm).  With friction (generalized-alpha, the loom's cylindrical law):
     6.1e-6 with the power joints, 7.5e-6 with their own rule in their place (the trapezoids at the accepted steps'
-    ends, tree_solve.power_sums; 3 December 2026), and 1.3e-4 under the quadrature (the guard after ~230
+    ends, tree_solve.power_sums; 3 December 2026), 6.6e-6 with Newton at 1e-5 for it (tree_implicit.
+    FRICTION_NEWTON_RELATIVE_TOLERANCE), and 1.3e-4 under the quadrature (the guard after ~230
     revolutions).  2e-5 keeps 500 revolutions below the guard."""
     scene = load_scene(scene_name, {"drive.revolutions": revolutions, "joint_e.clearance_mm": clearance_mm,
                                     "joint_e.friction_coefficient": mu})
