@@ -85,8 +85,9 @@ class TreeModel:
     memory: list  # [v_held, delta0, rate0] read by the force callback
     stash: list  # [t, delta, delta_dot, F_b,x, F_b,y, F_N, M_b, F_T v_T, v_T, D'_lub, U_a, W3', D'] of the last callback
     callback_calls: list = field(default_factory=lambda: [0])  # [count]
-    # [t, F_b,x, F_b,y, F_N, M_b, F_T v_T, D'_lub, U_a, v_T] per accepted state (tree_joint_force's joint force
-    # on the bearing, the lubricated part's dissipated power, the asperity potential, the sliding velocity)
+    # [t, F_b,x, F_b,y, F_N, M_b, F_T v_T, D'_lub, U_a, v_T, W3', D'] per accepted state (tree_joint_force's joint
+    # force on the bearing, the lubricated part's dissipated power, the asperity potential, the sliding velocity, the
+    # drawn and the dissipated power)
     bearing_force: list = field(default_factory=list)
 
     def accept(self, mbs: exu.MainSystem, t: float) -> None:
@@ -95,11 +96,11 @@ class TreeModel:
             q = mbs.GetNodeOutput(self.node, exu.OutputVariableType.Coordinates)
             q_t = mbs.GetNodeOutput(self.node, exu.OutputVariableType.Coordinates_t)
             self.force(mbs, t, self.tree, q, q_t)
-        _, delta, rate, fx, fy, f_n, m_b, power, v_t, lub_power, asperity_energy = self.stash[:11]
+        _, delta, rate, fx, fy, f_n, m_b, power, v_t, lub_power, asperity_energy, drawn, dissipated = self.stash
         tracker = self.tracker
         tracker.accept(t, delta, rate)
         self.memory[0], self.memory[1], self.memory[2] = tracker.held, delta, rate
-        self.bearing_force.append((t, fx, fy, f_n, m_b, power, lub_power, asperity_energy, v_t))
+        self.bearing_force.append((t, fx, fy, f_n, m_b, power, lub_power, asperity_energy, v_t, drawn, dissipated))
 
 
 def build_tree(mbs: exu.MainSystem, scene: Scene, callback: str = "auto", powers: bool = False) -> TreeModel:

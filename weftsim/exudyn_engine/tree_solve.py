@@ -68,7 +68,7 @@ OVT = exu.OutputVariableType
 EXPLICIT_METHODS = {"DOPRI5": exu.DynamicSolverType.DOPRI5, "ODE23": exu.DynamicSolverType.ODE23}
 _PROGRESS_EVERY = 0.001  # every 0.1 % of the run: a long run shows its first line soon (issue 16)
 END_OF_STEP_ACCELERATIONS = False
-RECORD_COLUMNS = 9  # TreeModel.bearing_force: t, F_b,x, F_b,y, F_N, M_b, F_T v_T, D'_lub, U_a, v_T
+RECORD_COLUMNS = 11  # TreeModel.bearing_force: t, F_b,x, F_b,y, F_N, M_b, F_T v_T, D'_lub, U_a, v_T, W3', D'
 
 
 def check_tree_settings(scene: Scene) -> str | None:
@@ -103,6 +103,28 @@ def step_advice(scene: Scene, implicit: bool) -> str:
     other = next(name for name in EXPLICIT_METHODS if name != scene.exudyn_solver.explicit_method)
     return (f"a looser solver.exudyn.relative_tolerance / absolute_tolerance, solver.exudyn.explicit_method = "
             f"{other!r}, or solver.exudyn.tree_solver = 'implicit'")
+
+
+def power_sums(scene: Scene) -> bool:
+    """True when the implicit tree integrates W3 and D by :func:`step_trapezoids` instead of the power joints: dry
+    friction at E without a tape (generalized-alpha at :data:`~weftsim.exudyn_engine.tree_implicit.SPECTRAL_RADIUS`
+    1 gives the power joints exactly these sums, without their two columns of Newton's numerical Jacobian)."""
+    return (scene.joint.friction_coefficient > 0.0 and not scene.joint.is_lubricated and scene.rapier_tape is None
+            and tree_solver(scene) == "implicit")
+
+
+def step_trapezoids(power: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Running trapezoidal sum of ``power`` over the accepted steps' ends ``t``, J.
+
+    What generalized-alpha at spectral radius 1 (alpha_m = alpha_f = 1/2, gamma = 1/2) makes of a power joint
+    q'' = P, unit mass, whose force does not depend on q: its algorithmic accelerations obey
+    a[n] + a[n+1] = P[n] + P[n+1], so q'[n+1] - q'[n] = h (a[n] + a[n+1]) / 2 = h (P[n] + P[n+1]) / 2, whatever
+    the starting acceleration.  P at the converged states is the callback's (its stash at each accepted step).
+    """
+    out = np.zeros_like(power)
+    if power.size > 1:
+        out[1:] = np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(t))
+    return out
 
 
 def contact_work(y: np.ndarray, t: np.ndarray, delta: np.ndarray) -> np.ndarray:
@@ -274,6 +296,8 @@ def tree_channels(model: TreeModel, data: dict) -> dict[str, np.ndarray]:
         energy = energy + force[:, 7]
     if q_t.shape[1] > 3:  # the power joints (build_tree(powers=True)): W3 and D integrated with the motion
         drawn, dissipated = q_t[:, 3] - q_t[0, 3], q_t[:, 4] - q_t[0, 4]
+    elif power_sums(scene):  # generalized-alpha's own rule for them, at the accepted steps' ends
+        drawn, dissipated = step_trapezoids(force[:, 9], t), step_trapezoids(force[:, 10], t)
     else:  # quadrature over the steps (the implicit tree with an oil film)
         drawn = contact_work(-q3 * omega, t, loaded)
         # the tree_joint_force's D': F_N (delta_dot + dc/dt) - F_el delta_dot - F_T v_T
@@ -333,11 +357,13 @@ def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, ca
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
     implicit = tree_solver(scene) == "implicit"
-    # The power joints (W3 and D integrated with the motion) on the explicit tree, and on the implicit one with dry
-    # friction: there the quadrature drifted 0.042 J a revolution on the loom at c = 0.1 mm (the energy guard's 1 %
-    # after ~230 revolutions), with them 4e-4 J, at 40 % more CPU time (two more Jacobian columns).  With an oil
-    # film they changed nothing (3.9e-3 and 4.3e-3 J in 3 revolutions) and cost 47 %: the quadrature stays.
-    powers = not implicit or (scene.joint.friction_coefficient > 0.0 and not scene.joint.is_lubricated)
+    # The power joints (W3 and D integrated with the motion) on the explicit tree.  On the implicit one with dry
+    # friction the contact_work quadrature drifted 0.042 J a revolution on the loom at c = 0.1 mm (the energy
+    # guard's 1 % after ~230 revolutions) and the power joints cost 40 % more CPU time (two more columns of the
+    # numerical Jacobian); their own rule, the trapezoid at the accepted steps' ends (power_sums), gives their
+    # balance without them.  With an oil film they changed nothing (3.9e-3 and 4.3e-3 J in 3 revolutions) and
+    # cost 47 %: the quadrature stays.
+    powers = not implicit
     # A flexible rapier tape: the tree of the linkage with a massless rapier, the tape and head on its wheel
     # (:mod:`.tape_tree`; its damping enters the power joint of D, so it needs the power joints).
     tape_scene = scene.rapier_tape is not None
