@@ -78,8 +78,7 @@ def pytest_sessionstart(session) -> None:
     compiles the same kernels at once (~90 s of CPU each on a fresh clone: docs/performance.md, "The test
     suite's time").  Runs in xdist's controller only (this hook precedes xdist's, which starts the workers);
     a warm cache costs one directory scan.  A warm-up that fails is left to the tests to report."""
-    config = session.config
-    if hasattr(config, "workerinput") or not getattr(config.option, "numprocesses", None) or _kernels_cached():
+    if not session.config.pluginmanager.has_plugin("dsession") or _kernels_cached():  # no workers to start
         return
     for name, engine in WARM_UP:
         try:
