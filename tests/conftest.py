@@ -57,6 +57,53 @@ def run_of():
     return run
 
 
+# The short runs that compile the kernels every engine path uses: the reference integrator (one
+# specialisation of weftsim.reference.compiled.advance holding every law, friction and film), its channels and
+# joint rows, the oiled joint's rows, and the Exudyn tree's force.
+WARM_UP = (("reference", "reference"), ("loom_oiled", "reference"), ("loom", "exudyn"))
+
+
+def _kernels_cached() -> bool:
+    """Whether numba's cache (weftsim's keyed folder, or the user's NUMBA_CACHE_DIR) holds the integrator."""
+    import weftsim.physics  # noqa: F401  # sets numba's cache folder (weftsim.physics.compiled_cache)
+    from numba.core import config
+
+    return any(Path(config.CACHE_DIR).rglob("compiled.advance-*.nbi"))
+
+
+def pytest_sessionstart(session) -> None:
+    """Compile the kernels once before pytest-xdist starts its workers, when the cache is empty (a fresh clone).
+
+    Otherwise every worker, and every weftsim process a test starts before one of them has written the cache,
+    compiles the same kernels at once (~90 s of CPU each on a fresh clone: docs/performance.md, "The test
+    suite's time").  Runs in xdist's controller only (this hook precedes xdist's, which starts the workers);
+    a warm cache costs one directory scan.  A warm-up that fails is left to the tests to report."""
+    if not session.config.pluginmanager.has_plugin("dsession") or _kernels_cached():  # no workers to start
+        return
+    for name, engine in WARM_UP:
+        try:
+            weftsim.simulate(scene_of(name, revolutions=0.01), engine, on_warning=quiet)
+        except Exception as error:  # noqa: BLE001  # the tests that run this scene say what is wrong
+            print(f"conftest: warming numba's cache with {name} on {engine} failed: {error}")
+
+
+# The longest test files, longest first (the fresh-clone parallel run of 3 December 2026, load ~7: the sum
+# of their tests' times over ~4.3, the run's wall-to-CPU ratio, in CPU s: 83, 65, 62, 61, 58, 57, 47, 41, 41,
+# 37).  pytest-xdist's loadfile hands out files in collection order (--no-loadscope-reorder, pyproject.toml);
+# in xdist's default order, most tests first, the wear files of few long tests came last and one worker ran
+# them while the other had finished.  Given first, the short files fill the end.
+LONGEST_FIRST = ("test_wear_life.py", "test_hostile_ensemble.py", "test_wear_exudyn.py", "test_exudyn_engine.py",
+                 "test_wear_ensemble.py", "test_reference_integrate.py", "test_cylindrical.py",
+                 "test_sweep_faults.py", "test_lubricated_steps.py", "test_rapier_tape.py")
+
+
+def pytest_collection_modifyitems(session, config, items) -> None:
+    """The files of :data:`LONGEST_FIRST` first, in that order; the rest, and the tests within each file, as
+    collected (a stable sort, the same on every worker, as xdist requires)."""
+    rank = {name: i for i, name in enumerate(LONGEST_FIRST)}
+    items.sort(key=lambda item: rank.get(item.path.name, len(rank)))
+
+
 def door(engine: str):
     """``solve(scene, progress=None, observe=None, callback=None)`` of ``engine`` through the one door
     (:func:`weftsim.simulate`: before-run checks, the engine's pure solve, the vetting), for tests written
