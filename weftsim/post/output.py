@@ -23,7 +23,7 @@ import os
 import shutil
 import tempfile
 from pathlib import Path
-from typing import Callable
+from typing import Any, Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -212,7 +212,7 @@ def write_figure(target: Path, figure: Figure) -> Path:
     import sys
 
     kind = target.suffix.lstrip(".")
-    options = {"pil_kwargs": {"compress_level": PNG_COMPRESS_LEVEL}} if kind == "png" else {}
+    options: dict[str, Any] = {"pil_kwargs": {"compress_level": PNG_COMPRESS_LEVEL}} if kind == "png" else {}
     try:
         return write_atomic(target, lambda p: figure.savefig(p, format=kind, dpi=130, **options))
     finally:
