@@ -54,7 +54,7 @@ def skip_final_collection() -> None:
     Python's shutdown collects every object still alive (numba's typing tables and loaded kernels, matplotlib's
     artists: ~10^5 objects after a run), 0.3-0.45 s of CPU after a ``weftsim run`` of the loom had written
     everything (issue 36, "the first second"; 0.3 s after a script that compiles one numba function).
-    :func:`gc.freeze` moves them to the permanent generation, which that collection skips; the memory goes back
+    ``gc.freeze()`` moves them to the permanent generation, which that collection skips; the memory goes back
     with the process.  Every file is closed and the standard streams are flushed by then.  Only in the command's
     own process: a caller of :func:`weftsim.cli.commands.main` in its own program keeps collecting.
     """
