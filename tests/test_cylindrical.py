@@ -193,3 +193,17 @@ def test_contact_law_study_lists_every_law_beside_the_fe_checked_one(joint):
                           "laws_on_the_scene": {"scene": "loom", "clearance_mm": 0.02, "loads_kN": [1, 10, 50],
                                                 "laws": rows}})
     assert "(FE-checked)" in text and "variable_kd" in text
+
+
+def test_the_stored_exact_dampings_are_the_solvers_roots_to_the_last_bit():
+    """weftsim.joint.exact_damping spares a run the import of scipy.optimize: each stored root is what the solver
+    returns, bit for bit (so a run reads the same damping from the table as solved), and restores its ce."""
+    from weftsim.joint.contact import solve_exact_hysteresis
+    from weftsim.joint.exact_damping import EXACT_HYSTERESIS
+
+    assert sorted(EXACT_HYSTERESIS) == [float(f"{0.05 * k:.2f}") for k in range(1, 20)]
+    for ce, xi in EXACT_HYSTERESIS.items():
+        assert solve_exact_hysteresis(ce) == xi, ce  # exactly: the table is the solver's output, not an approximation
+        assert exact_hysteresis(ce) == xi
+        assert restored_restitution(xi) == pytest.approx(ce, abs=1e-12)  # as the solved roots above
+    assert exact_hysteresis(0.901) == solve_exact_hysteresis(0.901)  # off the table: solved

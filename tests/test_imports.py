@@ -156,3 +156,26 @@ def test_house_floors_cover_every_subpackage():
     house = _house()
     for module in import_graph():
         house.floor(module)  # raises SystemExit for a subpackage in no floor
+
+
+def test_a_runs_set_up_imports_neither_scipy_optimize_nor_other_commands_packages():
+    """Issue 36's first second: the set-up of ``weftsim run loom`` (and of the reference scene) — the command's
+    parser, the scene, the estimate (which imports the engine), the contact law and the kernel parameters — does
+    not import ``scipy.optimize`` (0.2-0.4 s of CPU; the cylindrical law's exact damping at ce = 0.9 is stored,
+    weftsim.joint.exact_damping), nor the packages of other commands (optimize, sweep, wear)."""
+    code = (
+        "import sys\n"
+        "import weftsim\n"
+        "from weftsim.cli.commands import build_parser\n"
+        "from weftsim.cli.grammar import scene_from_args\n"
+        "from weftsim.model.dynamics import pack_parameters\n"
+        "for name in ('loom', 'reference'):\n"
+        "    scene = scene_from_args(build_parser('run').parse_args(['run', name]))\n"
+        "    weftsim.estimate(scene, 'exudyn')\n"
+        "    pack_parameters(scene)\n"
+        "print(' '.join(m for m in ('scipy.optimize', 'weftsim.optimize', 'weftsim.sweep', 'weftsim.wear')\n"
+        "               if m in sys.modules))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], cwd=PACKAGE.parent, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.split() == []

@@ -52,7 +52,9 @@ from weftsim.cli.startup import EXIT_INTERRUPTED  # 128 + SIGINT, defined once f
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE: the reader of stdout went away (`| head`), as for any Unix tool
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The ``weftsim`` parser; with ``only`` (a command's name) the flags of optimize, wear and bearing, whose help
+    imports their packages (~0.1 s of a ``weftsim run``), are added only if ``only`` is that command."""
     parser = Parser(
         prog="weftsim",
         description="Weft insertion mechanism of a rapier loom with a clearance joint at E: "
@@ -121,7 +123,8 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Differential evolution over the --vary keys (scipy), each design's runs on the "
                        "sweep's pool (or a Dask cluster), resumable: rerunning the same command continues.  "
                        "See docs/optimize.md.")
-    _add_optimize_flags(p)
+    if only in (None, "optimize"):
+        _add_optimize_flags(p)
 
     p = sub.add_parser("study", help="one of the paper's studies: figures, CSV and JSON (docs/paper-comparison.md)",
                        description="Run a study of the paper: contact-law (Fig. 7-9), clearance (Fig. 12), "
@@ -147,11 +150,13 @@ def build_parser() -> argparse.ArgumentParser:
                    help="write into an output directory that holds files weftsim did not write")
 
     p = sub.add_parser("wear", help=WEAR_HELP)
-    _add_wear_flags(p)
+    if only in (None, "wear"):
+        _add_wear_flags(p)
 
     p = sub.add_parser("bearing", help="steady plain-bearing check of an oiled joint: film, friction, temperature, "
                        "Stribeck curve (docs/lubricated-joint.md)")
-    _add_bearing_flags(p)
+    if only in (None, "bearing"):
+        _add_bearing_flags(p)
 
     p = sub.add_parser("bench", help="work-precision benchmark of every engine setting (docs/performance.md)",
                        description="Time every engine setting on an easy and two hard scenes against a converged "
@@ -678,11 +683,24 @@ def _one_line(text: object) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
+    from weftsim.cli.startup import skip_final_collection
+
+    try:
+        return _main(argv)
+    finally:
+        skip_final_collection()  # the process ends: 0.3-0.45 s of Python's last garbage collection spared
+
+
+def _main(argv: list[str] | None) -> int:
     from weftsim.cli.startup import release
 
-    parser = build_parser()  # imports what the flags' help lists (numba among them): still weftsim.cli.startup's
+    argv = sys.argv[1:] if argv is None else argv
+    # The command is the first word that is not an option (the top level's options take no value): only its
+    # flags are built (build_parser); no command, or a mistyped one, builds them all.
+    command = next((word for word in argv if not word.startswith("-")), None)
+    parser = build_parser(command if command in COMMANDS else None)  # still weftsim.cli.startup's SIGINT handler
     args = parser.parse_args(argv)
-    set_command(sys.argv[1:] if argv is None else argv)  # recorded in every output directory (weftsim.post.record)
+    set_command(argv)  # recorded in every output directory (weftsim.post.record)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(name)s: %(message)s")
     release()  # from here a Ctrl-C is a KeyboardInterrupt again, caught below and by the commands

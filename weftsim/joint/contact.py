@@ -82,6 +82,7 @@ import numpy as np
 
 from numba import njit
 
+from weftsim.joint.exact_damping import EXACT_HYSTERESIS
 from weftsim.physics import laws as kernel
 from weftsim.physics.python import python_form
 from weftsim.input.params import ClearanceJoint
@@ -453,16 +454,24 @@ def exact_hysteresis(restitution: float) -> float:
     equation is solved for xi at the requested ce (0 < ce <= 1), so the law restores ce to solver precision
     over the whole range (Lankarani-Nikravesh's 3 (1 - ce^2) / 4 is its first-order form as ce -> 1).
     Below ce = :data:`EXACT_RESTITUTION_FLOOR` the root sits closer to xi = 1 / ce than a double resolves
-    (1 - xi ce = 1.6e-8 at ce = 0.05, ~1e-21 at 0.02), so such a ce is refused with one line.
+    (1 - xi ce = 1.6e-8 at ce = 0.05, ~1e-21 at 0.02), so such a ce is refused with one line.  The roots of the
+    round restitutions 0.05, 0.10, ..., 0.95 are stored (:mod:`weftsim.joint.exact_damping`, the solver's values
+    to the last bit); any other ce is solved by :func:`solve_exact_hysteresis`.
     """
     if not EXACT_RESTITUTION_FLOOR <= restitution <= 1.0:
         raise ValueError(f"`restitution` must be in [{EXACT_RESTITUTION_FLOOR}, 1] for the cylindrical law's exact "
                          f"damping, got {restitution}")
     if restitution == 1.0:
         return 0.0
+    stored = EXACT_HYSTERESIS.get(restitution)
+    return solve_exact_hysteresis(restitution) if stored is None else stored
+
+
+def solve_exact_hysteresis(ce: float) -> float:
+    """The root xi > 0 of phi(-xi ce) = phi(xi) for 0.05 <= ce < 1 (:func:`exact_hysteresis`), by scipy's brentq
+    at rtol 1e-15 (imported here, when called: ``scipy.optimize`` costs ~0.35 s of CPU to import)."""
     from scipy.optimize import brentq
 
-    ce = restitution
     # phi(-xi ce) - phi(xi) = -(1 - ce^2) xi^2 / 2 + (1 + ce^3) xi^3 / 3 + ... < 0 below 1.5 (1 - ce^2) / (1 + ce^3),
     # and -> +inf as xi ce -> 1: the root xi > 0 (not the trivial xi = 0) lies between.
     lo = 0.1 * (1.0 - ce * ce)

@@ -23,7 +23,7 @@ import os
 import shutil
 import tempfile
 from pathlib import Path
-from typing import Callable
+from typing import Any, Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -203,11 +203,18 @@ def write_csv(target: Path, columns: Mapping[str, ArrayLike]) -> Path:
     return write_atomic(target, write)
 
 
+# zlib level of a PNG figure: the same pixels as matplotlib's default 6 in 60 % of the encoding's CPU time (0.08
+# against 0.13 s for the loom run's channels.png and orbit.png), the files 2-12 % larger.
+PNG_COMPRESS_LEVEL = 3
+
+
 def write_figure(target: Path, figure: Figure) -> Path:
     import sys
 
+    kind = target.suffix.lstrip(".")
+    options: dict[str, Any] = {"pil_kwargs": {"compress_level": PNG_COMPRESS_LEVEL}} if kind == "png" else {}
     try:
-        return write_atomic(target, lambda p: figure.savefig(p, format=target.suffix.lstrip("."), dpi=130))
+        return write_atomic(target, lambda p: figure.savefig(p, format=kind, dpi=130, **options))
     finally:
         if "matplotlib.pyplot" in sys.modules:  # a pyplot figure: free it (weftsim.post.plots.figure() are not held)
             sys.modules["matplotlib.pyplot"].close(figure)
