@@ -166,7 +166,8 @@ def test_the_film_below_its_floor_is_continued_and_its_torques_balance(loom_join
     """lubricated.film_at_floor below a floor of sigma against the film evaluated there (floor sigma / 4): continuous
     at the floor; at h_min = 0.7 sigma the force within 2 % for rotation, squeeze in and out and whirl (measured
     0.7-1.4 %; held at the floor it was 2-47 % short), the rotating journal's torque within 1 % (measured 0.7 %); the
-    torques balance about the true centre, T_j + T_b = -(e x f)_x; below the wall (sigma / 4) it is held.  (Nearer
+    torques balance about the true centre, T_j + T_b = -(e x f)_x; below the wall (sigma / 4) it is held (with the
+    journal's radial rate and whirl rate).  (Nearer
     the wall the table's own film is extrapolated past eps = 0.99 on this pin: 0.3 sigma differs by 7-53 %.)"""
     from weftsim.joint.steady import joint_block
     from weftsim.physics.joint import FILM_FLOOR
@@ -190,5 +191,6 @@ def test_the_film_below_its_floor_is_continued_and_its_torques_balance(loom_join
         ecc = c - 0.7 * sigma
         ex, ey = ecc * math.cos(angle), ecc * math.sin(angle)
         assert continued[2] + continued[3] == pytest.approx(-(ex * continued[1] - ey * continued[0]), rel=1e-9)
-        assert film(1.0, 0.1, rate) == pytest.approx(film(1.0, 0.2, rate), rel=1e-9)  # both below the wall
+    for rate in ((0.0, 0.0), inward):  # below the wall, held (a whirl rate is kept as a rate: its speed scales)
+        assert film(1.0, 0.1, rate) == pytest.approx(film(1.0, 0.2, rate), rel=1e-9)
     assert film(1.0, 0.7)[2] == pytest.approx(film(0.25, 0.7)[2], rel=0.01)
