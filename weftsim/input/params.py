@@ -218,10 +218,10 @@ class Lubrication:
         mu_b of the boundary friction on the asperity load (modified Coulomb, with the joint's
         ``friction_velocities``).  Default 0.1 (boundary-lubricated steel on steel or bronze).
     film_floor_ratio : float
-        A numerical guard: the film force is evaluated no closer than h_min = film_floor_ratio x sigma, so it
-        stays finite where the dry law starts (e = c); below that film its pressure field is held at the
-        floor's while the asperities take the rest.  In [0.25, 4] (the rough film's table reaches
-        sigma / 4); default 1 (film ratio 1).
+        A numerical knob: the film force is evaluated down to h_min = film_floor_ratio x sigma and continued
+        below it with its slope, curvature and turning rate there (:func:`weftsim.physics.lubricated.film_at_floor`)
+        down to the wall sigma / 4, where it is held, so it stays finite where the dry law starts (e = c).  In
+        [0.25, 4] (the rough film's table reaches sigma / 4); default 1 (film ratio 1).
     oil : str
         An ISO 3448 grade (``"ISO VG 220"``, :func:`weftsim.physics.oil.grade_names`): the viscosity then follows
         from the film's temperature (:mod:`weftsim.joint.heat`) instead of ``viscosity``.  Empty: not given.

@@ -141,8 +141,8 @@ def LUBRICATION_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 -
         Key(at + "boundary_friction_coefficient", to + "boundary_friction_coefficient", "float", 1, 0, 2, False,
             doc="friction coefficient of the solids' contact in oil, asperities and dry law (default 0.1)"),
         Key(at + "film_floor_ratio", to + "film_floor_ratio", "float", 1, 0.25, 4, False,
-            doc="the film force is evaluated no closer than this many RMS roughnesses (default 1); a floor above the "
-                "operating film decides the mixed regime's friction (docs/lubricated-joint.md)"),
+            doc="the film force is evaluated down to this many RMS roughnesses and continued below it with its slope "
+                "there, to sigma / 4 (default 1; a numerical knob: docs/lubricated-joint.md)"),
         # The oil and the heat balance (weftsim.physics.oil, weftsim.joint.heat): instead of viscosity_mpa_s.
         Key(at + "oil", to + "oil", "str",
             doc="an ISO 3448 grade (\"ISO VG 220\"): the viscosity follows from the film temperature of the "

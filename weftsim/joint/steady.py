@@ -15,7 +15,7 @@ Boyd, ASLE Trans. 1, 1958; Shigley's Mechanical Engineering Design, ch. 12):
 - the regime by the film ratio, as the regime map (docs/lubricated-joint.md): hydrodynamic above 3, mixed
   from 1 to 3, boundary below 1;
 - the film's inlet and side flow Q, Qs (:mod:`weftsim.joint.film_flow`) at the eccentricity the film is
-  evaluated at (the film floor holds it below c - h_floor).
+  evaluated at (held below c - h_wall, :mod:`weftsim.physics.lubricated`).
 """
 
 from __future__ import annotations
@@ -78,6 +78,7 @@ def steady_point(joint, load: float, omega: float, viscosity: float, prm: np.nda
 
     from weftsim.joint.film_flow import flow_variables
     from weftsim.physics.joint import VISCOSITY
+    from weftsim.physics.lubricated import FILM_WALL_RATIO
     from weftsim.physics.steady import steady_force
 
     prm = (joint_block(joint) if prm is None else prm).copy()
@@ -106,7 +107,7 @@ def steady_point(joint, load: float, omega: float, viscosity: float, prm: np.nda
     sommerfeld = (radius / c) ** 2 * viscosity * n / pressure if pressure > 0.0 else math.inf
     h_min = max(c - ecc, 0.0)
     ratio = h_min / lub.roughness
-    eps_film = min(ecc, c - lub.film_floor_ratio * lub.roughness) / c
+    eps_film = min(ecc, c - FILM_WALL_RATIO * lub.roughness) / c
     q_in, q_side = flow_variables(eps_film, length / (2.0 * radius))
     scale = radius * c * n * length
     f = float  # plain floats for JSON

@@ -73,7 +73,7 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from weftsim.physics.flow_factors import couette_factor_at
+from weftsim.physics.flow_factors import couette_factor_nodes, couette_factor_tail
 
 MODEL_FINITE, MODEL_SHORT, MODEL_LONG, MODEL_SHORT_HALF = 0, 1, 2, 3
 # MODEL_SHORT_HALF: width in sin(xi) of the blend between the two half films (short_half_force).
@@ -94,9 +94,13 @@ LOG_WIDTH_STEP = math.log(WIDTH_MAX / WIDTH_MIN) / (N_WIDTH - 1)
 # film is thick (nodes at h_min / sigma = inf, 2.73, 1.49, 0.76, 0.25).
 N_R, ROUGH_DECAY, RATIO_MIN = 5, 0.56, 0.25
 S_MAX = math.exp(-ROUGH_DECAY * RATIO_MIN)
-# Nodes of the rough film's Couette factor (the mean of phi_f over Sommerfeld's angle, trapezoid rule): against
-# 4096 nodes 4e-6 at h_min = sigma (c = 50 sigma), 1.5e-4 at h_min = sigma / 4 (32 nodes: 2e-3).
-COUETTE_POINTS = 64
+# The rough film's Couette factor (flow_factors.couette_factor_at, the mean of phi_f over Sommerfeld's angle) is
+# tabulated at import over u = 1 - sqrt(1 - eps) uniform on [0, 1] and log(h_min / sigma) uniform on
+# [COUETTE_RATIO_MIN, COUETTE_RATIO_MAX] (bicubic Catmull-Rom; thicker films: its closed-form tail, thinner: held),
+# each node summed on COUETTE_POINTS nodes of psi (9e-6 from 4096 nodes; 128: 1.2e-4).
+N_CU, N_CR, COUETTE_POINTS = 49, 97, 256
+COUETTE_RATIO_MIN, COUETTE_RATIO_MAX = 1.0 / 16.0, 20.0
+LOG_COUETTE_STEP = math.log(COUETTE_RATIO_MAX / COUETTE_RATIO_MIN) / (N_CR - 1)
 # First 16 hex digits of the SHA-256 of the stored table (scripts/make_film_table.py writes this
 # line).  numba freezes the table into the compiled code and keys its cache by this file, so a new
 # table must change this file; a table that does not match is not used (NaN forces).
@@ -190,6 +194,22 @@ ROUGH_TABLE = np.ascontiguousarray(_PADDED - _PADDED[1]).astype(np.float32)
 del _PADDED
 
 
+def _couette_table() -> np.ndarray:
+    """The Couette factor's nodes (u x log ratio) with one ghost node on each side (linear extrapolation)."""
+    u = np.linspace(0.0, 1.0, N_CU)
+    ratios = COUETTE_RATIO_MIN * np.exp(LOG_COUETTE_STEP * np.arange(N_CR))
+    out = np.empty((N_CU + 2, N_CR + 2))
+    out[1:-1, 1:-1] = couette_factor_nodes(1.0 - (1.0 - u) ** 2, ratios, COUETTE_POINTS)
+    out[0] = 2.0 * out[1] - out[2]
+    out[-1] = 2.0 * out[-2] - out[-3]
+    out[:, 0] = 2.0 * out[:, 1] - out[:, 2]
+    out[:, -1] = 2.0 * out[:, -2] - out[:, -3]
+    return out
+
+
+COUETTE_TABLE = _couette_table()
+
+
 @njit(cache=True, error_model="numpy", inline="always")
 def _catmull_rom(t: float):
     """Weights of the four nodes i-1, i, i+1, i+2 at the fraction t in [0, 1] of the interval (i, i+1)."""
@@ -280,20 +300,43 @@ def rough_finite_force(eps: float, xi: float, width: float, roughness: float):
     s = 0 (smooth surfaces, or a film so thick that s underflows) is :func:`finite_force` exactly.  Beyond
     s = S_MAX (h_min < sigma / 4, below the film floor's least value) the flow factors of sigma / 4 are kept.
     """
-    s = roughness_coordinate(eps, roughness)
-    f_along, f_ahead = finite_force(eps, xi, width)
-    if s <= 0.0:
-        return f_along, f_ahead
     scale, sign, iw, iu, ix, ww, wu, wx = _table_cells(eps, xi, width)
+    g0, g1 = _tricubic(FINITE_TABLE, iw, iu, ix, ww, wu, wx)
+    s = roughness_coordinate(eps, roughness)
+    if s <= 0.0:
+        return g0 * scale, sign * g1 * scale
     ir, tr = _cell(s / S_MAX * (N_R - 1), N_R)
     wr = _catmull_rom(tr)
-    g0 = 0.0
-    g1 = 0.0
+    r0 = 0.0
+    r1 = 0.0
     for m in range(4):
         h0, h1 = _tricubic(ROUGH_TABLE[ir + m], iw, iu, ix, ww, wu, wx)
-        g0 += wr[m] * h0
-        g1 += wr[m] * h1
-    return f_along + g0 * scale, f_ahead + sign * g1 * scale
+        r0 += wr[m] * h0
+        r1 += wr[m] * h1
+    return g0 * scale + r0 * scale, sign * g1 * scale + sign * r1 * scale
+
+
+@njit(cache=True, error_model="numpy")
+def couette_factor(eps: float, roughness: float) -> float:
+    """The rough film's Couette torque over the smooth film's (Patir and Cheng's phi_f averaged over the film,
+    :func:`weftsim.physics.flow_factors.couette_factor_at`) at eccentricity ratio eps and ``roughness`` = sigma / c
+    > 0: the table ``COUETTE_TABLE`` in u = 1 - sqrt(1 - eps) and log(h_min / sigma), bicubic; thicker than
+    COUETTE_RATIO_MAX its closed-form tail, thinner than COUETTE_RATIO_MIN the factor of that film kept."""
+    ratio = (1.0 - eps) / roughness
+    if ratio >= COUETTE_RATIO_MAX:
+        return couette_factor_tail(eps, ratio)
+    ratio = max(ratio, COUETTE_RATIO_MIN)
+    iu, tu = _cell((1.0 - math.sqrt(max(1.0 - eps, 0.0))) * (N_CU - 1), N_CU)
+    ir, tr = _cell(math.log(ratio / COUETTE_RATIO_MIN) / LOG_COUETTE_STEP, N_CR)
+    wu = _catmull_rom(tu)
+    wr = _catmull_rom(tr)
+    total = 0.0
+    for a in range(4):
+        row = 0.0
+        for b in range(4):
+            row += wr[b] * COUETTE_TABLE[iu + a, ir + b]
+        total += wu[a] * row
+    return total
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -527,12 +570,23 @@ def film_force(ey: float, ez: float, vy: float, vz: float, omega_j: float, omega
 
 
 @njit(cache=True, error_model="numpy")
+def couette_torque(eps: float, omega_j: float, omega_b: float, c: float, radius: float, length: float,
+                   viscosity: float, model: int, roughness: float) -> float:
+    """The Couette (Petroff) part of the film's torque on the journal, N m (module docstring), times
+    :func:`couette_factor` for the finite film between rough surfaces (``roughness`` = sigma, m, > 0)."""
+    couette = viscosity * radius ** 3 * length * (omega_b - omega_j) * TWO_PI / (c * math.sqrt(1.0 - eps * eps))
+    if model == MODEL_FINITE and roughness > 0.0:
+        couette *= couette_factor(eps, roughness / c)
+    return couette
+
+
+@njit(cache=True, error_model="numpy")
 def rough_film_force(ey: float, ez: float, vy: float, vz: float, omega_j: float, omega_b: float, c: float,
                      radius: float, length: float, viscosity: float, model: int, roughness: float):
     """:func:`film_force` between rough surfaces of combined RMS roughness ``roughness`` (sigma, m; 0: smooth).
 
     ``MODEL_FINITE``: Patir and Cheng's average-flow film (:func:`rough_finite_force`) and their shear factor on
-    the Couette torque (:func:`weftsim.physics.flow_factors.couette_factor_at`, COUETTE_POINTS nodes); the
+    the Couette torque (:func:`couette_factor`, tabulated); the
     pressure-gradient torque -(e x F)_x / 2 keeps its smooth form.  The other models stay smooth.  sigma = 0
     is the smooth film bit for bit.
     """
@@ -569,8 +623,6 @@ def rough_film_force(ey: float, ez: float, vy: float, vz: float, omega_j: float,
         scale = viscosity * radius * radius * ratio * ratio * speed / c
         fy = scale * (f_along * ny - f_ahead * nz)
         fz = scale * (f_along * nz + f_ahead * ny)
-    couette = viscosity * radius ** 3 * length * (omega_b - omega_j) * TWO_PI / (c * math.sqrt(1.0 - eps * eps))
-    if rough:
-        couette *= couette_factor_at(eps, roughness / c, COUETTE_POINTS)
+    couette = couette_torque(eps, omega_j, omega_b, c, radius, length, viscosity, model, roughness)
     pressure = -0.5 * (ey * fz - ez * fy)
     return fy, fz, couette + pressure, -couette + pressure

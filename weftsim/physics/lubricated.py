@@ -8,13 +8,20 @@ at every eccentricity, in contact or not::
                                                             and boundary friction on their load
               + f_dry                                       the dry law beyond |e| = c (:mod:`.joint`)
 
-- **Film.** Evaluated at |e*| = min(|e|, c - h_floor), h_floor = ``film_floor_ratio`` sigma: below a film
-  of h_floor its pressure field is held (the smooth-surface Reynolds film means nothing much thinner than
-  the roughness) and the asperities carry the rest.  e* keeps the direction of e; e_dot* keeps the
-  radial rate d|e|/dt and the whirl rate (e x e_dot)/|e|^2 (its tangential part scaled by |e*|/|e|), so
-  the squeeze and wedge terms see the true motion.  The film force then stays finite where the dry law
-  starts (its squeeze term grows as (1 - eps^2)^-2.5 towards eps = 1).  The film's shear torques act on
-  journal and bearing; its power -(f.e_dot + T_j omega_j + T_b omega_b) is dissipated.
+- **Film.** Evaluated at the journal's eccentricity while h_min = c - abs(e) >= h_floor = ``film_floor_ratio`` sigma.
+  Below the floor it is continued, not held: evaluated at abs(e*) = c - h_floor (e* along e; e_dot* with the true
+  radial rate d abs(e)/dt and whirl rate (e x e_dot) / abs(e)^2, the tangential part scaled by abs(e*) / abs(e)),
+  its force grown by exp(x (n + k x / 2)), x = ln(h_floor / h_min), with n = -d ln abs(f) / d ln h_min and k = dn/dx
+  its slope and curvature at the floor (from two steps FLOOR_SLOPE_STEP h_floor above it; n in [0,
+  FLOOR_SLOPE_MAX], k in [0, FLOOR_CURVATURE_MAX]) and its direction turned by x times its turning rate at the
+  floor (within FLOOR_TURN_MAX), the Couette torque at the true film and the pressure torque
+  -(e x f)_x / 2 at the true e, down to the wall h = h_wall = FILM_WALL_RATIO sigma (sigma / 4, where the rough
+  film's table ends: :mod:`weftsim.physics.film`); below the wall all of it is held at the wall's value.  So the
+  floor is a numerical knob that does not decide the mixed regime (the film between the floor and the wall is the
+  film continued with its own slope and curvature, not a frozen field), and the film force stays finite where the
+  dry law starts (its squeeze term grows as (1 - eps^2)^-2.5 towards eps = 1).  A floor of sigma / 4 (the least)
+  is the wall.  The
+  film's shear torques act on journal and bearing; its power -(f.e_dot + T_j omega_j + T_b omega_b) is dissipated.
 - **Asperities.** F_a(|e|) of :func:`weftsim.physics.asperity.asperity_load`, zero while h_min >= 4 sigma, up to
   |e| = c; beyond c the dry law takes it over (:func:`asperity_share`: the solids carry max(F_a(c), F_el)
   elastically).  That elastic share has a potential U_a (stored); on it the asperities' hysteresis loop
@@ -27,7 +34,7 @@ at every eccentricity, in contact or not::
   lubricated joint's block carries mu_b as its mu, :func:`weftsim.physics.joint.joint_parameters`: the solids'
   contact in oil is boundary-lubricated, so the load the asperities hand over keeps its friction): zero at
   |e| = c and growing from there, so the total radial force is continuous in |e| (the film term is continuous and held
-  constant in |e| beyond its floor, the asperity share is continuous and falls as the dry law rises).
+  constant in |e| beyond its wall, the asperity share is continuous and falls as the dry law rises).
 
 Dissipated power of the film, the boundary friction and the asperities' hysteresis, the part of the power the
 asperity potential does not store: D' = -(f_l.e_dot + M_lj omega_j + M_lb omega_b) - F_s d|e|/dt.
@@ -40,13 +47,23 @@ import math
 from numba import njit
 
 from weftsim.physics.asperity import asperity_load
-from weftsim.physics.film import rough_film_force
+from weftsim.physics.film import RATIO_MIN, couette_torque, rough_film_force
 from weftsim.physics.joint import (
     ASPERITY_COEF, ASPERITY_HYSTERESIS, BEARING_LENGTH, BEARING_RADIUS, BOUNDARY_MU, CLEARANCE, COEF, FILM_FLOOR,
     FILM_MODEL, JOURNAL_RADIUS, KIND, LUBRICATED, ROUGHNESS, V0, V1, V_MIN, VISCOSITY, connector_friction_force_at,
     tangential_velocity,
 )  # fmt: skip
 from weftsim.physics.laws import elastic_energy, elastic_force, friction_factor
+
+# The film's wall h_wall = FILM_WALL_RATIO sigma: the rough film's table ends there (film.RATIO_MIN, the least floor).
+FILM_WALL_RATIO = RATIO_MIN
+# Below the floor ln abs(f) is continued in x = ln(h_floor / h_min) with its slope n and curvature k at the floor
+# (film_at_floor), from steps of FLOOR_SLOPE_STEP h_floor above it; n in [0, FLOOR_SLOPE_MAX] (the table's squeeze
+# film near the wall: n ~ 2.5), k in [0, FLOOR_CURVATURE_MAX] (the loom's pin at h_floor = sigma: n 1.2-1.7,
+# k 0.26-0.36).
+FLOOR_SLOPE_STEP, FLOOR_SLOPE_MAX, FLOOR_CURVATURE_MAX = 0.05, 3.0, 1.0
+# Its direction turns by at most this rate in x, rad (the pin's attitude at sigma: -0.1 rad per unit x).
+FLOOR_TURN_MAX = 0.5
 
 # Outputs of lubricated_force, in order (the channels of weftsim.joint.lubrication read them by these indices).
 (L_FX, L_FY, L_MJ, L_MB, L_FILM, L_ASPERITY, L_FILM_TORQUE, L_ASPERITY_ENERGY, L_DISSIPATED, L_FILM_POWER) = range(10)
@@ -58,25 +75,64 @@ def is_lubricated(prm) -> bool:
     return prm[LUBRICATED] != 0.0
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _film_along(prm, clearance: float, ex: float, ey: float, vx: float, vy: float, w_j: float, w_b: float,
+                length: float, at: float) -> tuple[float, float, float, float]:
+    """The film of the journal moved along e from abs(e) = ``length`` to ``at``, keeping its radial rate d abs(e)/dt
+    and its whirl rate (e x e_dot) / abs(e)^2 (the tangential rate scaled by at / length)."""
+    nx, ny = ex / length, ey / length
+    radial = vx * nx + vy * ny
+    scale = at / length
+    tx, ty = vx - radial * nx, vy - radial * ny
+    return rough_film_force(at * nx, at * ny, radial * nx + scale * tx, radial * ny + scale * ty, w_j, w_b, clearance,
+                            prm[JOURNAL_RADIUS], prm[BEARING_LENGTH], prm[VISCOSITY], int(prm[FILM_MODEL]),
+                            prm[ROUGHNESS])  # fmt: skip
+
+
 @njit(cache=True, error_model="numpy")
 def film_at_floor(prm, clearance: float, ex: float, ey: float, vx: float, vy: float, w_j: float,
                   w_b: float) -> tuple[float, float, float, float]:
-    """Film force on the journal and shear torques (f_x, f_y, T_j, T_b), N and N m, with |e| held at
-    c - h_floor at most (module docstring); zeros at zero viscosity."""
-    viscosity = prm[VISCOSITY]
-    if viscosity <= 0.0:
+    """Film force on the journal and shear torques (f_x, f_y, T_j, T_b), N and N m, continued below the film
+    floor h_floor with its slope, curvature and turning rate in ln h_min down to the wall h_wall (module
+    docstring); zeros at zero viscosity."""
+    if prm[VISCOSITY] <= 0.0:
         return 0.0, 0.0, 0.0, 0.0
+    sigma = prm[ROUGHNESS]
     length = math.sqrt(ex * ex + ey * ey)
-    cap = clearance - prm[FILM_FLOOR] * prm[ROUGHNESS]
-    if length > cap:
-        nx, ny = ex / length, ey / length
-        radial = vx * nx + vy * ny
-        scale = cap / length
-        tx, ty = vx - radial * nx, vy - radial * ny
-        ex, ey = cap * nx, cap * ny
-        vx, vy = radial * nx + scale * tx, radial * ny + scale * ty
-    return rough_film_force(ex, ey, vx, vy, w_j, w_b, clearance, prm[JOURNAL_RADIUS], prm[BEARING_LENGTH], viscosity,
-                            int(prm[FILM_MODEL]), prm[ROUGHNESS])  # fmt: skip
+    h_floor = prm[FILM_FLOOR] * sigma
+    if clearance - length >= h_floor:
+        return rough_film_force(ex, ey, vx, vy, w_j, w_b, clearance, prm[JOURNAL_RADIUS], prm[BEARING_LENGTH],
+                                prm[VISCOSITY], int(prm[FILM_MODEL]), sigma)  # fmt: skip
+    fx, fy, t_j, t_b = _film_along(prm, clearance, ex, ey, vx, vy, w_j, w_b, length, clearance - h_floor)
+    h_wall = FILM_WALL_RATIO * sigma
+    if h_floor <= h_wall:  # a floor at the wall: the film held there
+        return fx, fy, t_j, t_b
+    # ln abs(f) continued as a parabola in x = ln(h_floor / h): slope n and curvature k at the floor from two steps
+    # of FLOOR_SLOPE_STEP h_floor above it (the secants' slopes at their midpoints), k in [0, FLOOR_CURVATURE_MAX],
+    # n in [0, FLOOR_SLOPE_MAX].
+    step = math.log1p(FLOOR_SLOPE_STEP)
+    gx, gy, _, _ = _film_along(prm, clearance, ex, ey, vx, vy, w_j, w_b, length, clearance - h_floor * math.exp(step))
+    kx, ky, _, _ = _film_along(prm, clearance, ex, ey, vx, vy, w_j, w_b, length,
+                               clearance - h_floor * math.exp(2.0 * step))  # fmt: skip
+    f0, f1, f2 = math.hypot(fx, fy), math.hypot(gx, gy), math.hypot(kx, ky)
+    slope = curvature = turn = 0.0
+    if f0 > 0.0 and f1 > 0.0 and f2 > 0.0:
+        near, far = math.log(f0 / f1) / step, math.log(f1 / f2) / step
+        curvature = min(max((near - far) / step, 0.0), FLOOR_CURVATURE_MAX)
+        slope = min(max(near + 0.5 * curvature * step, 0.0), FLOOR_SLOPE_MAX)
+        # The force's direction (its attitude to e) turns linearly in x at the floor's rate, within FLOOR_TURN_MAX.
+        turn = math.atan2(gx * fy - gy * fx, gx * fx + gy * fy) / step
+        turn = min(max(turn, -FLOOR_TURN_MAX), FLOOR_TURN_MAX)
+    h = max(clearance - length, h_wall)
+    x = math.log(h_floor / h)
+    grow = math.exp(x * (slope + 0.5 * curvature * x))
+    cos_t, sin_t = math.cos(turn * x), math.sin(turn * x)
+    fx, fy = grow * (cos_t * fx - sin_t * fy), grow * (sin_t * fx + cos_t * fy)
+    at = (clearance - h) / length
+    couette = couette_torque((clearance - h) / clearance, w_j, w_b, clearance, prm[JOURNAL_RADIUS],
+                             prm[BEARING_LENGTH], prm[VISCOSITY], int(prm[FILM_MODEL]), sigma)  # fmt: skip
+    pressure = -0.5 * at * (ex * fy - ey * fx)
+    return fx, fy, couette + pressure, -couette + pressure
 
 
 HANDOVER_TOL = 1e-13  # relative: the penetration at which the dry law's elastic force reaches F_a(c)
