@@ -348,3 +348,30 @@ def test_progress_on_a_closed_stream_does_not_end_the_run():
     progress(0.9)
     progress.close()
     assert progress.stream is None
+
+
+def test_a_run_whose_steps_outgrow_the_memory_stops_and_keeps_them(monkeypatch):
+    """A run that records more steps than half the free memory holds (the loom's worn E and F wear update: 12
+    million rows, a MemoryError at 2.24 GiB) stops with one line naming the key that shortens it, its rows kept;
+    a wear update that fails so is not retried at a tighter tolerance (more steps).  The free memory is made
+    small here: budget 200 rows, reached within the first 1 % of a 0.2-revolution run (~1,700 rows), and by the wear update's whole run."""
+    import weftsim
+    from weftsim.checks import guards
+    from weftsim.wear.extrapolate import UpdateFailed, simulate_update
+
+    monkeypatch.setattr(guards, "free_memory", lambda: 2.0 * 200 * guards.ROW_BYTES)
+    scene = load_scene("reference", overrides={"drive.revolutions": 0.2})
+    result = weftsim.simulate(scene, "reference", progress=lambda fraction: None, on_warning=lambda text: None)
+    assert result.status == "failed" and result.solver_stats["failure"] == "memory"
+    assert "solver steps" in result.message and "wear.revolutions_per_update" in result.message
+    assert "\n" not in result.message
+    t = result.steps["time_s"]
+    assert 0.0 < t[-1] < scene.drive.end_time and t.size >= 200
+    wearing = load_scene("reference")
+    calls = []
+    real = weftsim.engines.simulate
+    monkeypatch.setattr(weftsim.engines, "simulate", lambda *a, **k: calls.append(a) or real(*a, **k))
+    bearing = journal = np.zeros(wearing.joint.wear.profile_points)
+    with pytest.raises(UpdateFailed, match="solver steps"):
+        simulate_update(wearing, bearing, journal)
+    assert len(calls) == 1

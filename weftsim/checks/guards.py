@@ -136,6 +136,39 @@ def step_collapse_hint(scene: Scene, step_advice: str) -> str:
             f"{step_advice}, or check the joint's stiffness and the contact law")
 
 
+# Bytes a recorded step row holds by the time a run's result is built: its time, state, contact mask and impact
+# velocities (up to ~16 doubles) and some 25 response channels, times three for the working copies the channels
+# are built through.  The loom with both pins worn records ~2.4 million rows a revolution (docs/wear.md
+# section 10), ~2.3 GiB of channels for one 5-revolution wear update.
+ROW_BYTES = 8 * 40 * 3
+
+
+def free_memory() -> float:
+    """The memory the machine can still give, bytes (Linux's MemAvailable; inf where it cannot be read)."""
+    try:
+        with open("/proc/meminfo") as meminfo:
+            for line in meminfo:
+                if line.startswith("MemAvailable:"):
+                    return float(line.split()[1]) * 1024.0
+    except OSError:
+        pass
+    return math.inf
+
+
+def memory_breach(rows: int, budget: float) -> Breach | None:
+    """A breach when ``rows`` recorded steps would take more than ``budget`` bytes (at :data:`ROW_BYTES` each),
+    else None: a run stopped here keeps its rows and says why, where it would end in a MemoryError or swap."""
+    if rows * ROW_BYTES <= budget:
+        return None
+    return Breach(
+        "memory",
+        f"the run has recorded {rows:,} solver steps, about {rows * ROW_BYTES / 2**30:.2f} GiB with their "
+        f"channels, more than half the memory that was free when it started ({budget / 2**30:.2f} GiB)",
+        "simulate fewer revolutions (a wear prediction: a smaller wear.revolutions_per_update), a looser "
+        "tolerance, or free memory",
+    )
+
+
 class RunGuard:
     """The ``[limits]`` of one run, checked step by step.
 

@@ -14,7 +14,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.checks.guards import RunGuard, failure_message, non_finite_breach
+from weftsim.checks import guards
+from weftsim.checks.guards import RunGuard, failure_message, memory_breach, non_finite_breach
 from weftsim.input.params import Scene
 from weftsim.reference.compiled import (
     DECOMPOSITIONS, DENSE, DONE, EVENTS, IMPLICIT_STEPS, JACOBIANS, FIRST_CONTACT, FIRST_CONTACT_F, GUARD, IMPACTS, LAST_PENETRATION, LAST_PENETRATION_F,
@@ -93,11 +94,14 @@ def integrate_compiled(scene: Scene, progress: Callable[[float], None] | None = 
     rtol_asked = settings.rtol if rtol is None else rtol
     rtol = max(rtol_asked, 100.0 * np.finfo(float).eps)
     steps_seen = 0
+    recorded = 1  # rows in chunks
+    memory = 0.5 * guards.free_memory()  # the rows' budget: half of what the machine can give now
     while True:
         t_pause = next_report * t_end if pausing else 2.0 * t_end
         code, rows = advance(prm, code_method, rtol, settings.atol, settings.max_step / omega, t_end,
                              t_pause, limits, y, f, fst, ist, sample_times, *smp, *stp)  # fmt: skip
         chunks.append(tuple(b[:rows].copy() for b in stp))
+        recorded += rows
         t = fst[T]
         breach = None
         if code == GUARD:
@@ -111,6 +115,8 @@ def integrate_compiled(scene: Scene, progress: Callable[[float], None] | None = 
             breach = non_finite_breach("the right-hand side or the state turned non-finite (NaN or inf)")
         elif code != DONE:
             breach = guard.check(steps=int(ist[STEPS]) - steps_seen)  # the wall-time budget
+        if breach is None:  # checked at every return of advance: the rows overshoot by one buffer at most
+            breach = memory_breach(recorded, memory)
         steps_seen = int(ist[STEPS])
         if breach is not None:
             status, failure = "failed", breach.kind

@@ -288,6 +288,8 @@ def simulate_update(scene: Scene, bearing: np.ndarray, journal: np.ndarray,
             break
         if stop_requested() is not None or result.solver_stats.get("failure") == "interrupted":
             raise WearInterrupted(result.message)
+        if result.solver_stats.get("failure") == "memory":  # a tighter tolerance records more steps
+            raise UpdateFailed(f"the simulation on the worn geometry failed: {result.message}")
     else:
         raise UpdateFailed(f"the simulation on the worn geometry failed (also at rtol {RETRY_RTOL:g} and with "
                            f"{IMPLICIT_METHOD}): {result.message}")
