@@ -357,9 +357,10 @@ def test_a_run_whose_steps_outgrow_the_memory_stops_and_keeps_them(monkeypatch):
     small here: budget 200 rows, reached within the first 1 % of a 0.2-revolution run (~1,700 rows), and by the wear update's whole run."""
     import weftsim
     from weftsim.checks import guards
+    from weftsim.post import npz_guard
     from weftsim.wear.extrapolate import UpdateFailed, simulate_update
 
-    monkeypatch.setattr(guards, "free_memory", lambda: 2.0 * 200 * guards.ROW_BYTES)
+    monkeypatch.setattr(npz_guard, "available_memory", lambda: 2 * 200 * guards.ROW_BYTES)
     scene = load_scene("reference", overrides={"drive.revolutions": 0.2})
     result = weftsim.simulate(scene, "reference", progress=lambda fraction: None, on_warning=lambda text: None)
     assert result.status == "failed" and result.solver_stats["failure"] == "memory"

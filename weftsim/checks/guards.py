@@ -143,18 +143,6 @@ def step_collapse_hint(scene: Scene, step_advice: str) -> str:
 ROW_BYTES = 8 * 40 * 3
 
 
-def free_memory() -> float:
-    """The memory the machine can still give, bytes (Linux's MemAvailable; inf where it cannot be read)."""
-    try:
-        with open("/proc/meminfo") as meminfo:
-            for line in meminfo:
-                if line.startswith("MemAvailable:"):
-                    return float(line.split()[1]) * 1024.0
-    except OSError:
-        pass
-    return math.inf
-
-
 def memory_breach(rows: int, budget: float) -> Breach | None:
     """A breach when ``rows`` recorded steps would take more than ``budget`` bytes (at :data:`ROW_BYTES` each),
     else None: a run stopped here keeps its rows and says why, where it would end in a MemoryError or swap."""

@@ -14,7 +14,6 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from weftsim.checks import guards
 from weftsim.checks.guards import RunGuard, failure_message, memory_breach, non_finite_breach
 from weftsim.input.params import Scene
 from weftsim.reference.compiled import (
@@ -24,6 +23,7 @@ from weftsim.reference.compiled import (
     advance,
 )  # fmt: skip
 from weftsim.physics.chain_f import N_JOINTS
+from weftsim.post import npz_guard
 from weftsim.model.dynamics import initial_state, pack_parameters
 from weftsim.reference.integrate import _PROGRESS_EVERY
 from weftsim.post.results import RunResult
@@ -95,7 +95,8 @@ def integrate_compiled(scene: Scene, progress: Callable[[float], None] | None = 
     rtol = max(rtol_asked, 100.0 * np.finfo(float).eps)
     steps_seen = 0
     recorded = 1  # rows in chunks
-    memory = 0.5 * guards.free_memory()  # the rows' budget: half of what the machine can give now
+    available = npz_guard.available_memory()  # the rows' budget: half of what the machine can give now
+    memory = math.inf if available is None else 0.5 * available
     while True:
         t_pause = next_report * t_end if pausing else 2.0 * t_end
         code, rows = advance(prm, code_method, rtol, settings.atol, settings.max_step / omega, t_end,
