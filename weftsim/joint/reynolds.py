@@ -119,7 +119,7 @@ def assemble(nodes: np.ndarray, node_h3: np.ndarray, face_h3: np.ndarray, half_w
 
 
 def _film_pressure(matrix, active: np.ndarray, q: np.ndarray, n_zeta: int) -> np.ndarray:
-    """P solving K_AA P_A = q_A on the film's nodes A (``active``), 0 elsewhere.
+    """P solving K_AA P_A = q_A on the film's nodes A (``active``), 0 elsewhere (q: a vector, or columns).
 
     Where a whole line phi_i has no film, the film is a strip, not a ring: numbered from the line after that one,
     K_AA is banded (half-bandwidth n_zeta: the next line's node is at most n_zeta unknowns on) and solved by
@@ -135,7 +135,7 @@ def _film_pressure(matrix, active: np.ndarray, q: np.ndarray, n_zeta: int) -> np
         pressure[idx] = spsolve(matrix[idx][:, idx].tocsc(), q[idx])
         return pressure
     first = int(np.argmin(lines))  # a line without film: the strip starts after it
-    order = np.roll(np.arange(q.size).reshape(-1, n_zeta), -first, axis=0).ravel()
+    order = np.roll(np.arange(q.shape[0]).reshape(-1, n_zeta), -first, axis=0).ravel()
     idx = order[active[order]]
     sub = matrix[idx][:, idx]
     band = np.zeros((n_zeta + 1, idx.size))
