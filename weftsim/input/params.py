@@ -230,6 +230,9 @@ class Lubrication:
         delta, the mean height of the asperity summits above the surfaces' mean planes (both surfaces'
         together), m: Greenwood and Tripp's pressure is taken at the separation h - delta (MBDyn's "asperity mean
         height").  Used by the elastic film only (refused > 0 without it).  Default 0.
+    pressure_viscosity : float
+        Barus' pressure-viscosity coefficient alpha, 1/Pa: the film's viscosity eta exp(alpha p) (mineral oils
+        1-3e-8).  Used by the elastic film only (refused > 0 without it).  Default 0 (isoviscous).
     asperity_modulus : float
         E* of the asperity contact, Pa, where a source gives it apart from the parts' moduli (0: the joint's
         effective modulus from its two materials, the default).
@@ -262,6 +265,7 @@ class Lubrication:
     film_floor_ratio: float = 1.0
     elastic_film: bool = False
     summit_height: float = 0.0
+    pressure_viscosity: float = 0.0
     asperity_modulus: float = 0.0
     oil: str = ""
     oil_nu40: float = 0.0
@@ -335,6 +339,12 @@ def lubrication_problem(lub: Lubrication) -> str | None:
     if delta > 0.0 and not lub.elastic_film:
         return ("`lubrication.summit_height` is used by the elastic film only (the rigid kernel's asperities touch "
                 f"at h = 4 sigma): set `lubrication.elastic_film` = true or summit_height = 0, got {delta!r}")
+    alpha = lub.pressure_viscosity
+    if not (_number(alpha) and 0.0 <= alpha <= 1e-7):
+        return f"`lubrication.pressure_viscosity` must be in [0, 1e-7] (1/Pa, Barus' alpha), got {alpha!r}"
+    if alpha > 0.0 and not lub.elastic_film:
+        return ("`lubrication.pressure_viscosity` is used by the elastic film only (the rigid kernel's film is "
+                f"isoviscous): set `lubrication.elastic_film` = true or pressure_viscosity = 0, got {alpha!r}")
     if not (_number(lub.asperity_modulus) and lub.asperity_modulus >= 0.0):
         return f"`lubrication.asperity_modulus` must be >= 0 (Pa; 0 = the joint's effective modulus), got {lub.asperity_modulus!r}"
     return oil_problem(lub)

@@ -149,6 +149,9 @@ def LUBRICATION_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 -
         Key(at + "summit_height_um", to + "summit_height", "float", 1e-6, 0, 4 * ROUGHNESS_UM, False,
             doc="mean height of the asperity summits above the mean planes (both surfaces): Greenwood-Tripp at "
                 "h - delta (elastic film only; default 0)"),
+        Key(at + "pressure_viscosity_per_gpa", to + "pressure_viscosity", "float", 1e-9, 0, 100, False,
+            doc="Barus' pressure-viscosity coefficient alpha, 1/GPa (mineral oils 10-30; elastic film only; "
+                "default 0: isoviscous)"),
         Key(at + "asperity_modulus_gpa", to + "asperity_modulus", "float", GPA, 0, 1e4, False,
             doc="E* of the asperity contact where a source gives it apart from the materials (default 0: the "
                 "joint's effective modulus)"),

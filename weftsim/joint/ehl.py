@@ -89,6 +89,7 @@ class Pair:
     boundary_mu: float
     summit_height: float  # delta, m
     moduli: tuple[float, float, float, float]  # E_j, nu_j, E_b, nu_b
+    pressure_viscosity: float = 0.0  # Barus' alpha, 1/Pa
 
     @classmethod
     def of(cls, joint) -> Pair:
@@ -100,7 +101,8 @@ class Pair:
         return cls(joint.journal_radius, joint.bearing_radius, joint.clearance, joint.bearing_length, lub.roughness,
                    float(prm[ASPERITY_COEF]), lub.boundary_friction_coefficient, lub.summit_height,
                    (joint.journal_material.youngs_modulus, joint.journal_material.poisson_ratio,
-                    joint.bearing_material.youngs_modulus, joint.bearing_material.poisson_ratio))
+                    joint.bearing_material.youngs_modulus, joint.bearing_material.poisson_ratio),
+                   lub.pressure_viscosity)
 
 
 def _f52(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -139,6 +141,7 @@ class _Film:
         self.wall = FILM_WALL_RATIO * self.r
         self.offset = pair.summit_height / pair.sigma
         self.asperity = pair.asperity_coef / self.scale
+        self.alpha_full = pair.pressure_viscosity * self.scale  # Barus' alpha in the pressure scale
         n = self.nodes.size
         if rigid:
             self.gamma = (np.zeros((n, n)),) * 3
@@ -158,9 +161,12 @@ class _Film:
             up = _periodic_interpolation(self.nodes, fine)
             self.gamma_fine = (self.scale / c) * np.fft.irfft(gains[:, None] * np.fft.rfft(up, axis=0),
                                                               n=FINE_POINTS, axis=0)
-        self.width = None
-        self.fraction = 1.0
+        self.fraction = 1.0  # the continuation's share of the compliance and of alpha
         self.active = None
+
+    @property
+    def alpha(self) -> float:
+        return self.fraction * self.alpha_full
 
     def heights(self) -> np.ndarray:
         """The cells' heights in zeta (half a cell at the mid-plane; :func:`weftsim.joint.reynolds.assemble`)."""
@@ -180,12 +186,24 @@ class _Film:
 
         hn, hf, hd = self.gaps(s, eps)
         hn_film, hf_film = np.maximum(hn, self.wall), np.maximum(hf, self.wall)
-        f_along, f_ahead, field, matrix, volume = solve_gap(self.nodes, hn_film, hf_film, hd, self.half_width,
-                                                            self.n_zeta, self.r, True, self.active)
-        self.active = field > 0.0
+        _, _, reduced, matrix, volume = solve_gap(self.nodes, hn_film, hf_film, hd, self.half_width, self.n_zeta,
+                                                  self.r, True, self.active)
+        self.active = reduced > 0.0
+        # Barus: the film's pressure from the reduced pressure Q that Reynolds' equation of eta_0 gives
+        # (Q = (1 - exp(-alpha p)) / alpha), P = -ln(1 - alpha Q) / alpha; no finite P where alpha Q >= 1.
+        if self.alpha > 0.0:
+            inner = 1.0 - self.alpha * reduced
+            if inner.min() <= 0.0:
+                return np.full(s.size + 1, np.inf), None, None
+            field, stretch = -np.log(inner) / self.alpha, 1.0 / inner
+        else:
+            field, stretch = reduced, None
         dzeta = self.heights()
         width = volume[:, 0] / dzeta[0]
         mean = field @ dzeta / self.half_width
+        load = 2.0 * field * volume
+        f_along = -float(np.sum(load * np.cos(self.nodes)[:, None]))
+        f_ahead = -float(np.sum(load * np.sin(self.nodes)[:, None]))
         fa, dfa = _f52(hn / self.r - self.offset)
         p_a = self.asperity * fa
         ring = 2.0 * self.half_width * width  # the asperity pressure's area weight per node (both halves)
@@ -193,15 +211,15 @@ class _Film:
         f_ahead -= float(np.sum(ring * p_a * np.sin(self.nodes)))
         force = math.hypot(f_along, f_ahead)
         res = np.concatenate((s - (mean + p_a), [force - self.load]))
-        state = {"hn": hn, "hd": hd, "field": field, "volume": volume, "p_a": p_a, "ring": ring, "width": width,
+        state = {"hn": hn, "hd": hd, "field": field, "reduced": reduced, "volume": volume, "p_a": p_a, "ring": ring, "width": width,
                  "force": (f_along, f_ahead)}
         if not jacobian:
             return res, state
-        jac = self._jacobian(s, eps, hn, hf, hd, hn_film, hf_film, field, matrix, volume, dzeta, width, dfa, ring,
-                             (f_along, f_ahead), force)
+        jac = self._jacobian(hn, hf, hd, hn_film, hf_film, reduced, stretch, matrix, volume, dzeta, width, dfa,
+                             ring, (f_along, f_ahead), force)
         return res, state, jac
 
-    def _jacobian(self, s, eps, hn, hf, hd, hn_film, hf_film, field, matrix, volume, dzeta, width, dfa, ring,
+    def _jacobian(self, hn, hf, hd, hn_film, hf_film, field, stretch, matrix, volume, dzeta, width, dfa, ring,
                   forces, force):
         from weftsim.joint.reynolds import _film_pressure
         from weftsim.physics.flow_factors import contact_factor
@@ -243,6 +261,8 @@ class _Film:
         active = field.ravel() > 0.0
         dp = -_film_pressure(matrix, active, b, nz)  # K_AA dP_A = -b_A (banded Cholesky on the film's strip)
         dp = dp.reshape(n, nz, n + 1)
+        if stretch is not None:  # dP = dQ / (1 - alpha Q)
+            dp *= stretch[:, :, None]
         dmean = np.einsum("ijk,j->ik", dp, dzeta) / self.half_width
         dpa = (self.asperity * dfa / r)[:, None] * x_n
         top = -(dmean + dpa)
@@ -262,6 +282,8 @@ def _newton(film: _Film, s: np.ndarray, eps: float):
     """Newton with backtracking on (s, eps) at the film's current compliance fraction; (s, eps, its, norm)."""
     res, _, jac = film.evaluate(s, eps, True)
     norm = film.norm(res)
+    if jac is None:
+        return s, eps, 0, norm
     for it in range(1, MAX_ITERATIONS + 1):
         step = np.linalg.solve(jac, -res)
         alpha = 1.0
@@ -269,8 +291,10 @@ def _newton(film: _Film, s: np.ndarray, eps: float):
             s_new, eps_new = s + alpha * step[:-1], eps + alpha * step[-1]
             res_new, _, jac_new = film.evaluate(s_new, eps_new, True)
             norm_new = film.norm(res_new)
-            if norm_new < norm or alpha < 1e-3:
+            if norm_new < norm or (alpha < 1e-3 and jac_new is not None):
                 break
+            if alpha < 1e-6:
+                return s, eps, it, norm
             alpha *= 0.5
         s, eps, res, jac, norm = s_new, eps_new, res_new, jac_new, norm_new
         if norm <= TOLERANCE:
@@ -288,9 +312,10 @@ def elastic_point(pair: Pair, load: float, omega: float, viscosity: float, eps0:
 
     film = _Film(pair, load, omega, viscosity, eps0, rigid)
     n = film.nodes.size
-    start = (np.zeros(n), eps0)
-    _, state = film.evaluate(*start, False)
+    film.fraction = 0.0  # the rigid isoviscous film's pressure starts the iteration
+    _, state = film.evaluate(np.zeros(n), eps0, False)
     s0 = state["field"] @ film.heights() / film.half_width + state["p_a"]
+    film.fraction, film.active = 1.0, None
     s, eps, its, norm = _newton(film, s0, eps0)
     total = its
     if norm > TOLERANCE and not rigid:
@@ -323,6 +348,11 @@ def elastic_point(pair: Pair, load: float, omega: float, viscosity: float, eps0:
     else:
         phi_f = np.ones_like(h_fine)
     couette = viscosity * omega * radius**3 * pair.length / c * float(np.mean(phi_f / h_fine)) * 2.0 * math.pi
+    if film.alpha > 0.0:  # the film's viscosity exp(alpha p) over eta_0 where it is pressed: its excess on the nodes
+        hn = np.maximum(state["hn"], film.wall)
+        phi_n = np.array([shear_factor(h / film.r) for h in hn]) if pair.sigma > 0.0 else np.ones_like(hn)
+        excess = np.expm1(film.alpha * state["field"]) * (phi_n / hn)[:, None] * state["volume"]
+        couette += viscosity * omega * radius**3 * pair.length / c * float(np.sum(excess)) / film.half_width
     pressure_torque = -film.scale * c * radius**2 * float(np.sum(state["field"] * state["volume"]
                                                                   * state["hd"][:, None])) * 2.0 / 2.0
     normal = film.scale * radius**2 * float(np.sum(ring * p_a))
