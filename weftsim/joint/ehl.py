@@ -63,6 +63,7 @@ class ElasticPoint:
     min_film_m: float
     film_force_n: float
     asperity_load_n: float
+    carried_load_n: float  # abs(film force + asperity force): the load, to the residual
     friction_torque_nm: float
     couette_torque_nm: float
     pressure_torque_nm: float
@@ -126,14 +127,15 @@ def _conductance_slope(gap: np.ndarray, roughness: float) -> np.ndarray:
 class _Film:
     """The discrete problem of one operating point: grid, compliance, scales (module docstring)."""
 
-    def __init__(self, pair: Pair, load: float, omega: float, viscosity: float, eps0: float, rigid: bool):
+    def __init__(self, pair: Pair, load: float, omega: float, viscosity: float, eps0: float, rigid: bool,
+                 grid: tuple[int, int]):
         from weftsim.joint.elastic_film import FINE_POINTS, film_compliance
-        from weftsim.joint.reynolds import N_PHI, N_ZETA, _angles
+        from weftsim.joint.reynolds import _angles
         from weftsim.physics.lubricated import FILM_WALL_RATIO
 
-        self.pair, self.n_zeta = pair, N_ZETA
+        self.pair, self.n_zeta = pair, grid[1]
         c, radius = pair.clearance, pair.radius
-        self.nodes, self.faces = _angles(min(eps0, 0.99), N_PHI)
+        self.nodes, self.faces = _angles(min(eps0, 0.99), grid[0])
         self.half_width = 0.5 * pair.length / radius
         self.scale = viscosity * (radius / c) ** 2 * 0.5 * omega  # p_s, Pa
         self.load = load / (self.scale * radius**2)
@@ -302,15 +304,17 @@ def _newton(film: _Film, s: np.ndarray, eps: float):
     return s, eps, MAX_ITERATIONS, norm
 
 
-def elastic_point(pair: Pair, load: float, omega: float, viscosity: float, eps0: float,
-                  rigid: bool = False) -> ElasticPoint:
+def elastic_point(pair: Pair, load: float, omega: float, viscosity: float, eps0: float, rigid: bool = False,
+                  grid: tuple[int, int] | None = None) -> ElasticPoint:
     """The :class:`ElasticPoint` of ``pair`` under ``load`` (N) at journal speed ``omega`` (rad/s), viscosity
     ``viscosity`` (Pa s), from the rigid film's eccentricity ratio ``eps0`` (the kernel's,
     :func:`weftsim.joint.steady.steady_point`); ``rigid``: no deformation (Gamma = 0).  Refuses (SceneError, one
-    line) a point Newton does not converge on."""
+    line) a point Newton does not converge on.  ``grid``: (n_phi, n_zeta) of the Reynolds grid (default the
+    kernel table's, :data:`weftsim.joint.reynolds.N_PHI` x ``N_ZETA``)."""
+    from weftsim.joint.reynolds import N_PHI, N_ZETA
     from weftsim.physics.flow_factors import shear_factor
 
-    film = _Film(pair, load, omega, viscosity, eps0, rigid)
+    film = _Film(pair, load, omega, viscosity, eps0, rigid, (N_PHI, N_ZETA) if grid is None else grid)
     n = film.nodes.size
     film.fraction = 0.0  # the rigid isoviscous film's pressure starts the iteration
     _, state = film.evaluate(np.zeros(n), eps0, False)
@@ -360,7 +364,8 @@ def elastic_point(pair: Pair, load: float, omega: float, viscosity: float, eps0:
     opening = film.gamma_fine @ s
     return ElasticPoint(float(eps), float(math.degrees(math.atan2(abs(f_ahead), -f_along))),
                         float(c * h_fine.min()), float(scale_f * math.hypot(film_along, film_ahead)),
-                        float(scale_f * asp), float(couette + pressure_torque + boundary), float(couette),
+                        float(scale_f * asp), float(scale_f * math.hypot(f_along, f_ahead)),
+                        float(couette + pressure_torque + boundary), float(couette),
                         float(pressure_torque), float(boundary),
                         float(film.scale * (state["field"].max() + p_a.max())), float(c * opening.max()),
                         int(total), float(norm))
