@@ -201,7 +201,7 @@ def figure(rig, floored, elastic, path: Path) -> None:
             spent = (time.perf_counter() - start) / (CURVE_RPM.size * len(r.bearings))
             print(f"{name}, {case['load_n'] / 1e3:g} kN: least torque {min(curve):.3f} N m at "
                   f"{CURVE_RPM[int(np.argmin(curve))]:.0f} rpm (grid of {CURVE_RPM.size} speeds; "
-                  f"{1e3 * spent:.0f} ms a bearing's point)")
+                  f"{1e3 * spent:.1f} ms a bearing's point)")
             ax.plot(CURVE_RPM, curve, style, label=name)
         ax.axvline(case["minimum_rpm"], color="0.6", lw=0.8, ls=":")
         ax.set_xscale("log")
