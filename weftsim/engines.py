@@ -272,6 +272,11 @@ def simulate(scene: Scene | str | os.PathLike, engine: str = "auto", *,
     problem = exchange_problem(scene)  # e.g. an ideal taker of a tape that rapier_tape.model = 'auto' runs flexible
     if problem:
         raise SceneError(f"scene {scene.name}: {problem}")
+    for attr, table in (("joint", "joint_e"), ("joint_f", "joint_f")):
+        lub = getattr(scene, attr).lubrication
+        if lub is not None and lub.elastic_film:
+            raise SceneError(f"scene {scene.name}: {table}.lubrication.elastic_film = true is the steady elastic film "
+                             f"of `weftsim bearing` only; the transient engines run the rigid film: set it false")
     if engine == AUTO:  # a flexible rapier tape runs on the reference engine (resolve)
         chosen = get(resolve(engine, scene))
     if any(getattr(scene, attr).lubrication is not None and getattr(scene, attr).lubrication.has_oil

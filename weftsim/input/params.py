@@ -222,6 +222,20 @@ class Lubrication:
         below it with its slope, curvature and turning rate there (:func:`weftsim.physics.lubricated.film_at_floor`)
         down to the wall sigma / 4, where it is held, so it stays finite where the dry law starts (e = c).  In
         [0.25, 4] (the rough film's table reaches sigma / 4); default 1 (film ratio 1).
+    elastic_film : bool
+        ``weftsim bearing`` solves the steady point with the surfaces' elastic deformation under the film's and the
+        asperities' pressure (:mod:`weftsim.joint.ehl`; moduli of ``journal_material`` and ``bearing_material``).
+        The transient engines keep the rigid film (a transient run refuses the key).  Default False.
+    summit_height : float
+        delta, the mean height of the asperity summits above the surfaces' mean planes (both surfaces'
+        together), m: Greenwood and Tripp's pressure is taken at the separation h - delta (MBDyn's "asperity mean
+        height").  Used by the elastic film only (refused > 0 without it).  Default 0.
+    pressure_viscosity : float
+        Barus' pressure-viscosity coefficient alpha, 1/Pa: the film's viscosity eta exp(alpha p) (mineral oils
+        1-3e-8).  Used by the elastic film only (refused > 0 without it).  Default 0 (isoviscous).
+    asperity_modulus : float
+        E* of the asperity contact, Pa, where a source gives it apart from the parts' moduli (0: the joint's
+        effective modulus from its two materials, the default).
     oil : str
         An ISO 3448 grade (``"ISO VG 220"``, :func:`weftsim.physics.oil.grade_names`): the viscosity then follows
         from the film's temperature (:mod:`weftsim.joint.heat`) instead of ``viscosity``.  Empty: not given.
@@ -249,6 +263,10 @@ class Lubrication:
     roughness_radius_ratio: float = 1e-3
     boundary_friction_coefficient: float = 0.1
     film_floor_ratio: float = 1.0
+    elastic_film: bool = False
+    summit_height: float = 0.0
+    pressure_viscosity: float = 0.0
+    asperity_modulus: float = 0.0
     oil: str = ""
     oil_nu40: float = 0.0
     oil_nu100: float = 0.0
@@ -312,6 +330,23 @@ def lubrication_problem(lub: Lubrication) -> str | None:
     if not (_number(floor) and 0.25 <= floor <= 4.0):
         return (f"`lubrication.film_floor_ratio` must be in [0.25, 4] (film floor / sigma; the rough film is tabulated "
                 f"down to h_min = sigma / 4), got {floor!r}")
+    if not isinstance(lub.elastic_film, bool):
+        return f"`lubrication.elastic_film` must be true or false, got {lub.elastic_film!r}"
+    delta = lub.summit_height
+    if not (_number(delta) and 0.0 <= delta <= 4.0 * lub.roughness):
+        return (f"`lubrication.summit_height` must be in [0, 4 sigma] (m, the summits' mean height above the mean "
+                f"planes; sigma = {lub.roughness:.3g} m), got {delta!r}")
+    if delta > 0.0 and not lub.elastic_film:
+        return ("`lubrication.summit_height` is used by the elastic film only (the rigid kernel's asperities touch "
+                f"at h = 4 sigma): set `lubrication.elastic_film` = true or summit_height = 0, got {delta!r}")
+    alpha = lub.pressure_viscosity
+    if not (_number(alpha) and 0.0 <= alpha <= 1e-7):
+        return f"`lubrication.pressure_viscosity` must be in [0, 1e-7] (1/Pa, Barus' alpha), got {alpha!r}"
+    if alpha > 0.0 and not lub.elastic_film:
+        return ("`lubrication.pressure_viscosity` is used by the elastic film only (the rigid kernel's film is "
+                f"isoviscous): set `lubrication.elastic_film` = true or pressure_viscosity = 0, got {alpha!r}")
+    if not (_number(lub.asperity_modulus) and lub.asperity_modulus >= 0.0):
+        return f"`lubrication.asperity_modulus` must be >= 0 (Pa; 0 = the joint's effective modulus), got {lub.asperity_modulus!r}"
     return oil_problem(lub)
 
 

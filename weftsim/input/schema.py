@@ -143,6 +143,18 @@ def LUBRICATION_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 -
         Key(at + "film_floor_ratio", to + "film_floor_ratio", "float", 1, 0.25, 4, False,
             doc="the film force is evaluated down to this many RMS roughnesses and continued below it with its slope "
                 "there, to sigma / 4 (default 1; a numerical knob: docs/lubricated-joint.md)"),
+        Key(at + "elastic_film", to + "elastic_film", "bool",
+            doc="weftsim bearing: the steady point with the surfaces' elastic deformation (EHL, plane strain, moduli "
+                "of journal_material and bearing_material; default false; transient runs refuse it)"),
+        Key(at + "summit_height_um", to + "summit_height", "float", 1e-6, 0, 4 * ROUGHNESS_UM, False,
+            doc="mean height of the asperity summits above the mean planes (both surfaces): Greenwood-Tripp at "
+                "h - delta (elastic film only; default 0)"),
+        Key(at + "pressure_viscosity_per_gpa", to + "pressure_viscosity", "float", 1e-9, 0, 100, False,
+            doc="Barus' pressure-viscosity coefficient alpha, 1/GPa (mineral oils 10-30; elastic film only; "
+                "default 0: isoviscous)"),
+        Key(at + "asperity_modulus_gpa", to + "asperity_modulus", "float", GPA, 0, 1e4, False,
+            doc="E* of the asperity contact where a source gives it apart from the materials (default 0: the "
+                "joint's effective modulus)"),
         # The oil and the heat balance (weftsim.physics.oil, weftsim.joint.heat): instead of viscosity_mpa_s.
         Key(at + "oil", to + "oil", "str",
             doc="an ISO 3448 grade (\"ISO VG 220\"): the viscosity follows from the film temperature of the "

@@ -59,7 +59,11 @@ def _conductance(eps: float, angles: np.ndarray, roughness: float) -> np.ndarray
 
     ``roughness`` = sigma / c (0: smooth surfaces, phi_x = 1).
     """
-    gap = 1.0 - eps * np.cos(angles)
+    return conductance_of(1.0 - eps * np.cos(angles), roughness)
+
+
+def conductance_of(gap: np.ndarray, roughness: float) -> np.ndarray:
+    """H^3 phi_x(c H / sigma) of the dimensionless gap H (``roughness`` = sigma / c; 0: smooth, H^3)."""
     if roughness <= 0.0:
         return gap**3
     return gap**3 * pressure_flow_factor(gap / roughness)
@@ -73,14 +77,21 @@ def operator(eps: float, half_width: float, n_phi: int, n_zeta: int, roughness: 
     = sigma / c: the average-flow conductance phi_x H^3 (:mod:`weftsim.physics.flow_factors`).
     """
     nodes, faces = _angles(eps, n_phi)
+    matrix, volume = assemble(nodes, _conductance(eps, nodes, roughness), _conductance(eps, faces, roughness),
+                              half_width, n_zeta)
+    return matrix, nodes, volume
+
+
+def assemble(nodes: np.ndarray, node_h3: np.ndarray, face_h3: np.ndarray, half_width: float, n_zeta: int):
+    """K (sparse, SPD) and the cell volumes of the half film on the increasing angles ``nodes`` (one turn from
+    -pi, faces midway in the mapped angle), with the conductances H^3 phi_x at the nodes (axial fluxes) and at
+    the faces phi_{i+1/2} (circumferential fluxes): :func:`operator`'s, for any gap."""
     dz = half_width / n_zeta
     gap = np.diff(np.concatenate((nodes, [nodes[0] + 2.0 * math.pi])))  # phi_{i+1} - phi_i
-    face_h3 = _conductance(eps, faces, roughness)
     width = 0.5 * (gap + np.roll(gap, 1))  # control-volume width in phi
-    node_h3 = _conductance(eps, nodes, roughness)
     dzeta = np.full(n_zeta, dz)
     dzeta[0] = 0.5 * dz  # the mid-plane cell is half a cell
-    index = np.arange(n_phi * n_zeta).reshape(n_phi, n_zeta)
+    index = np.arange(nodes.size * n_zeta).reshape(nodes.size, n_zeta)
     rows, cols, vals = [], [], []
     # Circumferential fluxes: conductance H^3 / gap times the cell height in zeta.
     g_phi = (face_h3 / gap)[:, None] * dzeta[None, :]
@@ -101,14 +112,14 @@ def operator(eps: float, half_width: float, n_phi: int, n_zeta: int, roughness: 
     rows.append(index[:, -1])
     cols.append(index[:, -1])
     vals.append(g_z[:, -1])
-    size = n_phi * n_zeta
+    size = nodes.size * n_zeta
     matrix = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(size, size))
     volume = width[:, None] * dzeta[None, :]
-    return matrix, nodes, volume
+    return matrix, volume
 
 
 def _film_pressure(matrix, active: np.ndarray, q: np.ndarray, n_zeta: int) -> np.ndarray:
-    """P solving K_AA P_A = q_A on the film's nodes A (``active``), 0 elsewhere.
+    """P solving K_AA P_A = q_A on the film's nodes A (``active``), 0 elsewhere (q: a vector, or columns).
 
     Where a whole line phi_i has no film, the film is a strip, not a ring: numbered from the line after that one,
     K_AA is banded (half-bandwidth n_zeta: the next line's node is at most n_zeta unknowns on) and solved by
@@ -124,7 +135,7 @@ def _film_pressure(matrix, active: np.ndarray, q: np.ndarray, n_zeta: int) -> np
         pressure[idx] = spsolve(matrix[idx][:, idx].tocsc(), q[idx])
         return pressure
     first = int(np.argmin(lines))  # a line without film: the strip starts after it
-    order = np.roll(np.arange(q.size).reshape(-1, n_zeta), -first, axis=0).ravel()
+    order = np.roll(np.arange(q.shape[0]).reshape(-1, n_zeta), -first, axis=0).ravel()
     idx = order[active[order]]
     sub = matrix[idx][:, idx]
     band = np.zeros((n_zeta + 1, idx.size))
@@ -132,6 +143,26 @@ def _film_pressure(matrix, active: np.ndarray, q: np.ndarray, n_zeta: int) -> np
         band[n_zeta - k, k:] = sub.diagonal(k)
     pressure[idx] = solveh_banded(band, q[idx])
     return pressure
+
+
+def complementary(matrix, q: np.ndarray, n_zeta: int, supply: bool, active: np.ndarray) -> np.ndarray:
+    """P of the cavitating film K P = q (the complementarity problem of the module docstring), by the primal-dual
+    active set from the film ``active`` (P > 0 of a first guess); ``supply``: P = 0 held on the first line of
+    nodes (phi = -pi, the thickest film)."""
+    active = active.copy()
+    if supply:
+        active[:n_zeta] = False
+    for _ in range(200):
+        pressure = _film_pressure(matrix, active, q, n_zeta)
+        residual = matrix @ pressure - q
+        new = (pressure > 0.0) | (~active & (residual < 0.0))
+        new &= ~(active & (pressure <= 0.0))
+        if supply:
+            new[:n_zeta] = False
+        if np.array_equal(new, active):
+            return pressure
+        active = new
+    raise RuntimeError("active-set iteration did not settle")  # pragma: no cover - it terminates on M-matrices
 
 
 def solve(eps: float, xi: float, half_width: float, n_phi: int = N_PHI, n_zeta: int = N_ZETA,
@@ -154,26 +185,46 @@ def solve(eps: float, xi: float, half_width: float, n_phi: int = N_PHI, n_zeta: 
     q = rhs.ravel()
     pressure = spsolve(matrix.tocsc(), q) if start is None or not cavitation else start.ravel()
     if cavitation:
-        active = pressure > 0.0
-        if supply:
-            active[:n_zeta] = False
-        for _ in range(200):
-            pressure = _film_pressure(matrix, active, q, n_zeta)
-            residual = matrix @ pressure - q
-            new = (pressure > 0.0) | (~active & (residual < 0.0))
-            new &= ~(active & (pressure <= 0.0))
-            if supply:
-                new[:n_zeta] = False
-            if np.array_equal(new, active):
-                break
-            active = new
-        else:  # pragma: no cover - the method terminates on M-matrices
-            raise RuntimeError("active-set iteration did not settle")
+        pressure = complementary(matrix, q, n_zeta, supply, pressure > 0.0)
     field = pressure.reshape(volume.shape)
     load = 2.0 * field * volume  # both halves of the film
     f_along = -float(np.sum(load * np.cos(nodes)[:, None]))
     f_ahead = -float(np.sum(load * np.sin(nodes)[:, None]))
     return f_along, f_ahead, field
+
+
+def rotation_source(gap: np.ndarray, slope: np.ndarray, volume: np.ndarray, roughness: float = 0.0) -> np.ndarray:
+    """q of a journal spinning in a still bearing, any gap: -12 Phi(c H / sigma) dH/dphi per cell volume.
+
+    Reynolds' equation of steady rotation, d/dx (h^3 dp/dx) + d/dz (h^3 dp/dz) = 6 eta U dh/dx with U = omega R
+    (the mean surface speed omega_m = omega / 2 twice), becomes with p = eta (R/c)^2 omega_m P and h = c H
+    div(H^3 grad P) = 12 dH/dphi, phi in the direction of the journal's surface motion (Patir and Cheng's mean
+    gap: times Phi).  For H = 1 - eps cos phi this is :func:`solve`'s right-hand side at xi = -pi/2 (the squeeze
+    velocity of rotation, 90 deg behind e) times eps, its pressure scale being abs(V) / c = omega_m eps.
+    ``gap``, ``slope``: H and dH/dphi at the nodes; ``volume`` the cells' (:func:`assemble`)."""
+    source = -12.0 * slope
+    if roughness > 0.0:
+        source = source * contact_factor(gap / roughness)
+    return (source[:, None] * volume).ravel()
+
+
+def solve_gap(nodes: np.ndarray, gap_nodes: np.ndarray, gap_faces: np.ndarray, slope_nodes: np.ndarray,
+              half_width: float, n_zeta: int = N_ZETA, roughness: float = 0.0, supply: bool = True,
+              active: np.ndarray | None = None):
+    """The cavitating film of a journal spinning in a still bearing with the gap H(phi) (uniform along the axis;
+    at the increasing ``nodes`` from -pi and at their faces, with its slope at the nodes): (f_along_e, f_ahead,
+    P[i, j], K, cell volumes), dimensionless as :func:`rotation_source` (p = eta (R/c)^2 (omega / 2) P, force
+    eta R^2 (R/c)^2 (omega / 2) f).  ``supply``: P = 0 on the line phi = -pi (the film fed at its thickest line,
+    as the kernel's fed film); ``active``: a first guess of the film (P > 0) for the active set."""
+    matrix, volume = assemble(nodes, conductance_of(gap_nodes, roughness), conductance_of(gap_faces, roughness),
+                              half_width, n_zeta)
+    q = rotation_source(gap_nodes, slope_nodes, volume, roughness)
+    guess = np.ones(q.size, bool) if active is None else active.ravel()
+    pressure = complementary(matrix, q, n_zeta, supply, guess)
+    field = pressure.reshape(volume.shape)
+    load = 2.0 * field * volume
+    return -float(np.sum(load * np.cos(nodes)[:, None])), -float(np.sum(load * np.sin(nodes)[:, None])), field, \
+        matrix, volume
 
 
 def supply_weight(xi: float) -> float:

@@ -16,6 +16,10 @@ Boyd, ASLE Trans. 1, 1958; Shigley's Mechanical Engineering Design, ch. 12):
   from 1 to 3, boundary below 1;
 - the film's inlet and side flow Q, Qs (:mod:`weftsim.joint.film_flow`) at the eccentricity the film is
   evaluated at (held below c - h_wall, :mod:`weftsim.physics.lubricated`).
+
+With ``lubrication.elastic_film`` the point is the elastic film's (:mod:`weftsim.joint.ehl`, started from the rigid
+point): eccentricity, attitude, minimum film (of the deformed gap), friction torque, film force and asperity load
+are its, the Sommerfeld number and the flows stay the rigid film's, and ``elastic`` holds its own numbers.
 """
 
 from __future__ import annotations
@@ -52,6 +56,7 @@ class SteadyPoint:
     inlet_flow_m3_s: float
     side_flow_m3_s: float
     regime: str
+    elastic: dict | None = None  # the elastic film's own numbers (weftsim.joint.ehl.ElasticPoint), when it is on
 
     def as_dict(self) -> dict:
         """JSON-ready (plain floats and the regime's name)."""
@@ -106,11 +111,19 @@ def steady_point(joint, load: float, omega: float, viscosity: float, prm: np.nda
     n = omega / (2.0 * math.pi)
     sommerfeld = (radius / c) ** 2 * viscosity * n / pressure if pressure > 0.0 else math.inf
     h_min = max(c - ecc, 0.0)
-    ratio = h_min / lub.roughness
     eps_film = min(ecc, c - FILM_WALL_RATIO * lub.roughness) / c
+    elastic = None
+    if lub.elastic_film and load > 0.0:  # the elastic film from the rigid one's eccentricity (weftsim.joint.ehl)
+        from weftsim.joint.ehl import Pair, elastic_point
+
+        point = elastic_point(Pair.of(joint), load, omega, viscosity, min(ecc / c, 0.99))
+        elastic = point.as_dict()
+        ecc, attitude, h_min = point.eccentricity_ratio * c, point.attitude_angle_deg, point.min_film_m
+        torque, film, asperity, dry = point.friction_torque_nm, point.film_force_n, point.asperity_load_n, 0.0
+    ratio = h_min / lub.roughness
     q_in, q_side = flow_variables(eps_film, length / (2.0 * radius))
     scale = radius * c * n * length
     f = float  # plain floats for JSON
     return SteadyPoint(f(load), f(omega), f(viscosity), f(sommerfeld), f(ecc / c), f(attitude), f(h_min), f(ratio),
                        f(torque), f(torque / (load * radius)) if load > 0.0 else math.inf, f(torque * omega),
-                       f(film), f(asperity), f(dry), f(q_in * scale), f(q_side * scale), regime_of(ratio))
+                       f(film), f(asperity), f(dry), f(q_in * scale), f(q_side * scale), regime_of(ratio), elastic)

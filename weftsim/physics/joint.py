@@ -70,8 +70,9 @@ def joint_parameters(joint: ClearanceJoint, law: _Law) -> np.ndarray:
         out[VISCOSITY] = lub.viscosity
         out[FILM_MODEL] = lub.model_code
         out[ROUGHNESS] = lub.roughness
+        modulus = lub.asperity_modulus if lub.asperity_modulus > 0.0 else joint.effective_modulus
         out[ASPERITY_COEF] = greenwood_tripp_coefficient(lub.asperity_density_radius_roughness,
-                                                         lub.roughness_radius_ratio, joint.effective_modulus)
+                                                         lub.roughness_radius_ratio, modulus)
         out[BOUNDARY_MU] = lub.boundary_friction_coefficient
         # The solids' contact in oil is boundary-lubricated: beyond abs(e) = c, where the dry law takes the
         # asperities' load over (weftsim.physics.lubricated.asperity_share), its friction is mu_b too, so the

@@ -8,7 +8,8 @@ and the shaft's input torque measured against speed at each load.  Every bearing
 scene's joint E with those keys (:func:`weftsim.input.scene.load_scene`: the keys are checked as a scene's),
 and each operating point is the one ``weftsim bearing SCENE --load-kn F --journal-rpm N`` evaluates
 (:func:`weftsim.joint.bearing.operating_point`, the steady kernel of the transient engines); the rig's torque
-is the sum over its bearings.
+is the sum over its bearings.  An optional ``[elastic]`` table holds further ``[joint_e.lubrication]`` keys that
+turn the elastic film on (:func:`with_elastic`).
 """
 
 from __future__ import annotations
@@ -45,6 +46,7 @@ class Rig:
     source: str
     bearings: tuple[RigBearing, ...]
     loads: tuple[dict, ...]
+    elastic: tuple[RigBearing, ...] = ()  # the bearings with the rig's [elastic] keys as well (empty: none given)
 
 
 def load_rig(path: str | Path) -> Rig:
@@ -55,17 +57,24 @@ def load_rig(path: str | Path) -> Rig:
     try:
         data = tomllib.loads(path.read_text())
         shared = {f"joint_e.lubrication.{key}": value for key, value in data["lubrication"].items()}
-        bearings = []
+        extra = {f"joint_e.lubrication.{key}": value for key, value in data.get("elastic", {}).items()}
+        bearings, elastic = [], []
         for name, table in data["bearings"].items():
             keys = {f"joint_e.{key}": value for key, value in table["keys"].items()}
-            scene = load_scene(BASE_SCENE, overrides={**keys, **shared},
-                               overrides_from=f"rig file {path}, [bearings.{name}]")
-            bearings.append(RigBearing(name, scene.joint, int(table["count"]), float(table["load_share"])))
+
+            def bearing(more: dict, name=name, table=table, keys=keys) -> RigBearing:
+                scene = load_scene(BASE_SCENE, overrides={**keys, **shared, **more},
+                                   overrides_from=f"rig file {path}, [bearings.{name}]")
+                return RigBearing(name, scene.joint, int(table["count"]), float(table["load_share"]))
+
+            bearings.append(bearing({}))
+            if extra:
+                elastic.append(bearing(extra))
         loads = tuple({"load_n": 1e3 * float(case["load_kn"]), "rpm": [float(n) for n in case["rpm"]],
                        "torque_nm": [float(m) for m in case["torque_nm"]], "minimum_rpm": float(case["minimum_rpm"]),
                        **({"min_film_rpm": case["min_film_rpm"], "min_film_um": case["min_film_um"]}
                           if "min_film_rpm" in case else {})} for case in data["loads"])
-        return Rig(str(data["source"]), tuple(bearings), loads)
+        return Rig(str(data["source"]), tuple(bearings), loads, tuple(elastic))
     except SceneError:
         raise  # a bearing's scene key, named with the file by load_scene
     except KeyError as exc:
@@ -73,6 +82,13 @@ def load_rig(path: str | Path) -> Rig:
                          "(see tests/data/stribeck_sander2016.toml)") from None
     except (OSError, tomllib.TOMLDecodeError, TypeError, ValueError) as exc:
         raise SceneError(f"rig file {path}: {exc}") from None
+
+
+def with_elastic(rig: Rig) -> Rig:
+    """The rig with its ``[elastic]`` keys (the elastic film of :mod:`weftsim.joint.ehl`); refused if it has none."""
+    if not rig.elastic:
+        raise SceneError("the rig file has no [elastic] table (keys of [joint_e.lubrication] for the elastic film)")
+    return replace(rig, bearings=rig.elastic, elastic=())
 
 
 def with_floor(rig: Rig, floor: float) -> Rig:
