@@ -28,6 +28,7 @@ UNITS: tuple[tuple[str, str, float], ...] = (
     ("_m_s2", "m/s²", 1.0),
     ("_m_s", "m/s", 1.0),
     ("_per_mille", "‰ (of the pin diameter)", 1e-3),
+    ("_per_gpa", "1/GPa", 1e-9),
     ("_gpa", "GPa", 1e9),
     ("_mpa", "MPa", 1e6),
     ("_deg", "deg", math.pi / 180.0),

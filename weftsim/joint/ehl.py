@@ -94,11 +94,11 @@ class Pair:
 
     @classmethod
     def of(cls, joint) -> Pair:
-        from weftsim.joint.steady import joint_block
-        from weftsim.physics.joint import ASPERITY_COEF
+        from weftsim.joint.contact import make_law
+        from weftsim.physics.joint import ASPERITY_COEF, joint_parameters
 
         lub = joint.lubrication
-        prm = joint_block(joint)
+        prm = joint_parameters(joint, make_law(joint))  # the kernel's block (not steady.joint_block: no cycle)
         return cls(joint.journal_radius, joint.bearing_radius, joint.clearance, joint.bearing_length, lub.roughness,
                    float(prm[ASPERITY_COEF]), lub.boundary_friction_coefficient, lub.summit_height,
                    (joint.journal_material.youngs_modulus, joint.journal_material.poisson_ratio,

@@ -61,7 +61,7 @@ def scene_identity(scene: Scene) -> str:
     ``[rapier_tape]`` keys of a scene without a tape and the ``[exchange]`` keys of a scene without an exchange (all
     unset), for a state written before the tape or the exchange existed, and
     an unset ``bushing_wall_mm`` (the cylindrical law's, which refuses a joint without it), for a state written
-    before that key existed.
+    before that key existed, and the elastic film's keys at their defaults (:data:`ELASTIC_DEFAULTS`).
     """
     from weftsim.input.scene import to_file_keys
 
@@ -91,7 +91,18 @@ def scene_identity(scene: Scene) -> str:
     for table in ("joint_e", "joint_f"):  # unset (None): only the cylindrical law reads it, and it refuses None
         if keys.get(f"{table}.bushing_wall_mm", 0.0) is None:
             keys.pop(f"{table}.bushing_wall_mm")
+    for table in ("joint_e", "joint_f"):  # the steady elastic film's keys at their defaults, for a state before them
+        for name, value in ELASTIC_DEFAULTS.items():
+            if keys.get(f"{table}.lubrication.{name}", value) in (value, None):  # None: a dry joint's
+                keys.pop(f"{table}.lubrication.{name}", None)
     return json.dumps(keys, sort_keys=True, default=str)
+
+
+# The keys of the steady elastic film (weftsim.joint.ehl) and the asperities' own modulus, at the values that change
+# nothing (weftsim.input.params.Lubrication's defaults; unset on a dry joint): a wear state written before them is
+# the same scene's.
+ELASTIC_DEFAULTS = {"elastic_film": False, "summit_height_um": 0.0, "pressure_viscosity_per_gpa": 0.0,
+                    "asperity_modulus_gpa": 0.0}
 
 
 DUTY_DEFAULTS = {"stops_per_hour": 0.0, "stop_minutes": 2.87, "hours_per_day": 24.0, "days_per_week": 7.0,

@@ -69,6 +69,9 @@ PREDICTION_SETTINGS = {
     "joint_e.wear.max_clearance_change": "it sets the update interval of the prediction (converged by design, "
                                          "docs/wear.md section 3), not the machine",
 }
+# Keys of the steady elastic film of `weftsim bearing` (weftsim.joint.ehl): a wear prediction runs the transient
+# engines, which keep the rigid film and refuse elastic_film, so these change nothing there.
+STEADY_ONLY = ("joint_e.lubrication.summit_height_um", "joint_e.lubrication.pressure_viscosity_per_gpa")
 
 
 def resolve(name: str) -> str:
@@ -105,6 +108,9 @@ def uncertain_key_problem(key: str, scene: Scene, others: tuple[str, ...] = ()) 
         return "it is a design limit the checks compare against; no force or wear depends on it"
     if key in PREDICTION_SETTINGS:
         return PREDICTION_SETTINGS[key]
+    if key in STEADY_ONLY:
+        return ("it is a key of the steady elastic film of `weftsim bearing` only; the wear runs' rigid film "
+                "does not read it, so it does not change the wear")
     if key.startswith("joint_f."):
         if scene.joint_f.is_ideal:
             return ("joint F is ideal in this scene (an ensemble wears E with F ideal): "
