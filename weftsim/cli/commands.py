@@ -164,7 +164,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
                        "The cases fix their scenes, so it takes no scene flags.")
     p.add_argument("--quick", action="store_true", help="a few settings, 2 revolutions (a few minutes)")
     p.add_argument("--targets", action="store_true",
-                   help="the speed targets of the default paths against the 0.1 defaults (about 10 min)")
+                   help="the speed targets of the default paths against the 0.1 defaults (about 4 min on an idle 2-core machine)")
     p.add_argument("-o", "--output", default=None,
                    help="output directory (default: out/bench, out/bench-quick or out/bench-targets)")
     p.add_argument("--case", action="append", help="only this case (repeatable): c0.25mm-400rpm, c0.01mm-800rpm, "
