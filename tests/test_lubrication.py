@@ -37,8 +37,9 @@ EXPLICIT = {"solver.reference.method": "numba_DOP853"}  # the dry runs' integrat
 GUARD_SETS_THE_START_UP_PEAK = (
     "the start-up impact drives the rigid film through its floor to its wall (h_min = sigma / 4, held below), where the "
     "film force peaks at 33-41 MN (100 GPa over the pin: the solids would deform) and the driving torque at 144, 155, "
-    "177 kN m for floors 0.25, 0.5, 1 sigma (the dry joint: 239 kN, 3.4 kN m): the guard sets the peak; the physics "
-    "that bounds it (the solids' elastic deformation under the film, EHL) is not in the transient film")
+    "177 kN m for floors 0.25, 0.5, 1 sigma (the dry joint: 239 kN, 3.4 kN m), and at 274-338 kN m with the wall at "
+    "sigma / 8: the guard sets the peak; the physics that bounds it (the solids' elastic deformation under the film, "
+    "EHL) is not in the transient film")
 
 
 def _scene(**keys):
@@ -272,6 +273,10 @@ def test_engines_agree_on_a_lubricated_run(runs):
     # (step_control.film_corners): 41.016 MN and 176.998 kN m against the reference engine's 40.899 MN and
     # 176.494 kN m (0.29 %; converged, RODAS4 at rtol 1e-9: 41.050 MN, 177.146 kN m).  A step across the corner
     # read 1.2 % low (40.418 MN at h_min = 0.2436 sigma), the states agreeing (h_min = 0.3 sigma 3.8 ns apart).
+    from weftsim.exudyn_engine.step_control import CORNER_TOL
+    from weftsim.physics.lubricated import FILM_WALL_RATIO
+
+    assert np.min(np.abs(tree.steps["film_ratio"] / FILM_WALL_RATIO - 1.0)) <= CORNER_TOL  # a step ends on the wall
     for name in ("driving_torque_Nm", "film_force_N", "rapier_acceleration_m_s2"):
         a, b = np.abs(ref.steps[name]).max(), np.abs(tree.steps[name]).max()
         assert b == pytest.approx(a, rel=tolerance), name
