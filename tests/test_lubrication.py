@@ -329,7 +329,7 @@ def test_reusable_exudyn_joint_carries_the_film(runs):
     from weftsim import exudyn_engine
 
     ref = runs["oil"]
-    # The squeeze film's peak at its wall lasts a fraction of a microsecond (above 90 % of it for 0.25 us): the
+    # The squeeze film's peak at its wall lasts a fraction of a microsecond (above 90 % of it for 0.22 us): the
     # rigid-body model's steps end on the wall's corner (step_control.film_corners), but at the default local error
     # (3e-10 m) its state there is 1.6 % short (40.250 MN); at 3e-11 m 40.909 MN, 176.535 kN m against the reference
     # engine's 40.899 MN, 176.494 kN m (without the corner step 40.406 MN, 1.2 % low; converged 41.050 MN).
