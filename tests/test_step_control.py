@@ -16,7 +16,7 @@ import pytest
 from weftsim import reference
 from conftest import door
 solve = door("exudyn")
-from weftsim.exudyn_engine.step_control import newmark_beta, to_sample_grid
+from weftsim.exudyn_engine.step_control import CORNER_TOL, StepController, film_corners, newmark_beta, to_sample_grid
 from weftsim.input.params import ClearanceJoint, Drive, ExudynSolver, ReferenceSolver, Scene
 from weftsim.input.scene import SceneError, load_scene
 
@@ -49,6 +49,30 @@ def test_steps_end_on_every_sample_without_slivers():
     assert to_sample_grid(0.0, 0.6e-3, period) == pytest.approx(0.5e-3)  # within 2 h: two equal steps
     assert to_sample_grid(0.0, 1e-4, period) == 1e-4  # far from it: the planned step
     assert to_sample_grid(period * (1.0 - 1e-15), 2e-3, period) == pytest.approx(period)  # on a sample: the next
+
+
+def test_a_step_across_the_film_wall_is_cut_to_end_on_it():
+    """The film's wall (h_min = sigma / 4, held below it) is a corner of the film force: a step crossing it is
+    repeated with the fraction of it that ends there (linear in h_min), the nearest corner first; a step ending
+    within CORNER_TOL of it, starting on it or not crossing it goes on."""
+    from weftsim.input.params import Lubrication
+    from weftsim.physics.lubricated import FILM_WALL_RATIO
+
+    sigma = 0.4e-6
+    oiled = ClearanceJoint(clearance=0.25e-3, law="variable_kd", lubrication=Lubrication(viscosity=0.08, roughness=sigma))
+    (wall,) = film_corners(oiled)
+    assert wall == FILM_WALL_RATIO * sigma
+    assert film_corners(ClearanceJoint(clearance=0.25e-3, law="variable_kd")) == ()  # dry: no film, no corner
+    no_oil = ClearanceJoint(clearance=0.25e-3, law="variable_kd", lubrication=Lubrication(viscosity=0.0))
+    assert film_corners(no_oil) == ()
+    control = StepController.__new__(StepController)
+    control.corners = (wall, 4.0 * wall)
+    assert control.corner_fraction(2.0 * wall, 0.5 * wall) == pytest.approx(2.0 / 3.0)  # inwards
+    assert control.corner_fraction(0.5 * wall, 2.0 * wall) == pytest.approx(1.0 / 3.0)  # outwards
+    assert control.corner_fraction(8.0 * wall, 0.5 * wall) == pytest.approx(4.0 / 7.5)  # the nearer corner first
+    assert control.corner_fraction(2.0 * wall, wall * (1.0 - 0.5 * CORNER_TOL)) is None  # ended on it
+    assert control.corner_fraction(wall * (1.0 + 0.5 * CORNER_TOL), 0.5 * wall) is None  # started on it
+    assert control.corner_fraction(2.0 * wall, 1.5 * wall) is None and control.corner_fraction(None, 0.0) is None
 
 
 def test_samples_are_step_ends_and_the_step_varies(startup):

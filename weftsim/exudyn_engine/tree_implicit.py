@@ -34,7 +34,7 @@ import exudyn as exu
 from weftsim.exudyn_engine.clearance_joint import register_post_step
 from weftsim.exudyn_engine.friction_segments import MAX_SWITCHES, FrictionSegments
 from weftsim.exudyn_engine.selection import largest_step, tree_local_error
-from weftsim.exudyn_engine.step_control import StepController, newmark_beta, to_sample_grid
+from weftsim.exudyn_engine.step_control import StepController, film_corners, newmark_beta, to_sample_grid
 
 if TYPE_CHECKING:
     from weftsim.exudyn_engine.tree import TreeModel
@@ -133,9 +133,15 @@ class ImplicitTree:
         period = scene.output.sample_angle / scene.drive.speed
         self.max_step = largest_step(scene)
         g = scene.geometry
+        stash = model.stash
+
+        def gap(mbs_: exu.MainSystem) -> float:  # h_min = -delta of the callback's last state (post_newton: the trial)
+            return -stash[1]
+
         self.control = TreeStepController(mbs, solver, model.node, 0.0, tree_local_error(scene),
                                           scene.limits.min_step, self.max_step, period, newmark_beta(SPECTRAL_RADIUS),
-                                          jump=tree_jump(g.l_fg, g.l_ef))  # fmt: skip
+                                          jump=tree_jump(g.l_fg, g.l_ef), gap=gap,
+                                          corners=film_corners(scene.joint))  # fmt: skip
         friction = scene.joint.friction_coefficient > 0.0
         self.segments = FrictionSegments(model.force) if friction else None
 
