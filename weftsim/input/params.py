@@ -233,6 +233,16 @@ class Lubrication:
     pressure_viscosity : float
         Barus' pressure-viscosity coefficient alpha, 1/Pa: the film's viscosity eta exp(alpha p) (mineral oils
         1-3e-8).  Used by the elastic film only (refused > 0 without it).  Default 0 (isoviscous).
+    surface_roughness : tuple of float or None
+        (sigma_journal, sigma_bearing), m: the two surfaces' own RMS roughnesses for Patir and Cheng's average flow
+        of the elastic film (its H = h / sqrt(sigma_j^2 + sigma_b^2), and the shear flow of unlike surfaces,
+        :class:`weftsim.physics.flow_factors.SurfacePair`); ``roughness`` stays the asperity contact's.  Used by the
+        elastic film only.  Default None: both alike, of the combined ``roughness``.
+    peklenik_numbers : tuple of float or None
+        (gamma_journal, gamma_bearing): the surfaces' Peklenik numbers, the ratio of their correlation lengths
+        along the sliding (circumferential) direction and across it (> 1: ridges along the motion), for Patir and
+        Cheng's anisotropic flow factors of the elastic film.  Used by the elastic film only.  Default None:
+        isotropic (1, 1).
     asperity_modulus : float
         E* of the asperity contact, Pa, where a source gives it apart from the parts' moduli (0: the joint's
         effective modulus from its two materials, the default).
@@ -267,6 +277,8 @@ class Lubrication:
     summit_height: float = 0.0
     pressure_viscosity: float = 0.0
     asperity_modulus: float = 0.0
+    surface_roughness: tuple[float, float] | None = None
+    peklenik_numbers: tuple[float, float] | None = None
     oil: str = ""
     oil_nu40: float = 0.0
     oil_nu100: float = 0.0
@@ -345,6 +357,17 @@ def lubrication_problem(lub: Lubrication) -> str | None:
     if alpha > 0.0 and not lub.elastic_film:
         return ("`lubrication.pressure_viscosity` is used by the elastic film only (the rigid kernel's film is "
                 f"isoviscous): set `lubrication.elastic_film` = true or pressure_viscosity = 0, got {alpha!r}")
+    for name, pair, allowed in (("surface_roughness", lub.surface_roughness, "RMS roughnesses of journal and "
+                                                                                "bearing, m, each > 0"),
+                                ("peklenik_numbers", lub.peklenik_numbers, "Peklenik numbers of journal and "
+                                                                           "bearing, each > 0")):
+        if pair is None:
+            continue
+        if not (isinstance(pair, (tuple, list)) and len(pair) == 2 and all(_number(v) and v > 0.0 for v in pair)):
+            return f"`lubrication.{name}` must be two numbers ({allowed}), got {pair!r}"
+        if not lub.elastic_film:
+            return (f"`lubrication.{name}` is used by the elastic film only (the rigid kernel's table has isotropic "
+                    f"alike surfaces): set `lubrication.elastic_film` = true or leave {name} unset, got {pair!r}")
     if not (_number(lub.asperity_modulus) and lub.asperity_modulus >= 0.0):
         return f"`lubrication.asperity_modulus` must be >= 0 (Pa; 0 = the joint's effective modulus), got {lub.asperity_modulus!r}"
     return oil_problem(lub)

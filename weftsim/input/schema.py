@@ -152,6 +152,16 @@ def LUBRICATION_KEYS(table: str, joint: str) -> tuple[Key, ...]:  # noqa: N802 -
         Key(at + "pressure_viscosity_per_gpa", to + "pressure_viscosity", "float", 1e-9, 0, 100, False,
             doc="Barus' pressure-viscosity coefficient alpha, 1/GPa (mineral oils 10-30; elastic film only; "
                 "default 0: isoviscous)"),
+        Key(at + "surface_roughness_um", to + "surface_roughness", "floats2", 1e-6, 0, ROUGHNESS_UM,
+            doc="[journal, bearing] RMS roughness of each surface for the elastic film's average flow (its H on "
+                "their composite, the shear flow of unlike surfaces; roughness_um stays the asperities'; elastic "
+                "film only; default unset: alike, of roughness_um)"),
+        # Patir and Cheng fitted gamma = 1/9 to 9; a bound of 100 refuses only a typo (beyond 9 the fit's last column
+        # is read, weftsim.physics.flow_factors).
+        Key(at + "peklenik_numbers", to + "peklenik_numbers", "floats2", 1, 0, 100,
+            doc="[journal, bearing] Peklenik numbers (correlation length along the motion over across it; > 1 "
+                "ridges along it) for Patir and Cheng's anisotropic flow factors (elastic film only; default "
+                "unset: isotropic)"),
         Key(at + "asperity_modulus_gpa", to + "asperity_modulus", "float", GPA, 0, 1e4, False,
             doc="E* of the asperity contact where a source gives it apart from the materials (default 0: the "
                 "joint's effective modulus)"),

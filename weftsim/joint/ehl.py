@@ -91,6 +91,12 @@ class Pair:
     summit_height: float  # delta, m
     moduli: tuple[float, float, float, float]  # E_j, nu_j, E_b, nu_b
     pressure_viscosity: float = 0.0  # Barus' alpha, 1/Pa
+    surfaces: object = None  # weftsim.physics.flow_factors.SurfacePair (journal, bearing); None: isotropic, alike
+
+    @property
+    def flow_sigma(self) -> float:
+        """The roughness of the average flow's H = h / sigma: the surfaces' composite, or ``sigma``."""
+        return self.sigma if self.surfaces is None else self.surfaces.sigma
 
     @classmethod
     def of(cls, joint) -> Pair:
@@ -99,11 +105,17 @@ class Pair:
 
         lub = joint.lubrication
         prm = joint_parameters(joint, make_law(joint))  # the kernel's block (not steady.joint_block: no cycle)
+        surfaces = None
+        if lub.surface_roughness is not None or lub.peklenik_numbers is not None:
+            from weftsim.physics.flow_factors import SurfacePair
+
+            half = lub.roughness / math.sqrt(2.0)
+            surfaces = SurfacePair(lub.surface_roughness or (half, half), lub.peklenik_numbers or (1.0, 1.0))
         return cls(joint.journal_radius, joint.bearing_radius, joint.clearance, joint.bearing_length, lub.roughness,
                    float(prm[ASPERITY_COEF]), lub.boundary_friction_coefficient, lub.summit_height,
                    (joint.journal_material.youngs_modulus, joint.journal_material.poisson_ratio,
                     joint.bearing_material.youngs_modulus, joint.bearing_material.poisson_ratio),
-                   lub.pressure_viscosity)
+                   lub.pressure_viscosity, surfaces)
 
 
 def _f52(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -114,12 +126,16 @@ def _f52(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return F52_SCALE * base**F52_EXPONENT, -F52_EXPONENT * F52_SCALE * base ** (F52_EXPONENT - 1.0)
 
 
-def _conductance_slope(gap: np.ndarray, roughness: float) -> np.ndarray:
-    """d(H^3 phi_x(H / r)) / dH (:func:`weftsim.joint.reynolds.conductance_of`)."""
+def _conductance_slope(gap: np.ndarray, roughness: float, surfaces=None, across: bool = False) -> np.ndarray:
+    """d(H^3 phi_x(H / r)) / dH (:func:`weftsim.joint.reynolds.conductance_of`); with ``surfaces`` phi_x or
+    (``across``) phi_z of :class:`weftsim.physics.flow_factors.SurfacePair`."""
     from weftsim.physics.flow_factors import PRESSURE_C, PRESSURE_R
 
     if roughness <= 0.0:
         return 3.0 * gap**2
+    if surfaces is not None:
+        value, rate = surfaces.pressure(gap / roughness, across, slope=True)
+        return 3.0 * gap**2 * value + gap**3 * rate / roughness
     decay = np.exp(-PRESSURE_R * gap / roughness)
     return 3.0 * gap**2 * (1.0 - PRESSURE_C * decay) + gap**3 * PRESSURE_C * PRESSURE_R / roughness * decay
 
@@ -139,7 +155,9 @@ class _Film:
         self.half_width = 0.5 * pair.length / radius
         self.scale = viscosity * (radius / c) ** 2 * 0.5 * omega  # p_s, Pa
         self.load = load / (self.scale * radius**2)
-        self.r = pair.sigma / c
+        self.r = pair.sigma / c  # the asperities' (and the wall's) roughness
+        self.r_flow = pair.flow_sigma / c  # the average flow's
+        self.surfaces = pair.surfaces
         self.wall = FILM_WALL_RATIO * self.r
         self.offset = pair.summit_height / pair.sigma
         self.asperity = pair.asperity_coef / self.scale
@@ -189,7 +207,7 @@ class _Film:
         hn, hf, hd = self.gaps(s, eps)
         hn_film, hf_film = np.maximum(hn, self.wall), np.maximum(hf, self.wall)
         _, _, reduced, matrix, volume = solve_gap(self.nodes, hn_film, hf_film, hd, self.half_width, self.n_zeta,
-                                                  self.r, True, self.active)
+                                                  self.r_flow, True, self.active, self.surfaces)
         self.active = reduced > 0.0
         # Barus: the film's pressure from the reduced pressure Q that Reynolds' equation of eta_0 gives
         # (Q = (1 - exp(-alpha p)) / alpha), P = -ln(1 - alpha Q) / alpha; no finite P where alpha Q >= 1.
@@ -233,12 +251,12 @@ class _Film:
         x_n = np.column_stack((gn, -np.cos(self.nodes)))
         x_f = np.column_stack((gf, -np.cos(self.faces)))
         x_d = np.column_stack((gd, np.sin(self.nodes)))
-        r = self.r
+        r = self.r_flow
         clamp_n, clamp_f = hn > self.wall, hf > self.wall
         # d(K P)/d(face conductance k): rows of line k (+) and line k+1 (-).
         step = np.diff(np.concatenate((self.nodes, [self.nodes[0] + 2.0 * math.pi])))
         flux = (field - np.roll(field, -1, axis=0)) * dzeta[None, :] / step[:, None]
-        dcf = _conductance_slope(hf_film, r) * clamp_f
+        dcf = _conductance_slope(hf_film, r, self.surfaces) * clamp_f
         face = (flux * dcf[:, None])[:, :, None] * x_f[:, None, :]
         b = face - np.roll(face, 1, axis=0)
         # d(K P)/d(node conductance i): the axial fluxes of line i.
@@ -248,12 +266,15 @@ class _Film:
         ax *= (width / dz)[:, None]
         row = ax.copy()
         row[:, 1:] -= ax[:, :-1]
-        dcn = _conductance_slope(hn_film, r) * clamp_n
+        dcn = _conductance_slope(hn_film, r, self.surfaces, across=True) * clamp_n
         coef_n = row * dcn[:, None]
-        # the source q = -12 Phi(H / r) H' vol: minus its derivatives
+        # the source q = -12 (Phi(H / r) + phi_s'(H / r)) H' vol: minus its derivatives
         if r > 0.0:
             phi = contact_factor(hn_film / r)
             density = np.exp(-0.5 * (hn_film / r) ** 2) / math.sqrt(2.0 * math.pi) / r * clamp_n
+            if self.surfaces is not None:
+                phi = phi + self.surfaces.shear_flow(hn_film / r, 1)
+                density = density + self.surfaces.shear_flow(hn_film / r, 2) / r * clamp_n
         else:
             phi, density = np.ones(n), np.zeros(n)
         coef_n = coef_n + 12.0 * (density * hd)[:, None] * volume
@@ -266,7 +287,7 @@ class _Film:
         if stretch is not None:  # dP = dQ / (1 - alpha Q)
             dp *= stretch[:, :, None]
         dmean = np.einsum("ijk,j->ik", dp, dzeta) / self.half_width
-        dpa = (self.asperity * dfa / r)[:, None] * x_n
+        dpa = (self.asperity * dfa / self.r)[:, None] * x_n
         top = -(dmean + dpa)
         top[:, :n] += np.eye(n)
         cos, sin = np.cos(self.nodes), np.sin(self.nodes)
@@ -348,13 +369,13 @@ def elastic_point(pair: Pair, load: float, omega: float, viscosity: float, eps0:
     h_fine = 1.0 - eps * np.cos(fine) + film.gamma_fine @ s
     h_fine = np.maximum(h_fine, film.wall)
     if pair.sigma > 0.0:
-        phi_f = np.array([shear_factor(h / film.r) for h in h_fine])
+        phi_f = np.array([shear_factor(h / film.r_flow) for h in h_fine])
     else:
         phi_f = np.ones_like(h_fine)
     couette = viscosity * omega * radius**3 * pair.length / c * float(np.mean(phi_f / h_fine)) * 2.0 * math.pi
     if film.alpha > 0.0:  # the film's viscosity exp(alpha p) over eta_0 where it is pressed: its excess on the nodes
         hn = np.maximum(state["hn"], film.wall)
-        phi_n = np.array([shear_factor(h / film.r) for h in hn]) if pair.sigma > 0.0 else np.ones_like(hn)
+        phi_n = np.array([shear_factor(h / film.r_flow) for h in hn]) if pair.sigma > 0.0 else np.ones_like(hn)
         excess = np.expm1(film.alpha * state["field"]) * (phi_n / hn)[:, None] * state["volume"]
         couette += viscosity * omega * radius**3 * pair.length / c * float(np.sum(excess)) / film.half_width
     pressure_torque = -film.scale * c * radius**2 * float(np.sum(state["field"] * state["volume"]

@@ -193,7 +193,8 @@ def solve(eps: float, xi: float, half_width: float, n_phi: int = N_PHI, n_zeta: 
     return f_along, f_ahead, field
 
 
-def rotation_source(gap: np.ndarray, slope: np.ndarray, volume: np.ndarray, roughness: float = 0.0) -> np.ndarray:
+def rotation_source(gap: np.ndarray, slope: np.ndarray, volume: np.ndarray, roughness: float = 0.0,
+                    surfaces=None) -> np.ndarray:
     """q of a journal spinning in a still bearing, any gap: -12 Phi(c H / sigma) dH/dphi per cell volume.
 
     Reynolds' equation of steady rotation, d/dx (h^3 dp/dx) + d/dz (h^3 dp/dz) = 6 eta U dh/dx with U = omega R
@@ -201,24 +202,44 @@ def rotation_source(gap: np.ndarray, slope: np.ndarray, volume: np.ndarray, roug
     div(H^3 grad P) = 12 dH/dphi, phi in the direction of the journal's surface motion (Patir and Cheng's mean
     gap: times Phi).  For H = 1 - eps cos phi this is :func:`solve`'s right-hand side at xi = -pi/2 (the squeeze
     velocity of rotation, 90 deg behind e) times eps, its pressure scale being abs(V) / c = omega_m eps.
-    ``gap``, ``slope``: H and dH/dphi at the nodes; ``volume`` the cells' (:func:`assemble`)."""
+    ``gap``, ``slope``: H and dH/dphi at the nodes; ``volume`` the cells' (:func:`assemble`).
+
+    ``surfaces`` (a :class:`weftsim.physics.flow_factors.SurfacePair`, journal first): unlike surfaces add Patir
+    and Cheng's shear flow, (U_1 - U_2) / 2 sigma d phi_s / dx on the right of the dimensional equation with the
+    journal's U_1 = omega R and the bearing's U_2 = 0.  (U_1 - U_2) / 2 = U_m, so it scales as the wedge term:
+    12 (sigma / c) d phi_s / dphi = 12 phi_s'(c H / sigma) dH/dphi, and the source is
+    -12 (Phi + phi_s') dH/dphi.  phi_s > 0 where the moving journal is the rougher (its valleys carry oil along),
+    < 0 where the still bearing is (it holds oil back)."""
     source = -12.0 * slope
     if roughness > 0.0:
-        source = source * contact_factor(gap / roughness)
+        factor = contact_factor(gap / roughness)
+        if surfaces is not None:
+            factor = factor + surfaces.shear_flow(gap / roughness, 1)
+        source = source * factor
     return (source[:, None] * volume).ravel()
+
+
+def conductances_of(gap_nodes: np.ndarray, gap_faces: np.ndarray, roughness: float, surfaces=None):
+    """The average-flow conductances at the nodes (the axial fluxes: phi_z H^3) and at the faces (the
+    circumferential ones: phi_x H^3); ``surfaces`` None: the isotropic :func:`conductance_of` for both."""
+    if surfaces is None or roughness <= 0.0:
+        return conductance_of(gap_nodes, roughness), conductance_of(gap_faces, roughness)
+    return (gap_nodes**3 * surfaces.pressure(gap_nodes / roughness, across=True),
+            gap_faces**3 * surfaces.pressure(gap_faces / roughness, across=False))
 
 
 def solve_gap(nodes: np.ndarray, gap_nodes: np.ndarray, gap_faces: np.ndarray, slope_nodes: np.ndarray,
               half_width: float, n_zeta: int = N_ZETA, roughness: float = 0.0, supply: bool = True,
-              active: np.ndarray | None = None):
+              active: np.ndarray | None = None, surfaces=None):
     """The cavitating film of a journal spinning in a still bearing with the gap H(phi) (uniform along the axis;
     at the increasing ``nodes`` from -pi and at their faces, with its slope at the nodes): (f_along_e, f_ahead,
     P[i, j], K, cell volumes), dimensionless as :func:`rotation_source` (p = eta (R/c)^2 (omega / 2) P, force
     eta R^2 (R/c)^2 (omega / 2) f).  ``supply``: P = 0 on the line phi = -pi (the film fed at its thickest line,
-    as the kernel's fed film); ``active``: a first guess of the film (P > 0) for the active set."""
-    matrix, volume = assemble(nodes, conductance_of(gap_nodes, roughness), conductance_of(gap_faces, roughness),
-                              half_width, n_zeta)
-    q = rotation_source(gap_nodes, slope_nodes, volume, roughness)
+    as the kernel's fed film); ``active``: a first guess of the film (P > 0) for the active set; ``surfaces``:
+    anisotropic or unlike rough surfaces (:func:`conductances_of`, :func:`rotation_source`; ``roughness`` then
+    their composite sigma / c)."""
+    matrix, volume = assemble(nodes, *conductances_of(gap_nodes, gap_faces, roughness, surfaces), half_width, n_zeta)
+    q = rotation_source(gap_nodes, slope_nodes, volume, roughness, surfaces)
     guess = np.ones(q.size, bool) if active is None else active.ravel()
     pressure = complementary(matrix, q, n_zeta, supply, guess)
     field = pressure.reshape(volume.shape)

@@ -31,11 +31,23 @@ which tends to 1 for thick films (as 1 + (3 sigma / h)^2 / 9, summed as that ser
 that the pressure's moment -(e x F)/2 carries, 1-2 % of the friction in the mixed regime of the tests).
 
 The fits hold for H >= 0.5 (phi_x) and all H (phi_f, Phi); below 0.5 they are continued as written.
+
+Anisotropic and unlike surfaces (:class:`SurfacePair`; the steady elastic film only, :mod:`weftsim.joint.ehl`):
+Patir and Cheng's fits for Peklenik numbers gamma = 1/9 to 9 (gamma = lambda_x / lambda_y, the ratio of the
+surface's correlation lengths along and across the sliding direction),
+
+    phi_x = 1 - C exp(-r H)  (gamma <= 1),   phi_x = 1 + C H^(-r)  (gamma > 1),   phi_y(H, gamma) = phi_x(H, 1/gamma)
+    Phi_s = A_1 H^a_1 exp(-a_2 H + a_3 H^2)  (H <= 5),   Phi_s = A_2 exp(-0.25 H)  (H > 5)
+
+(1978, Table 1; 1979, Table 2: ``PRESSURE_COLUMNS``, ``SHEAR_FLOW_COLUMNS``), read linearly in gamma between
+the published columns and at the nearest column outside them.  The transient kernel's table keeps the isotropic
+factors above.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
@@ -116,3 +128,144 @@ def couette_factor_tail(eps: float, ratio: float) -> float:
     a2 = 1.0 / (ratio * (1.0 + eps)) ** 2
     e2 = eps * eps
     return 1.0 + a2 * (1.0 + 0.5 * e2 + a2 * (81.0 / 33.0) * (1.0 + e2 * (3.0 + 0.375 * e2)))
+
+
+# Anisotropic roughness (Patir and Cheng 1978, Table 1; 1979, Table 2): the columns of the published fits, by
+# Peklenik number gamma = lambda_x / lambda_y (the 0.5-correlation lengths along the sliding direction x and across
+# it): gamma > 1 longitudinal (ridges along the motion), < 1 transverse.  The same constants are reproduced in the
+# tribology literature and in independent implementations (foam-extend's flowFactorsPatirCheng).
+PEKLENIK_COLUMNS = (1.0 / 9.0, 1.0 / 6.0, 1.0 / 3.0, 1.0, 3.0, 6.0, 9.0)
+# phi_x = 1 - C exp(-r H) for gamma <= 1, 1 + C H^(-r) for gamma > 1 (their fits hold for H > 1 at gamma = 1/9 and
+# 1/6, H > 0.75 at 1/3, H > 0.5 at 1-9).
+PRESSURE_COLUMNS = ((1.48, 0.42), (1.38, 0.42), (1.18, 0.42), (PRESSURE_C, PRESSURE_R), (0.225, 1.5), (0.520, 1.5),
+                    (0.870, 1.5))
+# Below its range a transverse column (gamma < 1) would fall to 0 and below (1 - 1.48 exp(-0.42 H) < 0 at H < 0.93):
+# it is held at the range's end there (phi_x 0.028, 0.093, 0.139).  The others are continued as written (the
+# isotropic one as the kernel's table has it; 1 + C H^(-r) stays above 1, its conductance H^3 phi_x -> 0).
+PRESSURE_HELD_BELOW = (1.0, 1.0, 0.75, 0.0, 0.0, 0.0, 0.0)
+# Phi_s = A1 H^a1 exp(-a2 H + a3 H^2) for H <= 5, A2 exp(-H / 4) above: (A1, a1, a2, a3, A2).  The two branches meet
+# at H = 5 to the fits' rounding (1e-3 of the value; tests/test_film.py).
+SHEAR_FLOW_COLUMNS = ((2.046, 1.12, 0.78, 0.03, 1.856), (1.962, 1.08, 0.77, 0.03, 1.754),
+                      (1.858, 1.01, 0.76, 0.03, 1.561), (1.899, 0.98, 0.92, 0.05, 1.126),
+                      (1.560, 0.85, 1.13, 0.08, 0.556), (1.290, 0.62, 1.09, 0.08, 0.388),
+                      (1.011, 0.54, 1.07, 0.08, 0.295))
+SHEAR_FLOW_SPLIT, SHEAR_FLOW_DECAY = 5.0, 0.25
+
+
+def _columns(gamma: float) -> tuple[tuple[int, float], ...]:
+    """The published columns a Peklenik number ``gamma`` reads, with their weights: linear in gamma between the two
+    neighbouring columns (as foam-extend interpolates them), the nearest column outside [1/9, 9] (the fits are not
+    published beyond; an assumption, docs/lubricated-joint.md)."""
+    if not (math.isfinite(gamma) and gamma > 0.0):
+        raise ValueError(f"a Peklenik number must be > 0, got {gamma!r}")
+    cols = PEKLENIK_COLUMNS
+    if gamma <= cols[0]:
+        return ((0, 1.0),)
+    if gamma >= cols[-1]:
+        return ((len(cols) - 1, 1.0),)
+    for k in range(1, len(cols)):
+        if gamma == cols[k]:
+            return ((k, 1.0),)
+        if gamma < cols[k]:
+            w = (gamma - cols[k - 1]) / (cols[k] - cols[k - 1])
+            return ((k - 1, 1.0 - w), (k, w))
+    raise AssertionError("unreachable")  # pragma: no cover
+
+
+def _pressure_column(k: int, ratio: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """phi_x of column k and its slope d phi_x / dH."""
+    c, r = PRESSURE_COLUMNS[k]
+    if PEKLENIK_COLUMNS[k] <= 1.0:
+        held = ratio < PRESSURE_HELD_BELOW[k]
+        decay = np.exp(-r * np.maximum(ratio, PRESSURE_HELD_BELOW[k]))
+        return 1.0 - c * decay, np.where(held, 0.0, c * r * decay)
+    power = ratio ** (-r)
+    return 1.0 + c * power, -r * c * power / ratio
+
+
+def pressure_flow_factor_of(ratio, gamma: float, slope: bool = False):
+    """phi_x(H, gamma), Patir and Cheng's pressure flow factor along x at H = h / sigma for Peklenik number gamma
+    (1978, Table 1; ``_columns``); gamma = 1 is :func:`pressure_flow_factor`.  phi_y(H, gamma) = phi_x(H, 1 / gamma).
+    ``slope``: also d phi_x / dH.  numpy or float."""
+    ratio = np.asarray(ratio, dtype=float)
+    value, rate = np.zeros_like(ratio), np.zeros_like(ratio)
+    for k, w in _columns(gamma):
+        v, d = _pressure_column(k, ratio)
+        if w == 1.0:
+            value, rate = v, d
+        else:
+            value, rate = value + w * v, rate + w * d
+    return (value, rate) if slope else value
+
+
+def shear_flow_factor_of(ratio, gamma: float, order: int = 0):
+    """Phi_s(H, gamma), Patir and Cheng's shear flow factor of one rough surface against a smooth one (1979,
+    Table 2), H = h / sigma; ``order`` 1 or 2: its first or second derivative in H instead.  0 at H <= 0."""
+    ratio = np.asarray(ratio, dtype=float)
+    h = np.maximum(ratio, 1e-300)
+    out = np.zeros_like(h)
+    for k, w in _columns(gamma):
+        a1, p1, p2, p3, a2 = SHEAR_FLOW_COLUMNS[k]
+        x = np.minimum(h, SHEAR_FLOW_SPLIT)  # each branch on its own side (exp(a3 H^2) overflows far above)
+        low = a1 * x**p1 * np.exp(-p2 * x + p3 * x * x)
+        high = a2 * np.exp(-SHEAR_FLOW_DECAY * h)
+        if order >= 1:  # d ln(low) / dH = a1 / H - a2 + 2 a3 H
+            g = p1 / x - p2 + 2.0 * p3 * x
+            low = low * (g if order == 1 else g * g - p1 / (x * x) + 2.0 * p3)
+            high = high * (-SHEAR_FLOW_DECAY) ** order
+        out = out + w * np.where(h <= SHEAR_FLOW_SPLIT, low, high)
+    return np.where(ratio > 0.0, out, 0.0)
+
+
+@dataclass(frozen=True)
+class SurfacePair:
+    """The two surfaces of Patir and Cheng's average flow: their RMS roughnesses (m) and Peklenik numbers, surface
+    1 the journal (the one that moves in ``weftsim bearing``), surface 2 the bearing.
+
+    The flow factors are taken on the composite sigma = sqrt(sigma_1^2 + sigma_2^2), H = h / sigma, with the
+    variance ratios V_ri = (sigma_i / sigma)^2:
+
+    - the pressure flow factors along the motion (x) and across it (the axis z),
+      phi_x = V_r1 phi_x(H, gamma_1) + V_r2 phi_x(H, gamma_2),  phi_z = V_r1 phi_x(H, 1/gamma_1) + V_r2 phi_x(H, 1/gamma_2)
+      (Patir and Cheng fitted one composite surface of one gamma; for surfaces of two gammas the variance-weighted
+      mean is an assumption: it is their factor when the gammas are equal, and the one rough surface's when the
+      other is smooth);
+    - the shear flow factor phi_s = V_r1 Phi_s(H, gamma_1) - V_r2 Phi_s(H, gamma_2) (1979, eq. 25), which enters
+      as + (U_1 - U_2) / 2 sigma d phi_s / dx with U_i the surfaces' speeds: zero for alike surfaces.
+
+    ``isotropic(sigma)``: the alike isotropic surfaces of :func:`pressure_flow_factor` (phi_s = 0)."""
+
+    roughness: tuple[float, float]
+    peklenik: tuple[float, float] = (1.0, 1.0)
+
+    @classmethod
+    def isotropic(cls, sigma: float) -> SurfacePair:
+        half = sigma / math.sqrt(2.0)
+        return cls((half, half))
+
+    @property
+    def sigma(self) -> float:
+        return math.hypot(*self.roughness)
+
+    @property
+    def variance_ratios(self) -> tuple[float, float]:
+        s1, s2 = self.roughness
+        total = s1 * s1 + s2 * s2
+        return s1 * s1 / total, s2 * s2 / total
+
+    def pressure(self, ratio, across: bool, slope: bool = False):
+        """phi_x (``across`` False) or phi_z (True) at H = ``ratio``, with d/dH if ``slope``."""
+        values = [pressure_flow_factor_of(ratio, 1.0 / g if across else g, True) for g in self.peklenik]
+        (v1, d1), (v2, d2) = values
+        w1, w2 = self.variance_ratios
+        if self.peklenik[0] == self.peklenik[1]:
+            return (v1, d1) if slope else v1
+        return (w1 * v1 + w2 * v2, w1 * d1 + w2 * d2) if slope else w1 * v1 + w2 * v2
+
+    def shear_flow(self, ratio, order: int = 0):
+        """phi_s (``order`` 0) or its H-derivatives (1, 2) at H = ``ratio``."""
+        w1, w2 = self.variance_ratios
+        g1, g2 = self.peklenik
+        if g1 == g2 and w1 == w2:
+            return np.zeros_like(np.asarray(ratio, dtype=float))
+        return w1 * shear_flow_factor_of(ratio, g1, order) - w2 * shear_flow_factor_of(ratio, g2, order)

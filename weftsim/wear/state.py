@@ -102,7 +102,7 @@ def scene_identity(scene: Scene) -> str:
 # nothing (weftsim.input.params.Lubrication's defaults; unset on a dry joint): a wear state written before them is
 # the same scene's.
 ELASTIC_DEFAULTS = {"elastic_film": False, "summit_height_um": 0.0, "pressure_viscosity_per_gpa": 0.0,
-                    "asperity_modulus_gpa": 0.0}
+                    "asperity_modulus_gpa": 0.0, "surface_roughness_um": None, "peklenik_numbers": None}
 
 
 DUTY_DEFAULTS = {"stops_per_hour": 0.0, "stop_minutes": 2.87, "hours_per_day": 24.0, "days_per_week": 7.0,

@@ -71,7 +71,8 @@ PREDICTION_SETTINGS = {
 }
 # Keys of the steady elastic film of `weftsim bearing` (weftsim.joint.ehl): a wear prediction runs the transient
 # engines, which keep the rigid film and refuse elastic_film, so these change nothing there.
-STEADY_ONLY = ("joint_e.lubrication.summit_height_um", "joint_e.lubrication.pressure_viscosity_per_gpa")
+STEADY_ONLY = ("joint_e.lubrication.summit_height_um", "joint_e.lubrication.pressure_viscosity_per_gpa",
+               "joint_e.lubrication.surface_roughness_um", "joint_e.lubrication.peklenik_numbers")
 
 
 def resolve(name: str) -> str:
