@@ -55,23 +55,58 @@ def comparison_table(rig, rows: list[dict], floored: list[dict]) -> str:
     return "\n".join(lines)
 
 
-def elastic_table(rows: list[dict], elastic: list[dict]) -> str:
-    """Per point: published torque, the rigid and the elastic film's ratio to it, the elastic big end's minimum film,
-    asperity load, peak pressure and greatest opening of the gap, and its Newton iterations."""
-    lines = ["| load | rpm | published | rigid film | elastic film | ratio | big end h_min (film ratio) | asperity load | "
-             "peak pressure | gap opened by | Newton iterations (big end, support) |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
-    for case, el in zip(rows, elastic):
+def elastic_table(rows: list[dict], isotropic: list[dict], elastic: list[dict]) -> str:
+    """Per point: published torque, the rigid film's and the elastic film's of isotropic alike surfaces ratio to it,
+    the elastic film's (the source's surfaces) torque and ratio, the big end's minimum film, asperity load, peak
+    pressure and greatest opening of the gap, and its Newton iterations."""
+    lines = ["| load | rpm | published | rigid film | elastic, isotropic | elastic film | ratio | big end h_min (film "
+             "ratio) | asperity load | peak pressure | gap opened by | Newton iterations (big end, support) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for case, iso, el in zip(rows, isotropic, elastic):
         for k, rpm in enumerate(case["rpm"]):
             big, sup = (el["points"][k]["bearings"][name] for name in ("big_end", "support"))
             lines.append(f"| {case['load_n'] / 1e3:g} kN | {rpm:g} | {case['torque_nm'][k]:.3f} | "
-                         f"{case['ratio'][k]:.2f} | {el['weftsim_nm'][k]:.3f} | {el['ratio'][k]:.2f} | "
+                         f"{case['ratio'][k]:.2f} | {iso['ratio'][k]:.2f} | {el['weftsim_nm'][k]:.3f} | "
+                         f"{el['ratio'][k]:.2f} | "
                          f"{1e6 * big['min_film_m']:.3f} um ({big['film_ratio']:.2f}) | {big['asperity_load_n']:.0f} N | "
                          f"{big['elastic']['peak_pressure_pa'] / 1e6:.0f} MPa | "
                          f"{1e6 * big['elastic']['max_opening_m']:.2f} um | "
                          f"{big['elastic']['iterations']}, {sup['elastic']['iterations']} |")
         lines.append(f"| {case['load_n'] / 1e3:g} kN | least torque at | {case['minimum_rpm']:g} rpm | "
-                     f"{case['weftsim_minimum_rpm']:g} rpm | {el['weftsim_minimum_rpm']:g} rpm | | | | | | |")
+                     f"{case['weftsim_minimum_rpm']:g} rpm | {iso['weftsim_minimum_rpm']:g} rpm | "
+                     f"{el['weftsim_minimum_rpm']:g} rpm | | | | | | |")
+    return "\n".join(lines)
+
+
+def with_surfaces(rig, roughness, peklenik):
+    """The rig with every bearing's ``surface_roughness`` and ``peklenik_numbers`` replaced (None: unset)."""
+    bearings = []
+    for b in rig.bearings:
+        lub = replace(b.joint.lubrication, surface_roughness=roughness, peklenik_numbers=peklenik)
+        bearings.append(replace(b, joint=replace(b.joint, lubrication=lub)))
+    return replace(rig, bearings=tuple(bearings))
+
+
+def surface_table(elastic) -> str:
+    """The elastic film's ratio to the published torque at the mixed points with the surfaces' assumptions
+    changed one at a time."""
+    lub = elastic.bearings[0].joint.lubrication
+    rq, gamma = lub.surface_roughness, lub.peklenik_numbers
+    composite = math.hypot(*rq) / math.sqrt(2.0)
+    variants = (("isotropic, alike, on roughness_um (before)", None, None),
+                ("isotropic, alike, on the composite Rq", (composite, composite), None),
+                ("the source's surfaces (journal = 1)", rq, gamma),
+                ("surfaces swapped (journal = 2)", rq[::-1], gamma[::-1]),
+                ("the source's Rq, both gamma 1 (shear flow only)", rq, (1.0, 1.0)),
+                ("the source's gamma, alike Rq (no shear flow of unlike Rq)", (composite, composite), gamma))
+    points = [(8000.0, rpm) for rpm in (500.0, 400.0, 300.0, 250.0, 200.0, 150.0)] + [(4000.0, 250.0), (4000.0, 150.0)]
+    published = {(c["load_n"], n): m for c in elastic.loads for n, m in zip(c["rpm"], c["torque_nm"])}
+    lines = ["| surfaces | " + " | ".join(f"{load / 1e3:g} kN {rpm:g}" for load, rpm in points) + " |",
+             "|---|" + "---|" * len(points)]
+    for name, r, g in variants:
+        rig = with_surfaces(elastic, r, g)
+        lines.append(f"| {name} | " + " | ".join(f"{rig_point(rig, load, rpm)['torque_nm'] / published[load, rpm]:.2f}"
+                                               for load, rpm in points) + " |")
     return "\n".join(lines)
 
 
@@ -241,7 +276,10 @@ def main():
     elastic = with_elastic(rig)
     print()
     print("the elastic film (the rig's [elastic] keys):")
-    print(elastic_table(rows, comparison(elastic)))
+    print(elastic_table(rows, comparison(with_surfaces(elastic, None, None)), comparison(elastic)))
+    print()
+    print("the elastic film / published torque, the surfaces' assumptions changed one at a time:")
+    print(surface_table(elastic))
     out = ROOT / "docs" / "img" / "stribeck_sander.png"
     figure(rig, floored, elastic, out)
     print(f"wrote {out}")

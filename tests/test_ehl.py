@@ -219,3 +219,124 @@ def test_weftsim_bearing_takes_the_elastic_film():
     assert r["elastic"] is None and e["elastic"] is not None
     assert e["friction_torque_nm"] == e["elastic"]["friction_torque_nm"]
     assert e["min_film_m"] >= r["min_film_m"]  # conforming surfaces spread the load
+
+
+# Patir and Cheng's anisotropic and unlike surfaces (weftsim.physics.flow_factors.SurfacePair; the elastic film only).
+
+def test_the_anisotropic_factors_at_gamma_one_are_the_isotropic_ones():
+    """gamma = 1 is the kernel's isotropic factor bit for bit, and alike isotropic surfaces have phi_x = phi_z = that
+    factor and no shear flow (Patir and Cheng's phi_s cancels between alike surfaces)."""
+    from weftsim.physics.flow_factors import SurfacePair, pressure_flow_factor, pressure_flow_factor_of
+
+    ratio = np.array([0.1, 0.5, 1.0, 2.0, 3.5, 8.0, 40.0])
+    assert np.array_equal(pressure_flow_factor_of(ratio, 1.0), pressure_flow_factor(ratio))
+    alike = SurfacePair.isotropic(0.3e-6)
+    for across in (False, True):
+        assert np.array_equal(alike.pressure(ratio, across), pressure_flow_factor(ratio))
+    assert np.array_equal(alike.shear_flow(ratio), np.zeros_like(ratio))
+    assert alike.sigma == pytest.approx(0.3e-6, rel=1e-15)
+
+
+def test_the_anisotropic_factors_are_the_published_fits():
+    """Values worked by hand from Patir and Cheng's Tables (1978, Table 1; 1979, Table 2): phi_x(2, 6) = 1 + 0.520 /
+    2^1.5, phi_x(2, 1/3) = 1 - 1.18 exp(-0.84), Phi_s(1, 1) = 1.899 exp(-0.87), Phi_s(6, 9) = 0.295 exp(-1.5); gamma
+    = 4 reads 2/3 of column 3 and 1/3 of column 6; phi_y(H, gamma) = phi_x(H, 1/gamma).  The shear flow's two
+    branches meet at H = 5 in every column to the constants' rounding (measured at most 8e-4 of the value: a
+    mistyped constant breaks it); thick films: phi_x -> 1, Phi_s -> 0."""
+    from weftsim.physics.flow_factors import PEKLENIK_COLUMNS, SurfacePair, pressure_flow_factor_of, \
+        shear_flow_factor_of
+
+    assert pressure_flow_factor_of(2.0, 6.0) == pytest.approx(1.0 + 0.520 / 2.0**1.5, rel=1e-14)
+    assert pressure_flow_factor_of(2.0, 1.0 / 3.0) == pytest.approx(1.0 - 1.18 * math.exp(-0.84), rel=1e-14)
+    assert shear_flow_factor_of(1.0, 1.0) == pytest.approx(1.899 * math.exp(-0.87), rel=1e-14)
+    assert shear_flow_factor_of(6.0, 9.0) == pytest.approx(0.295 * math.exp(-1.5), rel=1e-14)
+    assert pressure_flow_factor_of(1.5, 4.0) == pytest.approx(
+        (2.0 * pressure_flow_factor_of(1.5, 3.0) + pressure_flow_factor_of(1.5, 6.0)) / 3.0, rel=1e-14)
+    pair = SurfacePair((0.2e-6, 0.2e-6), (4.0, 4.0))
+    assert pair.pressure(1.5, across=True) == pressure_flow_factor_of(1.5, 0.25)
+    for gamma in PEKLENIK_COLUMNS:
+        below, above = shear_flow_factor_of(5.0, gamma), shear_flow_factor_of(5.0 * (1.0 + 1e-12), gamma)
+        assert above == pytest.approx(below, rel=1e-3)  # the published constants' 3-4 digits
+        assert pressure_flow_factor_of(1e4, gamma) == pytest.approx(1.0, abs=1e-5)
+        assert shear_flow_factor_of(200.0, gamma) < 1e-20
+    # longitudinal roughness eases the flow along the ridges, transverse hinders it
+    assert pressure_flow_factor_of(2.0, 9.0) > pressure_flow_factor_of(2.0, 3.0) > 1.0 > \
+        pressure_flow_factor_of(2.0, 1.0) > pressure_flow_factor_of(2.0, 1.0 / 9.0) > 0.0
+
+
+def test_the_factors_slopes_are_their_derivatives():
+    """The slopes the Newton Jacobian takes (phi_x', phi_s', phi_s'') are the factors' central differences (step 1e-6:
+    truncation ~1e-12, round-off ~1e-10 of the value), on both sides of H = 5 and between columns."""
+    from weftsim.physics.flow_factors import SurfacePair, shear_flow_factor_of
+
+    pair = SurfacePair((0.20e-6, 0.34e-6), (4.0, 12.0))
+    step = 1e-6
+    for ratio in (0.8, 1.7, 3.0, 4.5, 6.5):
+        for across in (False, True):
+            _, slope = pair.pressure(ratio, across, slope=True)
+            difference = (pair.pressure(ratio + step, across) - pair.pressure(ratio - step, across)) / (2.0 * step)
+            assert slope == pytest.approx(difference, rel=1e-7, abs=1e-9)
+        for order in (1, 2):
+            difference = (pair.shear_flow(ratio + step, order - 1) - pair.shear_flow(ratio - step, order - 1)) / (2 * step)
+            assert pair.shear_flow(ratio, order) == pytest.approx(difference, rel=1e-6, abs=1e-9)
+        assert shear_flow_factor_of(ratio, 0.25, 1) == pytest.approx(
+            (shear_flow_factor_of(ratio + step, 0.25) - shear_flow_factor_of(ratio - step, 0.25)) / (2 * step), rel=1e-7)
+
+
+def _film_at(joint, surfaces, load=8000.0, rpm=300.0):
+    from weftsim.joint.ehl import Pair, elastic_point
+    from weftsim.joint.steady import steady_point
+
+    w, eta = rpm * math.pi / 30.0, joint.lubrication.viscosity
+    start = steady_point(joint, load, w, eta).eccentricity_ratio
+    return elastic_point(replace(Pair.of(joint), surfaces=surfaces), load, w, eta, start, rigid=True)
+
+
+def test_the_shear_flow_and_the_anisotropy_move_the_film_as_patir_and_cheng_say(rig):
+    """The rig's big end, rigid, 8 kN, 300 rpm, surfaces of 0.20 and 0.34 um: the rougher surface still (the bearing)
+    holds oil back in the converging gap and the film carries the load thicker than with the rougher surface
+    moving (the journal) (Patir and Cheng 1979: roughness on the stationary surface raises the load).  Ridges across
+    the motion (gamma 1/9 on both) thicken the film against isotropic surfaces of the same Rq and ridges along it
+    (gamma 9) thin it, the classic result of the average flow (Patir and Cheng 1978) that holds on this short
+    bearing (B/D = 0.36) too: measured 0.501, 0.464, 0.374 um; the longitudinal ridges' lower side leakage
+    (phi_z < 1) loses against their easier circumferential flow (phi_x > 1).  Alike isotropic surfaces given as keys
+    are the unset film."""
+    from weftsim.physics.flow_factors import SurfacePair
+
+    joint = rig.bearings[0].joint
+    still_rough = _film_at(joint, SurfacePair((0.20e-6, 0.34e-6)))
+    moving_rough = _film_at(joint, SurfacePair((0.34e-6, 0.20e-6)))
+    assert still_rough.min_film_m > moving_rough.min_film_m
+    assert still_rough.asperity_load_n < moving_rough.asperity_load_n
+    isotropic = _film_at(joint, SurfacePair((0.28e-6, 0.28e-6)))
+    longitudinal = _film_at(joint, SurfacePair((0.28e-6, 0.28e-6), (9.0, 9.0)))
+    transverse = _film_at(joint, SurfacePair((0.28e-6, 0.28e-6), (1.0 / 9.0, 1.0 / 9.0)))
+    assert transverse.min_film_m > isotropic.min_film_m > longitudinal.min_film_m
+    unset = _film_at(joint, None)
+    alike = _film_at(joint, SurfacePair.isotropic(joint.lubrication.roughness))
+    assert alike.friction_torque_nm == pytest.approx(unset.friction_torque_nm, rel=1e-9)  # the Newton tolerance
+    assert alike.min_film_m == pytest.approx(unset.min_film_m, rel=1e-9)
+
+
+def test_the_surface_keys_are_the_elastic_films():
+    """surface_roughness_um and peklenik_numbers are [journal, bearing] pairs of the elastic film: read into the
+    Pair's SurfacePair, refused without elastic_film in one line naming the key, and unset they leave the Pair's
+    surfaces None (the isotropic film, bit for bit)."""
+    from weftsim.input.scene import load_scene
+    from weftsim.joint.ehl import Pair
+
+    base = {"joint_e.lubrication.viscosity_mpa_s": 50.0, "joint_e.lubrication.elastic_film": True}
+    scene = load_scene("loom", {**base, "joint_e.lubrication.surface_roughness_um": [0.2, 0.34],
+                                "joint_e.lubrication.peklenik_numbers": [4.0, 12.0]})
+    surfaces = Pair.of(scene.joint).surfaces
+    assert surfaces.roughness == pytest.approx((0.2e-6, 0.34e-6)) and surfaces.peklenik == (4.0, 12.0)
+    assert Pair.of(load_scene("loom", base).joint).surfaces is None
+    only_gamma = Pair.of(load_scene("loom", {**base, "joint_e.lubrication.peklenik_numbers": [4.0, 4.0]}).joint)
+    assert only_gamma.surfaces.sigma == pytest.approx(only_gamma.sigma, rel=1e-15)
+    for key, value in (("surface_roughness_um", [0.2, 0.34]), ("peklenik_numbers", [4.0, 12.0])):
+        with pytest.raises(SceneError) as error:
+            load_scene("loom", {"joint_e.lubrication.viscosity_mpa_s": 50.0, f"joint_e.lubrication.{key}": value})
+        assert key.removesuffix("_um") in str(error.value) and "elastic film only" in str(error.value)
+        assert "\n" not in str(error.value)
+        with pytest.raises(SceneError, match=key):
+            load_scene("loom", {**base, f"joint_e.lubrication.{key}": [0.2]})
