@@ -34,10 +34,19 @@ The friction torque on the journal (reported positive, as ``weftsim bearing``'s)
   (e x F)_x / 2, :mod:`weftsim.physics.film`);
 - boundary friction mu_b R times the asperities' normal load integral p_a dA (at the journal's surface).
 
+Surfaces (``Pair.surfaces``, the keys ``surface_roughness_um`` and ``peklenik_numbers``): Patir and Cheng's
+average flow of anisotropic, unlike surfaces (:class:`weftsim.physics.flow_factors.SurfacePair`, journal first):
+phi_z H^3 on the axial fluxes and phi_x H^3 on the circumferential ones, H = h / sigma on the surfaces' composite
+sigma (also in Phi and phi_f; the asperities keep the contact's sigma), and the shear flow of the moving journal
+against the still bearing, (U_1 - U_2) / 2 sigma d phi_s / dx = U_m sigma d phi_s / dx with U_1 = omega R, U_2 = 0,
+so that the source is -12 (Phi + phi_s') dH/dphi (:func:`weftsim.joint.reynolds.rotation_source`): with the rougher
+surface still (phi_s < 0, rising to 0 as the film thickens) the shear flow falls along the converging gap and adds
+pressure.  Unset: isotropic alike surfaces on ``sigma``, the film as before bit for bit.
+
 With Gamma = 0 (``rigid=True``) the same solve is the rigid film of the kernel's discretisation, solved directly
-instead of interpolated from the kernel's table (tests/test_ehl.py measures the difference).  Not modelled: the
-pressure's variation of viscosity, mass-conserving cavitation, the deformation's variation along the axis, the
-housing's stiffness beyond an infinite plate.
+instead of interpolated from the kernel's table (tests/test_ehl.py measures the difference).  Not modelled:
+mass-conserving cavitation, Patir and Cheng's shear-stress factor phi_fs of unlike surfaces, the deformation's
+variation along the axis, the housing's stiffness beyond an infinite plate.
 """
 
 from __future__ import annotations
