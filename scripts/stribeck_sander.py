@@ -98,15 +98,34 @@ def surface_table(elastic) -> str:
                 ("the source's surfaces (journal = 1)", rq, gamma),
                 ("surfaces swapped (journal = 2)", rq[::-1], gamma[::-1]),
                 ("the source's Rq, both gamma 1 (shear flow only)", rq, (1.0, 1.0)),
-                ("the source's gamma, alike Rq (no shear flow of unlike Rq)", (composite, composite), gamma))
+                ("the source's gamma, alike Rq (no shear flow of unlike Rq)", (composite, composite), gamma),
+                ("the bearing's gamma 6 instead of 12 (a sensitivity)", rq, (gamma[0], 6.0)))
     points = [(8000.0, rpm) for rpm in (500.0, 400.0, 300.0, 250.0, 200.0, 150.0)] + [(4000.0, 250.0), (4000.0, 150.0)]
     published = {(c["load_n"], n): m for c in elastic.loads for n, m in zip(c["rpm"], c["torque_nm"])}
     lines = ["| surfaces | " + " | ".join(f"{load / 1e3:g} kN {rpm:g}" for load, rpm in points) + " |",
              "|---|" + "---|" * len(points)]
+    def row(name, rig):
+        return f"| {name} | " + " | ".join(f"{rig_point(rig, load, rpm)['torque_nm'] / published[load, rpm]:.2f}"
+                                         for load, rpm in points) + " |"
+
     for name, r, g in variants:
-        rig = with_surfaces(elastic, r, g)
-        lines.append(f"| {name} | " + " | ".join(f"{rig_point(rig, load, rpm)['torque_nm'] / published[load, rpm]:.2f}"
-                                               for load, rpm in points) + " |")
+        lines.append(row(name, with_surfaces(elastic, r, g)))
+    # The other rule for two gammas: one composite gamma = V_r1 gamma_1 + V_r2 gamma_2 (the correlation lengths
+    # variance-weighted) in both pressure factors, the shear flow as before.
+    from unittest import mock
+
+    from weftsim.physics.flow_factors import SurfacePair, pressure_flow_factor_of
+
+    def composite_gamma(self, ratio, across, slope=False):
+        w1, w2 = self.variance_ratios
+        g = w1 * self.peklenik[0] + w2 * self.peklenik[1]
+        out = pressure_flow_factor_of(ratio, 1.0 / g if across else g, True)
+        return out if slope else out[0]
+
+    with mock.patch.object(SurfacePair, "pressure", composite_gamma):
+        g = (rq[0] ** 2 * gamma[0] + rq[1] ** 2 * gamma[1]) / (rq[0] ** 2 + rq[1] ** 2)
+        lines.append(row(f"one composite gamma {g:.1f} in phi_x, phi_z (the other rule for two gammas)",
+                         with_surfaces(elastic, rq, gamma)))
     return "\n".join(lines)
 
 
