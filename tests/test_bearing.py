@@ -477,3 +477,17 @@ def test_the_elastic_film_mixed_side_is_within_thirty_percent(sander_elastic):
     for case in rows:
         for rpm, ratio in zip(case["rpm"], case["ratio"]):
             assert ratio == pytest.approx(1.0, abs=STRIBECK_TOLERANCE), (case["load_n"], rpm)
+
+
+def test_a_mixed_point_of_the_rigid_film_says_what_it_was_measured_to_do():
+    """A result says when it lies outside what its model reproduced: a point of the rigid film in the mixed or
+    boundary regime carries a note naming the Stribeck test's 0.23-0.61 and the elastic film; a full-film point
+    none (the loom's mean point in ISO VG 220 at 40 C: film ratio > 3)."""
+    import weftsim
+
+    scene, report = _loom_report()
+    assert report["points"]["mean"]["regime"] == "hydrodynamic" and report["notes"] == []
+    slow = weftsim.bearing(scene, load_kn=FLOOR_LOAD_N / 1e3, journal_rpm=FLOOR_SPEEDS_RPM[0], stribeck=False)
+    assert slow["points"]["given"]["regime"] != "hydrodynamic"
+    (note,) = slow["notes"]
+    assert note.startswith("given: ") and "0.23-0.61" in note and "joint_e.lubrication.elastic_film = true" in note

@@ -58,6 +58,8 @@ def run(args: argparse.Namespace, scene: Scene, outdir) -> int:
           f"{report['roughness_um']:g} um, {oil}")
     for name, point in report["points"].items():
         print("  " + point_line(name, point))
+    for note in report.get("notes", []):
+        print("  note: " + note)
     curve = report.get("stribeck")
     if curve:
         k = min(range(len(curve["friction_coefficient"])), key=curve["friction_coefficient"].__getitem__)

@@ -129,11 +129,29 @@ def bearing(scene, joint: str = "e", load: float | None = None, journal_rpm: flo
     for name, (w, o) in points.items():  # the peak's film is the mean's: a peak lasts too short to heat it
         film = out["points"].get("mean") if name == "peak" else None
         out["points"][name] = operating_point(part, w, o, film)
+    out["notes"] = model_notes(lub, out["points"], joint)
     if curve:
         first_load, first_omega = next(iter(points.values()))
         out["stribeck"] = {"load_n": first_load, "operating_speed_rad_s": first_omega,
                            **stribeck(part, first_load, first_omega)}
     return out
+
+
+# What the rigid film was measured to do below its full-film range (docs/lubricated-joint.md, "Stribeck data"):
+# on Sander et al.'s rig it reads 0.23-0.61 of the published torque where the film is mixed, the elastic film with
+# the source's surfaces 0.81-1.16 at every published point.
+RIGID_MIXED_NOTE = ("{names}: mixed or boundary regime with the rigid film, whose friction there was measured at "
+                    "0.23-0.61 of a published Stribeck test (docs/lubricated-joint.md, Stribeck data); "
+                    "joint_{joint}.lubrication.elastic_film = true with the surfaces' keys (summit_height_um, "
+                    "surface_roughness_um, peklenik_numbers) matched it within 0.81-1.16")
+
+
+def model_notes(lub, points: dict, joint: str = "e") -> list[str]:
+    """Lines saying where a point lies outside what its film model was shown to reproduce (empty: none)."""
+    outside = [name for name, p in points.items() if p["regime"] != "hydrodynamic"]
+    if outside and not lub.elastic_film:
+        return [RIGID_MIXED_NOTE.format(names=", ".join(outside), joint=joint)]
+    return []
 
 
 def _balanced(part):
