@@ -144,6 +144,7 @@ class StepController:
         corners = film_corners(scene.joint) if clearance is not None else ()
 
         def gap(mbs_: exu.MainSystem) -> float:
+            assert clearance is not None  # gap is read only with the corners, which need a clearance
             return -clearance.state(mbs_)[0]
 
         return cls(mbs, solver, model.nodes["rod"], math.hypot(journal[0], journal[1]), s.local_error, scene.limits.min_step, period, period,

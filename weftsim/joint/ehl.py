@@ -53,10 +53,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from weftsim.errors import SceneError
+
+if TYPE_CHECKING:
+    from weftsim.physics.flow_factors import SurfacePair
 
 TOLERANCE = 1e-9  # relative residuals of the pressure (to the mean pressure) and the load at convergence
 MAX_ITERATIONS = 60
@@ -100,7 +104,7 @@ class Pair:
     summit_height: float  # delta, m
     moduli: tuple[float, float, float, float]  # E_j, nu_j, E_b, nu_b
     pressure_viscosity: float = 0.0  # Barus' alpha, 1/Pa
-    surfaces: object = None  # weftsim.physics.flow_factors.SurfacePair (journal, bearing); None: isotropic, alike
+    surfaces: SurfacePair | None = None  # weftsim.physics.flow_factors.SurfacePair (journal, bearing); None: isotropic, alike
 
     @property
     def flow_sigma(self) -> float:

@@ -238,7 +238,8 @@ def solve_gap(nodes: np.ndarray, gap_nodes: np.ndarray, gap_faces: np.ndarray, s
     as the kernel's fed film); ``active``: a first guess of the film (P > 0) for the active set; ``surfaces``:
     anisotropic or unlike rough surfaces (:func:`conductances_of`, :func:`rotation_source`; ``roughness`` then
     their composite sigma / c)."""
-    matrix, volume = assemble(nodes, *conductances_of(gap_nodes, gap_faces, roughness, surfaces), half_width, n_zeta)
+    node_h3, face_h3 = conductances_of(gap_nodes, gap_faces, roughness, surfaces)
+    matrix, volume = assemble(nodes, node_h3, face_h3, half_width, n_zeta)
     q = rotation_source(gap_nodes, slope_nodes, volume, roughness, surfaces)
     guess = np.ones(q.size, bool) if active is None else active.ravel()
     pressure = complementary(matrix, q, n_zeta, supply, guess)

@@ -92,8 +92,8 @@ def scene_identity(scene: Scene) -> str:
         if keys.get(f"{table}.bushing_wall_mm", 0.0) is None:
             keys.pop(f"{table}.bushing_wall_mm")
     for table in ("joint_e", "joint_f"):  # the steady elastic film's keys at their defaults, for a state before them
-        for name, value in ELASTIC_DEFAULTS.items():
-            if keys.get(f"{table}.lubrication.{name}", value) in (value, None):  # None: a dry joint's
+        for name, default in ELASTIC_DEFAULTS.items():
+            if keys.get(f"{table}.lubrication.{name}", default) in (default, None):  # None: a dry joint's
                 keys.pop(f"{table}.lubrication.{name}", None)
     return json.dumps(keys, sort_keys=True, default=str)
 
@@ -101,7 +101,7 @@ def scene_identity(scene: Scene) -> str:
 # The keys of the steady elastic film (weftsim.joint.ehl) and the asperities' own modulus, at the values that change
 # nothing (weftsim.input.params.Lubrication's defaults; unset on a dry joint): a wear state written before them is
 # the same scene's.
-ELASTIC_DEFAULTS = {"elastic_film": False, "summit_height_um": 0.0, "pressure_viscosity_per_gpa": 0.0,
+ELASTIC_DEFAULTS: dict[str, object] = {"elastic_film": False, "summit_height_um": 0.0, "pressure_viscosity_per_gpa": 0.0,
                     "asperity_modulus_gpa": 0.0, "surface_roughness_um": None, "peklenik_numbers": None}
 
 
