@@ -33,7 +33,7 @@ from numba import njit
 from weftsim.physics.chain import OMEGA, TRACK_MAX, V_MIN, eccentricity
 from weftsim.physics.joint import BEARING_RADIUS, MU, V1, tangential_velocity
 from weftsim.physics.lubricated import is_lubricated
-from weftsim.physics.chain_f import BLOCKS, N_JOINTS, joint_is_loose, penetration_at
+from weftsim.physics.chain_f import BLOCKS, N_JOINTS, PLAIN, joint_is_loose, penetration_at
 from weftsim.reference.compiled_rk import (
     _MAX_FACTOR, _MIN_FACTOR, _SAFETY, DOP853, RK45, _dense, _dense_coefficients, _error_norm, _f,
     _initial_step, _stages,
@@ -395,3 +395,7 @@ def advance(prm: np.ndarray, method: int, rtol: float, atol: float, max_step: fl
             return PAUSED, n_rows
     fst[T] = t
     return DONE, n_rows
+
+
+# advance for a plain scene (weftsim.physics.chain_f.PLAIN): the same loop, compiled on first use.
+advance_plain = specialize(advance, "plain", **PLAIN)
