@@ -112,9 +112,11 @@ _rate_peak = specialize(roots.rate_peak, state=_state)
 @njit(cache=True, error_model="numpy")
 def _record(buf_t, buf_y, buf_c, buf_i, n, t, y, contact, impact):
     buf_t[n] = t
-    buf_y[n, :] = y
+    for j in range(y.size):  # element by element: a slice copy needs numba's reference counting (lean forms)
+        buf_y[n, j] = y[j]
     buf_c[n] = contact
-    buf_i[n, :] = impact
+    for j in range(impact.size):
+        buf_i[n, j] = impact[j]
     return n + 1
 
 
@@ -154,8 +156,8 @@ def _events_of_joint(prm, method, F, t, h, y, tmp, joint, in_contact, held, g_ol
             peak_t[n], peak_r[n] = t_stop, value
             n += 1
         else:
-            peak_t[:n] = grid_t
-            peak_r[:n] = grid_r
+            for i in range(n):  # element by element: a slice copy needs numba's reference counting (lean forms)
+                peak_t[i], peak_r[i] = grid_t[i], grid_r[i]
         found, t_peak, r_peak = _rate_peak(args, peak_t, peak_r, n, held)
         if found:
             t_stop = t_peak
@@ -398,4 +400,4 @@ def advance(prm: np.ndarray, method: int, rtol: float, atol: float, max_step: fl
 
 
 # advance for a plain scene (weftsim.physics.chain_f.PLAIN): the same loop, compiled on first use.
-advance_plain = specialize(advance, "plain", **PLAIN)
+advance_plain = specialize(advance, "plain", lean=True, counted=("_initial_step", "jacobian", "_jacobian_central", "step"), **PLAIN)
