@@ -204,13 +204,13 @@ def local_clearances(prm: np.ndarray, t: float, y: np.ndarray, q: tuple) -> tupl
     return c_e, rate_e, c_f, rate_f
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")  # no extra call in rhs_any / penetration_at
 def penetration_e(prm: np.ndarray, t: float, y: np.ndarray, joint: int) -> tuple[float, float]:
     """:func:`penetration_at` of topology E_ONLY: :func:`weftsim.physics.chain.penetration` (``joint`` is E)."""
     return kc.penetration(prm, t, y)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")  # no extra call in rhs_any / penetration_at
 def rhs_e(prm: np.ndarray, t: float, y: np.ndarray, contact: int, impact: np.ndarray, out: np.ndarray) -> float:
     """:func:`rhs_any` of topology E_ONLY: :func:`weftsim.physics.chain.chain` with contact bit 0 and
     impact[0]; returns delta (m)."""
