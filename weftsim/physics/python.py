@@ -10,7 +10,7 @@ path.  :func:`specialize` does the same with some globals bound to other functio
 result: the compiled path binds the event search of :mod:`.roots` to its dense output that way
 (numba cannot cache a function that passes a compiled function on as an argument through branches
 or loops: it embeds the function's address), and builds the reference engine's plain kernel
-(:data:`weftsim.reference.compiled.PLAIN`) with the drive law, the film, the wear and the topology
+(:data:`weftsim.physics.chain_f.PLAIN`) with the drive law, the film, the wear and the topology
 bound to their constant-speed, dry, round, E-only forms.  :func:`specialize` rebuilds only the functions
 that read a bound name, directly or through a compiled callee (called by name or as ``module.function``);
 the others stay the shared compiled functions.
@@ -68,8 +68,8 @@ def specialize(fn: Dispatcher, tag: str = "", lean: bool = False, counted: tuple
     """``fn`` and its callees compiled (``cache=True``) with the globals in ``bind`` replaced.
 
     Only functions that read a bound name (themselves or through a compiled callee, called by name or as
-    ``module.function``) are rebuilt (every callee under ``lean``); a bound compiled function is itself rebuilt with ``bind`` when it reads
-    one.  numba's cache keys a function by its module, qualified name and signature, not by its globals:
+    ``module.function``) are rebuilt (every compiled callee under ``lean``); a bound compiled function is
+    itself rebuilt with ``bind`` when it reads one.  numba's cache keys a function by its module, qualified name and signature, not by its globals:
     ``tag`` (a name) is appended to the qualified name of every rebuilt function, so that forms of the same
     source with different bindings keep separate cache entries; without a tag, bind each name to one
     function per process.
@@ -153,7 +153,7 @@ def _compiled_form(fn, bind: dict, tag: str, memo: dict, reads: dict, options: d
             names[name] = _compiled_form(value, bind, tag, memo, reads, options)
         elif name in bind:
             names[name] = value
-        elif isinstance(value, types.ModuleType) and any(_reads(c, bind, reads) for n, c in _callees(fn, names)
-                                                         if n == name):  # fmt: skip
+        elif isinstance(value, types.ModuleType) and any((options or _reads(c, bind, reads))
+                                                         for n, c in _callees(fn, names) if n == name):  # fmt: skip
             names[name] = _module_view(value, code_names, bind, tag, memo, reads, options)
     return result
