@@ -57,9 +57,10 @@ def run_of():
     return run
 
 
-# The short runs that compile the kernels every engine path uses: the reference integrator (one
-# specialisation of weftsim.reference.compiled.advance holding every law, friction and film), its channels and
-# joint rows, the oiled joint's rows, and the Exudyn tree's force.
+# The short runs that compile the kernels every engine path uses: the reference integrator's plain kernel (a dry
+# scene: weftsim.physics.chain_f.PLAIN) and its general one (one specialisation of
+# weftsim.reference.compiled.advance holding every law, friction and film, compiled by the oiled loom), their
+# channels and joint rows, and the Exudyn tree's force.
 WARM_UP = (("reference", "reference"), ("loom_oiled", "reference"), ("loom", "exudyn"))
 
 

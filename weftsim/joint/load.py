@@ -26,6 +26,7 @@ from weftsim.physics import chain_f as kf
 from weftsim.physics.joint import BEARING_RADIUS, friction_force, tangential_velocity
 from weftsim.joint.lubrication import joint_states
 from weftsim.physics.lubricated import L_FX, L_FY, is_lubricated, lubricated_force
+from weftsim.physics.python import specialize
 from weftsim.model.channels import JOINT_FORCE_CHANNELS, JOINT_FORCE_CHANNELS_F, LOAD_FALLBACK
 
 JOINT_FORCE, JOINT_FORCE_F = JOINT_FORCE_CHANNELS + JOINT_FORCE_CHANNELS_F
@@ -65,6 +66,10 @@ def joint_force_rows(prm: np.ndarray, time: np.ndarray, states: np.ndarray, f_n_
             out_f[i] = _force(jf, c, e_y, e_z, v_y, v_z, w_j, w_b, f_n_f[i])
 
 
+# joint_force_rows for a plain scene (weftsim.physics.chain_f.PLAIN), compiled on first use.
+_joint_force_rows_plain = specialize(joint_force_rows, "plain", lean=True, **kf.PLAIN)
+
+
 def joint_force_table(scene: Scene, prm: np.ndarray, time: np.ndarray, states: np.ndarray,
                       channels: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     """``joint_force_N`` / ``joint_force_f_N`` of the scene's loose joints at the rows, from the states and the
@@ -76,8 +81,9 @@ def joint_force_table(scene: Scene, prm: np.ndarray, time: np.ndarray, states: n
         zero = np.zeros(n)
         f_n_e = np.ascontiguousarray(channels.get("contact_force_N", zero), dtype=float)
         f_n_f = np.ascontiguousarray(channels.get("contact_force_f_N", zero), dtype=float)
-        joint_force_rows(prm, np.ascontiguousarray(time, dtype=float), np.ascontiguousarray(states, dtype=float),
-                         f_n_e, f_n_f, out_e, out_f)  # fmt: skip
+        rows = _joint_force_rows_plain if kf.is_plain(prm) else joint_force_rows
+        rows(prm, np.ascontiguousarray(time, dtype=float), np.ascontiguousarray(states, dtype=float),
+             f_n_e, f_n_f, out_e, out_f)  # fmt: skip
     out = {}
     if loose_e:
         out[JOINT_FORCE] = out_e

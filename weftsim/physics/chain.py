@@ -67,6 +67,19 @@ def _ramp(tau: float) -> tuple[float, float, float]:
 
 
 @njit(cache=True, error_model="numpy")
+def constant_speed(prm: np.ndarray, t: float) -> tuple[float, float, float]:
+    """:func:`crank_motion` at constant speed: (omega t, omega, 0) (rad, rad/s, rad/s^2)."""
+    omega = prm[OMEGA]
+    return omega * t, omega, 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def constant_rate(prm: np.ndarray, t: float) -> float:
+    """:func:`crank_rate` at constant speed: omega (rad/s)."""
+    return prm[OMEGA]
+
+
+@njit(cache=True, error_model="numpy")
 def crank_motion(prm: np.ndarray, t: float) -> tuple[float, float, float]:
     """The crank's prescribed motion: (theta, theta_dot, theta_ddot) at time t (rad, rad/s, rad/s^2).
 
@@ -78,10 +91,10 @@ def crank_motion(prm: np.ndarray, t: float) -> tuple[float, float, float]:
     Both from theta0 = prm[DRIVE_THETA0] (the crank angle at t = 0).  A loom drive reaches full speed within
     the first pick or two (docs/wear.md section 12).
     """
-    omega = prm[OMEGA]
     law = prm[DRIVE_LAW]
     if law == CONSTANT_SPEED:
-        return omega * t, omega, 0.0
+        return constant_speed(prm, t)
+    omega = prm[OMEGA]
     t0, ramp, theta0 = prm[DRIVE_T0], prm[DRIVE_RAMP], prm[DRIVE_THETA0]
     if law == RUN_DOWN:
         if t <= t0:
@@ -104,7 +117,7 @@ def crank_motion(prm: np.ndarray, t: float) -> tuple[float, float, float]:
 def crank_rate(prm: np.ndarray, t: float) -> float:
     """theta_dot at time t (rad/s): prm[OMEGA] itself at constant speed (:func:`crank_motion`)."""
     if prm[DRIVE_LAW] == CONSTANT_SPEED:
-        return prm[OMEGA]
+        return constant_rate(prm, t)
     return crank_motion(prm, t)[1]
 
 
@@ -150,6 +163,13 @@ def local_clearance(prm: np.ndarray, t: float, ecc_y: float, ecc_z: float, v_y: 
     with the rod (its axis E -> F along u(psi)); the direction of e turns at (e x e_dot) / |e|^2.
     """
     return rod_clearance(prm, t, ecc_y, ecc_z, v_y, v_z, y[1], y[3])
+
+
+@njit(cache=True, error_model="numpy")
+def round_clearance(prm: np.ndarray, t: float, ecc_y: float, ecc_z: float, v_y: float, v_z: float,
+                    y: np.ndarray) -> tuple[float, float]:
+    """:func:`local_clearance` of a round joint (no wear tables): (c0, 0), m, m/s."""
+    return prm[CLEARANCE], 0.0
 
 
 @njit(cache=True, error_model="numpy", inline="always")

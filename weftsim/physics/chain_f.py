@@ -204,11 +204,45 @@ def local_clearances(prm: np.ndarray, t: float, y: np.ndarray, q: tuple) -> tupl
     return c_e, rate_e, c_f, rate_f
 
 
+@njit(cache=True, error_model="numpy", inline="always")  # no extra call in rhs_any / penetration_at
+def penetration_e(prm: np.ndarray, t: float, y: np.ndarray, joint: int) -> tuple[float, float]:
+    """:func:`penetration_at` of topology E_ONLY: :func:`weftsim.physics.chain.penetration` (``joint`` is E)."""
+    return kc.penetration(prm, t, y)
+
+
+@njit(cache=True, error_model="numpy", inline="always")  # no extra call in rhs_any / penetration_at
+def rhs_e(prm: np.ndarray, t: float, y: np.ndarray, contact: int, impact: np.ndarray, out: np.ndarray) -> float:
+    """:func:`rhs_any` of topology E_ONLY: :func:`weftsim.physics.chain.chain` with contact bit 0 and
+    impact[0]; returns delta (m)."""
+    return kc.chain(prm, t, y, (contact & 1) != 0, impact[0], out)[2]
+
+
+@njit(cache=True, error_model="numpy")
+def _no_film(prm: np.ndarray) -> bool:
+    """:func:`weftsim.physics.lubricated.is_lubricated` of a dry joint: False."""
+    return False
+
+
+# The plain scene: clearance at E alone (no tape), dry (no film), round (no wear tables), at constant speed:
+# the bindings that give the compiled paths its kernel (weftsim.physics.python.specialize; a tag "plain").
+# Bound, the drive law, the film, the wear and the topology dispatch leave the compiled code, and numba's
+# calls through them with it (each call that is not inlined increments and decrements the reference
+# counts of its array arguments: docs/performance.md, "The plain kernel").  Same arithmetic, same results.
+PLAIN = {"crank_motion": kc.constant_speed, "crank_rate": kc.constant_rate, "is_lubricated": _no_film,
+         "local_clearance": kc.round_clearance, "rhs_any": rhs_e, "penetration_at": penetration_e}  # fmt: skip
+
+
+def is_plain(prm: np.ndarray) -> bool:
+    """True when the kernel's parameter array ``prm`` is a plain scene's (:data:`PLAIN`)."""
+    return (prm[TOPOLOGY] == E_ONLY and not is_lubricated(prm) and prm.size <= kc.WEAR_E
+            and prm[kc.DRIVE_LAW] == kc.CONSTANT_SPEED)  # fmt: skip
+
+
 @njit(cache=True, error_model="numpy")
 def penetration_at(prm: np.ndarray, t: float, y: np.ndarray, joint: int) -> tuple[float, float]:
     """(delta, delta_dot) of ``joint`` (0 = E, 1 = F) of state y at time t (m, m/s)."""
     if prm[TOPOLOGY] == E_ONLY:
-        return kc.penetration(prm, t, y)
+        return penetration_e(prm, t, y, joint)
     if prm[TOPOLOGY] == E_TAPE:  # E's chain with the tape: the same first four coordinates, a round joint
         return kc.penetration(prm[:kc.WEAR_E], t, chain_state(prm, y))
     q = eccentricities(prm, t, y)
@@ -304,7 +338,7 @@ def rhs_any(prm: np.ndarray, t: float, y: np.ndarray, contact: int, impact: np.n
     :func:`weftsim.physics.tape.chain_tape` likewise.
     """
     if prm[TOPOLOGY] == E_ONLY:
-        return kc.chain(prm, t, y, (contact & 1) != 0, impact[0], out)[2]
+        return rhs_e(prm, t, y, contact, impact, out)
     if prm[TOPOLOGY] == E_TAPE:
         return chain_tape(prm, t, y, (contact & 1) != 0, impact[0], out)[2]
     r = chain_f(prm, t, y, contact, impact, out)

@@ -100,9 +100,9 @@ def friction_force(prm: np.ndarray, f_n: float, v_t: float) -> float:
     between ``prm[V0]`` and ``prm[V1]``; 0 when mu = 0 or F_N = 0.  ``v_t``: relative tangential velocity
     of the contact points (journal relative to bearing, :func:`tangential_velocity`), m/s.
     """
-    mu = prm[MU]
+    mu, v0, v1 = prm[MU], prm[V0], prm[V1]  # read first: see clearance_force_at
     if mu > 0.0 and f_n > 0.0:
-        c_d = friction_factor(v_t, prm[V0], prm[V1])
+        c_d = friction_factor(v_t, v0, v1)
         if c_d > 0.0:
             return -mu * c_d * f_n if v_t > 0.0 else mu * c_d * f_n
     return 0.0

@@ -33,7 +33,7 @@ from numba import njit
 from weftsim.physics.chain import OMEGA, TRACK_MAX, V_MIN, eccentricity
 from weftsim.physics.joint import BEARING_RADIUS, MU, V1, tangential_velocity
 from weftsim.physics.lubricated import is_lubricated
-from weftsim.physics.chain_f import BLOCKS, N_JOINTS, joint_is_loose, penetration_at
+from weftsim.physics.chain_f import BLOCKS, N_JOINTS, PLAIN, joint_is_loose, penetration_at
 from weftsim.reference.compiled_rk import (
     _MAX_FACTOR, _MIN_FACTOR, _SAFETY, DOP853, RK45, _dense, _dense_coefficients, _error_norm, _f,
     _initial_step, _stages,
@@ -112,9 +112,11 @@ _rate_peak = specialize(roots.rate_peak, state=_state)
 @njit(cache=True, error_model="numpy")
 def _record(buf_t, buf_y, buf_c, buf_i, n, t, y, contact, impact):
     buf_t[n] = t
-    buf_y[n, :] = y
+    for j in range(y.size):  # element by element: a slice copy needs numba's reference counting (lean forms)
+        buf_y[n, j] = y[j]
     buf_c[n] = contact
-    buf_i[n, :] = impact
+    for j in range(impact.size):
+        buf_i[n, j] = impact[j]
     return n + 1
 
 
@@ -154,8 +156,8 @@ def _events_of_joint(prm, method, F, t, h, y, tmp, joint, in_contact, held, g_ol
             peak_t[n], peak_r[n] = t_stop, value
             n += 1
         else:
-            peak_t[:n] = grid_t
-            peak_r[:n] = grid_r
+            for i in range(n):  # element by element: a slice copy needs numba's reference counting (lean forms)
+                peak_t[i], peak_r[i] = grid_t[i], grid_r[i]
         found, t_peak, r_peak = _rate_peak(args, peak_t, peak_r, n, held)
         if found:
             t_stop = t_peak
@@ -395,3 +397,7 @@ def advance(prm: np.ndarray, method: int, rtol: float, atol: float, max_step: fl
             return PAUSED, n_rows
     fst[T] = t
     return DONE, n_rows
+
+
+# advance for a plain scene (weftsim.physics.chain_f.PLAIN): the same loop, compiled on first use.
+advance_plain = specialize(advance, "plain", lean=True, counted=("_initial_step", "jacobian", "_jacobian_central", "step"), **PLAIN)

@@ -26,6 +26,8 @@ from weftsim.physics.chain import (
     COEF, COUPLING, GRAVITY, KIND, L_EF, L_FG, M11, M22, OMEGA, ROD_MASS, chain, crank_motion, local_clearance, penetration,
 )  # fmt: skip
 from weftsim.physics import chain_f as kf
+from weftsim.physics.chain_f import is_plain
+from weftsim.physics.python import specialize
 from weftsim.physics.laws import elastic_energy
 from weftsim.model.dynamics import initial_state, pack_parameters
 from weftsim.post.results import CHANNELS, JOINT_F_CHANNELS
@@ -132,6 +134,10 @@ def _fill(prm, table, a0, ratio, time, states, contact, impact, out):
         out[i, 17] = penetration(prm, t, y)[1]
 
 
+# _fill for a plain scene (weftsim.physics.chain_f.PLAIN), compiled on first use.
+_fill_plain = specialize(_fill, "plain", lean=True, **kf.PLAIN)
+
+
 @njit(cache=True, error_model="numpy")
 def _fill_f(prm, table, a0, ratio, time, states, contact, impact, out):
     """Rows of :data:`CHANNELS` then :data:`JOINT_F_CHANNELS` into out (n, 25), clearance at F.
@@ -202,7 +208,8 @@ def compiled_channels(scene: Scene, time: np.ndarray, states: np.ndarray, contac
     states = np.ascontiguousarray(states, dtype=float).reshape(time.size, size)
     if scene.joint_f.is_ideal:
         out = np.empty((time.size, len(CHANNELS)))
-        _fill(prm, table, a0, scene.geometry.rapier_ratio, time, states, np.asarray(contact, dtype=np.bool_),
+        fill = _fill_plain if is_plain(prm) else _fill
+        fill(prm, table, a0, scene.geometry.rapier_ratio, time, states, np.asarray(contact, dtype=np.bool_),
               np.asarray(impact, dtype=float), out)  # fmt: skip
         channels = dict(zip(CHANNELS, np.ascontiguousarray(out.T)))
     else:

@@ -20,9 +20,9 @@ from weftsim.reference.compiled import (
     DECOMPOSITIONS, DENSE, DONE, EVENTS, IMPLICIT_STEPS, JACOBIANS, FIRST_CONTACT, FIRST_CONTACT_F, GUARD, IMPACTS, LAST_PENETRATION, LAST_PENETRATION_F,
     LAST_STEP, MAX_RATE, METHODS, N_FLOAT_STATE, N_INT_STATE, NEXT_SAMPLE, NFEV, NON_FINITE, NONPOSITIVE, PAUSED,
     PEAKS, REJECTED, SEGMENTS, START, STEP_TOO_SMALL, STEPS, T, _STEP_BUFFER,
-    advance,
+    advance, advance_plain,
 )  # fmt: skip
-from weftsim.physics.chain_f import N_JOINTS
+from weftsim.physics.chain_f import N_JOINTS, is_plain
 from weftsim.post import npz_guard
 from weftsim.model.dynamics import initial_state, pack_parameters
 from weftsim.reference.integrate import _PROGRESS_EVERY
@@ -97,9 +97,10 @@ def integrate_compiled(scene: Scene, progress: Callable[[float], None] | None = 
     recorded = 1  # rows in chunks
     available = npz_guard.available_memory()  # the rows' budget: half of what the machine can give now
     memory = math.inf if available is None else 0.5 * available
+    kernel = advance_plain if is_plain(prm) else advance
     while True:
         t_pause = next_report * t_end if pausing else 2.0 * t_end
-        code, rows = advance(prm, code_method, rtol, settings.atol, settings.max_step / omega, t_end,
+        code, rows = kernel(prm, code_method, rtol, settings.atol, settings.max_step / omega, t_end,
                              t_pause, limits, y, f, fst, ist, sample_times, *smp, *stp)  # fmt: skip
         chunks.append(tuple(b[:rows].copy() for b in stp))
         recorded += rows
