@@ -67,7 +67,7 @@ def joint_force_rows(prm: np.ndarray, time: np.ndarray, states: np.ndarray, f_n_
 
 
 # joint_force_rows for a plain scene (weftsim.physics.chain_f.PLAIN), compiled on first use.
-_joint_force_rows_plain = specialize(joint_force_rows, "plain", lean=True, **kf.PLAIN)
+_joint_force_rows_plain = specialize(joint_force_rows, "plain", lean=True, counted=(), **kf.PLAIN)
 
 
 def joint_force_table(scene: Scene, prm: np.ndarray, time: np.ndarray, states: np.ndarray,

@@ -41,7 +41,7 @@ search follows and the energy balance, as the chain with E alone does.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from numba import njit
 
@@ -53,6 +53,8 @@ from weftsim.physics.tape import chain_state, chain_tape
 from weftsim.physics.wear import block_end, clearance_along
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
+
     import numpy as np
 
 # Indices after the chain's constants: joint F's block, the topology, J_FG and J4.
@@ -228,7 +230,7 @@ def _no_film(prm: np.ndarray) -> bool:
 # Bound, the drive law, the film, the wear and the topology dispatch leave the compiled code, and numba's
 # calls through them with it (each call that is not inlined increments and decrements the reference
 # counts of its array arguments: docs/performance.md, "The plain kernel").  Same arithmetic, same results.
-PLAIN = {"crank_motion": kc.constant_speed, "crank_rate": kc.constant_rate, "is_lubricated": _no_film,
+PLAIN: dict[str, Callable[..., Any]] = {"crank_motion": kc.constant_speed, "crank_rate": kc.constant_rate, "is_lubricated": _no_film,
          "local_clearance": kc.round_clearance, "rhs_any": rhs_e, "penetration_at": penetration_e}  # fmt: skip
 
 

@@ -19,7 +19,7 @@ the others stay the shared compiled functions.
 from __future__ import annotations
 
 import types
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from numba import njit
 from numba.core.registry import CPUDispatcher
@@ -63,7 +63,7 @@ def python_form(fn: Dispatcher, **bind: Callable) -> Callable:
     return form
 
 
-def specialize(fn: Dispatcher, tag: str = "", lean: bool = False, counted: tuple[str, ...] = (),
+def specialize(fn: Dispatcher, tag: str = "", lean: bool = False, *, counted: tuple[str, ...] = (),
                **bind: Callable) -> Dispatcher:
     """``fn`` and its callees compiled (``cache=True``) with the globals in ``bind`` replaced.
 
@@ -144,7 +144,7 @@ def _compiled_form(fn, bind: dict, tag: str, memo: dict, reads: dict, options: d
     form.__doc__ = source.__doc__
     form.__module__ = source.__module__
     form.__qualname__ = f"{source.__qualname__}.{tag}" if tag else source.__qualname__
-    lean = {} if root or source.__name__ in options.get("counted", ()) else {"_nrt": False} if options else {}
+    lean: dict[str, Any] = {} if root or source.__name__ in options.get("counted", ()) else {"_nrt": False} if options else {}
     result = memo[fn] = njit(cache=True, error_model="numpy", **lean)(form)
     code_names = source.__code__.co_names
     for name in code_names:

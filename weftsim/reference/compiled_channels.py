@@ -135,7 +135,7 @@ def _fill(prm, table, a0, ratio, time, states, contact, impact, out):
 
 
 # _fill for a plain scene (weftsim.physics.chain_f.PLAIN), compiled on first use.
-_fill_plain = specialize(_fill, "plain", lean=True, **kf.PLAIN)
+_fill_plain = specialize(_fill, "plain", lean=True, counted=(), **kf.PLAIN)
 
 
 @njit(cache=True, error_model="numpy")
