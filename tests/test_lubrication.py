@@ -352,6 +352,26 @@ def test_start_up_peak_does_not_depend_on_the_film_floor(runs):
         assert np.abs(steps["driving_torque_Nm"]).max() == pytest.approx(peak, rel=0.02), floor
 
 
+def test_a_run_whose_film_went_below_its_floor_says_so(runs):
+    """The start-up impact above goes through the floor (film ratio 0: the dry law carries), so its peaks depend on
+    the floor (the xfail above): the run says it in its warnings, with the floor's key; a film that stays above its
+    floor (the oiled loom's, ratio 18.9 at its thinnest) says nothing of it."""
+    from weftsim.checks.plausibility import film_floor_warning
+
+    oil = runs["oil"]
+    assert oil.steps["film_ratio"].min() < oil.scene.joint.lubrication.film_floor_ratio
+    (text,) = [w for w in oil.plausibility["warnings"] if "film_floor_ratio" in w]
+    assert "went below its floor (joint_e.lubrication.film_floor_ratio = 1): film ratio down to 0 at" in text
+    below = int(np.count_nonzero(oil.steps["film_ratio"] < 1.0))
+    assert f"at {below} steps" in text
+    loom = load_scene("loom_oiled")
+    steps = {"film_ratio": np.array([18.9, 25.0]), "time_s": np.array([0.0, 1e-3])}
+    assert film_floor_warning(loom, steps) == []
+    steps["film_ratio"][1] = 0.99 * loom.joint.lubrication.film_floor_ratio
+    (text,) = film_floor_warning(loom, steps)
+    assert "at 1 step, first at t = 0.001 s" in text
+
+
 # --- regime map ----------------------------------------------------------------------------------------
 
 
