@@ -106,7 +106,9 @@ def _scalar(key: Key, text: str, flag: str) -> Any:
             raise SweepError(f"{flag}: '{key.path}' takes true or false, got {text!r}")
         return text.lower() == "true"
     if not SAFE_TEXT.match(text):
-        raise SweepError(f"{flag}: value {text!r} of '{key.path}' may hold only letters, digits and _ . + -")
+        spaced = text.replace(" ", "_")
+        hint = f" (for a name with spaces write _: {spaced!r})" if " " in text and SAFE_TEXT.match(spaced) else ""
+        raise SweepError(f"{flag}: value {text!r} of '{key.path}' may hold only letters, digits and _ . + -{hint}")
     return text
 
 
