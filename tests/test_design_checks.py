@@ -153,6 +153,20 @@ def test_the_reference_scene_before_its_run(scene):
     assert "joint_e.design_clearance_per_mille" in warned[0].message and "12.5 per mille" in warned[0].message
 
 
+def test_the_before_run_checks_are_each_scenes_own(scene):
+    """A run reads its scene's before-run checks twice and the second reuses the first; a scene changed in
+    speed (a new object) gets its own: the ideal loads scale with the speed squared (400 -> 800 rpm: 4x the
+    rapier's peak acceleration, the pin force's inertial part alike), the same scene its same numbers."""
+    first = checks_by_name(before_run(scene))
+    fast = dataclasses.replace(scene, drive=dataclasses.replace(scene.drive, speed=2.0 * scene.drive.speed))
+    quick = checks_by_name(before_run(fast))
+    again = checks_by_name(before_run(scene))
+    peak = (None, "rapier_acceleration")
+    assert quick[peak].value == pytest.approx(4.0 * first[peak].value, rel=1e-12)
+    assert {k: c.as_dict() for k, c in again.items()} == {k: c.as_dict() for k, c in first.items()}
+    assert checks_by_name(before_run(fast))[peak].value == quick[peak].value
+
+
 @pytest.mark.parametrize("overrides, name, key, words", [
     ({"joint_e.bearing_material.max_pressure_mpa": 50.0}, "pin_pressure",
      "joint_e.bearing_material.max_pressure_mpa", "96.33 MPa"),

@@ -206,10 +206,20 @@ def rapier_check(scene: Scene, stage: str, peak: float, numbers: dict | None = N
     return Check("rapier_acceleration", stage, None, peak, limit, "m/s2", key, verdict, dict(numbers or {}), message)
 
 
+# (scene, checks) of the last :func:`before_run`: a run asks for its scene's before-run checks twice (their
+# warnings before the engine starts, then its plausibility block), so the second reads them here.  Keyed by
+# the scene object itself (a Scene is frozen, and this holds it, so its identity cannot be reused).
+_LAST_BEFORE: tuple = (None, ())
+
+
 def before_run(scene: Scene) -> list[Check]:
     """Every check that needs no simulation: each loose joint's, then the rapier's."""
+    global _LAST_BEFORE
     from weftsim.mechanism.kinematics import linkage_state
 
+    last, checks = _LAST_BEFORE
+    if last is scene:
+        return list(checks)
     out = []
     for name in scene.loose_joints:
         out += joint_checks_before(scene, name)
@@ -217,6 +227,7 @@ def before_run(scene: Scene) -> list[Check]:
     st = linkage_state(theta, scene.geometry, scene.inertia.rocker_com)
     peak = float(np.max(np.abs(st.dd_rapier_displacement))) * scene.drive.speed**2
     out.append(rapier_check(scene, "before", peak))
+    _LAST_BEFORE = (scene, tuple(out))
     return out
 
 
@@ -279,8 +290,7 @@ def after_run(result: RunResult) -> list[Check]:
         force_samples = np.asarray(joint_load(samples)) if samples["time_s"].size else force_steps
         theta_steps = np.radians(np.asarray(steps["crank_angle_deg"]))
         theta_samples = np.radians(np.asarray(samples["crank_angle_deg"])) if samples["time_s"].size else theta_steps
-        v_steps = sliding_speed_at(theta_steps, scene, name, joint.journal_radius)
-        v_samples = sliding_speed_at(theta_samples, scene, name, joint.journal_radius)
+        v_steps, v_samples = sliding_speed_at((theta_steps, theta_samples), scene, name, joint.journal_radius)
         out += pressure_checks("after", table, joint, float(force_steps.max()), float(force_samples.mean()),
                                float(np.mean(force_samples * v_samples)) / area,
                                float(np.max(force_steps * v_steps)) / area, float(v_steps.max()),

@@ -58,10 +58,11 @@ def reflected_mass_f(scene: Scene) -> float:
     return sector_group_inertia(scene) / scene.geometry.l_fg**2
 
 
-def reflected_mass_e(theta: np.ndarray, scene: Scene) -> np.ndarray:
-    """m_eff at E at crank angles ``theta`` (rad), kg (module docstring)."""
+def reflected_mass_e(theta: np.ndarray, scene: Scene, state=None) -> np.ndarray:
+    """m_eff at E at crank angles ``theta`` (rad), kg (module docstring); ``state``: the scene's
+    :func:`linkage_state` at ``theta`` when the caller has it."""
     g, m = scene.geometry, scene.inertia
-    st = linkage_state(theta, g, m.rocker_com)
+    st = _state(theta, scene, state)
     fb = fourbar(st.theta_oe, g)  # derivatives with respect to the rocker-arm angle q
     d_com = 0.5 * (g.l_oe * _normal(st.theta_oe) + g.l_fg * fb.d_theta_fg[..., None] * _normal(fb.theta_fg))
     energy = (m.rod_mass * np.sum(d_com**2, axis=-1) + m.rod_inertia * fb.d_theta_ef**2
@@ -91,12 +92,13 @@ class PinLoads:
     reflected_mass: np.ndarray
 
 
-def pin_forces(theta: np.ndarray, scene: Scene) -> tuple[np.ndarray, np.ndarray]:
+def pin_forces(theta: np.ndarray, scene: Scene, state=None) -> tuple[np.ndarray, np.ndarray]:
     """(F_E, F_s): force of the rocker on the rod at E and of the rod on the sector at F, N, shape (n, 2)
-    in (y, z), at crank angles ``theta`` and the scene's constant crank speed (module docstring)."""
+    in (y, z), at crank angles ``theta`` and the scene's constant crank speed (module docstring);
+    ``state`` as in :func:`reflected_mass_e`."""
     g, m = scene.geometry, scene.inertia
     w = scene.drive.speed
-    st = linkage_state(theta, g, m.rocker_com)
+    st = _state(theta, scene, state)
     gravity = np.array([0.0, -m.gravity])
     alpha_fg = w * w * st.dd_theta_fg
     alpha_ef = w * w * st.dd_theta_ef
@@ -113,20 +115,26 @@ def pin_forces(theta: np.ndarray, scene: Scene) -> tuple[np.ndarray, np.ndarray]
 def ideal_pin_loads(scene: Scene, joint: str, samples: int = SAMPLES) -> PinLoads:
     """:class:`PinLoads` of pin ``joint`` ("e" or "f") over one revolution of the ideal mechanism."""
     theta = np.arange(samples) * (2.0 * np.pi / samples)
-    f_e, f_s = pin_forces(theta, scene)
+    st = linkage_state(theta, scene.geometry, scene.inertia.rocker_com)  # one linkage solve for all three
+    f_e, f_s = pin_forces(theta, scene, st)
     if joint == "e":
         force, radius = np.hypot(*f_e.T), scene.joint.journal_radius
-        mass = reflected_mass_e(theta, scene)
+        mass = reflected_mass_e(theta, scene, st)
     else:
         force, radius = np.hypot(*f_s.T), scene.joint_f.journal_radius
         mass = np.full(theta.size, reflected_mass_f(scene))
-    return PinLoads(theta, force, sliding_speed(theta, scene, joint, radius), mass)
+    return PinLoads(theta, force, sliding_speed(theta, scene, joint, radius, st), mass)
 
 
-def sliding_speed(theta: np.ndarray, scene: Scene, joint: str, radius: float) -> np.ndarray:
+def _state(theta: np.ndarray, scene: Scene, state):
+    """``state`` when given, else the scene's :func:`linkage_state` at ``theta``."""
+    return linkage_state(theta, scene.geometry, scene.inertia.rocker_com) if state is None else state
+
+
+def sliding_speed(theta: np.ndarray, scene: Scene, joint: str, radius: float, state=None) -> np.ndarray:
     """R_j abs(omega_rel) of the ideal mechanism at crank angles ``theta``, m/s: rod against rocker at E,
-    rod against sector at F."""
-    st = linkage_state(theta, scene.geometry, scene.inertia.rocker_com)
+    rod against sector at F; ``state`` as in :func:`reflected_mass_e`."""
+    st = _state(theta, scene, state)
     other = st.d_phi if joint == "e" else st.d_theta_fg
     return radius * scene.drive.speed * np.abs(st.d_theta_ef - other)
 
@@ -139,8 +147,11 @@ def sliding_speed(theta: np.ndarray, scene: Scene, joint: str, radius: float) ->
 SLIDING_GRID = 7200
 
 
-def sliding_speed_at(theta: np.ndarray, scene: Scene, joint: str, radius: float) -> np.ndarray:
-    """:func:`sliding_speed` at any crank angles theta (rad), interpolated on a grid of one revolution."""
+def sliding_speed_at(theta: np.ndarray | tuple, scene: Scene, joint: str, radius: float) -> np.ndarray | tuple:
+    """:func:`sliding_speed` at any crank angles theta (rad), interpolated on a grid of one revolution;
+    ``theta`` a tuple of arrays reads them all from one grid (a tuple of results)."""
     grid = np.arange(SLIDING_GRID + 1) * (2.0 * np.pi / SLIDING_GRID)
     table = sliding_speed(grid, scene, joint, radius)
+    if isinstance(theta, tuple):
+        return tuple(np.interp(np.mod(t, 2.0 * np.pi), grid, table) for t in theta)
     return np.interp(np.mod(theta, 2.0 * np.pi), grid, table)

@@ -207,17 +207,17 @@ def compiled_channels(scene: Scene, time: np.ndarray, states: np.ndarray, contac
     size = initial_state(scene).size
     states = np.ascontiguousarray(states, dtype=float).reshape(time.size, size)
     if scene.joint_f.is_ideal:
-        out = np.empty((time.size, len(CHANNELS)))
+        out = np.empty((len(CHANNELS), time.size)).T  # rows written by the kernel, each channel contiguous
         fill = _fill_plain if is_plain(prm) else _fill
         fill(prm, table, a0, scene.geometry.rapier_ratio, time, states, np.asarray(contact, dtype=np.bool_),
               np.asarray(impact, dtype=float), out)  # fmt: skip
-        channels = dict(zip(CHANNELS, np.ascontiguousarray(out.T)))
+        channels = dict(zip(CHANNELS, out.T))
     else:
         names = CHANNELS + JOINT_F_CHANNELS
-        out = np.empty((time.size, len(names)))
+        out = np.empty((len(names), time.size)).T
         _fill_f(prm, table, a0, scene.geometry.rapier_ratio, time, states, np.asarray(contact, dtype=np.int64),
                 np.ascontiguousarray(impact, dtype=float).reshape(time.size, 2), out)  # fmt: skip
-        channels = dict(zip(names, np.ascontiguousarray(out.T)))
+        channels = dict(zip(names, out.T))
     if scene.joint.is_lubricated or scene.joint_f.is_lubricated:
         # The film and asperity channels; the asperities' potential joins the contact energy (the chain
         # books the film's, the boundary friction's and the asperities' hysteresis work as dissipated,
