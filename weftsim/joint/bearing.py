@@ -65,20 +65,22 @@ def mean_operating_point(scene, name: str) -> tuple[float, float, float]:
         scene, name).journal_radius
 
 
-def operating_point(joint, load: float, omega: float, film: dict | None = None) -> dict:
+def operating_point(joint, load: float, omega: float, film: dict | None = None, warm: dict | None = None) -> dict:
     """One steady point as a dict: the :class:`~weftsim.joint.steady.SteadyPoint` numbers, and the heat balance
-    (``heat``; None for a fixed viscosity, or when ``film``, another point's dict, gives the film's temperature)."""
+    (``heat``; None for a fixed viscosity, or when ``film``, another point's dict, gives the film's temperature).
+    ``warm``: the elastic film's start kept between neighbouring points (:func:`weftsim.joint.ehl.elastic_point`)."""
     from weftsim.joint.heat import heat_balance
     from weftsim.joint.steady import steady_point
 
     lub = joint.lubrication
     if film is not None:
-        point = steady_point(joint, load, omega, film["viscosity_pa_s"])
+        point = steady_point(joint, load, omega, film["viscosity_pa_s"], warm=warm)
         return {**point.as_dict(), "film_temperature_c": film["film_temperature_c"], "heat": None}
     if lub.has_oil:
-        balance = heat_balance(joint, load, omega)
+        balance = heat_balance(joint, load, omega, warm=warm)
         return {**balance.point.as_dict(), "film_temperature_c": balance.temperature_c, "heat": balance.as_dict()}
-    return {**steady_point(joint, load, omega, lub.viscosity).as_dict(), "film_temperature_c": None, "heat": None}
+    return {**steady_point(joint, load, omega, lub.viscosity, warm=warm).as_dict(), "film_temperature_c": None,
+            "heat": None}
 
 
 def stribeck(joint, load: float, omega: float, points: int = STRIBECK_POINTS) -> dict:
@@ -87,9 +89,10 @@ def stribeck(joint, load: float, omega: float, points: int = STRIBECK_POINTS) ->
     NaN, where no temperature balances the friction power)."""
     speeds = omega * np.geomspace(*STRIBECK_SPAN, points)
     rows = []
+    warm: dict = {}  # each speed's elastic film starts from the last one's (weftsim.joint.ehl.elastic_point)
     for w in speeds:
         try:
-            rows.append(operating_point(joint, load, float(w)))
+            rows.append(operating_point(joint, load, float(w), warm=warm))
         except SceneError:  # no heat balance at this speed: the bearing overheats there
             rows.append({"friction_coefficient": math.nan, "film_ratio": math.nan, "regime": "overheats",
                          "film_temperature_c": None})

@@ -22,7 +22,10 @@ by Newton's method with a backtracking line search: the film's P is the exact co
 iterate's gap, and its derivative in the gap that of the linear system on its film (the active set held), K_AA
 dP = -(d(K P - q)/dH) dH: one sparse factorisation and n_phi + 1 solves per iteration.  It starts from the rigid
 film (D = 0) at the kernel's eccentricity, and where Newton does not converge from there it continues in the
-compliance (Gamma scaled by 1/8, 1/4, 1/2, 1).  Converged when the pressure residual is below ``TOLERANCE`` of the
+compliance (Gamma scaled by 1/8, 1/4, 1/2, 1); a caller that solves neighbouring points in turn (the heat
+balance's temperatures, the Stribeck curve's speeds) passes ``warm`` and Newton starts from the last converged
+pressures and eccentricity instead, falling back to the cold start when that fails.  The Jacobian is formed at
+accepted iterates only.  Converged when the pressure residual is below ``TOLERANCE`` of the
 mean pressure W / (2 R L) and the load's below ``TOLERANCE`` of W; otherwise one line naming the point refuses it.
 
 The friction torque on the journal (reported positive, as ``weftsim bearing``'s):
@@ -227,7 +230,8 @@ class _Film:
         if self.alpha > 0.0:
             inner = 1.0 - self.alpha * reduced
             if inner.min() <= 0.0:
-                return np.full(s.size + 1, np.inf), None, None
+                res = np.full(s.size + 1, np.inf)
+                return (res, None, None) if jacobian else (res, None)
             field, stretch = -np.log(inner) / self.alpha, 1.0 / inner
         else:
             field, stretch = reduced, None
@@ -245,12 +249,16 @@ class _Film:
         force = math.hypot(f_along, f_ahead)
         res = np.concatenate((s - (mean + p_a), [force - self.load]))
         state = {"hn": hn, "hd": hd, "field": field, "reduced": reduced, "volume": volume, "p_a": p_a, "ring": ring, "width": width,
-                 "force": (f_along, f_ahead)}
+                 "force": (f_along, f_ahead),
+                 "parts": (hn, hf, hd, hn_film, hf_film, reduced, stretch, matrix, volume, dzeta, width, dfa, ring,
+                           (f_along, f_ahead), force)}
         if not jacobian:
             return res, state
-        jac = self._jacobian(hn, hf, hd, hn_film, hf_film, reduced, stretch, matrix, volume, dzeta, width, dfa,
-                             ring, (f_along, f_ahead), force)
-        return res, state, jac
+        return res, state, self.jacobian(state)
+
+    def jacobian(self, state: dict) -> np.ndarray:
+        """The Jacobian at the point :meth:`evaluate` gave ``state`` of (at this compliance fraction)."""
+        return self._jacobian(*state["parts"])
 
     def _jacobian(self, hn, hf, hd, hn_film, hf_film, field, stretch, matrix, volume, dzeta, width, dfa, ring,
                   forces, force):
@@ -315,59 +323,78 @@ class _Film:
 
 
 def _newton(film: _Film, s: np.ndarray, eps: float):
-    """Newton with backtracking on (s, eps) at the film's current compliance fraction; (s, eps, its, norm)."""
-    res, _, jac = film.evaluate(s, eps, True)
+    """Newton with backtracking on (s, eps) at the film's current compliance fraction; (s, eps, its, norm).
+
+    The Jacobian is formed at accepted iterates only (the line search's trials need the residual alone)."""
+    res, state = film.evaluate(s, eps, False)
     norm = film.norm(res)
-    if jac is None:
+    if state is None:
         return s, eps, 0, norm
+    jac = film.jacobian(state)
     for it in range(1, MAX_ITERATIONS + 1):
         step = np.linalg.solve(jac, -res)
         alpha = 1.0
         while True:
             s_new, eps_new = s + alpha * step[:-1], eps + alpha * step[-1]
-            res_new, _, jac_new = film.evaluate(s_new, eps_new, True)
+            res_new, state_new = film.evaluate(s_new, eps_new, False)
             norm_new = film.norm(res_new)
-            if norm_new < norm or (alpha < 1e-3 and jac_new is not None):
+            if norm_new < norm or (alpha < 1e-3 and state_new is not None):
                 break
             if alpha < 1e-6:
                 return s, eps, it, norm
             alpha *= 0.5
-        s, eps, res, jac, norm = s_new, eps_new, res_new, jac_new, norm_new
+        s, eps, res, norm = s_new, eps_new, res_new, norm_new
         if norm <= TOLERANCE:
             return s, eps, it, norm
+        jac = film.jacobian(state_new)
     return s, eps, MAX_ITERATIONS, norm
 
 
 def elastic_point(pair: Pair, load: float, omega: float, viscosity: float, eps0: float, rigid: bool = False,
-                  grid: tuple[int, int] | None = None) -> ElasticPoint:
+                  grid: tuple[int, int] | None = None, warm: dict | None = None) -> ElasticPoint:
     """The :class:`ElasticPoint` of ``pair`` under ``load`` (N) at journal speed ``omega`` (rad/s), viscosity
     ``viscosity`` (Pa s), from the rigid film's eccentricity ratio ``eps0`` (the kernel's,
     :func:`weftsim.joint.steady.steady_point`); ``rigid``: no deformation (Gamma = 0).  Refuses (SceneError, one
     line) a point Newton does not converge on.  ``grid``: (n_phi, n_zeta) of the Reynolds grid (default the
-    kernel table's, :data:`weftsim.joint.reynolds.N_PHI` x ``N_ZETA``)."""
+    kernel table's, :data:`weftsim.joint.reynolds.N_PHI` x ``N_ZETA``).
+
+    ``warm``: a dict the caller keeps between neighbouring points (the heat balance's temperatures): the converged
+    solution is left in it, and a later call starts Newton from it (its pressures, in pascals, interpolated onto
+    this point's nodes; its eccentricity) before the cold start below, which it falls back to.  Only the start
+    differs: the grid, the equations and the tolerance are the cold start's, so the point agrees with it to the
+    tolerance (tests/test_ehl.py)."""
     from weftsim.joint.reynolds import N_PHI, N_ZETA
     from weftsim.physics.flow_factors import shear_factor
 
     film = _Film(pair, load, omega, viscosity, eps0, rigid, (N_PHI, N_ZETA) if grid is None else grid)
     n = film.nodes.size
-    film.fraction = 0.0  # the rigid isoviscous film's pressure starts the iteration
-    _, state = film.evaluate(np.zeros(n), eps0, False)
-    s0 = state["field"] @ film.heights() / film.half_width + state["p_a"]
-    film.fraction, film.active = 1.0, None
-    s, eps, its, norm = _newton(film, s0, eps0)
-    total = its
-    if norm > TOLERANCE and not rigid:
-        s, eps = s0, eps0
-        for fraction in CONTINUATION:
-            film.fraction = fraction
-            film.active = None
-            s, eps, its, norm = _newton(film, s, eps)
-            total += its
-            if norm > TOLERANCE:
-                break
+    total, norm = 0, math.inf
+    if warm and not rigid and warm["nodes"].size == n:
+        film.active = None
+        start = np.interp(film.nodes, warm["nodes"], warm["pressure_pa"], period=2.0 * math.pi) / film.scale
+        s, eps, total, norm = _newton(film, start, warm["eps"])
+    if norm > TOLERANCE:
+        film.fraction = 0.0  # the rigid isoviscous film's pressure starts the iteration
+        film.active = None
+        _, state = film.evaluate(np.zeros(n), eps0, False)
+        s0 = state["field"] @ film.heights() / film.half_width + state["p_a"]
+        film.fraction, film.active = 1.0, None
+        s, eps, its, norm = _newton(film, s0, eps0)
+        total += its
+        if norm > TOLERANCE and not rigid:
+            s, eps = s0, eps0
+            for fraction in CONTINUATION:
+                film.fraction = fraction
+                film.active = None
+                s, eps, its, norm = _newton(film, s, eps)
+                total += its
+                if norm > TOLERANCE:
+                    break
     if norm > TOLERANCE:
         raise SceneError(f"bearing: the elastic film does not converge at {load / 1e3:.4g} kN, "
                          f"{omega * 30.0 / math.pi:.4g} rpm (residual {norm:.2g} after {total} Newton iterations)")
+    if warm is not None and not rigid:
+        warm.update(nodes=film.nodes, pressure_pa=s * film.scale, eps=float(eps))
     res, state = film.evaluate(s, eps, False)
     c, radius = pair.clearance, pair.radius
     f_along, f_ahead = state["force"]

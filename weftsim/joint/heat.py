@@ -87,12 +87,14 @@ def heat_out(point: SteadyPoint, oil, temperature: float, ambient: float, housin
 
 
 def heat_balance(joint, load: float, omega: float, viscosity=None, oil=None, ambient: float | None = None,
-                 housing: float | None = None, supply: str | None = None) -> HeatBalance:
+                 housing: float | None = None, supply: str | None = None, warm: dict | None = None) -> HeatBalance:
     """The :class:`HeatBalance` of the lubricated ``joint`` under ``load`` (N) at journal speed ``omega``
     (rad/s), bearing still.
 
     The oil, ambient temperature, k A and supply default to the joint's lubrication; ``viscosity``, a function
     of the temperature in C (Pa s), defaults to the oil's (``viscosity`` lets a check use a fixed one).
+    ``warm``: the elastic film's start, kept between the balance's temperatures and, when the caller passes one,
+    between its points (:func:`weftsim.joint.ehl.elastic_point`).
     """
     from scipy.optimize import brentq
 
@@ -106,9 +108,10 @@ def heat_balance(joint, load: float, omega: float, viscosity=None, oil=None, amb
     supply = lub.oil_supply if supply is None else supply
     eta = oil.viscosity if viscosity is None else viscosity
     prm = joint_block(joint)
+    warm = {} if warm is None else warm  # the elastic film's last solution starts the next one (weftsim.joint.ehl)
 
     def at(t: float) -> tuple[float, SteadyPoint]:
-        point = steady_point(joint, load, omega, float(eta(t)), prm)
+        point = steady_point(joint, load, omega, float(eta(t)), prm, warm)
         return point.power_loss_w - sum(heat_out(point, oil, t, ambient, housing, supply)), point
 
     limit = oil.temperature_limit()

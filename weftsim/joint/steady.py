@@ -76,9 +76,11 @@ def joint_block(joint) -> np.ndarray:
     return joint_parameters(joint, make_law(joint))
 
 
-def steady_point(joint, load: float, omega: float, viscosity: float, prm: np.ndarray | None = None) -> SteadyPoint:
+def steady_point(joint, load: float, omega: float, viscosity: float, prm: np.ndarray | None = None,
+                 warm: dict | None = None) -> SteadyPoint:
     """The :class:`SteadyPoint` of ``joint`` (lubricated) under ``load`` (N) at journal speed ``omega`` (rad/s)
-    with the film at ``viscosity`` (Pa s).  ``prm``: the joint's block, if already built (:func:`joint_block`)."""
+    with the film at ``viscosity`` (Pa s).  ``prm``: the joint's block, if already built (:func:`joint_block`);
+    ``warm``: the elastic film's start kept between neighbouring points (:func:`weftsim.joint.ehl.elastic_point`)."""
     from scipy.optimize import brentq
 
     from weftsim.joint.film_flow import flow_variables
@@ -116,7 +118,7 @@ def steady_point(joint, load: float, omega: float, viscosity: float, prm: np.nda
     if lub.elastic_film and load > 0.0:  # the elastic film from the rigid one's eccentricity (weftsim.joint.ehl)
         from weftsim.joint.ehl import Pair, elastic_point
 
-        point = elastic_point(Pair.of(joint), load, omega, viscosity, min(ecc / c, 0.99))
+        point = elastic_point(Pair.of(joint), load, omega, viscosity, min(ecc / c, 0.99), warm=warm)
         elastic = point.as_dict()
         ecc, attitude, h_min = point.eccentricity_ratio * c, point.attitude_angle_deg, point.min_film_m
         torque, film, asperity, dry = point.friction_torque_nm, point.film_force_n, point.asperity_load_n, 0.0
