@@ -191,8 +191,8 @@ def test_bearing_refuses_bad_input_in_one_line():
 
     oiled = {"joint_e.lubrication.oil": "ISO_VG_220"}
     cases = [({}, {}, "is dry"), ({**oiled, "joint_e.clearance_mm": 0.0}, {}, "is ideal"),
-             (oiled, {"joint": "f"}, "is ideal"), (oiled, {"load_kn": -1.0}, "must be a number > 0"),
-             (oiled, {"journal_rpm": float("nan")}, "must be a number > 0"), (oiled, {"joint": "g"}, "'e' or 'f'")]
+             (oiled, {"joint": "f"}, "is ideal"), (oiled, {"load_kn": -1.0}, "must be a finite number > 0"),
+             (oiled, {"journal_rpm": float("nan")}, "must be a finite number > 0"), (oiled, {"joint": "g"}, "'e' or 'f'")]
     for overrides, kwargs, text in cases:
         with pytest.raises(SceneError, match=text) as info:
             weftsim.bearing(weftsim.load_scene("loom", overrides), **kwargs)

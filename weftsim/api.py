@@ -191,7 +191,7 @@ def bearing(scene: Scene | str | os.PathLike, joint: str = "e", load_kn: float |
     for value, name in ((load_kn, "load_kn (--load-kn, kN)"), (journal_rpm, "journal_rpm (--journal-rpm)")):
         number = isinstance(value, (int, float)) and not isinstance(value, bool)
         if value is not None and not (number and math.isfinite(value) and value > 0.0):
-            raise SceneError(f"bearing: {name} must be a number > 0, got {value!r}")
+            raise SceneError(f"bearing: {name} must be a finite number > 0, got {value!r}")
     return check(scene, joint, None if load_kn is None else 1e3 * load_kn, journal_rpm, stribeck)
 
 

@@ -114,7 +114,7 @@ def bearing(scene, joint: str = "e", load: float | None = None, journal_rpm: flo
     check_bearing_joint(scene, joint)
     for value, what in ((load, "load"), (journal_rpm, "journal speed")):
         if value is not None and not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0.0):
-            raise SceneError(f"bearing: the {what} must be a number > 0, got {value!r}")
+            raise SceneError(f"bearing: the {what} must be a finite number > 0, got {value!r}")
     part = _joint(scene, joint)
     lub = part.lubrication
     mean, peak, omega = mean_operating_point(scene, joint)
