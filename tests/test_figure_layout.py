@@ -69,3 +69,43 @@ def test_wear_profile_legend_is_inside_the_figure():
         assert not box.overlaps(ax.get_window_extent(renderer))
     journal = fig.axes[1]
     assert abs(np.cos(np.radians(journal.get_rlabel_position()))) < 0.4
+
+
+def _draws(figure, target):
+    """How often saving ``figure`` to ``target`` draws it (weftsim.post.output.write_figure)."""
+    from weftsim.post.output import write_figure
+
+    calls = []
+    draw = type(figure).draw
+    figure.draw = lambda renderer: calls.append(1) or draw(figure, renderer)
+    write_figure(target, figure)
+    return len(calls)
+
+
+def test_a_tight_figure_is_drawn_once_when_saved_with_the_pixels_of_two_passes(tmp_path):
+    """Figure.tight_layout() leaves a placeholder layout engine for which savefig drew the figure twice."""
+    from PIL import Image
+
+    from weftsim.post.plots import figure
+
+    def tight():
+        fig = figure(figsize=(4, 3))
+        ax = fig.subplots()
+        ax.plot([0.0, 1.0, 2.0], [0.0, 10.0, 5.0])
+        ax.set_ylabel("a long label [N m]")
+        fig.tight_layout()
+        return fig
+
+    assert _draws(tight(), tmp_path / "once.png") == 1
+    two = tight()
+    two.savefig(tmp_path / "twice.png", dpi=130, pil_kwargs={"compress_level": 3})  # matplotlib's own two passes
+    assert np.array_equal(np.asarray(Image.open(tmp_path / "once.png")), np.asarray(Image.open(tmp_path / "twice.png")))
+
+
+def test_a_constrained_figure_keeps_its_layout_pass(tmp_path):
+    from weftsim.post.plots import figure
+
+    fig = figure(figsize=(4, 3), constrained_layout=True)
+    fig.subplots().plot([0.0, 1.0], [0.0, 1.0])
+    assert _draws(fig, tmp_path / "c.png") == 2  # the layout engine runs in its own draw
+    assert fig.get_layout_engine() is not None
