@@ -177,6 +177,29 @@ def test_numba_route_equals_python(max_approach):
                                    py(None, 0.0, 0, e, e_dot, mem, None, None), rtol=1e-13, atol=1e-9)  # fmt: skip
 
 
+def test_the_loaded_kernel_is_the_dispatchers_specialisation_without_its_type_dispatch():
+    """callbacks.loaded_kernel: the compiled entry point of the warm-up call's types gives the dispatcher's
+    result to the bit, takes an int where the float goes (converted, no new specialisation), and the python
+    route stays the plain kernel."""
+    pytest.importorskip("numba")
+    from weftsim.physics import joint as kernel_joint
+
+    law = make_law(JOINT)
+    prm = callbacks.connector_parameters(law, C, JOINT.min_impact_velocity, True)
+    function = kernel_joint.connector_force
+    loaded = callbacks.loaded_kernel(function, "numba", prm, 1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0)
+    assert loaded is not function and callable(loaded)
+    specialisations = len(function.overloads)
+    for e, e_dot, mem in STATES:
+        args = (prm, e[0], e[1], e_dot[0], e_dot[1], *mem)
+        assert loaded(*args) == function(*args)
+    assert loaded(prm, 1, 0, 0, 0, 1, -1, 0) == function(prm, 1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0)
+    assert len(function.overloads) == specialisations
+    plain = callbacks.loaded_kernel(function, "python", prm.tolist(), 1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0)
+    assert plain(prm.tolist(), 1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0) == pytest.approx(
+        function(prm, 1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0), rel=1e-13, abs=1e-9)
+
+
 def test_add_clearance_joint_rejects_ideal_joints_and_unknown_routes():
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()

@@ -47,7 +47,7 @@ def test_the_generalized_force_is_the_virtual_work_of_the_contact_force(route):
     against the reference engine's eccentricity (other coordinates: psi = q0 + q1 - pi)."""
     scene = load_scene(MODELS / "reference.toml")
     c = scene.joint.clearance
-    memory, stash, calls = [0.05, 1e-6, 0.05], [math.nan] * 13, [0]
+    memory, stash, calls = [0.05, 1e-6, 0.05], [math.nan, ()], [0]
     force = make_tree_force(pack_parameters(scene), memory, stash, route, calls)
     p = ChainConstants.from_scene(scene)
     a0, psi0, da0, dpsi0 = initial_state(scene)[:4]
@@ -67,9 +67,11 @@ def test_the_generalized_force_is_the_virtual_work_of_the_contact_force(route):
     ey, ez, vy, vz = eccentricity(NUMPY, p, t, q[0], q[0] + q[1] - math.pi, q_t[0], q_t[0] + q_t[1])[:4]
     length = math.hypot(ey, ez)
     # Same formula in other coordinates: ~1e-16 m of a 0.4 m chain.
-    assert stash[1] == pytest.approx(length - c, abs=1e-13)
-    assert stash[2] == pytest.approx((ey * vy + ez * vz) / length, rel=1e-9)
-    f_b = np.array([stash[3], stash[4]])
+    state = stash[1]
+    assert stash[0] == t and tuple(gen) == state[:2]
+    assert state[2] == pytest.approx(length - c, abs=1e-13)
+    assert state[3] == pytest.approx((ey * vy + ez * vz) / length, rel=1e-9)
+    f_b = np.array([state[4], state[5]])
     assert np.hypot(*f_b) > 0.0 and calls[0] >= 1
 
     def journal(qq):

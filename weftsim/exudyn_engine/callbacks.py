@@ -101,6 +101,26 @@ def kernel_form(function: Dispatcher, route: str) -> Callable:
     raise ValueError(route_error(route) or f"`callback` = {route!r} has no kernel form")
 
 
+def loaded_kernel(function: Dispatcher, route: str, *example: object) -> Callable:
+    """:func:`kernel_form` of ``function``, loaded (or compiled) now by one call with ``example``, not inside the
+    first step.
+
+    On the numba route it is the compiled entry point of the specialisation that call took: the dispatcher works
+    out the specialisation again at every call from its arguments' types, which is 0.5 us of the 1.1-1.2 us a
+    call of the tree's kernel costs from Python (nine arguments, measured 1 144 against 659 ns a call), and a
+    callback passes the same types at every call (floats and its one parameter array).  The dispatcher itself
+    where numba does not expose the entry point.
+    """
+    form = kernel_form(function, route)
+    if route != "numba":
+        return form
+    form(*example)
+    try:
+        return function.overloads[tuple(function.typeof_pyval(value) for value in example)].entry_point
+    except (AttributeError, KeyError):
+        return form
+
+
 def make_force(law: _Law, clearance: float, min_impact_velocity: float, route: str = "numba",
                counter: list | None = None, max_approach: bool = True) -> Callable[..., list[float]]:
     """Callback of a connector between a bearing marker and a journal marker (fixed frame).
@@ -109,10 +129,8 @@ def make_force(law: _Law, clearance: float, min_impact_velocity: float, route: s
     one-element list incremented per call (benchmarks only); ``max_approach`` selects the held
     impact velocity rule (False: ``"onset"``).
     """
-    force = kernel_form(kernel_joint.connector_force, route)
     prm = parameters_for_route(connector_parameters(law, clearance, min_impact_velocity, max_approach), route)
-    if route == "numba":
-        force(prm, 1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0)  # load (or compile) now, not inside the first step
+    force = loaded_kernel(kernel_joint.connector_force, route, prm, 1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0)
 
     def spring_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
         fx, fy, _, _ = force(prm, displacement[0], displacement[1], velocity[0], velocity[1],
@@ -141,6 +159,10 @@ def make_numba_force(law: _Law, clearance: float, min_impact_velocity: float,
     return make_force(law, clearance, min_impact_velocity, "numba", None, max_approach)
 
 
+# Indices into the tuple of :func:`weftsim.physics.chain.tree_joint_force` (the tree callback's ``stash[1]``).
+STASH_DELTA, STASH_SLIDING_SPEED = 2, 9
+
+
 def make_tree_force(prm: np.ndarray, memory: list, stash: list, route: str = "numba",
                     counter: list | None = None, powers: bool = False) -> Callable[..., list[float]]:
     """``forceUserFunction(mbs, t, itemNumber, q, q_t)`` of the kinematic tree: its joint forces.
@@ -149,8 +171,8 @@ def make_tree_force(prm: np.ndarray, memory: list, stash: list, route: str = "nu
     :func:`weftsim.physics.chain.tree_joint_force`.  ``prm``: the scene's kernel parameter array
     (:func:`weftsim.model.dynamics.pack_parameters`, friction included); ``memory`` =
     [v_held, delta0, rate0] of the last accepted step (written by the post-step bookkeeping); every
-    call leaves [t, delta, delta_dot, F_b,x, F_b,y, F_N, M_b, F_T v_T, v_T, D'_lub, U_a, W3', D'] in ``stash``
-    (F_b = F_N n - F_T t, the force on the bearing, plus the film's and asperities' of a lubricated joint; M_b
+    call leaves [t, (Q0, Q1, delta, delta_dot, F_b,x, F_b,y, F_N, M_b, F_T v_T, v_T, D'_lub, U_a, W3', D')] in
+    ``stash``, the kernel's tuple as it returned it (:data:`STASH_DELTA` and the other indices; F_b = F_N n - F_T t, the force on the bearing, plus the film's and asperities' of a lubricated joint; M_b
     its moment; F_T v_T the dry friction power; v_T the sliding speed; D'_lub and U_a the lubricated part's
     dissipated power and the asperity potential, 0 when dry; W3' and D' the drawn and dissipated powers): the
     last call of an accepted explicit step is at its end state (the last DOPRI5 / ODE23 stage), so the
@@ -159,21 +181,17 @@ def make_tree_force(prm: np.ndarray, memory: list, stash: list, route: str = "nu
     The parameters the callback reads are its attribute ``prm`` (a copy; :mod:`.friction_segments` sets the
     friction entries of it).
     """
-    force = kernel_form(kernel_chain.tree_joint_force, route)
     prm = prm.copy()
     prm[kernel_joint.DEAD_RATE] = RESTING_RATE_FRACTION * prm[kernel_joint.V_MIN]
     route_prm = parameters_for_route(prm, route)
+    force = loaded_kernel(kernel_chain.tree_joint_force, route, route_prm, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0)
     counter = [0] if counter is None else counter
-    if route == "numba":
-        force(route_prm, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0)  # load (or compile) now
 
     def tree_force(mbs, t, itemNumber, q, q_t):
         counter[0] += 1
-        (g0, g1, stash[1], stash[2], stash[3], stash[4], stash[5], stash[6], stash[7], stash[8], stash[9],
-         stash[10], stash[11], stash[12]) = force(
-            route_prm, t, q[0], q[1], q_t[0], q_t[1], memory[0], memory[1], memory[2])
+        stash[1] = out = force(route_prm, t, q[0], q[1], q_t[0], q_t[1], memory[0], memory[1], memory[2])
         stash[0] = t
-        return [g0, g1, stash[11], stash[12]] if powers else [g0, g1]
+        return [out[0], out[1], out[12], out[13]] if powers else [out[0], out[1]]
 
     setattr(tree_force, "prm", route_prm)  # a function attribute (mypy has no type for one)
     return tree_force

@@ -107,10 +107,9 @@ class JointFriction:
             function = connector_worn_lubricated_force if self.lubricated else connector_worn_force
         else:
             function = connector_lubricated_force if self.lubricated else kernel_joint.connector_friction_force
-        self.kernel = callbacks.kernel_form(function, route)
         self.prm = callbacks.parameters_for_route(prm, route)
-        if route == "numba":  # load (or compile) now
-            self.kernel(self.prm, 1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0, *((0.0, 0.0) if self.worn else ()))
+        self.kernel = callbacks.loaded_kernel(function, route, self.prm, 1.0, 0.0, 0.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0,
+                                              *((0.0, 0.0) if self.worn else ()))
         self.memory = memory
         self.connector = None
         self._key: tuple[float, ...] | None = None  # evaluate's memo: the state last evaluated, its kernel value

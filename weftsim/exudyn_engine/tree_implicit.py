@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING
 
 import exudyn as exu
 
+from weftsim.exudyn_engine import callbacks
 from weftsim.exudyn_engine.clearance_joint import register_post_step
 from weftsim.exudyn_engine.friction_segments import MAX_SWITCHES, FrictionSegments
 from weftsim.exudyn_engine.selection import largest_step, tree_local_error
@@ -136,7 +137,7 @@ class ImplicitTree:
         stash = model.stash
 
         def gap(mbs_: exu.MainSystem) -> float:  # h_min = -delta of the callback's last state (post_newton: the trial)
-            return -stash[1]
+            return -stash[1][callbacks.STASH_DELTA]
 
         self.control = TreeStepController(mbs, solver, model.node, 0.0, tree_local_error(scene),
                                           scene.limits.min_step, self.max_step, period, newmark_beta(SPECTRAL_RADIUS),
@@ -153,7 +154,8 @@ class ImplicitTree:
             q = mbs.GetNodeOutput(model.node, OVT.Coordinates)
             q_t = mbs.GetNodeOutput(model.node, OVT.Coordinates_t)
             model.force(mbs, t, model.tree, q, q_t)
-        if self.segments is not None and not self.segments.check(model.stash[1] > 0.0, model.stash[8]):
+        if self.segments is not None and not self.segments.check(model.stash[1][callbacks.STASH_DELTA] > 0.0,
+                                                                  model.stash[1][callbacks.STASH_SLIDING_SPEED]):
             return [_REPEAT, -1.0]
         return self.control.post_newton(mbs, t)
 
