@@ -150,6 +150,14 @@ def test_guard_criteria_and_their_order():
     assert guard.check(penetration=math.nan).kind == "non_finite"
     assert guard.check(finite=False, penetration=2 * bound).kind == "non_finite"  # checked first
     assert guard.steps == 5 and guard.check(steps=0).kind == "steps"  # more than 3 steps
+    # The state's verdicts, whichever joint carries them (a NaN or inf at either joint before any bound).
+    loose = RunGuard(scene(max_penetration=0.05, min_step=1e-9), clock)
+    for e, f, kind in ((-math.inf, None, "non_finite"), (math.inf, None, "non_finite"), (None, math.nan, "non_finite"),
+                       (2 * bound, math.nan, "non_finite"), (0.5 * bound, -math.inf, "non_finite"),
+                       (None, 1.01 * bound, "penetration"), (-1.0, None, None), (bound, bound, None)):
+        breach = loose.check(penetration=e, penetration_f=f, step_size=1e-6)
+        assert (breach.kind if breach else None) == kind, (e, f)
+    assert "[joint_f]" in loose.check(penetration=0.0, penetration_f=1.01 * bound).hint
     relaxed = RunGuard(scene(max_wall_time=2.0), clock)
     clock.now += 2.5
     breach = relaxed.check()

@@ -223,19 +223,13 @@ class RunGuard:
         if _STOP_REQUEST:
             return Breach("interrupted", _STOP_REQUEST[0],
                           "what was computed up to here is kept; rerun to compute the whole run")
-        if not finite or any(p is not None and not math.isfinite(p) for p in (penetration, penetration_f)):
-            return non_finite_breach()
-        for table, value, bound in (("joint_e", penetration, self.max_penetration),
-                                    ("joint_f", penetration_f, self.max_penetration_f)):
-            if value is not None and value > bound:
-                return Breach(
-                    "penetration",
-                    f"the penetration {value * 1e3:.4f} mm exceeds {self.ratio:g} of the journal radius "
-                    f"({bound * 1e3:.4f} mm, limits.max_penetration_ratio)",
-                    "the joint is too soft for its load or the contact law is used far outside its range: check "
-                    f"the materials, clearance and law of [{table}]; raise limits.max_penetration_ratio only if "
-                    "such a deformation is meant",
-                )  # fmt: skip
+        # A step of the Exudyn tree calls this once (~1 us of the ~40 us a step): the common case, finite
+        # penetrations within their bounds, is the two comparisons; anything else takes the checks in order.
+        if not (finite and (penetration is None or -math.inf < penetration <= self.max_penetration)
+                and (penetration_f is None or -math.inf < penetration_f <= self.max_penetration_f)):
+            breach = self._state_breach(penetration, finite, penetration_f)
+            if breach is not None:
+                return breach
         if step_size is not None and step_size < self.min_step:
             return Breach(
                 "step_size",
@@ -255,7 +249,7 @@ class RunGuard:
                 f"the run needs more than limits.max_steps = {self.max_steps} accepted steps",
                 "raise limits.max_steps, simulate fewer revolutions, or use a larger step or looser tolerance",
             )
-        elapsed = self.elapsed
+        elapsed = self.clock() - self.start
         if elapsed > self.max_wall_time:
             return Breach(
                 "wall_time",
@@ -263,6 +257,23 @@ class RunGuard:
                 f"({elapsed:.3g} s, {self.steps} steps)",
                 "raise limits.max_wall_time_s or simulate fewer revolutions",
             )
+        return None
+
+    def _state_breach(self, penetration: float | None, finite: bool, penetration_f: float | None) -> Breach | None:
+        """The state's checks of :meth:`check`: a NaN or inf first, then each joint's penetration bound."""
+        if not finite or any(p is not None and not math.isfinite(p) for p in (penetration, penetration_f)):
+            return non_finite_breach()
+        for table, value, bound in (("joint_e", penetration, self.max_penetration),
+                                    ("joint_f", penetration_f, self.max_penetration_f)):
+            if value is not None and value > bound:
+                return Breach(
+                    "penetration",
+                    f"the penetration {value * 1e3:.4f} mm exceeds {self.ratio:g} of the journal radius "
+                    f"({bound * 1e3:.4f} mm, limits.max_penetration_ratio)",
+                    "the joint is too soft for its load or the contact law is used far outside its range: check "
+                    f"the materials, clearance and law of [{table}]; raise limits.max_penetration_ratio only if "
+                    "such a deformation is meant",
+                )  # fmt: skip
         return None
 
 

@@ -383,18 +383,24 @@ def solve_tree(scene: Scene, progress: Callable[[float], None] | None = None, ca
     breach = []
     state = {"t": 0.0, "next_report": _PROGRESS_EVERY, "min_step": math.inf}
 
+    last_cut = t_end * (1.0 - 1e-12)  # the last step is cut to land on the end time
+    tracker = model.tracker
+
     def post_step(mbs, t):
         model.accept(mbs, t)
         if t <= 0.0:  # Exudyn also calls this once at t = 0: not a step
             return True
         h = t - state["t"]
         state["t"] = t
-        if t < t_end * (1.0 - 1e-12):  # the last step is cut to land on the end time
-            state["min_step"] = min(state["min_step"], h)
+        if t < last_cut:
+            if h < state["min_step"]:
+                state["min_step"] = h
+        else:
+            h = None
         if progress is not None and t >= state["next_report"] * t_end:
             progress(min(1.0, t / t_end))
             state["next_report"] = math.floor(t / t_end / _PROGRESS_EVERY + 1.0) * _PROGRESS_EVERY
-        found = guard.check(penetration=model.tracker.delta, step_size=h if t < t_end * (1.0 - 1e-12) else None,
+        found = guard.check(penetration=tracker.delta, step_size=h,
                             floor_fails=not implicit)  # the explicit solvers go on at the floor, unchecked
         if found is not None:
             breach.append(found)
