@@ -116,9 +116,11 @@ def loaded_kernel(function: Dispatcher, route: str, *example: object) -> Callabl
         return form
     form(*example)
     try:
-        return function.overloads[tuple(function.typeof_pyval(value) for value in example)].entry_point
-    except (AttributeError, KeyError):
+        loaded = function.overloads[tuple(function.typeof_pyval(value) for value in example)]
+    except KeyError:
         return form
+    # numba's CompileResult gets its entry point when it is compiled or loaded from the cache (not in its stub).
+    return getattr(loaded, "entry_point", form)
 
 
 def make_force(law: _Law, clearance: float, min_impact_velocity: float, route: str = "numba",
