@@ -249,7 +249,7 @@ class RunGuard:
                 f"the run needs more than limits.max_steps = {self.max_steps} accepted steps",
                 "raise limits.max_steps, simulate fewer revolutions, or use a larger step or looser tolerance",
             )
-        elapsed = self.clock() - self.start
+        elapsed = self.elapsed
         if elapsed > self.max_wall_time:
             return Breach(
                 "wall_time",

@@ -174,9 +174,10 @@ def make_tree_force(prm: np.ndarray, memory: list, stash: list, route: str = "nu
     (:func:`weftsim.model.dynamics.pack_parameters`, friction included); ``memory`` =
     [v_held, delta0, rate0] of the last accepted step (written by the post-step bookkeeping); every
     call leaves [t, (Q0, Q1, delta, delta_dot, F_b,x, F_b,y, F_N, M_b, F_T v_T, v_T, D'_lub, U_a, W3', D')] in
-    ``stash``, the kernel's tuple as it returned it (:data:`STASH_DELTA` and the other indices; F_b = F_N n - F_T t, the force on the bearing, plus the film's and asperities' of a lubricated joint; M_b
-    its moment; F_T v_T the dry friction power; v_T the sliding speed; D'_lub and U_a the lubricated part's
-    dissipated power and the asperity potential, 0 when dry; W3' and D' the drawn and dissipated powers): the
+    ``stash``, the kernel's tuple as it returned it (:data:`STASH_DELTA` and the other indices; F_b = F_N n -
+    F_T t, the force on the bearing, plus the film's and asperities' of a lubricated joint; M_b its moment;
+    F_T v_T the dry friction power; v_T the sliding speed; D'_lub and U_a the lubricated part's dissipated
+    power and the asperity potential, 0 when dry; W3' and D' the drawn and dissipated powers): the
     last call of an accepted explicit step is at its end state (the last DOPRI5 / ODE23 stage), so the
     bookkeeping needs no extra evaluation.  ``powers``: the tree has two more joints whose accelerations
     are W3' and D' (:func:`weftsim.exudyn_engine.tree.build_tree`), so the callback returns four forces.

@@ -83,7 +83,8 @@ class TreeModel:
     tracker: OnsetTracker
     route: str
     memory: list  # [v_held, delta0, rate0] read by the force callback
-    stash: list  # [t, (Q0, Q1, delta, delta_dot, F_b,x, F_b,y, F_N, M_b, F_T v_T, v_T, D'_lub, U_a, W3', D')] of the last callback
+    # [t, (Q0, Q1, delta, delta_dot, F_b,x, F_b,y, F_N, M_b, F_T v_T, v_T, D'_lub, U_a, W3', D')] of the last callback
+    stash: list
     callback_calls: list = field(default_factory=lambda: [0])  # [count]
     # [t, F_b,x, F_b,y, F_N, M_b, F_T v_T, D'_lub, U_a, v_T, W3', D'] per accepted state (tree_joint_force's joint
     # force on the bearing, the lubricated part's dissipated power, the asperity potential, the sliding velocity, the
@@ -96,7 +97,8 @@ class TreeModel:
             q = mbs.GetNodeOutput(self.node, exu.OutputVariableType.Coordinates)
             q_t = mbs.GetNodeOutput(self.node, exu.OutputVariableType.Coordinates_t)
             self.force(mbs, t, self.tree, q, q_t)
-        delta, rate, fx, fy, f_n, m_b, power, v_t, lub_power, asperity_energy, drawn, dissipated = self.stash[1][2:]
+        state = self.stash[1][callbacks.STASH_DELTA:]  # what the kernel returned after the two joint forces
+        delta, rate, fx, fy, f_n, m_b, power, v_t, lub_power, asperity_energy, drawn, dissipated = state
         tracker = self.tracker
         tracker.accept(t, delta, rate)
         self.memory[0], self.memory[1], self.memory[2] = tracker.held, delta, rate
